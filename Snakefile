@@ -1,0 +1,38 @@
+# hardpack: the studies as one Snakemake DAG.
+#   snakemake --cores all                                  full study (config/config.yaml)
+#   snakemake --cores 2 --configfile config/smoke.yaml     tiny systems, same DAG (CI)
+#   snakemake --cores 1 results/figures/<name>.pdf         one figure and only what it needs
+# Rules are thin: they call the `hardpack` CLI or a short script under workflow/scripts/.
+
+import json
+
+from snakemake.utils import validate
+
+from hardpack.distributions import from_spec
+
+# --configfile replaces the default study instead of being merged into it
+if not config:
+    configfile: "config/config.yaml"
+
+validate(config, "workflow/schemas/config.schema.yaml")
+for _name, _ens in config["ensembles"].items():
+    try:
+        from_spec(_ens["distribution"])
+    except ValueError as exc:
+        raise ValueError(f"config: ensembles.{_name}.distribution: {exc}") from None
+
+ENSEMBLES = config["ensembles"]
+
+wildcard_constraints:
+    ensemble="[A-Za-z][A-Za-z0-9_]*",
+    seed=r"\d+",
+
+
+include: "workflow/rules/ensembles.smk"
+include: "workflow/rules/figures.smk"
+
+
+rule all:
+    input:
+        expand("results/ensembles/{ensemble}/init_summary.nc", ensemble=ENSEMBLES),
+        "results/figures/size_distributions.pdf",

@@ -1,0 +1,291 @@
+"""Particle-size distributions, parameterised as in Ogarko's dissertation (seed 002, ch. 2-3).
+
+Every distribution is a number pdf f(a) of sphere radii a. Widths follow Ogarko: omega is always
+the ratio of radii a_max / a_min (note 002_ogarko.md sec. 1.1). Scale: every continuous
+distribution is normalised to mean radius <a> = ``mean_radius`` (default 1), which is the unit of
+length of ch. 3 (Table 3.2); packings are rescaled to the target density afterwards, so only the
+shape of the distribution matters.
+
+- :class:`Monodisperse`
+- :class:`Discrete` (bidisperse, tridisperse equivalents, any finite mixture) and
+  :func:`bidisperse` (size ratio R = a_large / a_small, number fraction x of the large species)
+- :class:`PowerLaw` f(a) ~ a^alpha on [a_min, omega a_min] (ch. 2.2, Eq. 2.37); alpha = 0 is
+  uniform in size (US), alpha = -3 the "uniform volume" (UV) distribution f ~ a^-3 of ch. 3
+  (Eq. 3.43; strictly uniform in a^-2, see the note's remark on the wording)
+- :func:`uniform_size` (US) and :func:`uniform_volume` (UV)
+- :class:`LogNormal` f(a) = exp(-(ln(a/a0))^2 / (2 sigma^2)) / (sigma sqrt(2 pi) a) (Eq. 3.46),
+  with <a^k> = a0^k exp(k^2 sigma^2 / 2) (Eq. 3.47)
+
+Each has analytic raw moments <a^k> (any real k >= 0 for the continuous ones), a quantile
+function, and ``sample(n, rng)`` with systematic (stratified-quantile) sampling: radius i is
+F^-1((i + u) / n) with one uniform offset u (u = 1/2 when no generator is given). This is the
+"systematic sampling" of L1121-1126 / L4469-4474, which guarantees that the rare largest sizes
+are present even in small systems.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import special, stats
+
+from hardpack.errors import InvalidInputError
+
+
+def _systematic_u(n: int, rng) -> np.ndarray:
+    if int(n) != n or n < 1:
+        raise InvalidInputError(f"number of particles must be a positive integer, got {n!r}")
+    offset = 0.5 if rng is None else float(rng.random())
+    return (np.arange(int(n)) + offset) / n
+
+
+class Distribution:
+    """Common interface: ``moment(k)``, ``ppf(q)``, ``pdf(a)``, ``support``, ``sample``."""
+
+    name = "distribution"
+
+    def moment(self, k: float) -> float:
+        raise NotImplementedError
+
+    def ppf(self, q):
+        raise NotImplementedError
+
+    def pdf(self, a):
+        raise NotImplementedError
+
+    @property
+    def support(self) -> tuple[float, float]:
+        raise NotImplementedError
+
+    def sample(self, n: int, rng: np.random.Generator | None = None) -> np.ndarray:
+        """n radii by systematic sampling, sorted ascending (shuffle positions, not radii)."""
+        return np.asarray(self.ppf(_systematic_u(n, rng)), dtype=float)
+
+    def moments(self, kmax: int = 5) -> np.ndarray:
+        """Raw moments <a^k> for k = 0..kmax."""
+        return np.array([self.moment(k) for k in range(kmax + 1)])
+
+    def params(self) -> dict:
+        """Parameters as a flat dict (stored in dataset attributes)."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Discrete(Distribution):
+    """A finite mixture: radii a_s with number fractions n_s (sum 1)."""
+
+    radii: tuple
+    fractions: tuple
+    name = "discrete"
+
+    def __post_init__(self):
+        r = np.asarray(self.radii, float)
+        f = np.asarray(self.fractions, float)
+        if r.ndim != 1 or r.shape != f.shape or r.size == 0:
+            raise InvalidInputError(
+                f"radii and fractions must be 1-d sequences of equal length, got {r.shape} and {f.shape}"
+            )
+        if not (np.isfinite(r).all() and (r > 0).all()):
+            raise InvalidInputError(f"species radii must be positive and finite, got {r.tolist()}")
+        if not (np.isfinite(f).all() and (f >= 0).all() and abs(f.sum() - 1) < 1e-9):
+            raise InvalidInputError(
+                f"number fractions must be non-negative and sum to 1, got {f.tolist()} (sum {f.sum()})"
+            )
+        order = np.argsort(r)
+        object.__setattr__(self, "radii", tuple(r[order].tolist()))
+        object.__setattr__(self, "fractions", tuple(f[order].tolist()))
+
+    def moment(self, k: float) -> float:
+        r, f = np.asarray(self.radii), np.asarray(self.fractions)
+        return float(np.sum(f * r**k))
+
+    def ppf(self, q):
+        cum = np.cumsum(self.fractions)
+        cum[-1] = 1.0
+        idx = np.searchsorted(cum, np.asarray(q, float), side="right")
+        return np.asarray(self.radii)[np.minimum(idx, len(cum) - 1)]
+
+    def pdf(self, a):
+        raise InvalidInputError("a discrete mixture has no density; use radii and fractions")
+
+    @property
+    def support(self):
+        return (self.radii[0], self.radii[-1])
+
+    def species_of(self, radii: np.ndarray) -> np.ndarray:
+        """Species index (0 = smallest) of each sampled radius."""
+        return np.searchsorted(np.asarray(self.radii), radii).astype(np.int32)
+
+    def params(self):
+        return {"radii": list(self.radii), "fractions": list(self.fractions)}
+
+
+def monodisperse(radius: float = 1.0) -> Discrete:
+    """All spheres of one radius."""
+    return Discrete((float(radius),), (1.0,))
+
+
+def bidisperse(size_ratio: float, large_fraction: float, mean_radius: float = 1.0) -> Discrete:
+    """Binary mixture: a_large / a_small = ``size_ratio`` >= 1, number fraction ``large_fraction``
+    of the large species (Ogarko's n_1 and R; Donev's kappa and x). Scaled to <a> = mean_radius."""
+    if not (size_ratio >= 1 and math.isfinite(size_ratio)):
+        raise InvalidInputError(f"size_ratio must be >= 1 (large / small radius), got {size_ratio}")
+    if not 0 <= large_fraction <= 1:
+        raise InvalidInputError(f"large_fraction must be in [0, 1], got {large_fraction}")
+    mean = large_fraction * size_ratio + (1 - large_fraction)
+    small = mean_radius / mean
+    return Discrete((small, small * size_ratio), (1 - large_fraction, large_fraction))
+
+
+@dataclass(frozen=True)
+class PowerLaw(Distribution):
+    """f(a) = C a^alpha on [a_min, omega a_min], scaled so that <a> = mean_radius (Eq. 2.37)."""
+
+    omega: float
+    alpha: float
+    mean_radius: float = 1.0
+    name = "power_law"
+
+    def __post_init__(self):
+        if not (math.isfinite(self.omega) and self.omega > 1):
+            raise InvalidInputError(
+                f"omega = a_max / a_min must be > 1 for a power law (use monodisperse for 1), got {self.omega}"
+            )
+        if not math.isfinite(self.alpha):
+            raise InvalidInputError(f"alpha must be finite, got {self.alpha}")
+        if not self.mean_radius > 0:
+            raise InvalidInputError(f"mean_radius must be positive, got {self.mean_radius}")
+
+    def _unit_moment(self, k: float) -> float:
+        """<a^k> for a_min = 1."""
+        def integral(p):  # int_1^omega a^p da
+            if abs(p + 1) < 1e-12:
+                return math.log(self.omega)
+            return (self.omega ** (p + 1) - 1) / (p + 1)
+        return integral(k + self.alpha) / integral(self.alpha)
+
+    @property
+    def a_min(self) -> float:
+        return self.mean_radius / self._unit_moment(1)
+
+    def moment(self, k: float) -> float:
+        return self.a_min**k * self._unit_moment(k)
+
+    @property
+    def support(self):
+        return (self.a_min, self.omega * self.a_min)
+
+    def pdf(self, a):
+        a = np.asarray(a, float)
+        lo, hi = self.support
+        p = self.alpha + 1
+        if abs(p) < 1e-12:
+            norm = math.log(hi / lo)
+        else:
+            norm = (hi**p - lo**p) / p
+        return np.where((a >= lo) & (a <= hi), a**self.alpha / norm, 0.0)
+
+    def ppf(self, q):
+        q = np.asarray(q, float)
+        lo, hi = self.support
+        p = self.alpha + 1
+        if abs(p) < 1e-12:
+            return lo * (hi / lo) ** q
+        return (lo**p + q * (hi**p - lo**p)) ** (1 / p)
+
+    def params(self):
+        return {"omega": self.omega, "alpha": self.alpha, "mean_radius": self.mean_radius}
+
+
+def uniform_size(omega: float, mean_radius: float = 1.0) -> PowerLaw:
+    """US: radii uniform on [a_min, omega a_min] (Ogarko ch. 3, Eq. 3.23 for its moments)."""
+    return PowerLaw(omega, 0.0, mean_radius)
+
+
+def uniform_volume(omega: float, mean_radius: float = 1.0) -> PowerLaw:
+    """UV: f(a) ~ a^-3 on [a_min, omega a_min] (Ogarko Eq. 3.43)."""
+    return PowerLaw(omega, -3.0, mean_radius)
+
+
+@dataclass(frozen=True)
+class LogNormal(Distribution):
+    """Log-normal radii (Eq. 3.46), a0 = mean_radius exp(-sigma^2 / 2) so that <a> = mean_radius.
+
+    The distribution is unbounded; systematic sampling of n radii reaches the quantile
+    1 - 1/(2n) at most, so the sampled moments converge from below as n grows.
+    """
+
+    sigma: float
+    mean_radius: float = 1.0
+    name = "lognormal"
+
+    def __post_init__(self):
+        if not (math.isfinite(self.sigma) and self.sigma > 0):
+            raise InvalidInputError(
+                f"sigma must be positive (use monodisperse for sigma = 0), got {self.sigma}"
+            )
+        if not self.mean_radius > 0:
+            raise InvalidInputError(f"mean_radius must be positive, got {self.mean_radius}")
+
+    @property
+    def a0(self) -> float:
+        return self.mean_radius * math.exp(-0.5 * self.sigma**2)
+
+    def moment(self, k: float) -> float:
+        return self.a0**k * math.exp(0.5 * k * k * self.sigma**2)
+
+    def _dist(self):
+        return stats.lognorm(s=self.sigma, scale=self.a0)
+
+    def pdf(self, a):
+        return self._dist().pdf(a)
+
+    def ppf(self, q):
+        return self.a0 * np.exp(self.sigma * math.sqrt(2) * special.erfinv(2 * np.asarray(q, float) - 1))
+
+    @property
+    def support(self):
+        return (0.0, math.inf)
+
+    def params(self):
+        return {"sigma": self.sigma, "mean_radius": self.mean_radius}
+
+
+def from_spec(spec: dict) -> Distribution:
+    """Build a distribution from a config mapping such as ``{"kind": "uniform_volume", "omega": 4}``.
+
+    kinds: monodisperse; bidisperse (size_ratio, large_fraction); uniform_size (omega);
+    uniform_volume (omega); power_law (omega, alpha); lognormal (sigma);
+    discrete (radii, fractions). Unknown kinds or keys are refused with the key named.
+    """
+    if not isinstance(spec, dict) or "kind" not in spec:
+        raise InvalidInputError(f"a distribution spec must be a mapping with a 'kind', got {spec!r}")
+    kind = spec["kind"]
+    allowed = {
+        "monodisperse": ((), monodisperse),
+        "bidisperse": (("size_ratio", "large_fraction"), bidisperse),
+        "uniform_size": (("omega",), uniform_size),
+        "uniform_volume": (("omega",), uniform_volume),
+        "power_law": (("omega", "alpha"), PowerLaw),
+        "lognormal": (("sigma",), LogNormal),
+        "discrete": (("radii", "fractions"), Discrete),
+    }
+    if kind not in allowed:
+        raise InvalidInputError(f"unknown distribution kind {kind!r}; choose one of {sorted(allowed)}")
+    keys, ctor = allowed[kind]
+    extra = set(spec) - set(keys) - {"kind"}
+    if extra:
+        raise InvalidInputError(
+            f"distribution {kind!r} does not take key(s) {sorted(extra)}; it takes {list(keys)}"
+        )
+    missing = [k for k in keys if k not in spec]
+    if missing:
+        raise InvalidInputError(f"distribution {kind!r} needs key(s) {missing}")
+    if kind == "monodisperse":
+        return monodisperse()
+    args = [tuple(spec[k]) if isinstance(spec[k], list) else spec[k] for k in keys]
+    if kind in ("uniform_size", "uniform_volume") and float(spec["omega"]) == 1.0:
+        return monodisperse()
+    return ctor(*args)

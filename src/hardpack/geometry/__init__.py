@@ -1,0 +1,11 @@
+"""Geometry: the packing model, d-ball volumes, periodic neighbour search and crystal lattices."""
+
+from hardpack.geometry.balls import ball_volume, unit_ball_volume
+from hardpack.geometry.lattices import lattice_packing
+from hardpack.geometry.neighbours import PairList, pairs_within
+from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, OverlapReport, Packing
+
+__all__ = [
+    "Packing", "OverlapReport", "DEFAULT_OVERLAP_TOL", "PairList", "pairs_within",
+    "ball_volume", "unit_ball_volume", "lattice_packing",
+]

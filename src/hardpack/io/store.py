@@ -1,0 +1,192 @@
+"""Packings and results as xarray Datasets in netCDF files.
+
+Packing layout (``hardpack_kind = "packing"``, ``hardpack_format = 1``):
+
+- ``position(particle, dim)``: Cartesian centres
+- ``radius(particle)``
+- ``lattice(dim, vector)``: column ``vector = k`` is the k-th lattice vector
+- ``species(particle)``: optional integer labels
+- attributes: ``N``, ``d``, ``phi``, ``boundary`` and the provenance of
+  :func:`hardpack.io.provenance` plus whatever protocol parameters the producer adds
+  (``seed``, ``distribution``, ``growth_rate``, ...).
+
+Every write is atomic: the dataset goes to a temporary file in the destination folder, is
+flushed to disk, and replaces the destination with :func:`os.replace`; a crash leaves either the
+old file or the new one, never a half-written one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from hardpack.errors import InvalidInputError, StoreError
+from hardpack.geometry.packing import Packing
+from hardpack.io.provenance import provenance
+
+FORMAT_VERSION = 1
+
+
+def _netcdf_attr(value):
+    """Coerce an attribute to a netCDF-storable value (dicts/lists of mixed types become JSON)."""
+    if isinstance(value, (bool, np.bool_)):
+        return int(value)
+    if isinstance(value, (str, int, float, np.integer, np.floating)):
+        return value
+    if isinstance(value, (list, tuple, np.ndarray)):
+        arr = np.asarray(value)
+        if arr.ndim == 1 and arr.dtype.kind in "if" and arr.size:
+            return arr
+    return json.dumps(value, sort_keys=True, default=str)
+
+
+def _clean_attrs(attrs: dict) -> dict:
+    return {str(k): _netcdf_attr(v) for k, v in attrs.items() if v is not None}
+
+
+def packing_to_dataset(packing: Packing, attrs: dict | None = None, extra: dict | None = None) -> xr.Dataset:
+    """Dataset of a packing (layout in the module docstring); ``extra`` adds data variables."""
+    data = {
+        "position": (("particle", "dim"), np.asarray(packing.positions)),
+        "radius": (("particle",), np.asarray(packing.radii)),
+        "lattice": (("dim", "vector"), np.asarray(packing.lattice)),
+    }
+    if packing.species is not None:
+        data["species"] = (("particle",), np.asarray(packing.species))
+    ds = xr.Dataset(data)
+    for name, value in (extra or {}).items():
+        ds[name] = value
+    ds.attrs.update(
+        hardpack_kind="packing", hardpack_format=FORMAT_VERSION, N=packing.n_particles,
+        d=packing.dim, phi=packing.phi, boundary=packing.boundary,
+    )
+    ds.attrs.update(_clean_attrs(attrs or {}))
+    return ds
+
+
+def dataset_to_packing(ds: xr.Dataset, source: str = "dataset", **packing_kwargs) -> Packing:
+    """Rebuild (and validate) a packing from its Dataset; errors name ``source``."""
+    missing = [v for v in ("position", "radius", "lattice") if v not in ds]
+    if missing:
+        raise StoreError(
+            f"{source} is not a hardpack packing: variable(s) {missing} missing "
+            f"(found {sorted(ds.data_vars)})"
+        )
+    try:
+        return Packing(
+            positions=ds["position"].transpose("particle", "dim").values,
+            radii=ds["radius"].values,
+            lattice=ds["lattice"].transpose("dim", "vector").values,
+            species=ds["species"].values if "species" in ds else None,
+            boundary=ds.attrs.get("boundary", "periodic"),
+            **packing_kwargs,
+        )
+    except InvalidInputError as exc:
+        raise StoreError(f"{source} holds an invalid packing: {exc}") from None
+
+
+def write_dataset(ds: xr.Dataset, path, *, attrs: dict | None = None, config=None, seed=None) -> Path:
+    """Atomically write ``ds`` to netCDF at ``path``, adding provenance attributes.
+
+    Existing attributes of ``ds`` win over the provenance defaults except for the version,
+    commit and time stamps, which always describe this write.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    out = ds.copy()
+    prov = provenance(config=config, seed=seed)
+    merged = {k: v for k, v in prov.items() if k in ("config", "seed")}
+    merged.update(out.attrs)
+    merged.update({k: v for k, v in prov.items() if k not in ("config", "seed")})
+    merged.update(attrs or {})
+    out.attrs = _clean_attrs(merged)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def save_packing(packing: Packing, path, *, attrs: dict | None = None, extra: dict | None = None,
+                 config=None, seed=None) -> Path:
+    """Atomically write a packing with provenance (see :func:`write_dataset`)."""
+    return write_dataset(packing_to_dataset(packing, attrs, extra), path, config=config, seed=seed)
+
+
+def load_dataset(path, kind: str | None = None) -> xr.Dataset:
+    """Load a hardpack netCDF file fully into memory; errors name the file.
+
+    With ``kind`` the file's ``hardpack_kind`` attribute must match.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise StoreError(f"{path}: no such file")
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as ds:
+            ds = ds.load()
+    except Exception as exc:  # netCDF4/HDF5 raise assorted types for corrupt files
+        raise StoreError(f"{path} cannot be read as netCDF ({type(exc).__name__}: {exc})") from None
+    found = ds.attrs.get("hardpack_kind")
+    if kind is not None and found != kind:
+        raise StoreError(f"{path} holds hardpack_kind={found!r}, expected {kind!r}")
+    return ds
+
+
+def load_packing(path, **packing_kwargs) -> Packing:
+    """Load and validate a packing written by :func:`save_packing`."""
+    ds = load_dataset(path, kind="packing")
+    return dataset_to_packing(ds, source=str(path), **packing_kwargs)
+
+
+def combine_ensemble(sources, index=("seed",), variables=None) -> xr.Dataset:
+    """One Dataset over a ``sample`` dimension from packings (paths or Datasets).
+
+    Each ``index`` name (a protocol parameter such as ``seed``, ``N``, ``d``, ``distribution``,
+    ``growth_rate``) becomes a coordinate along ``sample`` taken from the file attributes;
+    scalar attributes ``N``, ``d``, ``phi`` and any numeric ones named in ``variables`` become
+    data variables, with the radius range and mean. Per-particle arrays are stacked along
+    ``sample`` only when every member has the same N and d.
+    """
+    dsets, names = [], []
+    for src in sources:
+        ds = load_dataset(src) if not isinstance(src, xr.Dataset) else src
+        dsets.append(ds)
+        names.append(str(src) if not isinstance(src, xr.Dataset) else f"dataset {len(names)}")
+    if not dsets:
+        raise InvalidInputError("combine_ensemble needs at least one packing")
+    coords, scalars = {}, {}
+    for key in index:
+        vals = []
+        for ds, name in zip(dsets, names):
+            if key not in ds.attrs:
+                raise StoreError(f"{name} has no attribute {key!r} to index the ensemble by")
+            vals.append(ds.attrs[key])
+        coords[key] = ("sample", np.asarray(vals))
+    for key in ("N", "d", "phi", *(variables or ())):
+        if all(key in ds.attrs for ds in dsets):
+            scalars[key] = ("sample", np.asarray([ds.attrs[key] for ds in dsets]))
+    if all("radius" in ds for ds in dsets):
+        scalars["radius_min"] = ("sample", np.array([float(ds["radius"].min()) for ds in dsets]))
+        scalars["radius_max"] = ("sample", np.array([float(ds["radius"].max()) for ds in dsets]))
+        scalars["radius_mean"] = ("sample", np.array([float(ds["radius"].mean()) for ds in dsets]))
+    out = xr.Dataset(scalars, coords=coords)
+    shapes = {(ds.sizes.get("particle"), ds.sizes.get("dim")) for ds in dsets}
+    if len(shapes) == 1 and None not in next(iter(shapes)):
+        for var in ("position", "radius", "lattice"):
+            if all(var in ds for ds in dsets):
+                out[var] = xr.concat([ds[var] for ds in dsets], dim="sample")
+    out.attrs["hardpack_kind"] = "ensemble"
+    out.attrs["index"] = list(index)
+    return out

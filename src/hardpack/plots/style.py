@@ -1,0 +1,50 @@
+"""The house style of hardpack figures and an atomic PDF + PNG writer."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+RC = {
+    "figure.figsize": (5.0, 3.6),
+    "figure.dpi": 150,
+    "font.size": 9,
+    "axes.labelsize": 9,
+    "axes.titlesize": 9,
+    "legend.fontsize": 7.5,
+    "legend.frameon": False,
+    "axes.grid": True,
+    "grid.alpha": 0.25,
+    "lines.linewidth": 1.3,
+    "savefig.bbox": "tight",
+}
+
+
+def figure(nrows: int = 1, ncols: int = 1, **kwargs):
+    """A figure in the house style (``plt.subplots`` arguments)."""
+    with plt.rc_context(RC):
+        return plt.subplots(nrows, ncols, **kwargs)
+
+
+def save(fig, *paths) -> None:
+    """Write the figure to each path (format from the suffix) atomically, then close it."""
+    with plt.rc_context(RC):
+        for path in paths:
+            path = Path(path)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=path.suffix)
+            os.close(fd)
+            try:
+                fig.savefig(tmp, format=path.suffix.lstrip("."))
+                os.replace(tmp, path)
+            except BaseException:
+                if os.path.exists(tmp):
+                    os.unlink(tmp)
+                raise
+    plt.close(fig)

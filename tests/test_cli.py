@@ -1,0 +1,40 @@
+"""The hardpack command line: init, info, combine, and its error messages."""
+
+import json
+
+import numpy as np
+
+from hardpack.cli import main
+from hardpack.io import load_dataset, load_packing
+
+
+def test_init_info_combine(tmp_path, capsys):
+    spec = json.dumps({"kind": "uniform_size", "omega": 2})
+    paths = []
+    for seed in (1, 2):
+        out = tmp_path / f"seed{seed}.nc"
+        assert main(["init", "--n", "100", "--d", "3", "--phi", "0.2", "--distribution", spec,
+                     "--seed", str(seed), "--out", str(out), "--attr", "ensemble=us2"]) == 0
+        paths.append(str(out))
+    p = load_packing(paths[0])
+    assert p.n_particles == 100 and abs(p.phi - 0.2) < 1e-12
+    attrs = load_dataset(paths[0]).attrs
+    assert attrs["ensemble"] == "us2" and attrs["seed"] == 1 and attrs["distribution"] == "uniform_size"
+
+    assert main(["info", paths[0]]) == 0
+    text = capsys.readouterr().out
+    assert "N = 100, d = 3, phi = 0.2" in text
+    assert "radii: min" in text and "git_commit" in text and "numba_version" in text
+
+    summary = tmp_path / "summary.nc"
+    assert main(["combine", *paths, "--index", "seed", "--variable", "init_phi", "--out", str(summary)]) == 0
+    ds = load_dataset(summary, kind="ensemble")
+    assert list(ds["seed"].values) == [1, 2] and np.allclose(ds["init_phi"], 0.2)
+
+
+def test_errors_are_reported_not_raised(tmp_path, capsys):
+    assert main(["info", str(tmp_path / "nope.nc")]) == 2
+    assert "nope.nc: no such file" in capsys.readouterr().err
+    assert main(["init", "--n", "10", "--d", "3", "--phi", "0.2", "--distribution",
+                 '{"kind": "uniform_size"}', "--seed", "1", "--out", str(tmp_path / "x.nc")]) == 2
+    assert "needs key(s) ['omega']" in capsys.readouterr().err
