@@ -1,0 +1,5 @@
+"""Hierarchical grid (HGrid) for contact detection of polydisperse spheres (Ogarko ch. 2).
+
+- :mod:`hardpack.hgrid.cost_model`  analytic cost T/N of an HGrid for power-law radii (ch. 2.2)
+- :mod:`hardpack.hgrid.levels`      "equal particles per cell" level assignment for actual radii (ch. 2.1)
+"""
