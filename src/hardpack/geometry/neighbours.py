@@ -8,8 +8,9 @@ lexicographically positive.
 Two search paths (both scipy's cKDTree):
 - orthorhombic cells with cutoff below half the smallest cell width: a periodic tree with
   ``boxsize`` (minimum image is then exact), O(N log N);
-- any other cell: the tree of the wrapped centres queried against each lattice-shifted copy
-  n with |n_k| <= ceil(cutoff / h_k) (h_k = perpendicular cell width), which is exhaustive.
+- any other cell: the tree of the wrapped centres queried against one tree of all their
+  lattice-shifted images n with |n_k| <= ceil(cutoff / h_k) (h_k = perpendicular cell width),
+  which is exhaustive.
 """
 
 from __future__ import annotations
@@ -43,11 +44,6 @@ class PairList:
         return self.distance / self.contact - 1.0
 
 
-def _lexicographically_positive(n: np.ndarray) -> bool:
-    nz = np.flatnonzero(n)
-    return nz.size > 0 and n[nz[0]] > 0
-
-
 def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None) -> PairList:
     """All pairs with distance <= (1 + rel_gap)(r_i + r_j), or <= ``cutoff`` if given.
 
@@ -79,27 +75,20 @@ def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None) -> 
         sep = dx + shift * box
     else:
         ks = np.ceil(search / heights).astype(int)
-        tree = cKDTree(x)
-        parts_i, parts_j, parts_n = [], [], []
-        for n in itertools.product(*[range(-k, k + 1) for k in ks]):
-            n = np.array(n, dtype=np.int64)
-            if not n.any():
-                ij = tree.query_pairs(search, output_type="ndarray")
-                a, b = ij[:, 0], ij[:, 1]
-            else:
-                shifted = cKDTree(x + lat @ n)
-                sdm = tree.sparse_distance_matrix(shifted, search, output_type="ndarray")
-                a, b = sdm["i"].astype(np.int64), sdm["j"].astype(np.int64)
-                # every shift is visited, so (a, b, n) and (b, a, -n) both appear: keep a < b,
-                # and a self-image (a, a, n) once, for n lexicographically positive
-                keep = (a < b) | ((a == b) & _lexicographically_positive(n))
-                a, b = a[keep], b[keep]
-            parts_i.append(a)
-            parts_j.append(b)
-            parts_n.append(np.tile(n, (len(a), 1)))
-        ii = np.concatenate(parts_i).astype(np.int64)
-        jj = np.concatenate(parts_j).astype(np.int64)
-        shift = np.concatenate(parts_n).reshape(-1, d).astype(np.int64)
+        shifts = np.array(list(itertools.product(*[range(-k, k + 1) for k in ks])), dtype=np.int64)
+        n_particles = len(x)
+        images = (x[None, :, :] + (shifts @ lat.T)[:, None, :]).reshape(-1, d)
+        sdm = cKDTree(x).sparse_distance_matrix(cKDTree(images), search, output_type="ndarray")
+        ii = sdm["i"].astype(np.int64)
+        jj = sdm["j"].astype(np.int64) % n_particles
+        shift = shifts[sdm["j"] // n_particles]
+        # every shift is visited, so (i, j, n) and (j, i, -n) both appear: keep i < j, and a
+        # self-image (i, i, n) once, for n lexicographically positive (n = 0 is the particle itself)
+        nonzero = shift != 0
+        first = np.argmax(nonzero, axis=1)
+        lex_positive = nonzero.any(axis=1) & (shift[np.arange(len(shift)), first] > 0)
+        keep = (ii < jj) | ((ii == jj) & lex_positive)
+        ii, jj, shift = ii[keep], jj[keep], shift[keep]
         sep = x[jj] + shift @ lat.T - x[ii]
 
     dist = np.sqrt(np.einsum("ij,ij->i", sep, sep))

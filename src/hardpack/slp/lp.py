@@ -1,0 +1,146 @@
+"""One linear program of the Torquato-Jiao sequential-LP packing algorithm (PRE 82, 061302, 2010).
+
+Variables (all continuous, box-bounded by the trust region):
+
+- global displacements u_n = M dx_n of every sphere (N x d; the paper uses lattice-coordinate
+  displacements dx_n, Eq. 19; the global form is the same LP in better-conditioned variables,
+  SLP note sec. 5.1); u_0 = 0 removes the free global translation;
+- the symmetric strain eps of the cell, M -> (I + eps) M (Eqs. 8-10): d(d+1)/2 entries for a
+  deforming cell, or one scalar e (eps = e I) for an isotropically shrinking cell.
+
+Objective (Eq. 18): minimise tr(eps) (the relative volume change to first order).
+
+Constraints (Eq. 19 with R = 0): for every pair (m, n, image k) with centre distance below the
+influence radius gamma_mn = alpha D_mn, r = x_n + M k - x_m the current separation and
+delta = u_n - u_m,
+
+    r^T eps r + delta . r >= (D_mn^2 - r . r) / 2,
+
+the first-order expansion of |(I + eps)(r + delta)|^2 >= D_mn^2 (exact remainder in the SLP
+note sec. 1.4; signs re-derived and tested here). Self-images (m = n, k != 0) constrain the
+strain alone, which is the lattice (N = 1) problem.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.optimize import linprog
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.neighbours import pairs_within
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """Trust-region widths: |eps_aa| <= strain, |eps_ab| <= shear (a != b), |u_n,a| <= displacement * <D>."""
+
+    strain: float
+    shear: float
+    displacement: float
+
+    def __post_init__(self):
+        for name in ("strain", "shear", "displacement"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise InvalidInputError(f"bound {name} must be a finite non-negative number, got {value}")
+        if self.strain <= 0:
+            raise InvalidInputError("the strain bound must be positive, otherwise the cell cannot shrink")
+
+    def scaled(self, s: float) -> "Bounds":
+        return Bounds(self.strain * s, self.shear * s, self.displacement * s)
+
+
+@dataclass(frozen=True)
+class StepSolution:
+    """Optimal step: strain (d x d), displacements (N x d), predicted tr(eps), pair count, LP time."""
+
+    strain: np.ndarray
+    displacement: np.ndarray
+    trace: float
+    n_constraints: int
+    lp_seconds: float
+    duals: np.ndarray
+    pairs: object
+
+
+def strain_index(d: int, deforming: bool):
+    """(rows, cols) of the independent strain entries: upper triangle, or the single isotropic one."""
+    if not deforming:
+        return np.array([0]), np.array([0])
+    return np.triu_indices(d)
+
+
+def solve_step(packing, alpha: float, bounds: Bounds, deforming: bool = True,
+               feasibility_tol: float = 1e-10) -> StepSolution:
+    """Build and solve one SLP linear program for ``packing`` (see the module docstring)."""
+    if not (np.isfinite(alpha) and alpha >= 1):
+        raise InvalidInputError(f"influence-sphere factor alpha = gamma / D must be >= 1, got {alpha}")
+    n, d = packing.n_particles, packing.dim
+    pairs = pairs_within(packing, rel_gap=alpha - 1.0)
+    rows_a, cols_a = strain_index(d, deforming)
+    n_strain = len(rows_a)
+    m = len(pairs)
+    r = pairs.separation
+    # strain coefficients: r^T eps r = sum_a eps_aa r_a^2 + sum_{a<b} 2 eps_ab r_a r_b
+    if deforming:
+        factor = np.where(rows_a == cols_a, 1.0, 2.0)
+        strain_coef = r[:, rows_a] * r[:, cols_a] * factor
+    else:
+        strain_coef = np.einsum("ij,ij->i", r, r)[:, None]
+    # displacement coefficients: +r for u_n (j), -r for u_m (i); self-images cancel
+    ii, jj = pairs.i, pairs.j
+    row_idx = np.repeat(np.arange(m), d)
+    disp_cols_j = (n_strain + jj[:, None] * d + np.arange(d)).ravel()
+    disp_cols_i = (n_strain + ii[:, None] * d + np.arange(d)).ravel()
+    not_self = np.repeat(ii != jj, d)
+    data = np.concatenate([
+        -strain_coef.ravel(),
+        -r.ravel()[not_self],
+        r.ravel()[not_self],
+    ])
+    rows = np.concatenate([np.repeat(np.arange(m), n_strain), row_idx[not_self], row_idx[not_self]])
+    cols = np.concatenate([np.tile(np.arange(n_strain), m), disp_cols_j[not_self], disp_cols_i[not_self]])
+    a_ub = sp.csr_matrix((data, (rows, cols)), shape=(m, n_strain + n * d))
+    b_ub = 0.5 * (np.einsum("ij,ij->i", r, r) - pairs.contact**2)
+
+    c = np.zeros(n_strain + n * d)
+    if deforming:
+        c[:n_strain] = (rows_a == cols_a).astype(float)
+    else:
+        c[0] = d
+    mean_diameter = 2.0 * packing.radii.mean()
+    lower = np.empty_like(c)
+    upper = np.empty_like(c)
+    if deforming:
+        diag = rows_a == cols_a
+        upper[:n_strain] = np.where(diag, bounds.strain, bounds.shear)
+    else:
+        upper[:n_strain] = bounds.strain
+    upper[n_strain:] = bounds.displacement * mean_diameter
+    upper[n_strain:n_strain + d] = 0.0  # pin sphere 0: no free global translation
+    lower[:] = -upper
+    start = time.perf_counter()
+    res = linprog(c, A_ub=a_ub, b_ub=b_ub, bounds=np.column_stack([lower, upper]), method="highs",
+                  options={"primal_feasibility_tolerance": feasibility_tol,
+                           "dual_feasibility_tolerance": feasibility_tol})
+    elapsed = time.perf_counter() - start
+    if res.status != 0:
+        raise InvalidInputError(
+            f"the SLP linear program failed ({res.message}); the start configuration may overlap "
+            "or the bounds may be degenerate"
+        )
+    x = res.x
+    eps = np.zeros((d, d))
+    if deforming:
+        eps[rows_a, cols_a] = x[:n_strain]
+        eps[cols_a, rows_a] = x[:n_strain]
+    else:
+        eps = x[0] * np.eye(d)
+    return StepSolution(
+        strain=eps, displacement=x[n_strain:].reshape(n, d), trace=float(np.trace(eps)),
+        n_constraints=m, lp_seconds=elapsed, duals=-res.ineqlin.marginals, pairs=pairs,
+    )
