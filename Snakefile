@@ -29,6 +29,7 @@ wildcard_constraints:
 
 
 include: "workflow/rules/ensembles.smk"
+include: "workflow/rules/slp.smk"
 include: "workflow/rules/figures.smk"
 
 
@@ -36,3 +37,4 @@ rule all:
     input:
         expand("results/ensembles/{ensemble}/init_summary.nc", ensemble=ENSEMBLES),
         "results/figures/size_distributions.pdf",
+        "results/figures/slp_densest.pdf" if config.get("slp", {}).get("densest") else [],

@@ -127,3 +127,12 @@ def test_combine_ensemble_indexes_by_protocol_parameters(tmp_path):
     assert ds.set_index(sample=["seed"]).sel(sample=2)["N"] == 50
     with pytest.raises(StoreError, match="has no attribute 'omega'"):
         combine_ensemble(paths, index=("omega",))
+
+
+def test_combine_mixed_sizes_indexed_by_dimension(tmp_path):
+    """Packings of different N and d combine into scalars only, indexed by (d, seed)."""
+    paths = [save_packing(lattice_packing(name, 2), tmp_path / f"{name}.nc", attrs={"seed": 0})
+             for name in ("triangular", "fcc")]
+    ds = combine_ensemble(paths, index=("d", "seed"))
+    assert list(ds["d"].values) == [2, 3] and "d" not in ds.data_vars
+    assert list(ds["N"].values) == [4, 32] and "position" not in ds

@@ -14,3 +14,16 @@ rule fig_size_distributions:
         "results/logs/figures/size_distributions.log",
     script:
         "../scripts/plot_size_distributions.py"
+
+
+rule fig_slp_densest:
+    """Table II: SLP densities from N = 3^d starts against the densest known packings."""
+    input:
+        "results/slp/densest_summary.nc",
+    output:
+        pdf="results/figures/slp_densest.pdf",
+        png="results/figures/slp_densest.png",
+    log:
+        "results/logs/figures/slp_densest.log",
+    script:
+        "../scripts/plot_slp_densest.py"

@@ -175,7 +175,7 @@ def combine_ensemble(sources, index=("seed",), variables=None) -> xr.Dataset:
             vals.append(ds.attrs[key])
         coords[key] = ("sample", np.asarray(vals))
     for key in ("N", "d", "phi", *(variables or ())):
-        if all(key in ds.attrs for ds in dsets):
+        if key not in coords and all(key in ds.attrs for ds in dsets):
             scalars[key] = ("sample", np.asarray([ds.attrs[key] for ds in dsets]))
     if all("radius" in ds for ds in dsets):
         scalars["radius_min"] = ("sample", np.array([float(ds["radius"].min()) for ds in dsets]))
