@@ -31,6 +31,7 @@ wildcard_constraints:
 include: "workflow/rules/ensembles.smk"
 include: "workflow/rules/slp.smk"
 include: "workflow/rules/figures.smk"
+include: "workflow/rules/validation.smk"
 
 
 rule all:
@@ -38,3 +39,4 @@ rule all:
         expand("results/ensembles/{ensemble}/init_summary.nc", ensemble=ENSEMBLES),
         "results/figures/size_distributions.pdf",
         "results/figures/slp_densest.pdf" if config.get("slp", {}).get("densest") else [],
+        "results/validation/report.md",

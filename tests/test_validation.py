@@ -1,0 +1,57 @@
+"""Validation report: rows, pass/fail logic, formats, and the analytic rows it always contains."""
+
+import math
+
+import numpy as np
+import pytest
+
+from hardpack.cli import main
+from hardpack.io import load_dataset, save_packing
+from hardpack.geometry import lattice_packing
+from hardpack.validation import Row, to_dataset, to_markdown
+from hardpack.validation.analytic import moment_table_rows
+from hardpack.validation.rows import within
+from hardpack.validation.slp import densest_rows
+from hardpack.io import combine_ensemble
+
+
+def test_within_uses_tolerance_plus_two_standard_errors():
+    assert within(1.004, 1.0, 0.005)
+    assert not within(1.006, 1.0, 0.005)
+    assert within(1.006, 1.0, 0.005, uncertainty=0.001)
+    assert not within(math.nan, 1.0, 1.0)
+
+
+def test_moment_tables_all_reproduced():
+    rows = moment_table_rows()
+    assert len(rows) == 9 + 9 + 7 + 20  # one row per printed line of Tables 3.1 (US, UV), 3.3, 3.4
+    assert all(r.passed for r in rows), [r.quantity for r in rows if not r.passed]
+
+
+def test_a_wrong_value_fails_and_is_reported():
+    rows = [Row("s", "good", "src L1", 1.0, 1.0, math.nan, 0.1, "why", True),
+            Row("s", "bad", "src L2", 1.0, 2.0, 0.01, 0.1, "why", False, "detail")]
+    md = to_markdown(rows)
+    assert "1 of 2 rows pass (50%)" in md and "| **no** |" in md
+    ds = to_dataset(rows)
+    assert ds.attrs["n_passed"] == 1 and list(ds["passed"].values) == [1, 0]
+    assert ds["quantity"].values[1] == "bad" and np.isnan(ds["uncertainty"].values[0])
+
+
+def test_densest_rows_from_a_summary(tmp_path):
+    # a perfect triangular packing counts as a hit; an off-density one as a miss
+    good = save_packing(lattice_packing("triangular", 3), tmp_path / "a.nc", attrs={"seed": 0})
+    bad = save_packing(lattice_packing("square", 3), tmp_path / "b.nc", attrs={"seed": 1})
+    rows = densest_rows(combine_ensemble([good, bad], index=("d", "seed")))
+    assert len(rows) == 1 and rows[0].passed and "1 of 2 seeds" in rows[0].detail
+    rows = densest_rows(combine_ensemble([bad], index=("d", "seed")))
+    assert not rows[0].passed
+
+
+@pytest.mark.slow
+def test_cli_writes_table_and_report(tmp_path):
+    nc, md = tmp_path / "v.nc", tmp_path / "r.md"
+    assert main(["validate", "--out-nc", str(nc), "--out-md", str(md)]) == 0
+    ds = load_dataset(nc, kind="validation")
+    assert ds.sizes["row"] >= 48 and ds.attrs["n_passed"] == ds.sizes["row"]
+    assert md.read_text().startswith("# hardpack validation report")
