@@ -18,8 +18,6 @@ old file or the new one, never a half-written one.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +25,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError, StoreError
 from hardpack.geometry.packing import Packing
+from hardpack.io.atomic import atomic_path
 from hardpack.io.provenance import provenance
 
 FORMAT_VERSION = 1
@@ -97,7 +96,6 @@ def write_dataset(ds: xr.Dataset, path, *, attrs: dict | None = None, config=Non
     commit and time stamps, which always describe this write.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     out = ds.copy()
     prov = provenance(config=config, seed=seed)
     merged = {k: v for k, v in prov.items() if k in ("config", "seed")}
@@ -105,17 +103,8 @@ def write_dataset(ds: xr.Dataset, path, *, attrs: dict | None = None, config=Non
     merged.update({k: v for k, v in prov.items() if k not in ("config", "seed")})
     merged.update(attrs or {})
     out.attrs = _clean_attrs(merged)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return path
 
 

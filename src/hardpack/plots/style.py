@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+from hardpack.io.atomic import atomic_path  # noqa: E402
 
 RC = {
     "figure.figsize": (5.0, 3.6),
@@ -36,15 +36,6 @@ def save(fig, *paths) -> None:
     """Write the figure to each path (format from the suffix) atomically, then close it."""
     with plt.rc_context(RC):
         for path in paths:
-            path = Path(path)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=path.suffix)
-            os.close(fd)
-            try:
-                fig.savefig(tmp, format=path.suffix.lstrip("."))
-                os.replace(tmp, path)
-            except BaseException:
-                if os.path.exists(tmp):
-                    os.unlink(tmp)
-                raise
+            with atomic_path(path, fsync=False) as tmp:
+                fig.savefig(tmp, format=Path(path).suffix.lstrip("."))
     plt.close(fig)

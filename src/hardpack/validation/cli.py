@@ -3,24 +3,14 @@
 from __future__ import annotations
 
 import logging
-import os
-import tempfile
-from pathlib import Path
 
 from hardpack.io import load_dataset, write_dataset
+from hardpack.io.atomic import write_text
 from hardpack.validation.analytic import hgrid_rows, moment_table_rows
 from hardpack.validation.rows import to_dataset, to_markdown
 from hardpack.validation.slp import densest_rows
 
 log = logging.getLogger(__name__)
-
-
-def _write_text(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
 
 
 def cmd_validate(args) -> int:
@@ -29,7 +19,7 @@ def cmd_validate(args) -> int:
     if args.slp_densest:
         rows += densest_rows(load_dataset(args.slp_densest))
     write_dataset(to_dataset(rows), args.out_nc)
-    _write_text(Path(args.out_md), to_markdown(rows))
+    write_text(args.out_md, to_markdown(rows))
     n_pass = sum(r.passed for r in rows)
     log.info("validation: %d of %d rows pass; wrote %s and %s", n_pass, len(rows), args.out_nc, args.out_md)
     return 0
