@@ -16,7 +16,7 @@ import numpy as np
 from hardpack import __version__
 from hardpack.errors import InvalidInputError
 
-SUBCOMMAND_MODULES: tuple[str, ...] = ("hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli")
+SUBCOMMAND_MODULES: tuple[str, ...] = ("hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli", "hardpack.structure.cli")
 
 
 def _json_arg(text: str):

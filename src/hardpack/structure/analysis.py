@@ -1,0 +1,69 @@
+"""One call for the standard structure analysis of a packing (what ``hardpack structure`` writes).
+
+Merges g2 (absolute and scaled), Z(l) (with and without rattlers when a mask is given), the
+shell-averaged S(k) with the linear S(0) fit over kD < 2 pi 0.4 (Donev ch. 10, ch10-14
+L178-181; D = mean diameter), and the order metrics of the dimension: Q6 (bond-averaged), mean
+q6, T and the q6 crystallinity in 3D; psi6 and T in 2D; T in d >= 4.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.structure.order import (
+    crystallinity,
+    psi6,
+    steinhardt,
+    translational_order,
+)
+from hardpack.structure.pair import (
+    DEFAULT_CONTACT_TOL,
+    cumulative_coordination,
+    pair_correlation,
+)
+from hardpack.structure.sk import extrapolate_s0, structure_factor
+
+S0_FIT_KD = 2 * np.pi * 0.4
+
+
+def analyse(packing, r_max: float | None = None, k_max: float | None = None, rattlers=None,
+            contact_tol: float = DEFAULT_CONTACT_TOL, gap_max: float = 0.5,
+            dr: float | None = None, order: bool = True) -> xr.Dataset:
+    """Structure Dataset of one packing; ``k_max`` defaults to 20 / mean diameter."""
+    diameter = 2.0 * float(np.mean(packing.radii))
+    k_max = 20.0 / diameter if k_max is None else k_max
+    g2 = pair_correlation(packing, r_max=r_max, dr=dr, contact_tol=contact_tol)
+    z = cumulative_coordination(packing, gap_max=gap_max, rattlers=rattlers, contact_tol=contact_tol)
+    sk = structure_factor(packing, k_max)
+    parts = [ds.copy() for ds in (g2, z, sk)]
+    for ds in parts:
+        ds.attrs = {}
+    scalars = {}
+    try:
+        s0, s0_err, coef = extrapolate_s0(sk, S0_FIT_KD / diameter, "linear")
+        scalars.update(S0=s0, S0_err=s0_err, S0_slope=float(coef[1]))
+    except InvalidInputError:  # too few k-shells below the fit range (small systems)
+        scalars.update(S0=np.nan, S0_err=np.nan, S0_slope=np.nan)
+    if order and packing.dim >= 2:
+        scalars["T"] = translational_order(packing)
+        if packing.dim == 3:
+            st = steinhardt(packing)
+            scalars.update(Q6=float(st.Q6), q6_mean=float(np.nanmean(st.q6)))
+            cr = crystallinity(packing)
+            scalars["crystallinity"] = float(cr.crystallinity)
+            parts.append(xr.Dataset(dict(q6=st.q6, solid=cr.solid)))
+        elif packing.dim == 2:
+            ps = psi6(packing)
+            scalars.update(psi6_global=float(ps.psi6_global), psi6_local_mean=float(ps.psi6_local_mean))
+    parts.append(xr.Dataset({k: ((), v) for k, v in scalars.items()}))
+    out = xr.merge(parts, compat="no_conflicts")
+    out.attrs = dict(
+        hardpack_kind="structure", n_particles=packing.n_particles, dim=packing.dim,
+        phi=packing.phi, mean_diameter=diameter, contact_tol=contact_tol, k_max=float(k_max),
+        s0_fit="linear S0 + s1 k over shells with k D < 2 pi 0.4",
+        g2_normalisation=g2.attrs["normalisation"], gap_definition=z.attrs["gap_definition"],
+        order_neighbours="Q6/q6: within 1.2 contact distances; crystallinity: regular triangulation",
+    )
+    return out

@@ -1,0 +1,52 @@
+"""``hardpack structure`` (hardpack.structure.cli) and the combined analysis Dataset."""
+
+import argparse
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.lattices import lattice_packing
+from hardpack.io import save_packing
+from hardpack.structure import cli
+from hardpack.structure.analysis import analyse
+
+
+def run(argv):
+    parser = argparse.ArgumentParser()
+    cli.register(parser.add_subparsers())
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+def test_cli_writes_structure_of_a_crystal(tmp_path):
+    p = lattice_packing("fcc", 4)
+    mask = np.zeros(p.n_particles, bool)
+    mask[0] = True
+    src, out = tmp_path / "fcc.nc", tmp_path / "fcc_structure.nc"
+    save_packing(p, src, extra={"rattler": ("particle", mask)})
+    assert run(["structure", str(src), "--out", str(out), "--rattlers", "rattler",
+                "--kmax", "9", "--rmax", "2"]) == 0
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["hardpack_kind"] == "structure"
+        assert float(ds.z_contacts) == 12.0
+        assert abs(float(ds.Q6) - 0.57452) < 1e-5 and abs(float(ds["T"]) - 1) < 1e-12
+        assert float(ds.crystallinity) == 1.0
+        n = p.n_particles
+        plateau = (ds.gap.values > 1e-12) & (ds.gap.values < 0.4)
+        np.testing.assert_allclose(ds.Z_backbone.values[plateau], 2 * (6 * n - 12) / (n - 1))
+        bragg = ds.S.values > 1  # FCC: S is N on Bragg shells and 0 elsewhere
+        assert np.all(ds.S.values[~bragg] < 1e-16)
+
+
+def test_cli_refuses_missing_rattler_variable(tmp_path):
+    src = tmp_path / "sc.nc"
+    save_packing(lattice_packing("sc", 3), src)
+    with pytest.raises(InvalidInputError):
+        run(["structure", str(src), "--out", str(tmp_path / "o.nc"), "--rattlers", "nope"])
+
+
+def test_analyse_two_dimensional_packing_has_psi6():
+    ds = analyse(lattice_packing("triangular", (8, 9)), k_max=8.0)
+    assert abs(float(ds.psi6_global) - 1) < 1e-12 and "Q6" not in ds
