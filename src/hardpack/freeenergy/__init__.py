@@ -1,0 +1,26 @@
+"""Free energies of nearly jammed hard-sphere packings (Donev dissertation ch. 6).
+
+- :mod:`hardpack.freeenergy.simplex`: exact simplex volumes (Eq. 6.5) and the jamming-simplex
+  constant f_J of isostatic packings (Eqs. 6.3-6.4).
+- :mod:`hardpack.freeenergy.bcmd`: bounding-cell molecular dynamics (sec. 6.3), the free energy
+  from the kinetic-energy ratio Delta f = (d_f/2) ln(K/K_0) (Eq. 6.12).
+- :mod:`hardpack.freeenergy.billiard`: the same identity for a point billiard in a polytope
+  intersected with a shrinking ball (Fig. 6.1; validation of the estimator).
+"""
+
+from hardpack.freeenergy.bcmd import BCMDResult, run_bcmd
+from hardpack.freeenergy.billiard import volume_estimate
+from hardpack.freeenergy.simplex import (
+    JammingSimplex,
+    jamming_simplex,
+    log_simplex_volume,
+)
+
+__all__ = [
+    "BCMDResult",
+    "JammingSimplex",
+    "jamming_simplex",
+    "log_simplex_volume",
+    "run_bcmd",
+    "volume_estimate",
+]

@@ -1,0 +1,136 @@
+"""Exact volume of a simplex and the jamming-simplex constant f_J of an isostatic packing.
+
+Donev dissertation ch. 6 (seeds/000_chapters/ch06.txt), note ``bcmd_free_energy.md`` sec. 1.3:
+
+- H-representation (Eq. 6.5, [C:289-308]): for the simplex {x in R^n : A x <= b}, A of shape
+  (n+1, n), set the square matrix At = [A b] and a = At^{-T} e_{n+1} (the last row of At^{-1}).
+  Then V^{-1} = n! |det At| prod_i a_i. Derivation (checked here): y = b - A x >= 0 satisfies
+  [x; -1] = -At^{-1} y, whose last component gives a^T y = 1, so the simplex is bounded exactly
+  when every a_i > 0; the function refuses anything else.
+- Jamming simplex (Eqs. 6.3-6.4, [C:164-189]): P_x = {x : A^T x <= e} with A the N_f x M
+  rigidity matrix (journal sign convention; the chapter's A^T x >= -e is its mirror image and has
+  the same volume). With M = N_f + 1 the augmented matrix is At = [A; e^T] and the contact forces
+  f~ = At^{-1} e_{M} (force balance A f~ = 0, unit sum) are the a_i above, so
+  |P_x|^{-1} = N_f! |det At| prod f~. The per-particle constant is f_J = ln|P_x| / N_eff.
+
+Log-determinants come from one sparse LU (scipy.sparse.linalg.splu), so N ~ 10^3 is cheap.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+from scipy.special import gammaln
+
+from hardpack.errors import InvalidInputError
+
+
+def _log_det_and_last_solve(mat: sp.spmatrix) -> tuple[float, np.ndarray]:
+    """ln|det mat| and mat^{-1} e_last for a square sparse matrix, from one sparse LU."""
+    n = mat.shape[0]
+    try:
+        lu = splu(sp.csc_matrix(mat, dtype=float))
+    except RuntimeError as exc:  # "Factor is exactly singular"
+        raise InvalidInputError(
+            f"the augmented matrix is singular ({exc}): the constraints do not bound a simplex "
+            "(check for duplicated or dependent constraints)"
+        ) from None
+    diag = lu.U.diagonal()
+    if np.any(diag == 0) or not np.all(np.isfinite(diag)):
+        raise InvalidInputError(
+            "the augmented matrix is singular: the constraints do not bound a simplex"
+        )
+    rhs = np.zeros(n)
+    rhs[-1] = 1.0
+    return float(np.sum(np.log(np.abs(diag)))), lu.solve(rhs)
+
+
+def log_simplex_volume(a, b) -> float:
+    """ln V of the simplex {x in R^n : a @ x <= b}, a of shape (n+1, n), b > 0 (Eq. 6.5).
+
+    Refuses (InvalidInputError) shapes that are not (n+1, n), b <= 0 (the origin must be interior)
+    and constraint sets that do not bound a simplex (some a_i <= 0 or a singular [A b]).
+    """
+    a_mat = (
+        sp.csc_matrix(a, dtype=float) if sp.issparse(a) else np.asarray(a, dtype=float)
+    )
+    b = np.asarray(b, dtype=float).ravel()
+    if (
+        a_mat.ndim != 2
+        or a_mat.shape[0] != a_mat.shape[1] + 1
+        or b.shape != (a_mat.shape[0],)
+    ):
+        raise InvalidInputError(
+            f"a simplex in R^n needs A of shape (n+1, n) and b of length n+1; got A {a_mat.shape} "
+            f"and b {b.shape}"
+        )
+    if not np.all(np.isfinite(b)) or np.any(b <= 0):
+        raise InvalidInputError(
+            "b must be finite and > 0 (shift the simplex so the origin is interior)"
+        )
+    n = a_mat.shape[1]
+    at = sp.hstack([sp.csc_matrix(a_mat), sp.csc_matrix(b[:, None])]).tocsc()
+    # a = last row of At^{-1} = At^{-T} e_last: solve with the transpose.
+    log_det, last = _log_det_and_last_solve(at.T)
+    if np.any(last <= 0):
+        raise InvalidInputError(
+            f"the constraints A x <= b do not bound a simplex ({np.sum(last <= 0)} of the "
+            "weights a_i = (At^-T e)_i are <= 0)"
+        )
+    return float(-(gammaln(n + 1) + log_det + np.sum(np.log(last))))
+
+
+@dataclass(frozen=True)
+class JammingSimplex:
+    """Result of :func:`jamming_simplex` (note sec. 1.3).
+
+    log_volume: ln|P_x|; forces: f~ (unit sum, length M); f_j: ln|P_x| / n_eff;
+    f_j_minus_fcj: f_J - f_c^J with f_c^J = ln V_p, the quantity BCMD measures (Eq. 6.18).
+    """
+
+    log_volume: float
+    forces: np.ndarray
+    n_dof: int
+    n_eff: int
+    f_j: float
+    f_j_minus_fcj: float
+
+
+def jamming_simplex(
+    rigidity, n_eff: int, log_vp: float = 0.0, force_tol: float = 0.0
+) -> JammingSimplex:
+    """Volume of the jamming polytope P_x = {x : A^T x <= e} of an isostatic packing (Eq. 6.3).
+
+    rigidity: the N_f x M rigidity matrix A (rows of frozen particles already removed; for spheres
+    of unit diameter shrunk by (1 - delta) the gaps are delta e, so x = dR / delta).
+    n_eff: the number of moving particles (N - 1 with one frozen particle) used in
+    f_J = ln|P_x| / n_eff. log_vp: ln V_p of the particle (ln(pi/6) for unit-diameter spheres,
+    ln(pi/4) for unit disks); it only shifts ``f_j_minus_fcj``.
+
+    Refuses a packing that is not isostatic (M != N_f + 1) or whose contact forces
+    f~ = [A; e^T]^{-1} e_M are not all > force_tol (then P_x is not a bounded simplex).
+    """
+    a = sp.csc_matrix(rigidity, dtype=float)
+    n_f, m = a.shape
+    if m != n_f + 1:
+        raise InvalidInputError(
+            f"the packing is not isostatic: M = {m} contacts but N_f + 1 = {n_f + 1}; the "
+            "jamming polytope is a simplex only when M = N_f + 1 (remove rattlers, freeze one "
+            "particle, and use a gap tolerance that finds exactly the true contacts)"
+        )
+    if int(n_eff) < 1:
+        raise InvalidInputError(f"n_eff must be a positive particle count, got {n_eff}")
+    at = sp.vstack([a, sp.csr_matrix(np.ones((1, m)))]).tocsc()
+    log_det, forces = _log_det_and_last_solve(at)
+    if np.any(forces <= force_tol):
+        bad = int(np.sum(forces <= force_tol))
+        raise InvalidInputError(
+            f"{bad} contact force(s) f~ = [A; e^T]^-1 e are <= {force_tol} (min {forces.min():.3g}): "
+            "the packing is not rigid with strictly positive forces, so P_x is not a bounded simplex"
+        )
+    log_volume = float(-(gammaln(n_f + 1) + log_det + np.sum(np.log(forces))))
+    f_j = log_volume / int(n_eff)
+    return JammingSimplex(log_volume, forces, n_f, int(n_eff), f_j, f_j - float(log_vp))

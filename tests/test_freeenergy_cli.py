@@ -1,0 +1,58 @@
+"""``hardpack bcmd`` subcommand, driven through its own argparse registration."""
+
+import argparse
+
+import numpy as np
+import pytest
+
+from hardpack.freeenergy import cli
+from hardpack.geometry.lattices import lattice_packing
+from hardpack.io import load_dataset, save_packing
+
+
+def parse(argv):
+    parser = argparse.ArgumentParser()
+    cli.register(parser.add_subparsers())
+    return parser.parse_args(argv)
+
+
+def test_bcmd_cli_disjoint(tmp_path):
+    # half-size spheres at phi/8: disjoint cells throughout, Delta f = d ln(dmu_max/dmu_min)
+    src = tmp_path / "fcc.nc"
+    save_packing(lattice_packing("fcc", (2, 2, 2)), src)
+    out = tmp_path / "res.nc"
+    phi = 0.74048048969 / 8
+    args = parse(
+        [
+            "bcmd",
+            str(src),
+            "--out",
+            str(out),
+            "--phi",
+            str(phi),
+            "--dmu-max",
+            "0.4",
+            "--dmu-min",
+            "0.1",
+            "--gamma0",
+            "2e-3",
+            "--theta",
+            "0",
+            "--seed",
+            "2",
+        ]
+    )
+    assert args.func(args) == 0
+    ds = load_dataset(out)
+    assert ds.attrs["delta_f"] == pytest.approx(3 * np.log(4.0), abs=2e-3)
+    assert ds.attrs["phi"] == pytest.approx(phi, rel=1e-9)
+
+
+def test_bcmd_cli_refuses(tmp_path, capsys):
+    src = tmp_path / "fcc.nc"
+    save_packing(lattice_packing("fcc", (2, 2, 2)), src)
+    args = parse(
+        ["bcmd", str(src), "--out", str(tmp_path / "r.nc"), "--dmu-max", "0.1"]
+    )
+    assert args.func(args) == 2  # touching spheres: cells never disjoint
+    assert "never disjoint" in capsys.readouterr().err
