@@ -29,7 +29,11 @@ wildcard_constraints:
 
 
 include: "workflow/rules/ensembles.smk"
+include: "workflow/rules/md.smk"
+include: "workflow/rules/jamming.smk"
+include: "workflow/rules/structure.smk"
 include: "workflow/rules/slp.smk"
+include: "workflow/rules/freeenergy.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/validation.smk"
 
@@ -37,6 +41,13 @@ include: "workflow/rules/validation.smk"
 rule all:
     input:
         expand("results/ensembles/{ensemble}/init_summary.nc", ensemble=ENSEMBLES),
+        expand("results/ensembles/{ensemble}/jammed_summary.nc", ensemble=ENSEMBLES),
+        expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=ENSEMBLES),
+        expand("results/ensembles/{ensemble}/slp_jamming_summary.nc",
+               ensemble=config.get("slp", {}).get("mrj", {}).get("ensembles", [])),
+        [f"results/ensembles/{e}/structure/seed{s}.nc" for e in ENSEMBLES for s in ENSEMBLES[e]["seeds"]],
         "results/figures/size_distributions.pdf",
         "results/figures/slp_densest.pdf" if config.get("slp", {}).get("densest") else [],
+        "results/figures/slp_vs_ls.pdf" if config.get("slp", {}).get("mrj") else [],
+        "results/figures/bcmd_fcc.pdf" if config.get("freeenergy") else [],
         "results/validation/report.md",

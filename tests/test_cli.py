@@ -38,3 +38,11 @@ def test_errors_are_reported_not_raised(tmp_path, capsys):
     assert main(["init", "--n", "10", "--d", "3", "--phi", "0.2", "--distribution",
                  '{"kind": "uniform_size"}', "--seed", "1", "--out", str(tmp_path / "x.nc")]) == 2
     assert "needs key(s) ['omega']" in capsys.readouterr().err
+
+
+def test_lattice_command_writes_a_crystal(tmp_path):
+    out = tmp_path / "fcc.nc"
+    assert main(["lattice", "--name", "fcc", "--reps", "3", "--out", str(out)]) == 0
+    p = load_packing(out)
+    assert p.n_particles == 108 and abs(p.phi - np.pi / np.sqrt(18)) < 1e-12
+    assert main(["lattice", "--name", "fcx", "--out", str(out)]) == 2

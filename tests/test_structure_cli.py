@@ -8,7 +8,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.lattices import lattice_packing
-from hardpack.io import save_packing
+from hardpack.io import save_packing, write_dataset
 from hardpack.structure import cli
 from hardpack.structure.analysis import analyse
 
@@ -25,8 +25,11 @@ def test_cli_writes_structure_of_a_crystal(tmp_path):
     mask = np.zeros(p.n_particles, bool)
     mask[0] = True
     src, out = tmp_path / "fcc.nc", tmp_path / "fcc_structure.nc"
-    save_packing(p, src, extra={"rattler": ("particle", mask)})
-    assert run(["structure", str(src), "--out", str(out), "--rattlers", "rattler",
+    save_packing(p, src)
+    verdict = tmp_path / "verdict.nc"
+    write_dataset(xr.Dataset({"rattler": ("particle", mask.astype(np.int8))},
+                             attrs={"hardpack_kind": "jamming"}), verdict)
+    assert run(["structure", str(src), "--out", str(out), "--jamming", str(verdict),
                 "--kmax", "9", "--rmax", "2"]) == 0
     with xr.open_dataset(out) as ds:
         assert ds.attrs["hardpack_kind"] == "structure"
@@ -40,13 +43,27 @@ def test_cli_writes_structure_of_a_crystal(tmp_path):
         assert np.all(ds.S.values[~bragg] < 1e-16)
 
 
-def test_cli_refuses_missing_rattler_variable(tmp_path):
+def test_cli_refuses_a_verdict_of_another_packing(tmp_path):
     src = tmp_path / "sc.nc"
     save_packing(lattice_packing("sc", 3), src)
-    with pytest.raises(InvalidInputError):
-        run(["structure", str(src), "--out", str(tmp_path / "o.nc"), "--rattlers", "nope"])
+    verdict = write_dataset(xr.Dataset({"rattler": ("particle", np.zeros(5, np.int8))},
+                                       attrs={"hardpack_kind": "jamming"}), tmp_path / "v.nc")
+    with pytest.raises(InvalidInputError, match="no per-particle 'rattler' mask for the 27 particles"):
+        run(["structure", str(src), "--out", str(tmp_path / "o.nc"), "--jamming", str(verdict)])
 
 
 def test_analyse_two_dimensional_packing_has_psi6():
     ds = analyse(lattice_packing("triangular", (8, 9)), k_max=8.0)
     assert abs(float(ds.psi6_global) - 1) < 1e-12 and "Q6" not in ds
+
+
+def test_cli_analyses_all_particles_when_the_verdict_leaves_no_backbone(tmp_path):
+    src = tmp_path / "sc.nc"
+    save_packing(lattice_packing("sc", 3), src)
+    verdict = write_dataset(xr.Dataset({"rattler": ("particle", np.ones(27, np.int8))},
+                                       attrs={"hardpack_kind": "jamming", "verdict": "not jammed"}),
+                            tmp_path / "v.nc")
+    out = tmp_path / "o.nc"
+    assert run(["structure", str(src), "--out", str(out), "--jamming", str(verdict), "--kmax", "7"]) == 0
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["rattler_mask"] == "none" and float(ds.z_contacts) == 6.0

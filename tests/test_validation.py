@@ -55,3 +55,18 @@ def test_cli_writes_table_and_report(tmp_path):
     ds = load_dataset(nc, kind="validation")
     assert ds.sizes["row"] >= 48 and ds.attrs["n_passed"] == ds.sizes["row"]
     assert md.read_text().startswith("# hardpack validation report")
+
+
+def test_bcmd_rows_need_a_finite_size_extrapolation():
+    import xarray as xr
+    from hardpack.validation.freeenergy import bcmd_rows, finite_size_extrapolation
+
+    n = np.array([108, 256, 500, 864])
+    exact = 5.91916 - 3 * np.log(n) / n  # a + b ln N / N with a = the published value
+    est, err, how = finite_size_extrapolation(n, exact)
+    assert est == pytest.approx(5.91916, abs=1e-9) and "fit" in how
+    ds = xr.Dataset({"n_particles": ("sample", n), "excess": ("sample", exact)})
+    assert bcmd_rows({"melting": ds})[0].passed
+    small = ds.isel(sample=[0, 1])
+    row = bcmd_rows({"melting": small})[0]
+    assert not row.passed and "inconclusive" in row.detail

@@ -16,7 +16,7 @@ import numpy as np
 from hardpack import __version__
 from hardpack.errors import InvalidInputError
 
-SUBCOMMAND_MODULES: tuple[str, ...] = ("hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli", "hardpack.structure.cli")
+SUBCOMMAND_MODULES: tuple[str, ...] = ("hardpack.md.cli", "hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli", "hardpack.structure.cli", "hardpack.jamming.cli", "hardpack.freeenergy.cli")
 
 
 def _json_arg(text: str):
@@ -86,6 +86,17 @@ def cmd_info(args) -> int:
     return 0
 
 
+def cmd_lattice(args) -> int:
+    """A crystal packing (spheres of radius 1/2 at contact), e.g. the FCC input of BCMD."""
+    from hardpack.geometry.lattices import lattice_packing
+    from hardpack.io import save_packing
+
+    packing = lattice_packing(args.name, args.reps)
+    save_packing(packing, args.out, attrs={"lattice_name": args.name, "reps": args.reps, "protocol": "lattice"})
+    logging.info("wrote %s: %r", args.out, packing)
+    return 0
+
+
 def cmd_combine(args) -> int:
     """Combine per-seed packings into one ensemble Dataset indexed by protocol parameters."""
     from hardpack.io import combine_ensemble, write_dataset
@@ -113,6 +124,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",
                    help="extra attribute stored in the file (repeatable), e.g. ensemble=mono3d")
     p.set_defaults(func=cmd_init)
+
+    p = sub.add_parser("lattice", help=cmd_lattice.__doc__)
+    p.add_argument("--name", required=True, help="fcc, hcp, bcc, sc, diamond, triangular, square, honeycomb, kagome, D<d>, hypercubic<d>")
+    p.add_argument("--reps", type=int, nargs="+", default=[1], help="unit cells along each lattice vector")
+    p.add_argument("--out", required=True, help="output netCDF file")
+    p.set_defaults(func=cmd_lattice)
 
     p = sub.add_parser("info", help=cmd_info.__doc__)
     p.add_argument("file", help="a netCDF file written by hardpack")

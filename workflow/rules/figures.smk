@@ -27,3 +27,30 @@ rule fig_slp_densest:
         "results/logs/figures/slp_densest.log",
     script:
         "../scripts/plot_slp_densest.py"
+
+
+rule fig_slp_vs_ls:
+    """Table I: SLP and LS jamming densities of the same ensembles, beside the published values."""
+    input:
+        slp=expand("results/ensembles/{ensemble}/slp_summary.nc", ensemble=SLP_MRJ["ensembles"]) if SLP_MRJ else [],
+        ls=expand("results/ensembles/{ensemble}/jammed_summary.nc", ensemble=SLP_MRJ["ensembles"]) if SLP_MRJ else [],
+    output:
+        pdf="results/figures/slp_vs_ls.pdf",
+        png="results/figures/slp_vs_ls.png",
+    log:
+        "results/logs/figures/slp_vs_ls.log",
+    script:
+        "../scripts/plot_slp_vs_ls.py"
+
+
+rule fig_bcmd_fcc:
+    """BCMD free energy of FCC at melting and in the jamming limit vs N, with the published values."""
+    input:
+        expand("results/freeenergy/{state}_summary.nc", state=["melting", "jamming"]),
+    output:
+        pdf="results/figures/bcmd_fcc.pdf",
+        png="results/figures/bcmd_fcc.png",
+    log:
+        "results/logs/figures/bcmd_fcc.log",
+    script:
+        "../scripts/plot_bcmd_fcc.py"

@@ -53,3 +53,61 @@ rule slp_densest_summary:
     shell:
         "hardpack combine {input} --index d seed --variable n_steps --variable n_rejected"
         " --variable wall_seconds --variable converged --out {output} 2> {log}"
+
+
+SLP_MRJ = config.get("slp", {}).get("mrj")
+if SLP_MRJ:
+    for _name in SLP_MRJ["ensembles"]:
+        if _name not in ENSEMBLES:
+            raise ValueError(f"config: slp.mrj.ensembles names {_name!r}, which is not an ensemble")
+
+
+rule slp_mrj_init:
+    """Dilute RSA start (Table I: phi0 = 0.05) with the ensemble's N, d and size distribution."""
+    output:
+        "results/ensembles/{ensemble}/slp_init/seed{seed}.nc",
+    params:
+        n=lambda w: ENSEMBLES[w.ensemble]["N"],
+        d=lambda w: ENSEMBLES[w.ensemble]["d"],
+        phi=SLP_MRJ["init_phi"] if SLP_MRJ else None,
+        distribution=lambda w: json.dumps(ENSEMBLES[w.ensemble]["distribution"]),
+    log:
+        "results/logs/slp_mrj_init/{ensemble}_seed{seed}.log",
+    shell:
+        "hardpack init --n {params.n} --d {params.d} --phi {params.phi}"
+        " --distribution '{params.distribution}' --seed {wildcards.seed}"
+        " --attr ensemble={wildcards.ensemble} --out {output} 2> {log}"
+
+
+rule slp_mrj:
+    """SLP with a deforming cell to a jammed MRJ-like packing (Table I settings from the config)."""
+    input:
+        "results/ensembles/{ensemble}/slp_init/seed{seed}.nc",
+    output:
+        packing="results/ensembles/{ensemble}/slp/seed{seed}.nc",
+        history="results/ensembles/{ensemble}/slp/history_seed{seed}.nc",
+    params:
+        alpha=SLP_MRJ["alpha"] if SLP_MRJ else None,
+        bounds=SLP_MRJ["bounds"] if SLP_MRJ else None,
+    log:
+        "results/logs/slp_mrj/{ensemble}_seed{seed}.log",
+    shell:
+        "hardpack slp --init {input} --out {output.packing} --history {output.history}"
+        " --alpha {params.alpha} --strain-bound {params.bounds[strain]}"
+        " --shear-bound {params.bounds[shear]} --displacement-bound {params.bounds[displacement]} 2> {log}"
+
+
+rule slp_mrj_summary:
+    """SLP densities of an ensemble over its seeds."""
+    input:
+        lambda w: expand("results/ensembles/{ensemble}/slp/seed{seed}.nc", ensemble=w.ensemble,
+                         seed=ENSEMBLES[w.ensemble]["seeds"]),
+    output:
+        "results/ensembles/{ensemble}/slp_summary.nc",
+    params:
+        distribution=lambda w: json.dumps(ENSEMBLES[w.ensemble]["distribution"]),
+    log:
+        "results/logs/slp_mrj_summary/{ensemble}.log",
+    shell:
+        "hardpack combine {input} --index seed --variable n_steps --variable wall_seconds"
+        " --attr ensemble={wildcards.ensemble} --attr distribution='{params.distribution}' --out {output} 2> {log}"

@@ -267,7 +267,7 @@ def run_bcmd(
     f = f_c - delta_f
     f_ideal = -np.log(packing.volume / unit**d / n) - 1.0
     attrs = {
-        "kind": "bcmd",
+        "hardpack_kind": "bcmd",
         "n_particles": n,
         "dim": d,
         "phi": packing.phi,

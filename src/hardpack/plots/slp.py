@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from hardpack.plots.style import figure
-from hardpack.slp.published import TABLE_II
+from hardpack.slp.published import TABLE_I, TABLE_II
 
 
 def plot_densest(summary):
@@ -32,4 +32,33 @@ def plot_densest(summary):
     ax.set_xlabel("dimension d (densest known packing, N = 3^d)")
     ax.set_ylabel(r"$\phi$ / $\phi_{\rm densest\ known}$")
     ax.legend(loc="lower left")
+    return fig
+
+
+def plot_slp_vs_ls(pairs: dict):
+    """Mean +- standard error of phi per ensemble for SLP and LS, with Table I where it applies.
+
+    ``pairs`` maps an ensemble name to (SLP summary, LS jammed summary) Datasets.
+    """
+    fig, ax = figure()
+    names = list(pairs)
+    x = np.arange(len(names))
+    for offset, which, color, label in ((-0.1, 0, "C0", "hardpack SLP"), (0.1, 1, "C1", "hardpack LS")):
+        phi = [pairs[n][which]["phi"].values for n in names]
+        mean = np.array([p.mean() for p in phi])
+        sem = np.array([p.std(ddof=1) / np.sqrt(p.size) if p.size > 1 else 0.0 for p in phi])
+        ax.errorbar(x + offset, mean, yerr=sem, fmt="o", color=color, capsize=3, label=label)
+    for k, n in enumerate(names):
+        d = int(pairs[n][0]["d"].values[0]) if "d" in pairs[n][0] else None
+        if d in TABLE_I:
+            _, ls_pub, _, slp_pub, _ = TABLE_I[d]
+            ax.errorbar(k - 0.25, slp_pub[0], yerr=slp_pub[1], fmt="s", mfc="none", color="C0", capsize=3,
+                        label="Torquato & Jiao SLP (Table I)" if k == 0 else None)
+            ax.errorbar(k + 0.25, ls_pub[0], yerr=ls_pub[1], fmt="^", mfc="none", color="C1", capsize=3,
+                        label="Torquato & Jiao LS (Table I)" if k == 0 else None)
+    ax.set_xticks(x)
+    ax.set_xticklabels(names)
+    ax.set_ylabel(r"jamming density $\phi_J$")
+    ax.set_xlabel("ensemble")
+    ax.legend()
     return fig

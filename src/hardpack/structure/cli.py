@@ -19,17 +19,22 @@ def cmd_structure(args) -> int:
     ds = load_dataset(args.packing, kind="packing")
     packing = dataset_to_packing(ds, source=str(args.packing), allow_overlap=True)
     rattlers = None
-    if args.rattlers:
-        if args.rattlers not in ds:
+    if args.jamming:
+        verdict = load_dataset(args.jamming, kind="jamming")
+        if "rattler" not in verdict or verdict.sizes.get("particle") != packing.n_particles:
             raise InvalidInputError(
-                f"{args.packing} has no variable {args.rattlers!r} to use as the rattler mask; "
-                f"variables: {sorted(ds.data_vars)}")
-        rattlers = np.asarray(ds[args.rattlers].values).astype(bool)
+                f"{args.jamming} has no per-particle 'rattler' mask for the {packing.n_particles} "
+                f"particles of {args.packing}; pass the output of `hardpack verify` on that packing")
+        rattlers = np.asarray(verdict["rattler"].values).astype(bool)
+        if rattlers.all():
+            log.warning("%s flags every particle as a rattler (verdict: %s); analysing all particles",
+                        args.jamming, verdict.attrs.get("verdict", "?"))
+            rattlers = None
     out = analyse(packing, r_max=args.rmax, k_max=args.kmax, rattlers=rattlers,
                   contact_tol=args.contact_tol, gap_max=args.gap_max, dr=args.dr,
                   order=not args.no_order)
     write_dataset(out, args.out, attrs=dict(source=str(args.packing),
-                                            rattler_mask=args.rattlers or ""))
+                                            rattler_mask=str(args.jamming or "") if rattlers is not None else "none"))
     log.info("wrote %s", args.out)
     return 0
 
@@ -44,7 +49,7 @@ def register(subparsers) -> None:
     p.add_argument("--contact-tol", type=float, default=1e-9,
                    help="relative gap below which a pair is a contact (delta peak)")
     p.add_argument("--gap-max", type=float, default=0.5, help="largest relative gap for Z(l)")
-    p.add_argument("--rattlers", default=None, metavar="VAR",
-                   help="boolean per-particle variable of the packing file flagging rattlers")
+    p.add_argument("--jamming", default=None, metavar="VERDICT.nc",
+                   help="jamming verdict of this packing (hardpack verify) whose rattlers are excluded")
     p.add_argument("--no-order", action="store_true", help="skip the order metrics")
     p.set_defaults(func=cmd_structure)

@@ -1,0 +1,33 @@
+"""Rigorous jamming tests for periodic sphere packings (Donev dissertation ch. 4).
+
+Entry point :func:`verify` -> :class:`JammingResult` (``.summary()``, ``.to_dataset()``).
+Building blocks: :func:`contact_network`, :func:`rigidity_matrix` (scipy.sparse),
+:func:`remove_rattlers` (iterative local test), :func:`ideal_test` (Algorithm 13),
+:func:`sequential_test` (Algorithm 14), :func:`self_stress` and :func:`statics` (forces,
+isostaticity, pressure). :mod:`hardpack.jamming.isostatic` solves the LPs exactly through the
+self-stress space of rigid, nearly isostatic backbones (the common case for LS packings), HiGHS
+(scipy ``linprog``) does the rest. CLI: ``hardpack verify`` (:mod:`hardpack.jamming.cli`).
+"""
+
+from hardpack.jamming.contacts import ContactNetwork, contact_network
+from hardpack.jamming.forces import self_stress, statics
+from hardpack.jamming.ideal import ideal_test
+from hardpack.jamming.rattlers import remove_rattlers
+from hardpack.jamming.result import JammingResult
+from hardpack.jamming.rigidity import rigidity_matrix, strain_pairs
+from hardpack.jamming.sequential import sequential_test
+from hardpack.jamming.verify import verify
+
+__all__ = [
+    "ContactNetwork",
+    "JammingResult",
+    "contact_network",
+    "ideal_test",
+    "remove_rattlers",
+    "rigidity_matrix",
+    "self_stress",
+    "sequential_test",
+    "statics",
+    "strain_pairs",
+    "verify",
+]

@@ -1,0 +1,67 @@
+"""``hardpack verify PACKING.nc --out VERDICT.nc``: jamming verdict of a stored packing.
+
+Prints :meth:`JammingResult.summary` and writes :meth:`JammingResult.to_dataset` with
+:func:`hardpack.io.write_dataset` (provenance attributes, atomic write). The generator's
+reduced pressure, when the packing file carries one (attribute ``pressure``,
+``reduced_pressure`` or ``final_pressure``), is compared with the free-volume pressure from the
+contact forces.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+
+from hardpack.errors import InvalidInputError
+from hardpack.jamming.result import CATEGORIES
+from hardpack.jamming.verify import DEFAULT_DELTA, METHODS, verify
+
+#: attributes holding the generator's reduced pressure PV/(NkT); hardpack.md.compress stores it as "Z"
+PRESSURE_ATTRS = ("reduced_pressure", "pressure", "final_pressure", "Z")
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "verify",
+        help="LP jamming tests (local/collective/strict), rattlers, forces of a packing",
+        description=__doc__.splitlines()[0],
+    )
+    p.add_argument("packing", help="packing netCDF file (hardpack.io.save_packing)")
+    p.add_argument("--out", required=True, help="output netCDF file for the verdict")
+    p.add_argument("--delta", type=float, default=DEFAULT_DELTA,
+                   help=f"relative gap tolerance for contacts, 0 < delta < 1 (default {DEFAULT_DELTA:g})")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random loads (default 0)")
+    p.add_argument("--method", choices=METHODS, default="ideal",
+                   help="ideal: Algorithm 13 (default); sequential: Algorithm 14")
+    p.add_argument("--tests", nargs="+", choices=CATEGORIES, default=list(CATEGORIES),
+                   help="tests to run (default: all three)")
+    p.add_argument("--dr-large", type=float, default=None,
+                   help="displacement counted as unjamming (default delta x mean diameter)")
+    p.add_argument("--threshold", type=float, default=1e-3,
+                   help="sequential method: mean displacement / D above which 'not jammed'")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from hardpack.io import dataset_to_packing, load_dataset, write_dataset
+
+    try:
+        ds = load_dataset(args.packing, kind="packing")
+        packing = dataset_to_packing(ds, source=str(args.packing))
+        pressure = next((float(ds.attrs[k]) for k in PRESSURE_ATTRS if k in ds.attrs), None)
+        if pressure is not None and not (math.isfinite(pressure) and pressure > 0):
+            pressure = None  # e.g. a generator that stopped before measuring one
+        result = verify(
+            packing, delta=args.delta, tests=tuple(args.tests), seed=args.seed,
+            method=args.method, dr_large=args.dr_large, threshold=args.threshold,
+            md_pressure=pressure,
+        )
+    except InvalidInputError as exc:
+        print(f"hardpack verify: error: {exc}", file=sys.stderr)
+        return 2
+    out = result.to_dataset()
+    out.attrs["source"] = str(args.packing)
+    write_dataset(out, args.out, seed=args.seed)
+    print(result.summary())
+    print(f"written {args.out}")
+    return 0

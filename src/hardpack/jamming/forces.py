@@ -1,0 +1,212 @@
+"""Contact forces, statics and counting of a rattler-free backbone.
+
+Forces: two LPs on the backbone's equilibrium matrix A (particle rows only, fixed cell).
+
+1. Jamming-gap LP: ``mu* = min h^T f  s.t.  A f = 0, f >= 0, D^T f = 1``. It is the dual of
+   "grow every diameter by the largest common factor 1 + mu with linearised contacts",
+   ``max mu  s.t.  A^T dR >= mu D - h`` (the growth LP behind SLP/CALiPPSO; Donev's estimate
+   Eq. 5.19, seeds/000_chapters/ch04-05.txt L3527-L3531, up to its normalisation), so f is the
+   force network the packing would carry at the jamming point it is closest to. Because
+   A f = 0, f^T h does not change when particles move inside their cage, so mu* does not depend
+   on where the snapshot sits in the cage.
+2. Among optimal f (h^T f <= mu* (1 + 1e-6) + 1e-14 D), the most uniform one:
+   ``max t  s.t.  f >= t`` -- Donev's self-stress LP (5.9), L3114-L3127. For an isostatic
+   backbone both LPs return the unique self-stress; for crystals (h = 0) step 2 picks uniform
+   forces. t > 0 certifies a strict self-stress (L3160-L3165).
+
+When the backbone is rigid with few self-stresses (K = M - d(N_b - 1) <= 12, one of them
+positive), both LPs are solved in the K coordinates of the self-stress basis from one sparse LU
+(:class:`hardpack.jamming.isostatic.RigidBackbone`); for K = 1 (isostatic) the self-stress is
+unique and no LP is needed. The LP solution balances forces to the solver tolerance; :func:`polish` projects it onto the
+null space of A restricted to the loaded contacts (regularised normal equations, SuperLU,
+iterative refinement), which brings the imbalance to round-off. Forces are reported with mean 1
+over the backbone contacts.
+
+Statics (each checked by the tests):
+
+- virial ``p V = (1/d) sum_c f_c |r_c|``, stress ``sigma = (1/V) sum_c f_c |r_c| u u^T``
+  (Eq. 4.24, L1325-L1351); with balanced forces this equals the boundary form (4.23).
+- free-volume reduced pressure ``p = PV/(NkT) = (N_b - 1) / (N mu*)``: for homogeneous gaps the
+  basin {A^T dR >= -h} scales like mu*, its volume like mu*^(d (N_b - 1)), and a relative length
+  dilation eps raises mu* by eps, so beta P = d(N_b - 1) / (d V mu*) (derived here; to first order
+  it is Salsburg-Wood / Donev Eq. 1.1 and 5.24, p = d / (1 - phi/phi_J) with 1 - phi/phi_J = d mu*).
+  It is exact for uniformly shrunk jammed packings; for thermal snapshots with very unequal gaps the
+  basin is not a scaled copy of itself and the estimate is only indicative.
+- isostaticity counts (Eqs. 4.8, 4.9, L497-L535): N_f = d(N_b - 1) in a fixed cell and
+  N_f + d(d+1)/2 - 1 with a deformable cell; an isostatic backbone has M_b = N_f + 1, and
+  ``gap = M_b - N_f - 1`` is 0 (isostatic), > 0 (hyperstatic) or < 0 (hypostatic).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from hardpack.jamming.contacts import ContactNetwork
+from hardpack.jamming.isostatic import RigidBackbone
+from hardpack.jamming.lp import LPFailure, solve_lp
+from hardpack.jamming.rigidity import rigidity_transpose
+
+
+@dataclass(frozen=True)
+class Forces:
+    """Self-stress of the backbone: ``forces`` (M,) is 0 off the backbone, mean 1 on it."""
+
+    forces: np.ndarray
+    min_force: float  # optimum t of LP 5.9 (relative to the mean force)
+    jamming_gap: float  # mu* of the jamming-gap LP
+    imbalance: np.ndarray  # (N, d) net contact force on each particle (0 off the backbone)
+    exists: bool  # False when the backbone admits no non-negative self-stress
+
+
+def backbone_rows(net: ContactNetwork, backbone: np.ndarray, contacts: np.ndarray) -> sp.csr_matrix:
+    """A restricted to the backbone particles' rows and the given contact columns, (N_b d, M_b)."""
+    at = rigidity_transpose(net)[contacts]
+    dofs = np.flatnonzero(np.repeat(backbone, net.dim))
+    return at[:, dofs].T.tocsr()
+
+
+def self_stress(net: ContactNetwork, backbone: np.ndarray) -> Forces:
+    """Forces of the backbone from the two LPs of the module docstring, polished to round-off."""
+    n, d = net.n_particles, net.dim
+    contacts = net.among(backbone)
+    m = int(contacts.sum())
+    forces = np.zeros(net.n_contacts)
+    failed = Forces(forces, np.nan, np.nan, np.zeros((n, d)), False)
+    if m == 0:
+        return failed
+    a = backbone_rows(net, backbone, contacts)
+    h, dist = net.gap[contacts], net.contact_distance[contacts]
+    rigid = RigidBackbone.build(net, backbone)
+    if rigid is not None:  # the same two LPs in the K self-stress coordinates f = N alpha
+        f, t, mu = _reduced_lps(rigid.null, h, dist, rigid.f0)
+        f = polish(a, f)
+        f *= m / f.sum()
+        forces[contacts] = f
+        imbalance = np.zeros((n, d))
+        imbalance[backbone] = (a @ f).reshape(-1, d)
+        return Forces(forces, t, mu, imbalance, True)
+    zeros = np.zeros(a.shape[0])
+    # 1. jamming gap: min h^T f  s.t.  A f = 0, D^T f = 1, f >= 0
+    try:
+        res = solve_lp(
+            h, A_eq=sp.vstack([a, sp.csr_matrix(dist[None, :])], format="csr"),
+            b_eq=np.append(zeros, 1.0), bounds=(0, None), method="highs-ipm",
+        )
+    except LPFailure:  # infeasible: no non-negative self-stress
+        return failed
+    mu = float(res.fun)
+    # 2. most uniform optimal f = g + t:  max t  s.t.  A g + t A 1 = 0,  D^T g + t sum D = 1,
+    #    h^T g + t sum h <= mu (1 + 1e-6) + 1e-14 mean(D),  g >= 0
+    col_sum = np.asarray(a.sum(axis=1)).ravel()
+    a_eq = sp.vstack([
+        sp.hstack([a, sp.csr_matrix(col_sum[:, None])]),
+        sp.csr_matrix(np.append(dist, dist.sum())[None, :]),
+    ], format="csr")
+    a_ub = sp.csr_matrix(np.append(h, h.sum())[None, :])
+    c = np.zeros(m + 1)
+    c[-1] = -1.0
+    try:
+        res2 = solve_lp(
+            c, A_ub=a_ub, b_ub=[mu * (1 + 1e-6) + 1e-14 * dist.mean()], A_eq=a_eq,
+            b_eq=np.append(zeros, 1.0), bounds=[(0, None)] * m + [(None, None)], method="highs-ipm",
+        )
+        f = res2.x[:m] + res2.x[-1]
+        t = res2.x[-1] * m / f.sum()  # relative to the mean force
+    except LPFailure:  # keep the jamming-gap solution
+        f, t = res.x, 0.0
+    f = polish(a, np.maximum(f, 0.0))
+    f *= m / f.sum()
+    forces[contacts] = f
+    imbalance = np.zeros((n, d))
+    imbalance[backbone] = (a @ f).reshape(-1, d)
+    return Forces(forces, float(t), mu, imbalance, True)
+
+
+def _reduced_lps(null: np.ndarray, h: np.ndarray, dist: np.ndarray, uniform: np.ndarray):
+    """LPs 1 and 2 of the module docstring with f = null @ alpha (a strictly positive self-stress
+    ``uniform`` exists). Returns (f, min force / mean, mu*)."""
+    m, k = null.shape
+    if k == 1:
+        f = uniform
+        return f, float(f.min() / f.mean()), float(f @ h / (f @ dist))
+    hn, dn = h @ null, dist @ null
+    res = solve_lp(hn, A_ub=-null, b_ub=np.zeros(m), A_eq=dn[None, :], b_eq=[1.0],
+                   bounds=[(None, None)] * k)
+    mu = float(res.fun)
+    c = np.r_[np.zeros(k), -1.0]
+    a_ub = np.vstack([np.column_stack([-null, np.ones(m)]), np.r_[hn, 0.0][None, :]])
+    b_ub = np.r_[np.zeros(m), mu * (1 + 1e-6) + 1e-14 * dist.mean()]
+    try:
+        res2 = solve_lp(c, A_ub=a_ub, b_ub=b_ub, A_eq=np.r_[dn, 0.0][None, :], b_eq=[1.0],
+                        bounds=[(None, None)] * (k + 1))
+        f = null @ res2.x[:k]
+    except LPFailure:
+        f = null @ res.x
+    f = np.where(f < 0, 0.0, f)  # round-off negatives (f = N alpha >= t >= 0 up to tolerance)
+    return f, float(f.min() / f.mean()), mu
+
+
+def polish(a: sp.csr_matrix, f: np.ndarray, iterations: int = 4) -> np.ndarray:
+    """Project f onto {A f = 0} changing only the loaded contacts (f > 1e-9 max f).
+
+    Solves (A_S A_S^T + lam I) y = A_S f_S and sets f_S -= A_S^T y, repeated (iterative
+    refinement); lam = 1e-12 times the mean diagonal only regularises floppy directions.
+    """
+    f = f.copy()
+    start = f.copy()
+    support = f > 1e-9 * f.max()
+    a_s = a[:, support].tocsc()
+    solve = None
+    for _ in range(iterations):
+        r = a_s @ f[support]
+        if np.abs(r).max(initial=0.0) <= 1e-15 * f.max():
+            break
+        if solve is None:
+            normal = (a_s @ a_s.T).tocsc()
+            lam = 1e-12 * normal.diagonal().mean()
+            solve = spla.splu(normal + lam * sp.identity(normal.shape[0], format="csc")).solve
+        f[support] -= a_s.T @ solve(r)
+    if np.abs(a @ f).max() > np.abs(a @ start).max() or f.min() < 0:
+        return start  # a floppy support: the projection did not help
+    return f
+
+
+@dataclass(frozen=True)
+class Statics:
+    """Counting and pressure of a backbone with forces (see the module docstring)."""
+
+    n_backbone: int
+    n_contacts: int  # M_b, self-image contacts once
+    z_mean: float  # 2 M_b / N_b
+    n_dof_collective: int  # d (N_b - 1)
+    n_dof_strict: int  # d (N_b - 1) + d(d+1)/2 - 1
+    isostaticity_gap: int  # M_b - n_dof_collective - 1  (0 = isostatic in a fixed cell)
+    isostaticity_gap_strict: int  # M_b - n_dof_strict - 1
+    pressure_virial: float  # sum f |r| / (d V), forces normalised to mean 1
+    stress: np.ndarray  # (d, d) virial stress tensor, same units
+    jamming_gap: float  # mu* = sum f h / sum f D
+    pressure_free_volume: float  # (N_b - 1) / (N mu*), reduced pressure PV/(NkT)
+
+
+def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: float) -> Statics:
+    d, n = net.dim, net.n_particles
+    contacts = net.among(backbone)
+    nb, mb = int(backbone.sum()), int(contacts.sum())
+    nf = d * (nb - 1) if nb else 0
+    nf_strict = nf + d * (d + 1) // 2 - 1 if nb else 0
+    f = forces.forces[contacts]
+    r, u = net.distance[contacts], net.normal[contacts]
+    stress = np.einsum("k,kp,kq->pq", f * r, u, u) / volume if forces.exists else np.full((d, d), np.nan)
+    p_vir = float(np.trace(stress) / d)
+    mu = forces.jamming_gap
+    p_fv = (nb - 1) / (n * mu) if forces.exists and mu > 0 else np.inf if forces.exists else np.nan
+    return Statics(
+        n_backbone=nb, n_contacts=mb, z_mean=2.0 * mb / nb if nb else np.nan,
+        n_dof_collective=nf, n_dof_strict=nf_strict,
+        isostaticity_gap=mb - nf - 1 if nb else 0, isostaticity_gap_strict=mb - nf_strict - 1 if nb else 0,
+        pressure_virial=p_vir, stress=stress, jamming_gap=mu, pressure_free_volume=float(p_fv),
+    )

@@ -1,0 +1,197 @@
+"""Exact LP solutions through the self-stress space of a rigid, nearly isostatic backbone.
+
+Generic disordered packings from LS / MD have, after rattler removal, a backbone that is rigid
+(rank A' = N_f = d(N_b - 1); A' is A without one "anchor" particle's rows, which fixes the
+translation) with M = N_f + K contacts, K small (K = 1: isostatic, Eq. 4.8, L497-L535; a few
+more with near contacts inside delta). Then every LP the tests need reduces, through one sparse
+LU factorisation, to an LP in K unknowns. Derivations (ours):
+
+- Self-stress space. Remove K columns R from A' so that the square A'_{-R} is regular (LU).
+  For each removed column c, n_c = e_c - A'_{-R}^{-1} a'_c (on the kept columns) solves
+  A' n_c = 0: the K columns n_c span null(A'). A strictly positive self-stress exists iff
+  max t s.t. N alpha >= t, sum(N alpha) = M has t > 0; otherwise the LP polytope is unbounded
+  (Stiemke) and the callers use HiGHS, which finds the unjamming motion.
+- Load B (collective test, LP 4.10 and its dual 4.12 without the box): the dual is
+  min h^T f s.t. A' f = -B, f >= 0. With y a particular solution (y_R = 0, LU solve), f = y + N
+  alpha, a K-variable LP solved by HiGHS in milliseconds (closed form for K = 1: the contact
+  with the smallest y_j / f0_j opens). At its (nondegenerate) optimum exactly N_f forces are
+  positive; complementary slackness closes those contacts and leaves K slacks sigma_Q unknown,
+  fixed by the K rows the LU left out: K + 1 triangular solves with the same LU and a K x K
+  system give the displacement, the same vertex a simplex method returns. If the vertex is
+  degenerate or leaves the LP box, the callers fall back to HiGHS.
+- Strain (strict test): the strain adds d(d+1)/2 unknowns and one constraint (trace), so for
+  K <= d(d+1)/2 - 2 the strict LP is unbounded. An exact unjamming direction is a strain with
+  Tr eps = 0 and S_c . eps = 0 for the stress S_c = A_eps n_c of every self-stress (Eq. 4.23):
+  then A'^T dR = -A_eps^T eps is consistent, and (dR, eps) keeps every contact closed to first
+  order at constant volume. We project the random strain load onto that subspace and scale it
+  to the LP box.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from hardpack.jamming.contacts import ContactNetwork
+from hardpack.jamming.lp import LPFailure, solve_lp
+from hardpack.jamming.rigidity import (
+    rigidity_transpose,
+    strain_coefficients,
+    strain_pairs,
+    strain_tensor,
+)
+
+#: backbones with more than this many self-stresses are left to HiGHS
+MAX_SELF_STRESSES = 12
+
+
+@dataclass
+class RigidBackbone:
+    """LU factorisation and self-stress basis of a rigid backbone (module docstring)."""
+
+    moving: np.ndarray  # (N,) particles with variables (backbone minus the anchor)
+    contacts: np.ndarray  # (N_contacts,) mask of the backbone contacts
+    a: object  # A' (csc), (N_f, M)
+    lu: object  # splu of A'_{-R}
+    removed: np.ndarray  # R, K column indices
+    null: np.ndarray  # (M, K) basis of the self-stresses
+    f0: np.ndarray  # (M,) most uniform strictly positive self-stress, mean 1
+    h: np.ndarray  # (M,) gaps
+
+    @classmethod
+    def build(cls, net: ContactNetwork, backbone: np.ndarray) -> RigidBackbone | None:
+        d = net.dim
+        contacts = net.among(backbone)
+        m, nb = int(contacts.sum()), int(backbone.sum())
+        nf = d * (nb - 1)
+        k = m - nf
+        if nb < 2 or not 1 <= k <= MAX_SELF_STRESSES:
+            return None
+        moving = backbone.copy()
+        moving[np.flatnonzero(backbone)[0]] = False
+        at = rigidity_transpose(net)[contacts][:, np.flatnonzero(np.repeat(moving, d))]
+        a = at.T.tocsc()
+        rng = np.random.default_rng(0)
+        norms = np.asarray(abs(a).sum(axis=0)).ravel()
+        for attempt in range(4):  # a regular square subsystem: keep all but K columns
+            removed = np.argsort(-norms)[:1] if attempt == 0 else np.array([], dtype=int)
+            others = np.setdiff1d(np.arange(m), removed)
+            removed = np.sort(np.r_[removed, rng.choice(others, k - removed.size, replace=False)])
+            rest = np.setdiff1d(np.arange(m), removed)
+            try:
+                lu = spla.splu(a[:, rest].tocsc(), permc_spec="COLAMD")
+                break
+            except RuntimeError:  # exactly singular
+                lu = None
+        if lu is None:
+            return None
+        null = np.zeros((m, k))
+        null[removed, np.arange(k)] = 1.0
+        null[rest] = lu.solve(-a[:, removed].toarray())
+        if not np.all(np.isfinite(null)) or np.abs(a @ null).max() > 1e-9 * np.abs(null).max():
+            return None
+        f0 = _uniform_self_stress(null)
+        if f0 is None:
+            return None
+        return cls(moving, contacts, a, lu, removed, null, f0, net.gap[contacts])
+
+    @property
+    def n_self_stresses(self) -> int:
+        return self.null.shape[1]
+
+    def optimum(self, load: np.ndarray, d: int, box: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """Optimal vertex of LP (4.10) for ``load`` (N, d): (displacement (N, d), forces (M,)),
+        or None when the vertex is degenerate or leaves the box (use HiGHS then)."""
+        m = self.f0.size
+        y = np.zeros(m)
+        rest = np.setdiff1d(np.arange(m), self.removed)
+        y[rest] = self.lu.solve(-load[self.moving].ravel())
+        if self.n_self_stresses == 1:  # closed form: the contact with the smallest y / f0 opens
+            n0 = self.null[:, 0] if self.null[:, 0].sum() > 0 else -self.null[:, 0]
+            ratio = y / n0
+            forces = y - ratio.min() * n0
+        else:
+            try:
+                res = solve_lp(self.h @ self.null, A_ub=-self.null, b_ub=y,
+                               bounds=[(None, None)] * self.n_self_stresses)
+            except LPFailure:
+                return None
+            forces = y + self.null @ res.x
+        support = forces > 1e-12 * np.abs(forces).max()
+        if support.sum() != self.a.shape[0]:
+            return None
+        x = self._closed_vertex(np.flatnonzero(~support), rest)
+        if x is None:
+            return None
+        if np.abs(x).max() > box:
+            return None
+        disp = np.zeros((self.moving.size, d))
+        disp[self.moving] = x.reshape(-1, d)
+        return disp, np.maximum(forces, 0.0)
+
+    def _closed_vertex(self, open_set: np.ndarray, rest: np.ndarray) -> np.ndarray | None:
+        """dR with A'^T dR + h = slack, slack zero except on the K contacts ``open_set``.
+
+        dR(sigma) = A'_{-R}^{-T} (sigma - h)_{rest} satisfies the kept rows; the K unknown slacks
+        sigma_Q follow from the K removed rows (a K x K system): no new factorisation.
+        """
+        m = self.f0.size
+        a_r = self.a[:, self.removed].T  # (K, N_f): rows of A'^T that the LU left out
+        x0 = self.lu.solve(-self.h[rest], trans="T")
+        r0 = a_r @ x0 + self.h[self.removed]
+        basis, resp = [], []
+        for q in open_set:
+            e = np.zeros(m)
+            e[q] = 1.0
+            xq = self.lu.solve(e[rest], trans="T")
+            basis.append(xq)
+            resp.append(a_r @ xq - e[self.removed])
+        try:
+            sigma = np.linalg.solve(np.column_stack(resp), -r0)
+        except np.linalg.LinAlgError:
+            return None
+        if sigma.min() < -1e-9 * max(np.abs(self.h).max(), 1e-300):
+            return None
+        return x0 + np.column_stack(basis) @ sigma
+
+    def strain_mode(self, net: ContactNetwork, strain_load: np.ndarray, box: float,
+                    cell_length: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """A first-order floppy motion (dR, eps) with Tr eps = 0 along the random strain load,
+        or None when no strain is orthogonal to the trace and to every self-stress's stress."""
+        d = net.dim
+        coef = strain_coefficients(net)[self.contacts]  # (M, s): A_eps^T
+        trace = np.array([1.0 if p == q else 0.0 for p, q in strain_pairs(d)])
+        q, _ = np.linalg.qr(np.column_stack([trace, coef.T @ self.null]))
+        eps_hat = np.asarray(strain_load, dtype=float)
+        eps_hat = eps_hat - q @ (q.T @ eps_hat)
+        if np.linalg.norm(eps_hat) <= 1e-12 * np.linalg.norm(strain_load):
+            return None  # e.g. d = 1, or more self-stresses than strain components
+        eps_hat *= box / (cell_length * np.abs(eps_hat).max())
+        rhs = -coef @ eps_hat
+        rest = np.setdiff1d(np.arange(self.f0.size), self.removed)
+        x = self.lu.solve(rhs[rest], trans="T")
+        disp = np.zeros((self.moving.size, d))
+        disp[self.moving] = x.reshape(-1, d)
+        return disp, strain_tensor(eps_hat, d)
+
+
+def _uniform_self_stress(null: np.ndarray) -> np.ndarray | None:
+    """max t s.t. N alpha >= t, mean(N alpha) = 1: the most uniform self-stress (Donev LP 5.9 in
+    the K coordinates alpha); None unless it is strictly positive."""
+    m, k = null.shape
+    if k == 1:
+        f = null[:, 0] * m / null[:, 0].sum()
+        return f if f.min() > 0 else None
+    c = np.r_[np.zeros(k), -1.0]
+    a_ub = np.column_stack([-null, np.ones(m)])  # t - N alpha <= 0
+    a_eq = np.r_[null.sum(axis=0), 0.0][None, :]
+    try:
+        res = solve_lp(c, A_ub=a_ub, b_ub=np.zeros(m), A_eq=a_eq, b_eq=[m],
+                       bounds=[(None, None)] * k + [(None, 1.0)])
+    except LPFailure:
+        return None
+    if res.x[-1] <= 1e-9:
+        return None
+    return null @ res.x[:k]

@@ -1,0 +1,193 @@
+"""JammingResult: the verdict of :func:`hardpack.jamming.verify` and its xarray form."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+
+from hardpack.jamming.contacts import ContactNetwork
+from hardpack.jamming.forces import Forces, Statics
+from hardpack.jamming.ideal import TestOutcome
+from hardpack.jamming.sequential import SequentialOutcome
+
+CATEGORIES = ("local", "collective", "strict")
+ADVERBS = {"local": "locally", "collective": "collectively", "strict": "strictly"}
+
+
+@dataclass
+class JammingResult:
+    """Everything :func:`verify` measured. ``None`` marks a test that was not run.
+
+    - ``local``/``collective``/``strict``: True when a (sub)packing is jammed in that sense
+      (Donev L268-L285: a packing with a jammed backbone counts as jammed).
+    - ``rattler``: particles outside the backbone (local rattlers, plus rattling clusters the
+      collective test removed when it found a jammed backbone).
+    - ``network``: all contacts within delta; ``forces.forces`` is the backbone self-stress.
+    """
+
+    params: dict
+    network: ContactNetwork
+    local: bool | None
+    local_rattler: np.ndarray
+    local_escape: np.ndarray
+    collective_test: TestOutcome | SequentialOutcome | None
+    strict_test: TestOutcome | SequentialOutcome | None
+    rattler: np.ndarray
+    forces: Forces
+    statics: Statics
+    volume: float
+    md_pressure: float | None = None
+    seconds: dict = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ verdicts
+    @property
+    def collective(self) -> bool | None:
+        return None if self.collective_test is None else bool(self.collective_test.jammed)
+
+    @property
+    def strict(self) -> bool | None:
+        return None if self.strict_test is None else bool(self.strict_test.jammed)
+
+    @property
+    def category(self) -> str:
+        """The strongest category that holds among the tests run ('not jammed' if none)."""
+        best = "not jammed"
+        for name in CATEGORIES:
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if not value:
+                break
+            best = ADVERBS[name] + " jammed"
+        return best
+
+    @property
+    def verdicts(self) -> dict:
+        return {name: getattr(self, name) for name in CATEGORIES}
+
+    # ------------------------------------------------------------------ numbers
+    @property
+    def z_mean(self) -> float:
+        """Mean contact number of the rattler-free backbone."""
+        return self.statics.z_mean
+
+    @property
+    def isostaticity_gap(self) -> int:
+        return self.statics.isostaticity_gap
+
+    @property
+    def rattler_fraction(self) -> float:
+        return float(self.rattler.mean())
+
+    @property
+    def pressure_ratio(self) -> float | None:
+        """Free-volume pressure from forces and gaps over the MD's reduced pressure."""
+        if self.md_pressure is None or not np.isfinite(self.statics.pressure_free_volume):
+            return None
+        return float(self.statics.pressure_free_volume / self.md_pressure)
+
+    def unjamming(self, test: str) -> dict:
+        """Size of the unjamming motion a test found, in mean diameters (0 when none): mean and
+        max of |dr_i| over the particles and the 2-norm of the strain. Ideal test: the first
+        motion that displaced something (LP rays stop at the box, so the size is the box's);
+        sequential test: the largest mean displacement over the loading sequences."""
+        out = self.collective_test if test == "collective" else self.strict_test
+        if out is None:
+            return {}
+        if isinstance(out, SequentialOutcome):
+            strain = 0.0 if out.strain is None else float(np.linalg.norm(out.strain, 2))
+            return {"mean": max(out.mean_displacement, default=0.0),
+                    "max": max(out.max_displacement, default=0.0), "strain": strain}
+        size = np.linalg.norm(out.motion, axis=1) / self.params["mean_diameter"]
+        return {"mean": float(size.mean()), "max": float(size.max(initial=0.0)),
+                "strain": out.strain_norm}
+
+    def summary(self) -> str:
+        """A few human-readable lines."""
+        p, s = self.params, self.statics
+        lines = [
+            (f"verdict: {self.category}  (local={_yn(self.local)}, collective={_yn(self.collective)}, "
+             f"strict={_yn(self.strict)}; method={p['method']}, delta={p['delta']:g}, "
+             f"dr_large={p['dr_large']:.3g}, seed={p['seed']})"),
+            (f"N={self.network.n_particles}, contacts={self.network.n_contacts}, "
+             f"rattlers={int(self.rattler.sum())} ({100 * self.rattler_fraction:.2f}%), "
+             f"backbone N_b={s.n_backbone}, M_b={s.n_contacts}, Z={s.z_mean:.4f}"),
+            (f"isostaticity: M_b - d(N_b-1) - 1 = {s.isostaticity_gap} (collective), "
+             f"M_b - [d(N_b-1) + d(d+1)/2] = {s.isostaticity_gap_strict} (strict)"),
+        ]
+        for test in ("collective", "strict"):
+            u = self.unjamming(test)
+            if u:
+                lines.append(
+                    f"{test} unjamming displacement / D: mean {u['mean']:.3g}, max {u['max']:.3g}"
+                    f", strain {u['strain']:.3g}"
+                )
+        if self.forces.exists:
+            lines.append(
+                f"forces: min/mean {self.forces.min_force:.3g}, max |imbalance| "
+                f"{np.abs(self.forces.imbalance).max():.2e}; virial p V / (mean f) = "
+                f"{s.pressure_virial * self.volume:.4g}; jamming gap mu* = {s.jamming_gap:.3e}"
+            )
+        if self.md_pressure is not None:
+            lines.append(
+                f"pressure: free-volume from forces {s.pressure_free_volume:.4g} vs MD "
+                f"{self.md_pressure:.4g} (ratio {self.pressure_ratio})"
+            )
+        return "\n".join(lines)
+
+    # ------------------------------------------------------------------ dataset
+    def to_dataset(self) -> xr.Dataset:
+        """Per-particle, per-contact and scalar results (dims 'particle', 'contact', 'dim')."""
+        net, d = self.network, self.network.dim
+        data = {
+            "contact_i": (("contact",), net.i),
+            "contact_j": (("contact",), net.j),
+            "contact_shift": (("contact", "dim"), net.shift),
+            "contact_gap": (("contact",), net.distance / net.contact_distance - 1.0),
+            "force": (("contact",), self.forces.forces),
+            "rattler": (("particle",), self.rattler.astype(np.int8)),
+            "local_rattler": (("particle",), self.local_rattler.astype(np.int8)),
+            "local_escape": (("particle",), self.local_escape),
+            "force_imbalance": (("particle", "dim"), self.forces.imbalance),
+            "stress": (("dim", "dim2"), self.statics.stress),
+        }
+        for name, out in (("collective", self.collective_test), ("strict", self.strict_test)):
+            if out is None:
+                continue
+            data[f"{name}_displacement"] = (("particle",), out.displacement)
+            data[f"{name}_motion"] = (("particle", "dim"), _or_zeros(out.motion, net.n_particles, d))
+            if out.strain is not None:
+                data[f"{name}_strain"] = (("dim", "dim2"), out.strain)
+            if isinstance(out, TestOutcome):
+                data[f"{name}_backbone"] = (("particle",), out.backbone.astype(np.int8))
+        s = self.statics
+        attrs = dict(
+            hardpack_kind="jamming", verdict=self.category,
+            **{k: -1 if v is None else int(v) for k, v in self.verdicts.items()},
+            **{k: v for k, v in self.params.items() if v is not None},
+            N=net.n_particles, d=d, n_contacts=net.n_contacts, n_rattlers=int(self.rattler.sum()),
+            rattler_fraction=self.rattler_fraction, n_backbone=s.n_backbone,
+            n_backbone_contacts=s.n_contacts, z_mean=s.z_mean,
+            isostaticity_gap=s.isostaticity_gap, isostaticity_gap_strict=s.isostaticity_gap_strict,
+            forces_exist=int(self.forces.exists), min_force=self.forces.min_force,
+            pressure_virial=s.pressure_virial, jamming_gap=s.jamming_gap,
+            pressure_free_volume=s.pressure_free_volume, volume=self.volume,
+        )
+        if self.md_pressure is not None:
+            attrs["md_pressure"] = self.md_pressure
+        for test in ("collective", "strict"):
+            for key, value in self.unjamming(test).items():
+                attrs[f"{test}_unjamming_{key}"] = value
+        for key, value in self.seconds.items():
+            attrs[f"seconds_{key}"] = value
+        return xr.Dataset(data, attrs=attrs)
+
+
+def _or_zeros(arr, n, d):
+    return np.zeros((n, d)) if arr is None else arr
+
+
+def _yn(value) -> str:
+    return "-" if value is None else ("yes" if value else "no")

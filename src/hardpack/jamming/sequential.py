@@ -1,0 +1,200 @@
+"""Algorithm 14 (sequential random loading) for packings with gaps, e.g. finite-rate LS packings.
+
+Donev dissertation sec. 4.6.2, seeds/000_chapters/ch04-05.txt L1678-L1814:
+
+3. rattlers are marked (iterative local test) and kept as fixed obstacles (no load on them;
+   the text keeps them as constraints, L1743-L1753; fixing them avoids the spurious
+   large rattler displacements the text warns about, L1746-L1751);
+4. random load B (zero on rattlers);
+5. solve LP 4.10 (+ 4.17 for the strict test) for a linearised motion (dR, eps);
+6. move along it as far as possible: the largest tau such that no pair overlaps for
+   t in [0, tau] (quadratic collision times of the straight-line motion, as in LS collision
+   scheduling, L1754-L1774), no pair outside the contact list can collide (every particle
+   moves less than the list's gap delta D_min), and det(I + tau eps) <= 1; then
+   R <- R + tau dR, Lambda <- (I + tau eps) Lambda, and the contact network is rebuilt;
+7. repeat 5-6 while some particle moved by more than beta D (at most ``max_steps`` LPs);
+9. the same with -B; 10. ``n_loads`` loads in all (the text used 3 loads x 2 directions x 3 LPs,
+   L2074-L2081).
+
+The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated over one loading
+sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
+subtracted), in units of the mean diameter, averaged over the non-rattlers (rattlers are fixed
+and excluded; Donev's tables include them, L2280-L2290). In the strict test dr_i includes the
+affine part of a cell deformation, as the LP variables of the text do; the accumulated strain
+is reported too. The verdict is "jammed" when no sequence reaches a mean of ``threshold`` (a
+judgement, as the text says, L1789-L1814).
+
+Round-off: a pair already in contact may approach by the LP feasibility tolerance (~1e-10);
+the collision time is therefore computed for a distance (1 - 1e-11) times the smaller of the
+current distance and D_ij, which never lets overlaps grow beyond the packing tolerance.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.packing import Packing
+from hardpack.jamming.contacts import ContactNetwork, contact_network
+from hardpack.jamming.ideal import cell_length
+from hardpack.jamming.lp import random_load, random_strain_load, solve_motion
+
+#: relative approach allowed for pairs in contact (see the module docstring)
+APPROACH_SLACK = 1e-11
+
+
+@dataclass
+class SequentialOutcome:
+    test: str
+    jammed: bool
+    threshold: float
+    mean_displacement: list = field(default_factory=list)  # per sequence, / mean diameter
+    strain_norm: list = field(default_factory=list)  # per sequence, |sum tau eps|_2
+    max_displacement: list = field(default_factory=list)  # per sequence, / mean diameter
+    steps: list = field(default_factory=list)  # LPs per sequence
+    displacement: np.ndarray | None = None  # (N,) largest |dr_i| / D over sequences
+    motion: np.ndarray | None = None  # (N, d) sequence with the largest mean displacement
+    strain: np.ndarray | None = None  # (d, d) total strain of that sequence
+    final: Packing | None = None  # the packing after all loads
+    n_lp: int = 0
+    seconds: float = 0.0
+    method: str = "sequential"
+
+
+def collision_step(net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None) -> float:
+    """Largest tau keeping every listed pair apart along x + t dR, Lambda + t eps Lambda."""
+    w = disp[net.j] - disp[net.i]
+    if eps is not None:
+        w = w + net.image_offset @ eps.T
+    s0 = net.separation
+    target = (1.0 - APPROACH_SLACK) * np.minimum(net.distance, net.contact_distance)
+    a = np.einsum("ij,ij->i", w, w)
+    b = 2.0 * np.einsum("ij,ij->i", s0, w)
+    c = net.distance**2 - target**2
+    disc = b * b - 4.0 * a * c
+    hit = (b < 0) & (disc >= 0) & (a > 0)
+    if not hit.any():
+        return np.inf
+    root = (2.0 * c[hit]) / (-b[hit] + np.sqrt(disc[hit]))  # smaller root, cancellation-free
+    return float(root.min())
+
+
+def list_step(net: ContactNetwork, radii: np.ndarray, disp: np.ndarray, eps: np.ndarray | None) -> float:
+    """Largest tau for which no pair outside the contact list (gap > delta D_ij) can touch.
+
+    A pair's relative velocity is dr_j - dr_i + eps Lambda n; for a pair within reach,
+    |Lambda n| <= |r_ij| + |x_j - x_i| <= (1 + delta) 2 r_max + sum of the lattice vector lengths.
+    """
+    speed = 2.0 * np.linalg.norm(disp, axis=1).max(initial=0.0)
+    if eps is not None:
+        span = np.linalg.norm(net.lattice, axis=0).sum()
+        speed += np.linalg.norm(eps, 2) * ((1.0 + net.delta) * 2.0 * radii.max() + span)
+    return np.inf if speed == 0 else net.delta * 2.0 * radii.min() / speed
+
+
+def volume_step(eps: np.ndarray | None) -> float:
+    """Largest tau with det(I + t eps) <= 1 for all t in [0, tau] (strict test only).
+
+    det(I + t eps) - 1 = prod_k (1 + t lambda_k) - 1 = t q(t); the first positive root of q.
+    """
+    if eps is None:
+        return np.inf
+    lams = np.linalg.eigvalsh(eps)
+    poly = np.array([1.0])  # ascending powers of t
+    for lam in lams:
+        poly = np.convolve(poly, [1.0, lam])
+    q = poly[1:]
+    q[np.abs(q) <= 1e-12 * np.abs(lams).max(initial=0.0) ** np.arange(1, q.size + 1)] = 0.0
+    while q.size and q[0] == 0.0:  # a zero low-order coefficient is a root at t = 0: divide it out
+        q = q[1:]
+    if q.size < 2:
+        return np.inf
+    roots = np.roots(q[::-1])
+    real = roots[np.abs(roots.imag) <= 1e-12 * np.abs(roots).max(initial=1.0)].real
+    positive = real[real > 0]
+    return float(positive.min()) if positive.size else np.inf
+
+
+def sequential_test(
+    packing: Packing,
+    delta: float,
+    *,
+    strict: bool,
+    rattlers: np.ndarray,
+    rng: np.random.Generator,
+    box: float,
+    threshold: float = 1e-3,
+    beta: float = 0.01,
+    n_loads: int = 3,
+    max_steps: int = 3,
+) -> SequentialOutcome:
+    """Algorithm 14 from ``packing`` (see the module docstring)."""
+    t0 = time.perf_counter()
+    n, d = packing.n_particles, packing.dim
+    diameter = 2.0 * packing.radii.mean()
+    moving = ~rattlers
+    out = SequentialOutcome(test="strict" if strict else "collective", jammed=True, threshold=threshold)
+    out.displacement = np.zeros(n)
+    current = packing
+    best = -1.0
+    for _ in range(n_loads):
+        base = random_load(rng, moving, d)
+        base_eps = random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None
+        for sign in (1.0, -1.0):
+            total = np.zeros((n, d))
+            strain_total = np.zeros((d, d))
+            steps = 0
+            for _step in range(max_steps):
+                net = contact_network(current, delta)
+                mot = solve_motion(
+                    net, moving, sign * base, fixed=rattlers, box=box,
+                    cell_length=cell_length(current.lattice),
+                    strain_load=None if base_eps is None else sign * base_eps,
+                )
+                steps += 1
+                tau = min(
+                    collision_step(net, mot.displacement, mot.strain),
+                    list_step(net, current.radii, mot.displacement, mot.strain),
+                    volume_step(mot.strain),
+                )
+                if not np.isfinite(tau) or tau <= 0:
+                    break
+                current, tau = _advance(current, net, mot.displacement, mot.strain, tau)
+                step = tau * mot.displacement
+                total += step
+                if strict:
+                    strain_total += tau * mot.strain
+                if np.linalg.norm(step[moving], axis=1).max(initial=0.0) <= beta * diameter:
+                    break
+            out.n_lp += steps
+            rel = total - np.median(total[moving], axis=0) if moving.any() else total
+            size = np.linalg.norm(rel, axis=1) / diameter
+            size[rattlers] = 0.0
+            mean = float(size[moving].mean()) if moving.any() else 0.0
+            out.mean_displacement.append(mean)
+            out.max_displacement.append(float(size.max(initial=0.0)))
+            out.steps.append(steps)
+            out.strain_norm.append(float(np.linalg.norm(strain_total, 2)))
+            out.displacement = np.maximum(out.displacement, size)
+            if mean > best:
+                best, out.motion = mean, rel
+                out.strain = strain_total if strict else None
+    out.jammed = bool(max(out.mean_displacement, default=0.0) < threshold)
+    out.final = current
+    out.seconds = time.perf_counter() - t0
+    return out
+
+
+def _advance(packing: Packing, net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None,
+             tau: float) -> tuple[Packing, float]:
+    """The packing moved by tau (dR, eps); tau is halved if round-off would create an overlap."""
+    for _ in range(60):
+        lattice = packing.lattice if eps is None else (np.eye(packing.dim) + tau * eps) @ packing.lattice
+        try:
+            return packing.replace(positions=net.positions + tau * disp, lattice=lattice), tau
+        except InvalidInputError:
+            tau *= 0.5
+    return packing, 0.0

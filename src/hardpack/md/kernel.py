@@ -1,0 +1,517 @@
+"""Numba kernels of the event-driven (collision-driven) hard-sphere MD engine.
+
+Algorithm (Donev dissertation ch. 3, note 000_ch1-3_md.md sec. 2.2-2.9), in the "one event per
+particle, lazy invalidation" form:
+
+- Every particle i carries ONE predicted event (partner ``ep[i]``) in a 4-ary min-heap whose keys
+  (event times) are stored in the heap array itself (``hkey``, ``heap``) with a position index
+  ``hpos``, so any particle's key changes in O(log N) and sifting touches few cache lines.
+- A predicted collision of i with j stores the collision counter of j at prediction time
+  (``ec[i] = cnt[j]``). When it pops and j has collided since (``cnt[j] != ec[i]``), the event is
+  stale and i just predicts again (lazy invalidation, instead of Donev's symmetric schedules with
+  third-party invalidation, Alg. 5 step 5). Correctness: whenever a particle changes velocity it
+  re-predicts against ALL its neighbours, so for every pair the particle that changed last holds a
+  prediction no later than the pair's true next collision.
+- Neighbour lists with immobile bounding spheres (Donev's NNL, sec. 2.9): particle i stays inside
+  the sphere ``bs[i]`` (centre bs[i, :d], radius bs[i, d]); particles whose bounding spheres do
+  not overlap cannot collide, so collisions are predicted only against the list ``nb[i, :nn[i]]``.
+  The extra event "i leaves its bounding sphere" (``ep = EXIT``; the exit time solves
+  |dr + v t| = R - a(t) with the radius growth included) rebuilds i's list only (Alg. 10)
+  with a cell grid of bounding-sphere centres whose cell width is at least the largest
+  bounding-sphere diameter. Each list entry packs the neighbour j and its periodic image as
+  j * 3^d + code, code indexing ``imgvec`` (shifts in {-1, 0, 1}^d); the image stays valid because
+  a position is re-wrapped into the box only when its own list is rebuilt.
+- Time is measured from the last synchronisation (Alg. 3); radii are a_i(t) = a_i (1 + kappa t)
+  with ONE relative growth rate kappa (radii grow in proportion to their size).
+
+Particle state is packed in one row per particle, ``P[i] = (x_0..x_{d-1}, v_0..v_{d-1}, t_i, a_i)``:
+position and velocity at the particle's own last update time t_i (Alg. 2 step 5, asynchronous
+updates), and its radius at window time 0. Masses are all 1.
+
+Pair collision time (note sec. 2.3, derived there; re-derived here): with r = x_j - x_i,
+u = v_j - v_i, sigma(t) = sigma_0 + g t, contact |r + u t|^2 = sigma(t)^2 gives
+A t^2 + 2 B t + C = 0 with A = u.u - g^2, B = r.u - sigma_0 g, C = r.r - sigma_0^2.
+C <= 0 (round-off overlap): collide now if B < 0; if B >= 0 but A < 0 (growth outruns the
+separation) the later root (B + sqrt(B^2 - AC)) / (-A) is the re-contact. C > 0: a root exists iff
+(B < 0 or A < 0) and B^2 - AC >= 0, and the first one is C / (-B + sqrt(B^2 - AC)) for B < 0 and
+(B + sqrt(B^2 - AC)) / (-A) for B >= 0 (the two stable forms of the same root).
+For shrinking spheres (kappa < 0) the squared equation also has roots with sigma(t) < 0, i.e.
+after t = 1/|kappa|; windows end before 0.5/|kappa| (engine), so such roots are never processed.
+
+Collision law (note sec. 2.4, sign-corrected there): n = r / |r| at contact,
+v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with equal masses the impulse
+on j is J = -v_n n (v_j += J, v_i -= J), which reverses the CONTACT normal velocity v_n -> -v_n.
+Kinetic energy changes by -v_n g (heating when growing). Collisions with v_n >= 0 are skipped
+(mispredicted or grazing, Alg. 12 step 3).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+EXIT = -1  # event: the particle leaves its bounding sphere
+NONE = -2  # nothing predicted (event time inf)
+
+# status codes of run_events
+DONE_COLLISIONS = 0  # the window's collision budget is used up (sync at the last collision time)
+DONE_TIME = 1  # the next event is later than t_cap (sync at t_cap)
+OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
+STUCK = 3  # no event can ever happen (nothing moves)
+BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
+
+# float accumulators, acc[...]
+A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE = 0, 1, 2, 3, 4
+# integer counters, iacc[...]
+I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE = 0, 1, 2, 3, 4
+N_COUNTERS = 5
+
+
+# --------------------------------------------------------------------------------- root finding
+@njit(cache=True)
+def pair_time(r, u, sig0, g):
+    """First contact time >= 0 of a pair (see module docstring); inf if none. r, u: (d,) arrays."""
+    rr = 0.0
+    ru = 0.0
+    uu = 0.0
+    for k in range(r.shape[0]):
+        rr += r[k] * r[k]
+        ru += r[k] * u[k]
+        uu += u[k] * u[k]
+    return _root(rr, ru, uu, sig0, g, np.inf)
+
+
+@njit(cache=True, inline="always")
+def _root(rr, ru, uu, sig0, g, tmax):
+    """First contact time in [0, tmax), else inf (module docstring). When A >= 0 the root is at
+    least C / (-2B), which rejects most pairs before the square root."""
+    b = ru - sig0 * g
+    a = uu - g * g
+    if b >= 0.0 and a >= 0.0:
+        return np.inf
+    c = rr - sig0 * sig0
+    if c <= 0.0:
+        if b < 0.0:
+            return 0.0
+        disc = b * b - a * c
+        disc = max(disc, 0.0)
+        return (b + np.sqrt(disc)) / (-a)
+    if a >= 0.0 and c >= -2.0 * b * tmax:
+        return np.inf
+    disc = b * b - a * c
+    if disc < 0.0:
+        return np.inf
+    if b < 0.0:
+        return c / (-b + np.sqrt(disc))
+    return (b + np.sqrt(disc)) / (-a)  # A < 0 here; same root, no cancellation when B >= 0
+
+
+@njit(cache=True)
+def exit_time(dr, v, rrem, adot):
+    """Time for a sphere (centre offset dr from its bounding centre, velocity v, radius growing at
+    adot) to touch its bounding sphere, whose radius exceeds the particle's by rrem now.
+
+    |dr + v t| = rrem - adot t  ->  A t^2 + 2 B t + C = 0 with A = v.v - adot^2,
+    B = dr.v + rrem adot, C = dr.dr - rrem^2 < 0; first root t = -C / (B + sqrt(B^2 - AC))
+    (note 000 sec. 2.9, valid for any sign of A). For shrinking particles (adot < 0) the root is
+    genuine because rrem - adot t stays positive.
+    """
+    dd = 0.0
+    dv = 0.0
+    vv = 0.0
+    for k in range(dr.shape[0]):
+        dd += dr[k] * dr[k]
+        dv += dr[k] * v[k]
+        vv += v[k] * v[k]
+    return _exit_root(dd, dv, vv, rrem, adot)
+
+
+@njit(cache=True, inline="always")
+def _exit_root(dd, dv, vv, rrem, adot):
+    c = dd - rrem * rrem
+    if c >= 0.0:
+        return 0.0
+    a = vv - adot * adot
+    b = dv + rrem * adot
+    disc = b * b - a * c
+    if disc < 0.0:
+        if adot > 0.0:  # round-off: a growing sphere always leaves
+            disc = 0.0
+        else:
+            return np.inf
+    den = b + np.sqrt(disc)
+    if den > 0.0:
+        return -c / den
+    if adot > 0.0:
+        return 0.0
+    return np.inf
+
+
+# --------------------------------------------------------------------------------- event loop
+@njit(cache=True)
+def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head, nxt,
+               prv, cell_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
+               coll_target, t_cap, rebuild_lists):
+    """One window: reset the schedule at t = 0, then process events in time order until
+    ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
+
+    Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
+    out of the hot path): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
+    NNL update of one particle (wrap, new bounding sphere, re-bin, list every overlapping bounding
+    sphere already binned; together a complete update, Alg. 9); the bounding radius is
+    min(a_i(t) + skin, rcap), one absolute skin for all sizes. A partial update edits only the
+    lists of neighbours gained or lost (``mark`` flags the old ones), plus those of kept ones if the
+    particle was wrapped back into the box (their image code changes). Without ``rebuild_lists``
+    the lists, bounding spheres and grid of the previous window are kept (they stay valid across
+    a synchronisation); (2) N predictions inserted into the heap (schedule reset, Alg. 4);
+    (3) events: stale collision -> re-predict; valid collision -> advance both, collide,
+    re-predict both; exit -> partial NNL update (Alg. 10) and re-predict.
+
+    ``acc`` holds float accumulators (A_T current time, A_VIRIAL sum of r_ij . J_ij, A_KEINT time
+    integral of the kinetic energy, A_KE current kinetic energy, A_TKE time of the last KE
+    update); ``iacc`` integer counters (collisions, events, stale events, exits, grazing skips).
+    Returns a status code (module constants).
+    """
+    d = len(dims)
+    n = P.shape[0]
+    ncode = 3**d
+    cap = nb.shape[1]
+    invL = 1.0 / L
+    xi = np.empty(d)
+    vi = np.empty(d)
+    rv = np.empty(d)
+    upd = np.empty(2, dtype=np.int64)
+    oldnb = np.empty(cap, dtype=np.int64)
+    mark[:] = 0
+    hpos[:] = -1
+    hsize = 0
+    stage = n
+    if rebuild_lists:
+        head[:] = -1
+        cell_of[:] = -1
+        nn[:] = 0
+        stage = 0
+    while True:
+        npred = 0
+        rebuild = False
+        if stage < n:  # (1) complete NNL update, one particle per step
+            i = stage
+            t = 0.0
+            rebuild = True
+            stage += 1
+        elif stage < 2 * n:  # (2) schedule reset
+            i = stage - n
+            t = 0.0
+            upd[0] = i
+            npred = 1
+            stage += 1
+        else:  # (3) events
+            i = heap[0]
+            t = hkey[0]
+            if t > t_cap:
+                acc[A_T] = t_cap
+                acc[A_KEINT] += acc[A_KE] * (t_cap - acc[A_TKE])
+                acc[A_TKE] = t_cap
+                return DONE_TIME
+            if t == np.inf:
+                return STUCK
+            iacc[I_EVENTS] += 1
+            p = ep[i]
+            if p < 0:  # leaves its bounding sphere
+                iacc[I_EXIT] += 1
+                rebuild = True
+                upd[0] = i
+                npred = 1
+            elif ec[i] != cnt[p]:  # the partner collided since the prediction: stale
+                iacc[I_STALE] += 1
+                upd[0] = i
+                npred = 1
+            else:  # binary collision of i and j at time t
+                j = p
+                dti = t - P[i, 2 * d]
+                dtj = t - P[j, 2 * d]
+                dist2 = 0.0
+                for k in range(d):
+                    P[i, k] += P[i, d + k] * dti
+                    P[j, k] += P[j, d + k] * dtj
+                    dx = P[j, k] - P[i, k]
+                    dx -= L[k] * np.floor(dx * invL[k] + 0.5)
+                    rv[k] = dx
+                    dist2 += dx * dx
+                P[i, 2 * d] = t
+                P[j, 2 * d] = t
+                dist = np.sqrt(dist2)
+                g = (P[i, 2 * d + 1] + P[j, 2 * d + 1]) * kappa
+                vn = 0.0
+                for k in range(d):
+                    rv[k] /= dist
+                    vn += rv[k] * (P[j, d + k] - P[i, d + k])
+                vn -= g
+                if vn < 0.0:
+                    for k in range(d):
+                        dv = vn * rv[k]
+                        P[i, d + k] += dv
+                        P[j, d + k] -= dv
+                    acc[A_VIRIAL] -= vn * dist
+                    acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+                    acc[A_TKE] = t
+                    acc[A_KE] -= vn * g
+                    cnt[i] += 1
+                    cnt[j] += 1
+                    iacc[I_COLL] += 1
+                else:  # mispredicted / grazing (Alg. 12 step 3): no impulse
+                    iacc[I_GRAZE] += 1
+                upd[0] = i
+                upd[1] = j
+                npred = 2
+
+        if rebuild:  # partial NNL update of particle i at time t (Alg. 10)
+            dt = t - P[i, 2 * d]
+            for k in range(d):
+                P[i, k] += P[i, d + k] * dt
+            P[i, 2 * d] = t
+            nold = nn[i]
+            for m in range(nold):  # remember (and mark) the old neighbours
+                j = nb[i, m] // ncode
+                oldnb[m] = j
+                mark[j] = 1
+            nn[i] = 0
+            wrapped = False
+            c = 0
+            stride = 1
+            for k in range(d):  # wrap into the box and find the new cell
+                x = P[i, k]
+                if x < 0.0 or x >= L[k]:
+                    x -= L[k] * np.floor(x * invL[k])
+                    if x >= L[k]:
+                        x -= L[k]
+                    x = max(x, 0.0)
+                    P[i, k] = x
+                    wrapped = True
+                bs[i, k] = x
+                gk = int(x * invL[k] * ncell[k])
+                if gk >= ncell[k]:
+                    gk = ncell[k] - 1
+                c += gk * stride
+                stride *= ncell[k]
+            a = P[i, 2 * d + 1] * (1.0 + kappa * t)
+            ri = a + skin
+            if ri > rcap:
+                ri = rcap
+                if a + 0.25 * skin >= rcap:
+                    acc[A_T] = t
+                    return BOUND_TOO_SMALL
+            bs[i, d] = ri
+            old = cell_of[i]
+            if c != old:
+                if old >= 0:  # unlink from the old cell
+                    pv = prv[i]
+                    nx = nxt[i]
+                    if pv >= 0:
+                        nxt[pv] = nx
+                    else:
+                        head[old] = nx
+                    if nx >= 0:
+                        prv[nx] = pv
+                h = head[c]  # link into the new one
+                nxt[i] = h
+                prv[i] = -1
+                if h >= 0:
+                    prv[h] = i
+                head[c] = i
+                cell_of[i] = c
+            for q in range(cellnb.shape[1]):  # list every overlapping bounding sphere
+                j = head[cellnb[c, q]]
+                while j >= 0:
+                    if j != i:
+                        code = 0
+                        d2 = 0.0
+                        for k in range(d):
+                            dx = bs[j, k] - bs[i, k]
+                            sh = 1
+                            if dx > 0.5 * L[k]:
+                                dx -= L[k]
+                                sh = 0
+                            elif dx < -0.5 * L[k]:
+                                dx += L[k]
+                                sh = 2
+                            code += sh * pow3[k]
+                            d2 += dx * dx
+                        s = ri + bs[j, d]
+                        if d2 < s * s:
+                            if nn[i] >= cap or nn[j] >= cap:
+                                acc[A_T] = t
+                                return OVERFLOW
+                            nb[i, nn[i]] = j * ncode + code
+                            nn[i] += 1
+                            back = i * ncode + (ncode - 1 - code)
+                            if mark[j] == 0:  # new neighbour
+                                nb[j, nn[j]] = back
+                                nn[j] += 1
+                            else:  # still a neighbour: j's entry changes only if i wrapped
+                                mark[j] = 0
+                                if wrapped:
+                                    for q2 in range(nn[j]):
+                                        if nb[j, q2] // ncode == i:
+                                            nb[j, q2] = back
+                                            break
+                    j = nxt[j]
+            for m in range(nold):  # drop i from the lists of former neighbours
+                j = oldnb[m]
+                if mark[j] == 1:
+                    mark[j] = 0
+                    last = nn[j] - 1
+                    for q2 in range(last + 1):
+                        if nb[j, q2] // ncode == i:
+                            nb[j, q2] = nb[j, last]
+                            nn[j] = last
+                            break
+
+        for q in range(npred):  # predict (Alg. 5 with NNLs) and update the heap
+            i = upd[q]
+            dt = t - P[i, 2 * d]
+            ai = P[i, 2 * d + 1]
+            grow = 1.0 + kappa * t
+            adot = ai * kappa
+            rrem = bs[i, d] - ai * grow
+            dd = 0.0
+            dv = 0.0
+            vv = 0.0
+            for k in range(d):
+                vk = P[i, d + k]
+                vi[k] = vk
+                xk = P[i, k] + vk * dt
+                xi[k] = xk
+                dx = xk - bs[i, k]
+                dd += dx * dx
+                dv += dx * vk
+                vv += vk * vk
+            best = _exit_root(dd, dv, vv, rrem, adot)
+            partner = EXIT if best < np.inf else NONE
+            for m in range(nn[i]):
+                e = nb[i, m]
+                j = e // ncode
+                im = e - j * ncode
+                dtj = t - P[j, 2 * d]
+                rr = 0.0
+                ru = 0.0
+                uu = 0.0
+                for k in range(d):
+                    vjk = P[j, d + k]
+                    r = P[j, k] + vjk * dtj - xi[k] + imgvec[im, k]
+                    u = vjk - vi[k]
+                    rr += r * r
+                    ru += r * u
+                    uu += u * u
+                s = ai + P[j, 2 * d + 1]
+                tc = _root(rr, ru, uu, s * grow, s * kappa, best)
+                if tc < best:
+                    best = tc
+                    partner = j
+            key = t + best
+            ep[i] = partner
+            if partner >= 0:
+                ec[i] = cnt[partner]
+            pos = hpos[i]
+            if pos < 0:  # first insertion (schedule reset)
+                pos = hsize
+                hsize += 1
+            while pos > 0:  # sift up
+                parent = (pos - 1) >> 2
+                if hkey[parent] <= key:
+                    break
+                hp = heap[parent]
+                hkey[pos] = hkey[parent]
+                heap[pos] = hp
+                hpos[hp] = pos
+                pos = parent
+            while True:  # sift down: smallest of up to 4 children
+                first = 4 * pos + 1
+                if first >= hsize:
+                    break
+                ch = first
+                kc = hkey[first]
+                last = min(first + 4, hsize)
+                for c2 in range(first + 1, last):
+                    if hkey[c2] < kc:
+                        kc = hkey[c2]
+                        ch = c2
+                if kc >= key:
+                    break
+                hc = heap[ch]
+                hkey[pos] = kc
+                heap[pos] = hc
+                hpos[hc] = pos
+                pos = ch
+            hkey[pos] = key
+            heap[pos] = i
+            hpos[i] = pos
+
+        if iacc[I_COLL] >= coll_target and npred == 2:
+            acc[A_T] = t
+            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+            acc[A_TKE] = t
+            return DONE_COLLISIONS
+
+
+# --------------------------------------------------------------------------------- sync
+@njit(cache=True)
+def synchronise(P, dims, t, kappa):
+    """Advance every particle to time t, move the radii to a_i (1 + kappa t) and reset the time
+    origin (Alg. 3). Returns the total kinetic energy sum_i v_i^2 / 2."""
+    d = len(dims)
+    ke = 0.0
+    grow = 1.0 + kappa * t
+    for i in range(P.shape[0]):
+        dt = t - P[i, 2 * d]
+        for k in range(d):
+            v = P[i, d + k]
+            P[i, k] += v * dt
+            ke += 0.5 * v * v
+        P[i, 2 * d] = 0.0
+        P[i, 2 * d + 1] *= grow
+    return ke
+
+
+@njit(cache=True)
+def max_overlap(P, dims, imgvec, nb, nn):
+    """Largest relative overlap 1 - |r_ij| / (a_i + a_j) over all listed pairs at a sync point (all
+    particles at t = 0), and the number of pairs with overlap > 0. Every touching pair is listed,
+    because touching spheres have overlapping bounding spheres."""
+    d = len(dims)
+    worst = -np.inf
+    count = 0
+    for i in range(P.shape[0]):
+        ncode = 3**d
+        for m in range(nn[i]):
+            j = nb[i, m] // ncode
+            if j < i:
+                continue
+            im = nb[i, m] - j * ncode
+            d2 = 0.0
+            for k in range(d):
+                dx = P[j, k] + imgvec[im, k] - P[i, k]
+                d2 += dx * dx
+            ov = 1.0 - np.sqrt(d2) / (P[i, 2 * d + 1] + P[j, 2 * d + 1])
+            worst = max(worst, ov)
+            if ov > 0.0:
+                count += 1
+    return worst, count
+
+
+@njit(cache=True)
+def totals(P, dims):
+    """(kinetic energy sum v^2/2, sum of radii, sum of radii^d) in a fixed summation order, so
+    that a resumed run computes bit-identical values."""
+    d = len(dims)
+    ke = 0.0
+    s1 = 0.0
+    sd = 0.0
+    for i in range(P.shape[0]):
+        for k in range(d):
+            v = P[i, d + k]
+            ke += 0.5 * v * v
+        a = P[i, 2 * d + 1]
+        s1 += a
+        sd += a**d
+    return ke, s1, sd

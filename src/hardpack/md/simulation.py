@@ -1,0 +1,226 @@
+"""One MD run: its complete state, window by window (shared by compress and equilibrate).
+
+Units and conventions (used throughout :mod:`hardpack.md`):
+
+- all masses are equal, m = 1 (the Skoge-Donev convention; equilibrium properties such as the
+  equation of state do not depend on the masses);
+- kT = 1: velocities start Maxwell-Boltzmann and are rescaled to kT = 2 KE / (d N) = 1 at every
+  synchronisation point when the particles grow (Donev sec. 3.3.1, L2582-2587), so the thermal
+  speed is sqrt(kT/m) = 1;
+- radii grow linearly in time in proportion to their size, a_i(t) = a_i(0) (1 + kappa t); the
+  relative rate of a window is kappa = Gamma / (2 <a>) with <a> the mean radius at the window
+  start, so the mean DIAMETER grows at d<D>/dt = Gamma (in units of the thermal speed) all run long.
+
+State saved at a synchronisation point that precedes a spatial sort and complete neighbour-list
+rebuild (positions, velocities, radii in the engine's order, the permutation to the caller's order,
+counters, the adaptive neighbour shell, the list capacity and the window records) determines the
+rest of the run exactly, which makes checkpoint/resume bit-identical.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.balls import unit_ball_volume
+from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
+from hardpack.md.engine import Engine
+
+#: initial bounding-sphere skin in units of the mean radius (R_i = a_i + shell <a>), its adaptive
+#: range and step factor
+SHELL_START, SHELL_MIN, SHELL_MAX, SHELL_STEP = 0.3, 0.02, 0.7, 1.25
+#: target range of neighbourhood exits per collision for the shell adaptation
+EXITS_LOW, EXITS_HIGH = 0.05, 0.2
+#: windows between spatial sorts (each followed by a complete neighbour-list rebuild); checkpoints
+#: are written only just before such a window, where the state is complete without the lists
+SORT_EVERY = 16
+
+RECORD_FIELDS = (
+    "time", "phi", "Z", "phi_J_est", "collisions", "kT", "kT_mean", "events", "stale", "exits",
+    "max_overlap", "shell", "neighbours", "wall_time",
+)
+
+
+class OverlapError(RuntimeError):
+    """Particles overlap beyond the tolerance at a synchronisation point (an engine failure)."""
+
+
+def maxwell_boltzmann(n: int, d: int, seed) -> np.ndarray:
+    """Velocities from numpy.random.default_rng(seed): Gaussian, zero total momentum, and scaled so
+    that kT = 2 KE / (d N) = 1 exactly (m = 1)."""
+    rng = np.random.default_rng(seed)
+    v = rng.standard_normal((n, d))
+    v -= v.mean(axis=0)
+    v *= np.sqrt(d * n / np.einsum("ij,ij->", v, v))
+    return v
+
+
+def check_packing(packing: Packing) -> None:
+    """Refuse packings the engine cannot run: sheared cells, fewer than 2 particles, overlaps."""
+    if not isinstance(packing, Packing):
+        raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
+    if not packing.is_orthorhombic:
+        raise InvalidInputError(
+            "the MD engine supports orthorhombic (diagonal) periodic cells only; this lattice is "
+            "sheared. Deforming/sheared cells are not implemented yet: pass a diagonal lattice"
+        )
+    if packing.n_particles < 2:
+        raise InvalidInputError("MD needs at least 2 particles")
+    report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
+    if report.n_overlapping:
+        raise InvalidInputError(
+            f"the start configuration has overlapping particles ({report}); hard-sphere MD needs a "
+            "non-overlapping start"
+        )
+
+
+class Simulation:
+    """State of one run; :meth:`run_window` advances it by one synchronisation window."""
+
+    def __init__(self, packing: Packing, velocities: np.ndarray, growth_rate: float,
+                 overlap_tol: float = DEFAULT_OVERLAP_TOL):
+        self.lattice = np.array(packing.lattice)
+        self.species = packing.species
+        self.box = np.diag(self.lattice).copy()
+        self.n, self.d = packing.n_particles, packing.dim
+        self.growth_rate = float(growth_rate)
+        self.overlap_tol = float(overlap_tol)
+        self.perm = np.arange(self.n)
+        self.engine = Engine(packing.fractional() * self.box, velocities, packing.radii, self.box)
+        self.time = 0.0
+        self.collisions = 0
+        self.events = 0
+        self.windows = 0
+        self.shell = SHELL_START
+        self.since_sort = SORT_EVERY  # sort (and rebuild the lists) before the first window
+        self.wall_time = 0.0
+        self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
+
+    # ----------------------------------------------------------------- derived quantities
+    @property
+    def volume(self) -> float:
+        return float(np.prod(self.box))
+
+    def phi(self) -> float:
+        return unit_ball_volume(self.d) * self.engine.totals()[2] / self.volume
+
+    def packing(self) -> Packing:
+        """The current configuration in the caller's particle order, centres wrapped into the box
+        (all particles are synchronised between windows)."""
+        inv = np.empty(self.n, dtype=np.int64)
+        inv[self.perm] = np.arange(self.n)
+        pos = self.engine.positions[inv]
+        pos = pos - np.floor(pos / self.box) * self.box
+        pos[pos >= self.box] = 0.0
+        return Packing(pos, self.engine.radii[inv].copy(), self.lattice, species=self.species,
+                       overlap_tol=self.overlap_tol)
+
+    def velocities(self) -> np.ndarray:
+        inv = np.empty(self.n, dtype=np.int64)
+        inv[self.perm] = np.arange(self.n)
+        return self.engine.velocities[inv].copy()
+
+    # ----------------------------------------------------------------- one window
+    def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
+        """Run one window of at most ``coll_target`` collisions (ending exactly when the volume
+        fraction reaches ``target_phi`` if that comes first), synchronise, measure, rescale."""
+        start = time.perf_counter()
+        eng = self.engine
+        rebuild = self.since_sort >= SORT_EVERY
+        if rebuild:
+            self.perm = self.perm[eng.sort_spatially()]
+            self.since_sort = 0
+        _, sum_a, sum_ad = eng.totals()
+        kappa = self.growth_rate / (2.0 * sum_a / self.n)
+        t_cap = np.inf
+        if target_phi is not None and kappa != 0.0:
+            phi0 = unit_ball_volume(self.d) * sum_ad / self.volume
+            t_phi = ((target_phi / phi0) ** (1.0 / self.d) - 1.0) / kappa
+            if t_phi >= 0.0:
+                t_cap = t_phi
+        res = eng.run_window(kappa, self.shell * sum_a / self.n, coll_target, t_cap, rebuild)
+        self.since_sort += 1
+        if res.max_overlap > self.overlap_tol:
+            raise OverlapError(
+                f"{res.n_overlapping} pair(s) overlap at the end of window {self.windows}; the "
+                f"worst relative overlap is {res.max_overlap:.3e} > tolerance {self.overlap_tol:g}"
+            )
+        n, d = self.n, self.d
+        self.time += res.duration
+        self.collisions += res.collisions
+        self.events += res.events
+        self.windows += 1
+        if res.duration > 0.0 and res.ke_integral > 0.0:
+            z = 1.0 + res.virial / (2.0 * res.ke_integral)
+            kt_mean = 2.0 * res.ke_integral / (d * n * res.duration)
+        else:  # no time elapsed: every collision happened at one instant
+            z = np.inf
+            kt_mean = 2.0 * res.ke_end / (d * n)
+        phi = self.phi()
+        phi_j = phi / (1.0 - d / z) if z > d else np.nan
+        if self.growth_rate != 0.0:
+            eng.rescale_velocities(1.0)
+        shell_used = self.shell
+        self._adapt_shell(res)
+        self.wall_time += time.perf_counter() - start
+        record = {
+            "time": self.time, "phi": phi, "Z": z, "phi_J_est": phi_j, "collisions": self.collisions,
+            "kT": 2.0 * res.ke_end / (d * n), "kT_mean": kt_mean, "events": self.events, "stale": res.stale,
+            "exits": res.exits, "max_overlap": res.max_overlap, "shell": shell_used,
+            "neighbours": res.mean_neighbours, "wall_time": self.wall_time,
+        }
+        for k in RECORD_FIELDS:
+            self.records[k].append(record[k])
+        return record
+
+    def _adapt_shell(self, res) -> None:
+        """Keep neighbourhood exits between EXITS_LOW and EXITS_HIGH per collision: a thicker shell
+        means longer lists, a thinner one more rebuilds (the trade-off Donev tunes with
+        mu_cutoff, sec. 3.4.3). SHELL_MAX caps the lists of dilute fluids, where exits stay
+        frequent whatever the shell (timed optimum ~0.7 at phi = 0.2-0.3, ~0.35 at 0.5, the
+        minimum near jamming). Exit counts are deterministic, so a restart adapts identically."""
+        if res.collisions == 0:
+            return
+        ratio = res.exits / res.collisions
+        if ratio > EXITS_HIGH:
+            self.shell = min(self.shell * SHELL_STEP, SHELL_MAX)
+        elif ratio < EXITS_LOW:
+            self.shell = max(self.shell / SHELL_STEP, SHELL_MIN)
+
+    # ----------------------------------------------------------------- checkpoint state
+    @property
+    def checkpoint_ready(self) -> bool:
+        """True when the next window starts with a sort and a complete rebuild, so that the state
+        below (which has no neighbour lists) continues exactly as this process would."""
+        return self.since_sort >= SORT_EVERY
+
+    def state(self) -> dict:
+        """Everything needed to continue bit-identically (numpy arrays and scalars)."""
+        out = {
+            "P": self.engine.P.copy(), "perm": self.perm.copy(), "time": self.time,
+            "collisions": self.collisions, "events": self.events, "windows": self.windows,
+            "shell": self.shell, "wall_time": self.wall_time, "since_sort": self.since_sort,
+            "capacity": self.engine.capacity,
+        }
+        for k, v in self.records.items():
+            out["rec_" + k] = np.asarray(v, dtype=float)
+        return out
+
+    def restore(self, state: dict) -> None:
+        """Load a :meth:`state` saved by a run of the same system (checked by the caller)."""
+        if state["P"].shape != self.engine.P.shape:
+            raise InvalidInputError("checkpoint state does not match this system's size")
+        self.engine.P[:] = state["P"]
+        self.perm = np.asarray(state["perm"], dtype=np.int64)
+        self.time = float(state["time"])
+        self.collisions = int(state["collisions"])
+        self.events = int(state["events"])
+        self.windows = int(state["windows"])
+        self.shell = float(state["shell"])
+        self.since_sort = int(state["since_sort"])
+        self.engine.alloc_lists(int(state["capacity"]))
+        self.engine.lists_valid = False
+        self.wall_time = float(state["wall_time"])
+        self.records = {k: list(np.asarray(state["rec_" + k], dtype=float)) for k in RECORD_FIELDS}

@@ -1,0 +1,59 @@
+"""Algorithm 14 (sequential random loading) on packings with known answers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hardpack.geometry.lattices import lattice_packing
+from hardpack.geometry.packing import Packing
+from hardpack.jamming import contact_network, verify
+from hardpack.jamming.sequential import collision_step, volume_step
+
+
+def _shrunk(p: Packing, s: float) -> Packing:
+    return p.replace(radii=p.radii * (1 - s))
+
+
+def test_collision_step_head_on():
+    """Two disks 0.1 apart approaching at relative speed 2 touch after t = 0.05 (less the
+    round-off slack of 1e-11 of the distance)."""
+    p = Packing([[0.0, 0.0], [1.1, 0.0]], [0.5, 0.5], 10 * np.eye(2))
+    net = contact_network(p, delta=0.5)
+    disp = np.array([[1.0, 0.0], [-1.0, 0.0]])
+    assert collision_step(net, disp, None) == pytest.approx(0.05, rel=1e-9)
+    assert collision_step(net, -disp, None) == np.inf  # separating pair never collides
+
+
+def test_volume_step():
+    """det(I + t eps) <= 1: pure shear never grows the cell; eps = diag(0.2, -0.1) crosses
+    det = 1 at (1 + 0.2 t)(1 - 0.1 t) = 1, i.e. t = 5."""
+    assert volume_step(np.diag([0.1, -0.1])) == np.inf
+    assert volume_step(np.diag([0.2, -0.1])) == pytest.approx(5.0)
+    assert volume_step(None) == np.inf
+
+
+def test_sliding_rows_unjam_square_lattice():
+    """Square lattice with gaps 1e-3 D in a 2 x 1 cell: rows slide (Table 4.1, C = N), so the
+    random loads carry the disks far: mean displacement >> threshold."""
+    p = _shrunk(lattice_packing("square", (2, 1)), 1e-3)
+    r = verify(p, delta=0.2, method="sequential", tests=("collective",), seed=1, threshold=1e-2)
+    assert not r.collective
+    assert max(r.collective_test.mean_displacement) > 0.05
+    r.collective_test.final.overlap_report()  # a valid packing (construction checks overlaps)
+
+
+def test_triangular_with_gaps_is_jammed_within_the_gaps():
+    """Triangular lattice with gaps 1e-4 D: every particle and the cell can only move within the
+    gaps (strictly jammed lattice), so the sequential test reports displacements of the order
+    of the gap, far below the 1e-2 threshold, in the collective and the strict test."""
+    p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-4)
+    r = verify(p, delta=0.2, method="sequential", seed=2, threshold=1e-2)
+    assert r.collective and r.strict
+    for out in (r.collective_test, r.strict_test):
+        assert max(out.max_displacement) < 1e-2
+        assert len(out.mean_displacement) == 2 * out_loads(r)
+
+
+def out_loads(r) -> int:
+    return r.params["n_loads"]

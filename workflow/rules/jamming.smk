@@ -1,0 +1,47 @@
+# Study 2: every generated packing gets an LP jamming verdict (Donev ch. 4): rattlers, contacts,
+# forces, isostaticity; plus an ensemble summary.
+
+
+rule verify_jamming:
+    """LP jamming tests of one LS packing."""
+    input:
+        "results/ensembles/{ensemble}/jammed/seed{seed}.nc",
+    output:
+        "results/ensembles/{ensemble}/jamming/seed{seed}.nc",
+    log:
+        "results/logs/verify_jamming/{ensemble}_seed{seed}.log",
+    shell:
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+
+
+rule verify_jamming_slp:
+    """LP jamming tests of one SLP packing (strict jamming expected: deforming cell)."""
+    input:
+        "results/ensembles/{ensemble}/slp/seed{seed}.nc",
+    output:
+        "results/ensembles/{ensemble}/slp_jamming/seed{seed}.nc",
+    log:
+        "results/logs/verify_jamming_slp/{ensemble}_seed{seed}.log",
+    shell:
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+
+
+rule jamming_summary:
+    """Verdicts, Z, rattler fractions and isostaticity gaps of an ensemble, indexed by seed."""
+    input:
+        lambda w: expand("results/ensembles/{ensemble}/{kind}/seed{seed}.nc", ensemble=w.ensemble,
+                         kind=w.kind, seed=ENSEMBLES[w.ensemble]["seeds"]),
+    output:
+        "results/ensembles/{ensemble}/{kind}_summary.nc",
+    wildcard_constraints:
+        kind="jamming|slp_jamming",
+    params:
+        distribution=lambda w: json.dumps(ENSEMBLES[w.ensemble]["distribution"]),
+        seeds=lambda w: ENSEMBLES[w.ensemble]["seeds"],
+    log:
+        "results/logs/jamming_summary/{ensemble}_{kind}.log",
+    shell:
+        "hardpack combine {input} --index seed --variable z_mean --variable rattler_fraction"
+        " --variable isostaticity_gap --variable local --variable collective --variable strict"
+        " --attr ensemble={wildcards.ensemble} --attr distribution='{params.distribution}'"
+        " --out {output} 2> {log}"
