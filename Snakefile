@@ -45,7 +45,7 @@ rule all:
         expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=ENSEMBLES),
         expand("results/ensembles/{ensemble}/slp_jamming_summary.nc",
                ensemble=config.get("slp", {}).get("mrj", {}).get("ensembles", [])),
-        [f"results/ensembles/{e}/structure/seed{s}.nc" for e in ENSEMBLES for s in ENSEMBLES[e]["seeds"]],
+        expand("results/figures/structure_{kind}.pdf", kind=["g2", "zl", "sk"]),
         "results/figures/size_distributions.pdf",
         "results/figures/slp_densest.pdf" if config.get("slp", {}).get("densest") else [],
         "results/figures/slp_vs_ls.pdf" if config.get("slp", {}).get("mrj") else [],

@@ -166,6 +166,8 @@ class Engine:
         if key != self._grid_key:
             self.ncell = ncell
             self.cellnb = cell_neighbour_table(ncell)
+            #: bounding spheres examined per partial rebuild (cells searched x mean occupancy)
+            self.candidates = self.cellnb.shape[1] * self.n / self.cellnb.shape[0]
             self.head = np.full(int(np.prod(ncell)), -1, dtype=np.int32)
             self._grid_key = key
 

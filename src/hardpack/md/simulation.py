@@ -31,8 +31,9 @@ from hardpack.md.engine import Engine
 #: initial bounding-sphere skin in units of the mean radius (R_i = a_i + shell <a>), its adaptive
 #: range and step factor
 SHELL_START, SHELL_MIN, SHELL_MAX, SHELL_STEP = 0.3, 0.02, 0.7, 1.25
-#: target range of neighbourhood exits per collision for the shell adaptation
-EXITS_LOW, EXITS_HIGH = 0.05, 0.2
+#: target range of the work of neighbourhood exits (candidates examined per exit) relative to the
+#: work of predictions (~2.4 predictions per collision, each over the neighbour list)
+EXIT_WORK_LOW, EXIT_WORK_HIGH = 0.15, 0.6
 #: windows between spatial sorts (each followed by a complete neighbour-list rebuild); checkpoints
 #: are written only just before such a window, where the state is complete without the lists
 SORT_EVERY = 16
@@ -176,17 +177,22 @@ class Simulation:
         return record
 
     def _adapt_shell(self, res) -> None:
-        """Keep neighbourhood exits between EXITS_LOW and EXITS_HIGH per collision: a thicker shell
-        means longer lists, a thinner one more rebuilds (the trade-off Donev tunes with
-        mu_cutoff, sec. 3.4.3). SHELL_MAX caps the lists of dilute fluids, where exits stay
-        frequent whatever the shell (timed optimum ~0.7 at phi = 0.2-0.3, ~0.35 at 0.5, the
-        minimum near jamming). Exit counts are deterministic, so a restart adapts identically."""
+        """Balance list length against rebuilds: a thicker shell means longer lists (more pair
+        predictions), a thinner one more neighbourhood exits (each examining the bounding spheres
+        of 3^d cells). The shell grows when exits cost more than EXIT_WORK_HIGH times the
+        prediction work (exits * candidates > EXIT_WORK_HIGH * 2.4 * neighbours per collision) and
+        shrinks below EXIT_WORK_LOW (Donev tunes mu_cutoff for the same trade-off, sec. 3.4.3).
+        In 3D at phi = 0.5 this keeps 0.05-0.2 exits per collision, the timed optimum; in small
+        high-d boxes, where a rebuild examines nearly all N spheres, it keeps exits much rarer.
+        SHELL_MAX caps the lists of dilute fluids, where exits stay frequent whatever the shell.
+        All inputs are counts, so a restarted run adapts identically."""
         if res.collisions == 0:
             return
-        ratio = res.exits / res.collisions
-        if ratio > EXITS_HIGH:
+        exit_work = res.exits * self.engine.candidates / res.collisions
+        predict_work = 2.4 * max(res.mean_neighbours, 1.0)
+        if exit_work > EXIT_WORK_HIGH * predict_work:
             self.shell = min(self.shell * SHELL_STEP, SHELL_MAX)
-        elif ratio < EXITS_LOW:
+        elif exit_work < EXIT_WORK_LOW * predict_work:
             self.shell = max(self.shell / SHELL_STEP, SHELL_MIN)
 
     # ----------------------------------------------------------------- checkpoint state

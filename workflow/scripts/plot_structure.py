@@ -1,0 +1,16 @@
+"""Snakemake script: one structure figure (snakemake.params.kind) over the ensembles' seeds."""
+
+import logging
+from collections import defaultdict
+
+from hardpack.io import load_dataset
+from hardpack.plots import structure
+from hardpack.plots.style import save
+
+logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+ensembles = defaultdict(list)
+for path in snakemake.input:
+    ensembles[path.split("/")[2]].append(load_dataset(path, kind="structure"))
+plot = {"g2": structure.plot_g2_near_contact, "zl": structure.plot_coordination,
+        "sk": structure.plot_structure_factor}[snakemake.params.kind]
+save(plot(dict(ensembles)), snakemake.output.pdf, snakemake.output.png)
