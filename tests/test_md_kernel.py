@@ -111,7 +111,7 @@ def test_periodic_image_collision():
     np.testing.assert_allclose(eng.velocities[:, 0], [1.0, -1.0], rtol=1e-14)
 
 
-@pytest.mark.parametrize("d, kappa", [(2, 0.05), (3, 0.0), (4, 0.02)])
+@pytest.mark.parametrize("d, kappa", [(2, 0.05), (3, 0.0), pytest.param(4, 0.02, marks=pytest.mark.slow)])
 def test_neighbour_lists_match_brute_force_after_many_partial_updates(d, kappa):
     """Invariants of the bounding-sphere lists (Donev sec. 2.9): every particle lies inside its
     bounding sphere, and i lists j (with the minimum-image shift) exactly when their bounding

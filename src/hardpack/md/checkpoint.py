@@ -1,11 +1,13 @@
 """Atomic checkpoints of an MD run, written at synchronisation points.
 
 A checkpoint is an ``.npz`` file with the complete :meth:`hardpack.md.simulation.Simulation.state`
-plus a fingerprint of the run's defining inputs (start packing, growth rate, seed, window size).
+plus a fingerprint of the run's defining inputs (start packing, growth rate, seed, window size,
+overlap tolerance).
 It is written to a temporary file in the destination folder, flushed, and moved over the old one
 with :func:`os.replace`, so a run killed at any moment (even with SIGKILL) leaves a complete
-checkpoint. Restarting with the same arguments loads it and continues; because the schedule and
-the neighbour lists are rebuilt from scratch at every synchronisation point, the continued run is
+checkpoint. Restarting with the same arguments loads it and continues. Checkpoints are taken only
+at synchronisation points after which the uninterrupted run also rebuilds its schedule and its
+neighbour lists from scratch (:attr:`Simulation.checkpoint_ready`), so the continued run is
 bit-identical to an uninterrupted one.
 """
 

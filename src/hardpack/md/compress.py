@@ -139,6 +139,7 @@ def timeseries_dataset(sim: Simulation, attrs: dict) -> xr.Dataset:
         "collisions": "cumulative collisions", "kT": "kinetic temperature at the end, before rescaling",
         "kT_mean": "time-averaged kinetic temperature of the window", "events": "cumulative events",
         "stale": "stale (invalidated) events in the window", "exits": "neighbourhood exits in the window",
+        "grazing": "predicted collisions skipped because v_n >= 0 (round-off grazes)",
         "max_overlap": "largest relative overlap 1 - r/(a_i + a_j) at the end",
         "shell": "bounding-sphere shell / radius used", "neighbours": "mean neighbour-list length",
         "wall_time": "cumulative wall-clock seconds",

@@ -1,15 +1,17 @@
 """One MD system in numba arrays, run window by window between synchronisation points.
 
 A *window* starts at a synchronisation point with time t = 0 (Donev Alg. 3): all particles are at
-the same time, the neighbour lists are rebuilt completely (Alg. 9) and the schedule is reset
-(Alg. 4). Events are then processed (:func:`hardpack.md.kernel.run_events`) until the window's
-collision budget is spent or a time cap is reached, and every particle is synchronised again.
-Because a window depends only on (positions, velocities, radii, growth rate, skin, budget, cap),
-saving those at a sync point makes a restart bit-identical (see :mod:`hardpack.md.checkpoint`).
+the same time and the schedule is reset (Alg. 4). Events are then processed
+(:func:`hardpack.md.kernel.run_events`) until the window's collision budget is spent or a time
+cap is reached, and every particle is synchronised again. The bounding-sphere neighbour lists
+persist across windows (positions are advanced, never re-wrapped, by a synchronisation); they are
+rebuilt completely (Alg. 9) after a spatial sort, when the particles have grown close to the
+bounding-radius cap, or when the requested skin no longer fits under it.
 
-If a neighbour list overflows its capacity in the middle of a window, the window is rolled back
-to its starting state and redone with twice the capacity; the capacity never changes the event
-sequence, so results do not depend on it.
+If a neighbour list overflows its capacity, or a particle outgrows the cap, the window is rolled
+back to its starting positions and velocities and redone after a complete rebuild (with twice the
+capacity after an overflow). Every such decision depends only on the state and on the capacity,
+which the checkpoint stores, so a restarted run repeats the same sequence bit for bit.
 """
 
 from __future__ import annotations
@@ -48,8 +50,6 @@ class WindowResult:
     max_overlap: float  # largest relative overlap 1 - r / (a_i + a_j) at the end
     n_overlapping: int  # pairs with a positive overlap at the end
     mean_neighbours: float
-    capped: bool  # ended at the time cap rather than at the collision budget
-    rebuilt: bool  # the neighbour lists were rebuilt completely at the start
 
 
 def _pow3(d: int) -> np.ndarray:
@@ -249,8 +249,7 @@ class Engine:
             collisions=int(iacc[kernel.I_COLL]), events=int(iacc[kernel.I_EVENTS]),
             stale=int(iacc[kernel.I_STALE]), exits=int(iacc[kernel.I_EXIT]),
             grazing=int(iacc[kernel.I_GRAZE]), max_overlap=float(worst), n_overlapping=int(n_over),
-            mean_neighbours=float(self.nn.mean()), capped=status == kernel.DONE_TIME,
-            rebuilt=rebuild,
+            mean_neighbours=float(self.nn.mean()),
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:

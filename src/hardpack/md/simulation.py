@@ -40,7 +40,7 @@ SORT_EVERY = 16
 
 RECORD_FIELDS = (
     "time", "phi", "Z", "phi_J_est", "collisions", "kT", "kT_mean", "events", "stale", "exits",
-    "max_overlap", "shell", "neighbours", "wall_time",
+    "grazing", "max_overlap", "shell", "neighbours", "wall_time",
 )
 
 
@@ -169,7 +169,7 @@ class Simulation:
         record = {
             "time": self.time, "phi": phi, "Z": z, "phi_J_est": phi_j, "collisions": self.collisions,
             "kT": 2.0 * res.ke_end / (d * n), "kT_mean": kt_mean, "events": self.events, "stale": res.stale,
-            "exits": res.exits, "max_overlap": res.max_overlap, "shell": shell_used,
+            "exits": res.exits, "grazing": res.grazing, "max_overlap": res.max_overlap, "shell": shell_used,
             "neighbours": res.mean_neighbours, "wall_time": self.wall_time,
         }
         for k in RECORD_FIELDS:
