@@ -23,6 +23,11 @@ for _name, _ens in config["ensembles"].items():
 
 ENSEMBLES = config["ensembles"]
 
+# Registries the study files fill: the figures `rule all` builds, and the summaries the validation
+# report reads, by row-builder name (hardpack.validation.cli.ROW_BUILDERS) -> list of paths.
+FIGURES = []
+VALIDATION_INPUTS = {}
+
 wildcard_constraints:
     ensemble="[A-Za-z][A-Za-z0-9_]*",
     seed=r"\d+",
@@ -34,7 +39,6 @@ include: "workflow/rules/jamming.smk"
 include: "workflow/rules/structure.smk"
 include: "workflow/rules/slp.smk"
 include: "workflow/rules/freeenergy.smk"
-include: "workflow/rules/figures.smk"
 include: "workflow/rules/validation.smk"
 
 
@@ -45,9 +49,5 @@ rule all:
         expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=ENSEMBLES),
         expand("results/ensembles/{ensemble}/slp_jamming_summary.nc",
                ensemble=config.get("slp", {}).get("mrj", {}).get("ensembles", [])),
-        expand("results/figures/structure_{kind}.pdf", kind=["g2", "zl", "sk"]),
-        "results/figures/size_distributions.pdf",
-        "results/figures/slp_densest.pdf" if config.get("slp", {}).get("densest") else [],
-        "results/figures/slp_vs_ls.pdf" if config.get("slp", {}).get("mrj") else [],
-        "results/figures/bcmd_fcc.pdf" if config.get("freeenergy") else [],
+        FIGURES,
         "results/validation/report.md",

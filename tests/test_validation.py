@@ -70,3 +70,14 @@ def test_bcmd_rows_need_a_finite_size_extrapolation():
     small = ds.isel(sample=[0, 1])
     row = bcmd_rows({"melting": small})[0]
     assert not row.passed and "inconclusive" in row.detail
+
+
+def test_validate_inputs_are_name_equals_path_with_known_names():
+    from hardpack.errors import InvalidInputError
+    from hardpack.validation.cli import parse_inputs
+
+    assert parse_inputs(["ls=a.nc", "bcmd=b.nc", "ls=c.nc"]) == {"ls": ["a.nc", "c.nc"], "bcmd": ["b.nc"]}
+    with pytest.raises(InvalidInputError, match="NAME=PATH"):
+        parse_inputs(["a.nc"])
+    with pytest.raises(InvalidInputError, match="unknown validation input name 'lss'"):
+        parse_inputs(["lss=a.nc"])

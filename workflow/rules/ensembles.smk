@@ -34,3 +34,21 @@ rule init_summary:
     shell:
         "hardpack combine {input} --index seed --variable init_phi"
         " --attr ensemble={wildcards.ensemble} --out {output} 2> {log}"
+
+
+rule fig_size_distributions:
+    """Sampled radii of every ensemble against the analytic size distribution."""
+    input:
+        expand("results/ensembles/{ensemble}/init_summary.nc", ensemble=ENSEMBLES),
+    output:
+        pdf="results/figures/size_distributions.pdf",
+        png="results/figures/size_distributions.png",
+    params:
+        distributions={name: ens["distribution"] for name, ens in ENSEMBLES.items()},
+    log:
+        "results/logs/figures/size_distributions.log",
+    script:
+        "../scripts/plot_size_distributions.py"
+
+
+FIGURES.append("results/figures/size_distributions.pdf")

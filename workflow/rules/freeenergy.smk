@@ -44,3 +44,24 @@ rule bcmd_fcc_summary:
     shell:
         "hardpack combine {input} --index n_particles seed --variable delta_f --variable excess"
         " --variable f --variable n_events --attr state={wildcards.state} --out {output} 2> {log}"
+
+
+rule fig_bcmd_fcc:
+    """BCMD free energy of FCC at melting and in the jamming limit vs N, with the published values."""
+    input:
+        expand("results/freeenergy/{state}_summary.nc", state=["melting", "jamming"]),
+    output:
+        pdf="results/figures/bcmd_fcc.pdf",
+        png="results/figures/bcmd_fcc.png",
+    log:
+        "results/logs/figures/bcmd_fcc.log",
+    script:
+        "../scripts/plot_bcmd_fcc.py"
+
+
+STRUCTURE_FILES = [f"results/ensembles/{e}/structure/seed{s}.nc" for e in ENSEMBLES for s in ENSEMBLES[e]["seeds"]]
+
+
+if FREEENERGY:
+    FIGURES.append("results/figures/bcmd_fcc.pdf")
+    VALIDATION_INPUTS["bcmd"] = expand("results/freeenergy/{state}_summary.nc", state=["melting", "jamming"])

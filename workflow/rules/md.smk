@@ -43,3 +43,5 @@ rule jammed_summary:
         "hardpack combine {input} --index seed --variable Z --variable phi_J_est --variable collisions"
         " --variable wall_time --variable growth_rate --attr ensemble={wildcards.ensemble}"
         " --attr distribution='{params.distribution}' --out {output} 2> {log}"
+
+VALIDATION_INPUTS["ls"] = expand("results/ensembles/{ensemble}/jammed_summary.nc", ensemble=ENSEMBLES)

@@ -111,3 +111,38 @@ rule slp_mrj_summary:
     shell:
         "hardpack combine {input} --index seed --variable n_steps --variable wall_seconds"
         " --attr ensemble={wildcards.ensemble} --attr distribution='{params.distribution}' --out {output} 2> {log}"
+
+
+rule fig_slp_densest:
+    """Table II: SLP densities from N = 3^d starts against the densest known packings."""
+    input:
+        "results/slp/densest_summary.nc",
+    output:
+        pdf="results/figures/slp_densest.pdf",
+        png="results/figures/slp_densest.png",
+    log:
+        "results/logs/figures/slp_densest.log",
+    script:
+        "../scripts/plot_slp_densest.py"
+
+
+rule fig_slp_vs_ls:
+    """Table I: SLP and LS jamming densities of the same ensembles, beside the published values."""
+    input:
+        slp=expand("results/ensembles/{ensemble}/slp_summary.nc", ensemble=SLP_MRJ["ensembles"]) if SLP_MRJ else [],
+        ls=expand("results/ensembles/{ensemble}/jammed_summary.nc", ensemble=SLP_MRJ["ensembles"]) if SLP_MRJ else [],
+    output:
+        pdf="results/figures/slp_vs_ls.pdf",
+        png="results/figures/slp_vs_ls.png",
+    log:
+        "results/logs/figures/slp_vs_ls.log",
+    script:
+        "../scripts/plot_slp_vs_ls.py"
+
+
+if SLP_DENSEST:
+    FIGURES.append("results/figures/slp_densest.pdf")
+    VALIDATION_INPUTS["slp_densest"] = ["results/slp/densest_summary.nc"]
+if SLP_MRJ:
+    FIGURES.append("results/figures/slp_vs_ls.pdf")
+    VALIDATION_INPUTS["slp_mrj"] = expand("results/ensembles/{ensemble}/slp_summary.nc", ensemble=SLP_MRJ["ensembles"])

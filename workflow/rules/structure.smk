@@ -12,3 +12,26 @@ rule structure:
         "results/logs/structure/{ensemble}_seed{seed}.log",
     shell:
         "hardpack structure {input.packing} --jamming {input.jamming} --out {output} 2> {log}"
+
+
+STRUCTURE_FILES = [f"results/ensembles/{e}/structure/seed{s}.nc" for e in ENSEMBLES for s in ENSEMBLES[e]["seeds"]]
+
+
+rule fig_structure:
+    """Structure figures of the LS packings: g2 near contact (split second peak), log-log Z(l), S(k) at small k."""
+    input:
+        STRUCTURE_FILES,
+    output:
+        pdf="results/figures/structure_{kind}.pdf",
+        png="results/figures/structure_{kind}.png",
+    wildcard_constraints:
+        kind="g2|zl|sk",
+    params:
+        kind=lambda w: w.kind,
+    log:
+        "results/logs/figures/structure_{kind}.log",
+    script:
+        "../scripts/plot_structure.py"
+
+
+FIGURES += expand("results/figures/structure_{kind}.pdf", kind=["g2", "zl", "sk"])
