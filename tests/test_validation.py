@@ -81,3 +81,50 @@ def test_validate_inputs_are_name_equals_path_with_known_names():
         parse_inputs(["a.nc"])
     with pytest.raises(InvalidInputError, match="unknown validation input name 'lss'"):
         parse_inputs(["lss=a.nc"])
+
+
+def _jamming_summary(z, rattlers, collective, d=3, kind="monodisperse"):
+    import json
+
+    import xarray as xr
+
+    n = len(z)
+    ds = xr.Dataset({"N": ("sample", [1000] * n), "d": ("sample", [d] * n), "z_mean": ("sample", z),
+                     "rattler_fraction": ("sample", rattlers), "isostaticity_gap": ("sample", [1] * n),
+                     "collective": ("sample", collective)})
+    spec = {"kind": kind} if kind == "monodisperse" else {"kind": kind, "size_ratio": 1.4, "large_fraction": 0.5}
+    ds.attrs.update(ensemble="e", distribution=json.dumps(spec))
+    return ds
+
+
+def test_jamming_rows_pass_for_isostatic_packings_and_fail_otherwise():
+    from hardpack.validation.jamming import jamming_rows
+
+    good = jamming_rows([_jamming_summary([5.99, 6.0, 5.995], [0.02, 0.025, 0.021], [1, 1, 1])])
+    assert [r.passed for r in good] == [True, True, True]
+    # hypostatic (fast single-stage LS), too many rattlers, one seed not collectively jammed
+    bad = jamming_rows([_jamming_summary([5.8, 5.85, 5.82], [0.05, 0.06, 0.05], [1, 0, 1])])
+    assert [r.passed for r in bad] == [False, False, False]
+    disks = jamming_rows([_jamming_summary([4.0, 3.99], [0.05, 0.04], [1, 1], d=2, kind="bidisperse")])
+    assert [r.published for r in disks] == [4.0, 1.0] and all(r.passed for r in disks)
+
+
+def test_structure_rows_on_a_bcc_crystal_fail_the_amorphous_signatures():
+    """BCC (shells 1, 1.155, 1.633, 1.915, 2) has no sub-peak at sqrt(3) and no near-contact power
+    law: those rows must fail. The CS fluid S(0) is the
+    compressibility-route value."""
+    from hardpack.structure.analysis import analyse
+    from hardpack.validation.structure import fluid_s0, structure_rows
+
+    from hardpack.eos.theory import carnahan_starling
+
+    # compressibility route: S(0) = 1 / d(phi Z)/d phi, by a central difference of the CS EOS
+    h = 1e-6
+    for phi in (0.1, 0.49, 0.64):
+        slope = ((phi + h) * carnahan_starling(phi + h) - (phi - h) * carnahan_starling(phi - h)) / (2 * h)
+        assert fluid_s0(phi) == pytest.approx(1 / slope, rel=1e-7)
+    ds = analyse(lattice_packing("bcc", (4, 4, 4)), channels=False, order=False)
+    ds.attrs["source"] = "results/ensembles/bcc/jammed/seed1.nc"
+    rows = {r.quantity.split(": ")[1]: r for r in structure_rows([ds])}
+    assert not rows["near-contact exponent alpha, rattlers removed"].passed
+    assert not rows["g2 second-peak sub-peak at sqrt(3) D"].passed

@@ -45,3 +45,5 @@ rule jamming_summary:
         " --variable isostaticity_gap --variable local --variable collective --variable strict"
         " --attr ensemble={wildcards.ensemble} --attr distribution='{params.distribution}'"
         " --out {output} 2> {log}"
+
+VALIDATION_INPUTS["jamming"] = expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=ENSEMBLES)

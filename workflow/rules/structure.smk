@@ -18,14 +18,14 @@ STRUCTURE_FILES = [f"results/ensembles/{e}/structure/seed{s}.nc" for e in ENSEMB
 
 
 rule fig_structure:
-    """Structure figures of the LS packings: g2 near contact (split second peak), log-log Z(l), S(k) at small k."""
+    """Structure figures of the LS packings: g2 near contact (split second peak), log-log Z(l), S(k) at small k, channel-size histograms."""
     input:
         STRUCTURE_FILES,
     output:
         pdf="results/figures/structure_{kind}.pdf",
         png="results/figures/structure_{kind}.png",
     wildcard_constraints:
-        kind="g2|zl|sk",
+        kind="g2|zl|sk|channels",
     params:
         kind=lambda w: w.kind,
     log:
@@ -34,4 +34,5 @@ rule fig_structure:
         "../scripts/plot_structure.py"
 
 
-FIGURES += expand("results/figures/structure_{kind}.pdf", kind=["g2", "zl", "sk"])
+FIGURES += expand("results/figures/structure_{kind}.pdf", kind=["g2", "zl", "sk", "channels"])
+VALIDATION_INPUTS["structure"] = STRUCTURE_FILES

@@ -12,5 +12,5 @@ ensembles = defaultdict(list)
 for path in snakemake.input:
     ensembles[path.split("/")[2]].append(load_dataset(path, kind="structure"))
 plot = {"g2": structure.plot_g2_near_contact, "zl": structure.plot_coordination,
-        "sk": structure.plot_structure_factor}[snakemake.params.kind]
+        "sk": structure.plot_structure_factor, "channels": structure.plot_channels}[snakemake.params.kind]
 save(plot(dict(ensembles)), snakemake.output.pdf, snakemake.output.png)

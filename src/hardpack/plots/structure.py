@@ -5,10 +5,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.plots.style import figure
-from hardpack.structure.pair import fit_coordination_power_law
+from hardpack.structure.pair import NEAR_CONTACT_FIT, fit_coordination_power_law
 
 
 def plot_g2_near_contact(ensembles: dict):
@@ -28,7 +29,7 @@ def plot_g2_near_contact(ensembles: dict):
     return fig
 
 
-def plot_coordination(ensembles: dict, gap_lo: float = 1e-6, gap_hi: float = 1e-2):
+def plot_coordination(ensembles: dict, gap_lo: float = NEAR_CONTACT_FIT[0], gap_hi: float = NEAR_CONTACT_FIT[1]):
     """log-log Z(l) - Z(0) of the rattler-free backbone with the fitted power law (Donev ch. 9: Z - 6 ~ 11 l^0.6)."""
     fig, ax = figure()
     for k, (name, members) in enumerate(ensembles.items()):
@@ -70,5 +71,26 @@ def plot_structure_factor(ensembles: dict, k_max_d: float = 12.0):
                 ax.plot([0], [s0], "s", color=f"C{k}", mfc="none")
     ax.set_xlabel(r"$k D$")
     ax.set_ylabel(r"$S(k)$ (open squares: extrapolated $S(0)$)")
+    ax.legend()
+    return fig
+
+
+def plot_channels(ensembles: dict, ratio_max: float = 1.5):
+    """Seed-averaged histogram of channel radii over central radius R / r (Ogarko ch. 4, bin 0.01);
+    the exact channels of touching equal spheres (triangle 2/sqrt(3) - 1, square sqrt(2) - 1) marked."""
+    fig, ax = figure()
+    for k, (name, members) in enumerate(ensembles.items()):
+        hists = [m["channel_density"] for m in members if "channel_density" in m]
+        if not hists:
+            continue
+        mean = xr.concat(xr.align(*hists, join="outer", fill_value=0.0), dim="seed").mean("seed")
+        keep = mean["ratio_bin"].values <= ratio_max
+        ax.plot(mean["ratio_bin"].values[keep], mean.values[keep], color=f"C{k}",
+                label=f"{name} ({len(hists)} seeds)")
+    for xv, label in ((2 / math.sqrt(3) - 1, "triangle"), (math.sqrt(2) - 1, "square")):
+        ax.axvline(xv, color="k", ls=":", lw=0.8)
+        ax.text(xv, ax.get_ylim()[1] * 0.95, label, ha="left", va="top", rotation=90, fontsize=7)
+    ax.set_xlabel(r"channel radius / central radius $R/r$")
+    ax.set_ylabel("probability density")
     ax.legend()
     return fig

@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 
 from hardpack.errors import InvalidInputError
+from hardpack.structure.channels import channel_histogram, channel_radii
 from hardpack.structure.order import (
     crystallinity,
     psi6,
@@ -20,7 +21,9 @@ from hardpack.structure.order import (
 )
 from hardpack.structure.pair import (
     DEFAULT_CONTACT_TOL,
+    NEAR_CONTACT_FIT,
     cumulative_coordination,
+    fit_coordination_power_law,
     pair_correlation,
 )
 from hardpack.structure.sk import extrapolate_s0, structure_factor
@@ -30,8 +33,13 @@ S0_FIT_KD = 2 * np.pi * 0.4
 
 def analyse(packing, r_max: float | None = None, k_max: float | None = None, rattlers=None,
             contact_tol: float = DEFAULT_CONTACT_TOL, gap_max: float = 0.5,
-            dr: float | None = None, order: bool = True) -> xr.Dataset:
-    """Structure Dataset of one packing; ``k_max`` defaults to 20 / mean diameter."""
+            dr: float | None = None, order: bool = True, channels: bool = True) -> xr.Dataset:
+    """Structure Dataset of one packing; ``k_max`` defaults to 20 / mean diameter.
+
+    Also the near-contact power law Z(l) - Z_c = a l^alpha fitted over :data:`NEAR_CONTACT_FIT`
+    (rattler-free backbone when a rattler mask is given; NaN when the window holds no gaps) and,
+    with ``channels`` in d = 2, 3, the histogram of channel radii R / r (Ogarko ch. 4, bin 0.01).
+    """
     diameter = 2.0 * float(np.mean(packing.radii))
     k_max = 20.0 / diameter if k_max is None else k_max
     g2 = pair_correlation(packing, r_max=r_max, dr=dr, contact_tol=contact_tol)
@@ -46,6 +54,15 @@ def analyse(packing, r_max: float | None = None, k_max: float | None = None, rat
         scalars.update(S0=s0, S0_err=s0_err, S0_slope=float(coef[1]))
     except InvalidInputError:  # too few k-shells below the fit range (small systems)
         scalars.update(S0=np.nan, S0_err=np.nan, S0_slope=np.nan)
+    try:
+        fit = fit_coordination_power_law(z, *NEAR_CONTACT_FIT)
+        scalars.update(alpha=fit.alpha, alpha_err=fit.alpha_err, alpha_amplitude=fit.amplitude)
+    except InvalidInputError:  # no gaps in the window (small or crystalline packings)
+        scalars.update(alpha=np.nan, alpha_err=np.nan, alpha_amplitude=np.nan)
+    if channels and packing.dim in (2, 3):
+        hist = channel_histogram(channel_radii(packing))
+        parts.append(xr.Dataset(dict(channel_density=hist["density"]), attrs={}))
+        scalars["n_channels"] = hist.attrs["n_channels"]
     if order and packing.dim >= 2:
         scalars["T"] = translational_order(packing)
         if packing.dim == 3:
@@ -61,7 +78,9 @@ def analyse(packing, r_max: float | None = None, k_max: float | None = None, rat
     out = xr.merge(parts, compat="no_conflicts")
     out.attrs = dict(
         hardpack_kind="structure", n_particles=packing.n_particles, dim=packing.dim,
-        phi=packing.phi, mean_diameter=diameter, contact_tol=contact_tol, k_max=float(k_max),
+        phi=packing.phi, mean_diameter=diameter,
+        radius_ratio=float(packing.radii.max() / packing.radii.min()),
+        alpha_window=list(NEAR_CONTACT_FIT), contact_tol=contact_tol, k_max=float(k_max),
         s0_fit="linear S0 + s1 k over shells with k D < 2 pi 0.4",
         g2_normalisation=g2.attrs["normalisation"], gap_definition=z.attrs["gap_definition"],
         order_neighbours="Q6/q6: within 1.2 contact distances; crystallinity: regular triangulation",

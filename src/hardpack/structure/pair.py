@@ -51,6 +51,12 @@ from hardpack.structure import _cells
 DEFAULT_CONTACT_TOL = 1e-9
 
 
+#: default fit window of the near-contact power law: above the contact delta peak (LS packings at
+#: Z = 1e12 have contact gaps ~1e-12, far below 1e-5 / 100, ch. 9 L1788-1799) and below the
+#: first minimum of g2 (l ~ 0.25), where Donev sees 11 l^0.6 hold
+NEAR_CONTACT_FIT = (1e-5, 1e-1)
+
+
 def _positive(name, value):
     if value is None or not np.isfinite(value) or value <= 0:
         raise InvalidInputError(f"{name} must be a positive finite number, got {value!r}")
