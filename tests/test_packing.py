@@ -139,3 +139,16 @@ def test_pairs_within_brute_force_small_triclinic_cell():
                     brute.add((i, j, tuple(n)))
     got = {(int(a), int(b), tuple(int(v) for v in n)) for a, b, n in zip(found.i, found.j, found.shift)}
     assert got == brute
+
+
+def test_tiled_packing_keeps_phi_and_contact_number():
+    from hardpack.geometry.lattices import lattice_packing
+    from hardpack.geometry.neighbours import pairs_within
+
+    p = lattice_packing("fcc", 1)
+    big = p.tiled((2, 3, 1))
+    assert big.n_particles == 6 * p.n_particles
+    assert big.phi == pytest.approx(p.phi, rel=1e-12)
+    assert len(pairs_within(big, rel_gap=1e-9).i) == 6 * len(pairs_within(p, rel_gap=1e-9).i)
+    with pytest.raises(InvalidInputError, match="positive integers"):
+        p.tiled(0)

@@ -47,3 +47,23 @@ rule jamming_summary:
         " --out {output} 2> {log}"
 
 VALIDATION_INPUTS["jamming"] = expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=ENSEMBLES)
+
+MONODISPERSE = [name for name, ens in ENSEMBLES.items() if ens["distribution"]["kind"] == "monodisperse"]
+
+
+rule fig_jamming_vs_d:
+    """phi_J and the contact number after rattlers of the monodisperse LS ensembles vs dimension."""
+    input:
+        jammed=expand("results/ensembles/{ensemble}/jammed_summary.nc", ensemble=MONODISPERSE),
+        verdicts=expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=MONODISPERSE),
+    output:
+        pdf="results/figures/jamming_vs_d.pdf",
+        png="results/figures/jamming_vs_d.png",
+    log:
+        "results/logs/figures/jamming_vs_d.log",
+    script:
+        "../scripts/plot_jamming_vs_d.py"
+
+
+if MONODISPERSE:
+    FIGURES.append("results/figures/jamming_vs_d.pdf")

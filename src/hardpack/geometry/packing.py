@@ -213,6 +213,22 @@ class Packing:
         fields.update(changes)
         return Packing(**fields)
 
+    def tiled(self, reps) -> "Packing":
+        """The periodic packing repeated ``reps`` times along each lattice vector (int or d ints):
+        N prod(reps) particles in the cell with columns reps_k * a_k, same phi and contacts."""
+        reps = np.broadcast_to(np.asarray(reps), (self.dim,))
+        if not np.issubdtype(reps.dtype, np.integer) or (reps < 1).any():
+            raise InvalidInputError(f"reps must be positive integers, one per lattice vector, got {reps.tolist()}")
+        shifts = np.stack(np.meshgrid(*[np.arange(r) for r in reps], indexing="ij"), -1).reshape(-1, self.dim)
+        offsets = shifts @ self.lattice.T  # (K, d) Cartesian translations
+        k = len(shifts)
+        return self.replace(
+            positions=(self.positions[None, :, :] + offsets[:, None, :]).reshape(-1, self.dim),
+            radii=np.tile(self.radii, k), lattice=self.lattice * reps[None, :],
+            species=None if self.species is None else np.tile(self.species, k),
+            orientations=None if self.orientations is None else np.concatenate([self.orientations] * k),
+        )
+
     def minimum_image(self, dx: np.ndarray) -> np.ndarray:
         """Reduce separation vectors (..., d) by lattice vectors: s - round(s) in fractional space.
 
