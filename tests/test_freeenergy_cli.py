@@ -56,3 +56,32 @@ def test_bcmd_cli_refuses(tmp_path, capsys):
     )
     assert args.func(args) == 2  # touching spheres: cells never disjoint
     assert "never disjoint" in capsys.readouterr().err
+
+
+def test_bcmd_simplex_cli_not_isostatic(tmp_path, capsys):
+    # an FCC crystal is hyperstatic (M = 6N contacts > 3(N-1) + 1): the summary says so, with
+    # no BCMD run and NaN values, instead of failing the pipeline
+    import xarray as xr
+
+    p = lattice_packing("fcc", (2, 2, 2))
+    src, verdict, out = tmp_path / "fcc.nc", tmp_path / "verdict.nc", tmp_path / "res.nc"
+    save_packing(p, src)
+    xr.Dataset(
+        {"rattler": ("particle", np.zeros(p.n_particles, np.int8))},
+        attrs={"hardpack_kind": "jamming", "delta": 1e-6},
+    ).to_netcdf(verdict)
+    args = parse(["bcmd-simplex", str(src), "--jamming", str(verdict), "--out", str(out)])
+    assert args.func(args) == 0
+    a = load_dataset(out).attrs
+    assert a["isostatic"] == 0
+    assert a["isostaticity_gap"] == 6 * 32 - (3 * 31 + 1)
+    assert np.isnan(a["bcmd"]) and a["n_events"] == 0
+
+
+def test_bcmd_ladder_cli(tmp_path):
+    out = tmp_path / "ladder.nc"
+    args = parse(["bcmd-ladder", "--out", str(out)])
+    assert args.func(args) == 0
+    ds = load_dataset(out)
+    # every cheap check within its tolerance (the rungs are tested in detail elsewhere)
+    assert np.all(np.abs(ds["value"] - ds["exact"]) <= ds["tolerance"])

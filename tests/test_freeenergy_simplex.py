@@ -7,19 +7,8 @@ from scipy.spatial import ConvexHull, HalfspaceIntersection
 from scipy.special import gammaln
 
 from hardpack.errors import InvalidInputError
+from hardpack.freeenergy.ladder import random_simplex
 from hardpack.freeenergy.simplex import jamming_simplex, log_simplex_volume
-
-
-def random_simplex(n, rng):
-    """n+1 random vertices around the origin -> (A, b) with A x <= b, and the qhull volume."""
-    while True:
-        verts = rng.normal(size=(n + 1, n))
-        verts -= verts.mean(axis=0)
-        if abs(np.linalg.det(verts[1:] - verts[0])) > 0.1:
-            break
-    hull = ConvexHull(verts)
-    eq = hull.equations  # normal . x + offset <= 0, one facet per row (n+1 facets)
-    return eq[:, :-1], -eq[:, -1], hull.volume
 
 
 def test_note_one_dimensional_example():

@@ -6,10 +6,16 @@
   from the kinetic-energy ratio Delta f = (d_f/2) ln(K/K_0) (Eq. 6.12).
 - :mod:`hardpack.freeenergy.billiard`: the same identity for a point billiard in a polytope
   intersected with a shrinking ball (Fig. 6.1; validation of the estimator).
+- :mod:`hardpack.freeenergy.isostatic`: BCMD of a rattler-free jammed packing against its exact
+  jamming simplex (Table 6.1), frozen particle or frozen centre of mass.
+- :mod:`hardpack.freeenergy.crystal`: reference curves of the FCC free energy vs density (EOS
+  integration from the published melting value, cell limit with the jamming constant).
+- :mod:`hardpack.freeenergy.ladder`: the cheap checks against exact values (note sec. 5.2).
 """
 
 from hardpack.freeenergy.bcmd import BCMDResult, run_bcmd
 from hardpack.freeenergy.billiard import volume_estimate
+from hardpack.freeenergy.isostatic import simplex_reference, simplex_test
 from hardpack.freeenergy.simplex import (
     JammingSimplex,
     jamming_simplex,
@@ -22,5 +28,7 @@ __all__ = [
     "jamming_simplex",
     "log_simplex_volume",
     "run_bcmd",
+    "simplex_reference",
+    "simplex_test",
     "volume_estimate",
 ]

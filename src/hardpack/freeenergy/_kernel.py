@@ -2,15 +2,23 @@
 
 Model (note ``bcmd_free_energy.md`` sec. 2 steps 3-4): sphere i has a fixed cell centre; its
 displacement ``dr_i`` from that centre is stored separately (precision at small Delta mu) and
-must satisfy |dr_i| <= rho_i(t) = R_i * (dmu0 - gamma (t - t0)), a spherical hard wall whose
-radius shrinks at speed w_i = -gamma R_i. Pairs (i, j) in the static neighbour list collide at
-|D_ij + dr_j - dr_i| = R_i + R_j, with D_ij the fixed vector between the cell centres (periodic
-image included). Particles with inverse mass 0 are frozen: never moved, never scheduled.
+must satisfy |dr_i| <= rho_i(s) = R_i (dmu0 - gamma s), a spherical hard wall whose radius
+shrinks at speed gamma R_i (s: time since the segment start). Pairs (i, j) of the static
+neighbour list collide at |D_ij + dr_j - dr_i| = R_i + R_j, with D_ij the fixed vector between
+the cell centres (periodic image included); entries nb_start[i]:nb_end[i] are the pairs whose
+cells can still overlap (the caller prunes them as the cells shrink). Particles with inverse
+mass 0 are frozen: never moved, never scheduled.
 
-Events: one per particle in a binary min-heap (``heap``, ``hpos``) keyed by ``ev_t``; the
-partner's collision counter at prediction time invalidates stale pair events lazily.
-Moving-wall law (Donev Eq. in [C:589-613]): v_n' = 2 w - v_n along the outward normal.
-Particle positions are advanced lazily: ``dr_i`` is valid at time ``tl_i``.
+State, one row per particle as in :mod:`hardpack.md.kernel`: ``P[i] = (dr_0..dr_{d-1},
+v_0..v_{d-1}, s_i)``, displacement and velocity at the particle's own last update time s_i.
+
+Events follow the md engine's scheme (one predicted event per particle in a 4-ary min-heap with
+the keys stored in heap order, lazy invalidation by the partner's collision counter); the
+contact-time roots are the md kernel's: pairs use ``_root`` (constant radii, g = 0, with its
+early rejection against the best time so far); the cell wall solves the md bounding-sphere exit
+equation |dr + v s| = rho - adot s (adot = gamma R_i) in a form stable right after a bounce
+(:func:`_wall_root`).
+Moving-wall law (Donev [C:589-613]): v_n' = 2 w - v_n along the outward normal, w = -gamma R_i.
 """
 
 from __future__ import annotations
@@ -18,13 +26,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-WALL = -1
-NONE = -2
+from hardpack.md.kernel import _root
+
+WALL = -1  # event: the particle hits its cell wall
+NONE = -2  # nothing predicted
 
 # float accumulators
-F_WALL_IMPULSE_R = (
-    0  # sum over wall events of 2 m (v_n - w) R_i (for the cell pressure)
-)
+F_WALL_IMPULSE_R = 0  # sum over wall events of 2 m (v_n - w) R_i (for the cell pressure)
 F_PAIR_VIRIAL = 1  # sum over pair events of |impulse| * (R_i + R_j)
 N_FLOAT = 2
 # integer counters
@@ -32,50 +40,77 @@ C_EVENTS, C_WALL, C_PAIR, C_STALE = 0, 1, 2, 3
 N_INT = 4
 
 
-@njit(cache=True)
-def _sift_up(heap, hpos, ev_t, k):
-    item = heap[k]
-    while k > 0:
-        parent = (k - 1) >> 1
-        if ev_t[heap[parent]] <= ev_t[item]:
+@njit(cache=True, inline="always")
+def heap_set(hkey, heap, hpos, hsize, i, key):
+    """Give item i the key ``key`` in a 4-ary min-heap whose keys are stored in heap order
+    (``hkey[k]`` is the key of ``heap[k]``, ``hpos[i]`` the slot of i, -1 if absent). An absent
+    item is appended first. Sifts up, then down; returns the new heap size."""
+    pos = hpos[i]
+    if pos < 0:
+        pos = hsize
+        hsize += 1
+    while pos > 0:  # sift up
+        parent = (pos - 1) >> 2
+        if hkey[parent] <= key:
             break
-        heap[k] = heap[parent]
-        hpos[heap[k]] = k
-        k = parent
-    heap[k] = item
-    hpos[item] = k
-
-
-@njit(cache=True)
-def _sift_down(heap, hpos, ev_t, k, size):
-    item = heap[k]
-    while True:
-        child = 2 * k + 1
-        if child >= size:
+        hp = heap[parent]
+        hkey[pos] = hkey[parent]
+        heap[pos] = hp
+        hpos[hp] = pos
+        pos = parent
+    while True:  # sift down: smallest of up to 4 children
+        first = 4 * pos + 1
+        if first >= hsize:
             break
-        if child + 1 < size and ev_t[heap[child + 1]] < ev_t[heap[child]]:
-            child += 1
-        if ev_t[heap[child]] >= ev_t[item]:
+        ch = first
+        kc = hkey[first]
+        for c in range(first + 1, min(first + 4, hsize)):
+            if hkey[c] < kc:
+                kc = hkey[c]
+                ch = c
+        if kc >= key:
             break
-        heap[k] = heap[child]
-        hpos[heap[k]] = k
-        k = child
-    heap[k] = item
-    hpos[item] = k
+        hc = heap[ch]
+        hkey[pos] = kc
+        heap[pos] = hc
+        hpos[hc] = pos
+        pos = ch
+    hkey[pos] = key
+    heap[pos] = i
+    hpos[i] = pos
+    return hsize
 
 
-@njit(cache=True)
-def _reschedule(heap, hpos, ev_t, i, size):
-    k = hpos[i]
-    _sift_up(heap, hpos, ev_t, k)
-    _sift_down(heap, hpos, ev_t, hpos[i], size)
+@njit(cache=True, inline="always")
+def _wall_root(dd, dv, vv, rho, adot):
+    """First s >= 0 with |dr + v s| = rho - adot s, given |dr|^2 = dd, dr.v = dv, |v|^2 = vv,
+    for a point inside (or, by round-off, on) a wall shrinking at adot >= 0; inf if none.
+
+    A s^2 + 2 B s + C = 0 with A = vv - adot^2, B = dv + rho adot, C = dd - rho^2 (the md
+    kernel's exit equation). The wanted root is the later one, (-B + sqrt(B^2 - AC)) / A, written
+    as -C / (B + sqrt(B^2 - AC)) when B > 0. Unlike md.kernel._exit_root (which uses the second
+    form for every B), the first form is used for B <= 0: right after a bounce the point sits on
+    the wall (C ~ 0) moving inwards (B < 0), where B + sqrt(B^2 - AC) cancels to 0 and the md
+    form returns 0 or inf instead of the next hit -2B/A.
+    On or beyond the wall (C >= 0) and moving outwards relative to it (B > 0): 0 (hit now).
+    A <= 0 with B <= 0: the point moves inwards at least as fast as the wall, inf.
+    """
+    c = dd - rho * rho
+    b = dv + rho * adot
+    a = vv - adot * adot
+    if b > 0.0:
+        if c >= 0.0:
+            return 0.0
+        return -c / (b + np.sqrt(max(b * b - a * c, 0.0)))
+    if a <= 0.0:
+        return np.inf
+    return (np.sqrt(max(b * b - a * c, 0.0)) - b) / a
 
 
 @njit(cache=True)
 def wall_time(dr, v, rho0, w):
-    """First t >= 0 with |dr + v t| = rho0 + w t and rho0 + w t >= 0, for a point inside the
-    ball (|dr| <= rho0, round-off tolerated); inf if none. Returns 0 when the point is at or
-    beyond the wall and moving outward relative to it."""
+    """First t >= 0 with |dr + v t| = rho0 + w t for a point inside a ball whose radius moves
+    at w (<= 0: shrinking); inf if none (see :func:`_wall_root`)."""
     dd = 0.0
     dv = 0.0
     vv = 0.0
@@ -83,295 +118,153 @@ def wall_time(dr, v, rho0, w):
         dd += dr[k] * dr[k]
         dv += dr[k] * v[k]
         vv += v[k] * v[k]
-    a = vv - w * w
-    b = dv - rho0 * w  # f(t) = a t^2 + 2 b t + c = |dr+vt|^2 - (rho0+wt)^2
-    c = dd - rho0 * rho0
-    if c >= 0.0 and b > 0.0:
-        return 0.0
-    disc = b * b - a * c
-    disc = max(disc, 0.0)
-    s = np.sqrt(disc)
-    if a > 0.0:
-        # the larger root: the exit through the wall (the smaller one is <= 0, or ~0 just
-        # after a bounce, and must be skipped to avoid re-colliding at the same point)
-        t = (s - b) / a if b <= 0.0 else -c / (b + s)
-    elif b > 0.0:
-        # a <= 0 (wall faster than the particle): the wall catches up at the smaller root
-        t = -c / (b + s)
-    else:
-        return np.inf
-    t = max(t, 0.0)
-    if rho0 + w * t < 0.0:
-        return np.inf
-    return t
+    return _wall_root(dd, dv, vv, rho0, -w)
 
 
 @njit(cache=True)
-def _pair_time(r, u, sig):
-    """First t >= 0 with |r + u t| = sig for an approaching pair, else inf."""
-    rr = 0.0
-    ru = 0.0
-    uu = 0.0
-    for k in range(r.shape[0]):
-        rr += r[k] * r[k]
-        ru += r[k] * u[k]
-        uu += u[k] * u[k]
-    if ru >= 0.0:
-        return np.inf
-    c = rr - sig * sig
-    if c <= 0.0:
-        return 0.0
-    disc = ru * ru - uu * c
-    if disc < 0.0:
-        return np.inf
-    return c / (-ru + np.sqrt(disc))
+def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, gamma, s_end,
+                facc, iacc, max_events):
+    """Run the events of s in [0, s_end) with cell radii R_i (dmu0 - gamma s); every particle is
+    synchronised at s = 0 on entry and at s_end on exit (P updated in place, s_i = 0 on exit).
+    Returns the number of events processed (stops after max_events; the caller then treats the
+    run as failed).
 
-
-@njit(cache=True)
-def _advance(i, t, dr, v, tl):
-    dt = t - tl[i]
-    for k in range(dr.shape[1]):
-        dr[i, k] += v[i, k] * dt
-    tl[i] = t
-
-
-@njit(cache=True)
-def _predict(
-    i,
-    t,
-    t0,
-    dmu0,
-    gamma,
-    dr,
-    v,
-    tl,
-    radii,
-    invm,
-    nb_start,
-    nb_j,
-    nb_disp,
-    nb_sig,
-    coll,
-    ev_t,
-    ev_p,
-    ev_c,
-    ev_q,
-    r,
-    u,
-):
-    """Next event of particle i (advanced to time t): its wall or a neighbour."""
-    _advance(i, t, dr, v, tl)
-    d = dr.shape[1]
-    rho0 = radii[i] * (dmu0 - gamma * (t - t0))
-    best = t + wall_time(dr[i], v[i], rho0, -gamma * radii[i])
-    partner = WALL
-    qbest = -1
-    for q in range(nb_start[i], nb_start[i + 1]):
-        j = nb_j[q]
-        dtj = t - tl[j]
-        for k in range(d):
-            r[k] = nb_disp[q, k] + dr[j, k] + v[j, k] * dtj - dr[i, k]
-            u[k] = v[j, k] - v[i, k]
-        tc = t + _pair_time(r, u, nb_sig[q])
-        if tc < best:
-            best = tc
-            partner = j
-            qbest = q
-    ev_t[i] = best
-    ev_p[i] = partner
-    ev_c[i] = coll[partner] if partner >= 0 else 0
-    ev_q[i] = qbest
-
-
-@njit(cache=True)
-def run_segment(
-    t0,
-    t1,
-    dmu0,
-    gamma,
-    dr,
-    v,
-    radii,
-    invm,
-    nb_start,
-    nb_j,
-    nb_disp,
-    nb_sig,
-    facc,
-    iacc,
-    max_events,
-):
-    """Run events in [t0, t1) with cell radii R_i (dmu0 - gamma (t - t0)); all particles are
-    synchronised at t0 on entry and at t1 on exit (dr, v updated in place). Returns the number
-    of events processed (stops early after max_events; then the caller treats the run as
-    failed)."""
-    n, d = dr.shape
-    tl = np.full(n, t0)
+    Single loop in the md engine's style (no sub-call takes arrays): (1) schedule reset, one
+    prediction per moving particle; (2) events: stale pair -> re-predict i; wall -> reflect,
+    re-predict i; pair -> collide, re-predict both.
+    """
+    n = P.shape[0]
+    d = (P.shape[1] - 1) // 2
+    ts = 2 * d
     coll = np.zeros(n, np.int64)
-    ev_t = np.full(n, np.inf)
-    ev_p = np.full(n, NONE, np.int64)
-    ev_c = np.zeros(n, np.int64)
-    ev_q = np.full(n, -1, np.int64)
-    r = np.empty(d)
-    u = np.empty(d)
+    ep = np.full(n, NONE, np.int64)  # partner of the predicted event
+    ec = np.zeros(n, np.int64)  # partner's collision count at prediction time
+    eq = np.zeros(n, np.int64)  # neighbour-list entry of the predicted pair event
+    hkey = np.empty(n)
     heap = np.empty(n, np.int64)
     hpos = np.full(n, -1, np.int64)
-    size = 0
-    for i in range(n):
-        if invm[i] > 0.0:
-            _predict(
-                i,
-                t0,
-                t0,
-                dmu0,
-                gamma,
-                dr,
-                v,
-                tl,
-                radii,
-                invm,
-                nb_start,
-                nb_j,
-                nb_disp,
-                nb_sig,
-                coll,
-                ev_t,
-                ev_p,
-                ev_c,
-                ev_q,
-                r,
-                u,
-            )
-            heap[size] = i
-            hpos[i] = size
-            size += 1
-    for k in range(size // 2 - 1, -1, -1):
-        _sift_down(heap, hpos, ev_t, k, size)
-    count = 0
+    xi = np.empty(d)
     nrm = np.empty(d)
-    while size > 0 and count < max_events:
-        i = heap[0]
-        t = ev_t[i]
-        if t >= t1:
-            break
-        j = ev_p[i]
-        if j >= 0 and coll[j] != ev_c[i]:
-            iacc[C_STALE] += 1
-            _predict(
-                i,
-                t,
-                t0,
-                dmu0,
-                gamma,
-                dr,
-                v,
-                tl,
-                radii,
-                invm,
-                nb_start,
-                nb_j,
-                nb_disp,
-                nb_sig,
-                coll,
-                ev_t,
-                ev_p,
-                ev_c,
-                ev_q,
-                r,
-                u,
-            )
-            _reschedule(heap, hpos, ev_t, i, size)
-            continue
-        count += 1
-        iacc[C_EVENTS] += 1
-        _advance(i, t, dr, v, tl)
-        if j == WALL:
-            w = -gamma * radii[i]
-            norm = 0.0
-            for k in range(d):
-                norm += dr[i, k] * dr[i, k]
-            norm = np.sqrt(norm)
-            vn = 0.0
-            for k in range(d):
-                nrm[k] = dr[i, k] / norm
-                vn += v[i, k] * nrm[k]
-            if vn > w:
+    upd = np.empty(2, np.int64)
+    hsize = 0
+    stage = 0
+    count = 0
+    while True:
+        npred = 0
+        if stage < n:  # (1) schedule reset
+            i = stage
+            stage += 1
+            s = 0.0
+            if invm[i] > 0.0:
+                upd[0] = i
+                npred = 1
+        else:  # (2) events
+            if hsize == 0 or count >= max_events:
+                break
+            i = heap[0]
+            s = hkey[0]
+            if s >= s_end:
+                break
+            j = ep[i]
+            upd[0] = i
+            npred = 1
+            if j >= 0 and coll[j] != ec[i]:  # the partner collided since: stale
+                iacc[C_STALE] += 1
+            else:
+                count += 1
+                iacc[C_EVENTS] += 1
+                dti = s - P[i, ts]
                 for k in range(d):
-                    v[i, k] += 2.0 * (w - vn) * nrm[k]
-                facc[F_WALL_IMPULSE_R] += 2.0 * (vn - w) * radii[i] / invm[i]
-            iacc[C_WALL] += 1
-            coll[i] += 1
-        else:
-            _advance(j, t, dr, v, tl)
-            dist = 0.0
-            qj = ev_q[i]
+                    P[i, k] += P[i, d + k] * dti
+                P[i, ts] = s
+                coll[i] += 1
+                if j == WALL:
+                    w = -gamma * radii[i]
+                    norm = 0.0
+                    for k in range(d):
+                        norm += P[i, k] * P[i, k]
+                    norm = np.sqrt(norm)
+                    vn = 0.0
+                    for k in range(d):
+                        nrm[k] = P[i, k] / norm
+                        vn += P[i, d + k] * nrm[k]
+                    if vn > w:
+                        for k in range(d):
+                            P[i, d + k] += 2.0 * (w - vn) * nrm[k]
+                        facc[F_WALL_IMPULSE_R] += 2.0 * (vn - w) * radii[i] / invm[i]
+                    iacc[C_WALL] += 1
+                else:
+                    dtj = s - P[j, ts]
+                    for k in range(d):
+                        P[j, k] += P[j, d + k] * dtj
+                    P[j, ts] = s
+                    qj = eq[i]
+                    dist = 0.0
+                    for k in range(d):
+                        nrm[k] = nb_disp[qj, k] + P[j, k] - P[i, k]
+                        dist += nrm[k] * nrm[k]
+                    dist = np.sqrt(dist)
+                    un = 0.0
+                    for k in range(d):
+                        nrm[k] /= dist
+                        un += (P[j, d + k] - P[i, d + k]) * nrm[k]
+                    if un < 0.0:
+                        imp = -2.0 * un / (invm[i] + invm[j])
+                        for k in range(d):
+                            P[i, d + k] -= imp * invm[i] * nrm[k]
+                            P[j, d + k] += imp * invm[j] * nrm[k]
+                        facc[F_PAIR_VIRIAL] += imp * nb_sig[qj]
+                    iacc[C_PAIR] += 1
+                    coll[j] += 1
+                    if invm[j] > 0.0:
+                        upd[1] = j
+                        npred = 2
+
+        for q in range(npred):  # predict the next event of upd[q] at time s
+            i = upd[q]
+            dt = s - P[i, ts]
+            adot = gamma * radii[i]
+            dd = 0.0
+            dv = 0.0
+            vv = 0.0
             for k in range(d):
-                nrm[k] = nb_disp[qj, k] + dr[j, k] - dr[i, k]
-                dist += nrm[k] * nrm[k]
-            dist = np.sqrt(dist)
-            un = 0.0
-            for k in range(d):
-                nrm[k] /= dist
-                un += (v[j, k] - v[i, k]) * nrm[k]
-            if un < 0.0:
-                imp = -2.0 * un / (invm[i] + invm[j])
+                vk = P[i, d + k]
+                x = P[i, k] + vk * dt
+                xi[k] = x
+                dd += x * x
+                dv += x * vk
+                vv += vk * vk
+            best = _wall_root(dd, dv, vv, radii[i] * (dmu0 - gamma * s), adot)
+            partner = WALL
+            qbest = -1
+            for m in range(nb_start[i], nb_end[i]):
+                j = nb_j[m]
+                dtj = s - P[j, ts]
+                rr = 0.0
+                ru = 0.0
+                uu = 0.0
                 for k in range(d):
-                    v[i, k] -= imp * invm[i] * nrm[k]
-                    v[j, k] += imp * invm[j] * nrm[k]
-                facc[F_PAIR_VIRIAL] += imp * nb_sig[qj]
-            iacc[C_PAIR] += 1
-            coll[i] += 1
-            coll[j] += 1
-            if invm[j] > 0.0:
-                _predict(
-                    j,
-                    t,
-                    t0,
-                    dmu0,
-                    gamma,
-                    dr,
-                    v,
-                    tl,
-                    radii,
-                    invm,
-                    nb_start,
-                    nb_j,
-                    nb_disp,
-                    nb_sig,
-                    coll,
-                    ev_t,
-                    ev_p,
-                    ev_c,
-                    ev_q,
-                    r,
-                    u,
-                )
-                _reschedule(heap, hpos, ev_t, j, size)
-        _predict(
-            i,
-            t,
-            t0,
-            dmu0,
-            gamma,
-            dr,
-            v,
-            tl,
-            radii,
-            invm,
-            nb_start,
-            nb_j,
-            nb_disp,
-            nb_sig,
-            coll,
-            ev_t,
-            ev_p,
-            ev_c,
-            ev_q,
-            r,
-            u,
-        )
-        _reschedule(heap, hpos, ev_t, i, size)
-    for i in range(n):
+                    vjk = P[j, d + k]
+                    r = nb_disp[m, k] + P[j, k] + vjk * dtj - xi[k]
+                    u = vjk - P[i, d + k]
+                    rr += r * r
+                    ru += r * u
+                    uu += u * u
+                tc = _root(rr, ru, uu, nb_sig[m], 0.0, best)
+                if tc < best:
+                    best = tc
+                    partner = j
+                    qbest = m
+            ep[i] = partner
+            eq[i] = qbest
+            if partner >= 0:
+                ec[i] = coll[partner]
+            hsize = heap_set(hkey, heap, hpos, hsize, i, s + best)
+
+    for i in range(n):  # synchronise at s_end
         if invm[i] > 0.0:
-            _advance(i, t1, dr, v, tl)
+            dt = s_end - P[i, ts]
+            for k in range(d):
+                P[i, k] += P[i, d + k] * dt
+        P[i, ts] = 0.0
     return count
