@@ -14,6 +14,9 @@ the CPU-time rate is printed too.
    Z = 1e12 (numba compilation excluded: a small run compiles first), plus the collision rate in
    the dense part of the run (Z >= 1e3).
 3. Compile time: first call of the engine in a fresh process with an empty numba cache.
+4. Wide size distribution (issue 6): NVE rate of N = 1e4 spheres in 3D with radii uniform in volume
+   over a factor omega = 10 (hardpack.distributions.uniform_volume(10), several grid levels) against
+   monodisperse spheres, both at phi = 0.5.
 """
 
 from __future__ import annotations
@@ -35,16 +38,17 @@ def _peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def worker_rate(d: int, n: int, repeats: int) -> dict:
+def worker_rate(d: int, n: int, repeats: int, phi: float | None = None, omega: float = 1.0) -> dict:
     import numpy as np
 
-    from hardpack.distributions import monodisperse
+    from hardpack.distributions import monodisperse, uniform_volume
     from hardpack.initial import random_packing
     from hardpack.md import StopCriteria, compress
     from hardpack.md.simulation import Simulation, maxwell_boltzmann
 
-    phi = 0.6 * PHI_J[d]
-    packing = random_packing(n, d, monodisperse(0.5), min(phi, RSA_START[d]), seed=1)
+    phi = 0.6 * PHI_J[d] if phi is None else phi
+    dist = monodisperse(0.5) if omega == 1.0 else uniform_volume(omega)
+    packing = random_packing(n, d, dist, min(phi, RSA_START[d]), seed=1)
     t0 = time.perf_counter()
     if phi > packing.phi:
         packing = compress(packing, 0.1, 1, stop=StopCriteria(max_pressure=None, target_phi=phi)).packing
@@ -58,9 +62,10 @@ def worker_rate(d: int, n: int, repeats: int) -> dict:
         rec = sim.run_window(5 * n)
         wall.append((sim.collisions - c0) / (time.perf_counter() - w0))
         cpu.append((sim.collisions - c0) / (time.process_time() - p0))
-    return {"d": d, "n": n, "phi": phi, "rate": float(np.median(wall)), "cpu_rate": float(np.median(cpu)),
-                "Z": rec["Z"], "neighbours": rec["neighbours"], "shell": rec["shell"], "prep_s": prep,
-                "peak_mb": _peak_mb()}
+    return {"d": d, "n": n, "phi": phi, "omega": omega, "rate": float(np.median(wall)),
+            "cpu_rate": float(np.median(cpu)), "Z": rec["Z"], "neighbours": rec["neighbours"],
+            "shell": rec["shell"], "levels": int(sim.engine.ncl.shape[0]), "prep_s": prep,
+            "peak_mb": _peak_mb()}
 
 
 def worker_jam(n: int, growth_rate: float) -> dict:
@@ -123,6 +128,8 @@ def main() -> None:
         kind, *rest = args.worker
         if kind == "rate":
             result = worker_rate(int(rest[0]), int(rest[1]), int(rest[2]))
+        elif kind == "poly":
+            result = worker_rate(3, int(rest[0]), int(rest[1]), phi=0.5, omega=float(rest[2]))
         elif kind == "jam":
             result = worker_jam(int(rest[0]), float(rest[1]))
         else:
@@ -155,6 +162,22 @@ def main() -> None:
                 continue
             print(f"| {d} | {n} | {r['phi']:.3f} | {r['Z']:.2f} | {r['rate']:.3g} | {r['cpu_rate']:.3g} "
                   f"| {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
+
+    print(f"\n## Wide size distribution: 3D, N = 1e4, phi = 0.5, NVE collisions per second (median of "
+          f"{repeats}); uniform-in-volume radii over omega = 10 vs monodisperse")
+    print("| radii | grid levels | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
+    print("|---|---|---|---|---|---|---|")
+    poly = {}
+    for omega in (1.0, 10.0):
+        r = poly[omega] = _run(["poly", 10000, repeats, omega])
+        label = "monodisperse" if omega == 1.0 else f"UV omega = {omega:g}"
+        if "error" in r:
+            print(f"| {label} | error: {r['error']} | | | | | |")
+            continue
+        print(f"| {label} | {r['levels']} | {r['Z']:.2f} | {r['rate']:.3g} | {r['cpu_rate']:.3g} "
+              f"| {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
+    if all("error" not in r for r in poly.values()):
+        print(f"CPU-rate ratio monodisperse / UV omega = 10: {poly[1.0]['cpu_rate'] / poly[10.0]['cpu_rate']:.2f}")
 
     print(f"\n## Time to jam: N = 1e4, d = 3, Gamma = 0.02, RSA phi0 = 0.1 -> Z = 1e12 (median of "
           f"{repeats}, compile excluded)")

@@ -111,35 +111,41 @@ def test_periodic_image_collision():
     np.testing.assert_allclose(eng.velocities[:, 0], [1.0, -1.0], rtol=1e-14)
 
 
-@pytest.mark.parametrize("d, kappa", [(2, 0.05), (3, 0.0), pytest.param(4, 0.02, marks=pytest.mark.slow)])
-def test_neighbour_lists_match_brute_force_after_many_partial_updates(d, kappa):
+@pytest.mark.parametrize("d, kappa, omega", [(2, 0.05, 1.0), (3, 0.0, 1.0), (3, 0.02, 10.0),
+                                             pytest.param(4, 0.02, 1.0, marks=pytest.mark.slow)])
+def test_neighbour_lists_match_brute_force_after_many_partial_updates(d, kappa, omega):
     """Invariants of the bounding-sphere lists (Donev sec. 2.9): every particle lies inside its
     bounding sphere, and i lists j (with the minimum-image shift) exactly when their bounding
-    spheres overlap. Checked by brute force after windows full of partial updates."""
-    from hardpack.distributions import monodisperse
+    spheres overlap. Checked by brute force after windows full of partial updates; omega = 10
+    (radii uniform in volume over a factor 10) puts the spheres on several grid levels."""
+    from hardpack.distributions import monodisperse, uniform_volume
     from hardpack.initial import random_packing
     from hardpack.md.simulation import maxwell_boltzmann
 
-    packing = random_packing(150, d, monodisperse(0.5), 0.25 if d < 4 else 0.15, seed=d)
+    dist = monodisperse(0.5) if omega == 1.0 else uniform_volume(omega)
+    n = 150 if omega == 1.0 else 600
+    packing = random_packing(n, d, dist, 0.25 if d < 4 else 0.15, seed=d)
     eng = Engine(packing.fractional() * np.diag(packing.lattice),
-                 maxwell_boltzmann(150, d, 1), packing.radii, np.diag(packing.lattice))
+                 maxwell_boltzmann(n, d, 1), packing.radii, np.diag(packing.lattice))
     exits = 0
     for w in range(6):
         res = eng.run_window(kappa, 0.3, 300, np.inf, rebuild=(w == 0))
         exits += res.exits
-        box, ncode = eng.box, 3**d
+        box = eng.box
         bc, br, x, a = eng.bs[:, :d], eng.bs[:, d], eng.positions, eng.radii
         assert np.all(np.linalg.norm(x - bc, axis=1) + a <= br * (1 + 1e-12))
         for i in range(eng.n):
-            listed = {int(e) // ncode: int(e) % ncode for e in eng.nb[i, : eng.nn[i]]}
+            partners, shifts = eng.neighbours(i)
+            listed = dict(zip(partners.tolist(), shifts))
             assert len(listed) == eng.nn[i]  # no duplicates
             sep = bc - bc[i]
             shift = -np.round(sep / box)
             dist = np.linalg.norm(sep + shift * box, axis=1)
             expected = {j for j in np.flatnonzero(dist < br[i] + br) if j != i}
             assert set(listed) == expected
-            for j, code in listed.items():
-                n = (code // 3 ** np.arange(d)) % 3 - 1
-                np.testing.assert_allclose(eng.imgvec[code], n * box)
-                np.testing.assert_array_equal(n, shift[j])
+            codes = eng.nb[i, : eng.nn[i]].astype(np.int64) & ((1 << 2 * d) - 1)
+            np.testing.assert_allclose(eng.imgvec[codes], shifts * box)
+            for j, nvec in listed.items():
+                np.testing.assert_array_equal(nvec, shift[j])
     assert exits > 50  # the windows really exercised partial updates
+    assert (eng.ncl.shape[0] > 1) == (omega > 1.0)  # several grid levels only for wide sizes

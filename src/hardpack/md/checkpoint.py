@@ -2,7 +2,7 @@
 
 A checkpoint is an ``.npz`` file with the complete :meth:`hardpack.md.simulation.Simulation.state`
 plus a fingerprint of the run's defining inputs (start packing, growth rate, seed, window size,
-overlap tolerance).
+overlap tolerance, final growth stage, contact-force windows).
 It is written to a temporary file in the destination folder, flushed, and moved over the old one
 with :func:`os.replace`, so a run killed at any moment (even with SIGKILL) leaves a complete
 checkpoint. Restarting with the same arguments loads it and continues. Checkpoints are taken only
@@ -24,7 +24,7 @@ import numpy as np
 
 from hardpack.errors import InvalidInputError
 
-FORMAT = 1
+FORMAT = 2
 
 
 def fingerprint(packing, **params) -> str:
@@ -67,8 +67,8 @@ def load(path, fp: str) -> dict | None:
                                 "delete it to start afresh") from None
     if int(state.pop("format", -1)) != FORMAT or str(state.pop("fingerprint", "")) != fp:
         raise InvalidInputError(
-            f"checkpoint {path} belongs to a different run (other start packing, growth rate, seed "
-            "or window size); delete it or choose another checkpoint path"
+            f"checkpoint {path} belongs to a different run (other start packing, growth rates, seed, "
+            "window size or contact-force option); delete it or choose another checkpoint path"
         )
     return {k: (v.item() if v.ndim == 0 else v) for k, v in state.items()}
 

@@ -41,10 +41,15 @@ def cmd_compress(args) -> int:
     stop = StopCriteria(max_pressure=args.max_pressure, target_phi=args.target_phi,
                         max_collisions=args.max_collisions, max_wall_time=args.max_wall_time)
     result = compress(packing, args.growth_rate, args.seed, stop=stop, checkpoint=args.checkpoint,
-                      window=args.window, checkpoint_interval=args.checkpoint_interval)
+                      window=args.window, checkpoint_interval=args.checkpoint_interval,
+                      final_growth_rate=args.final_growth_rate, switch_pressure=args.switch_pressure,
+                      contact_forces=args.contact_forces, contact_windows=args.contact_windows)
     config = {"init": str(args.init), "growth_rate": args.growth_rate, "seed": args.seed,
               "max_pressure": args.max_pressure, "target_phi": args.target_phi,
-              "max_collisions": args.max_collisions, "window": args.window}
+              "max_collisions": args.max_collisions, "window": args.window,
+              "final_growth_rate": args.final_growth_rate,
+              "switch_pressure": args.switch_pressure if args.final_growth_rate else None,
+              "contact_windows": args.contact_windows if args.contact_forces else None}
     result.save(args.out, args.timeseries, config=config)
     s = result.stats
     log.info("wrote %s: phi=%.8f Z=%.4g phi_J_est=%.8f (%s, %d collisions, %.1f s)", args.out,
@@ -92,6 +97,16 @@ def register(subparsers) -> None:
                    help="seconds between checkpoints (default 300)")
     p.add_argument("--window", type=float,
                    help="collisions per particle between velocity rescalings (default: from Gamma)")
+    p.add_argument("--final-growth-rate", type=float,
+                   help="two-stage protocol: grow at this (slow) Gamma once Z >= --switch-pressure "
+                        "(isostatic, collectively jammed packings; e.g. 3e-4)")
+    p.add_argument("--switch-pressure", type=float, default=1e3,
+                   help="reduced pressure at which --final-growth-rate takes over (default 1e3)")
+    p.add_argument("--contact-forces", action="store_true",
+                   help="store the time-averaged MD contact forces (per-pair impulse sums over the "
+                        "last --contact-windows windows) as md_contact_* variables in --out")
+    p.add_argument("--contact-windows", type=int, default=10,
+                   help="windows averaged for --contact-forces (default 10)")
     p.set_defaults(func=cmd_compress)
 
     p = subparsers.add_parser("eos", help=cmd_eos.__doc__)

@@ -18,6 +18,32 @@ Conversions to the seeds' conventions:
 - Ogarko Gamma_O (Eq. 3.32: da_i/dt = Gamma_O (a_i/a_max) v0, v0 = sqrt(2E/(3M)) = sqrt(kT/m)
   in 3D): Gamma = 2 Gamma_O <a>/a_max (= 2 Gamma_O for monodisperse spheres).
 
+**Two-stage protocol** (``final_growth_rate``): fast growth straight to Z = 1e12 leaves the
+packing out of equilibrium near jamming, and the final packings are hypostatic and not even
+locally jammed (3D, N = 500, Gamma = 0.02: 1362 contacts within 1e-6 against ~1470 for an
+isostatic backbone). Growing at ``growth_rate`` until the window pressure reaches
+``switch_pressure`` and then at the much smaller ``final_growth_rate`` lets the contact network
+relax while the pressure diverges. The slow stage dominates the cost, about
+c N ln(Z_max / Z_switch) / Gamma_f collisions with c ~ 1.7 in 3D and ~1.0 in 2D (the
+collisions per particle per e-fold of Z are ~ 1 / Gamma_f). Measured (N = 500, Gamma = 0.02,
+Z_switch = 1e3, Z_max = 1e12, 3 seeds each, :func:`hardpack.jamming.verify`):
+
+- 3D monodisperse: Gamma_f = 1e-3: hypostatic by 5-6 contacts, never collectively jammed
+  (1.8e7 collisions); 3e-4: isostatic within +-1, collectively jammed in 2 of 3 (5.8e7);
+  2e-4: isostatic (Z = 5.992 without rattlers, 1.4-3.0 % rattlers) in 3 of 3 and collectively
+  jammed in 3 of 3 when the ideal test ignores motions below 1e-3 D (its default threshold,
+  1.3e-6 D, flags 2 of them for motions of 2e-6 and 6e-6 D) (8.8e7 collisions, ~60 s CPU);
+  1e-4: isostatic and collectively jammed in 3 of 3 with the default test, 2.2-3.4 % rattlers
+  (1.7e8 collisions, ~120 s CPU).
+- 2D equimolar binary disks (ratio 1.4): 1e-3: 0 of 3; 3e-4: 2 of 3; 2e-4 and 1e-4: 3 of 3
+  collectively jammed and isostatic, 5-8 % rattlers (5.6e7 and 1.1e8 collisions).
+- Switching at Z = 1e2 or 1e4 instead of 1e3 changes nothing systematic (only the cost, by
+  ln(Z_max / Z_switch)); going back to fast growth after the slow stage (slow only up to Z = 1e6)
+  destroys the isostatic network again: the slow rate is needed all the way to Z_max.
+
+Recommended: ``growth_rate=0.02, switch_pressure=1e3, final_growth_rate=2e-4`` (1e-4 where the
+verifier's default thresholds must pass).
+
 **Pressure.** Per window Z = pV/(NkT) = 1 + sum_coll r_ij . J_ij / (d N kT dt) with kT the
 window's time-averaged kinetic temperature (note sec. 2.5; Z = 1 + virial / (2 * integral of
 KE dt)); the running jamming-density estimate is phi_J_est = phi / (1 - d/Z), the free-volume form
@@ -101,18 +127,24 @@ class StopCriteria:
 
 @dataclass
 class CompressResult:
-    """Final packing, final velocities (m = 1, kT = 1), per-window time series and run stats."""
+    """Final packing, final velocities (m = 1, kT = 1), per-window time series, run stats and
+    optionally the MD contact forces."""
 
     packing: Packing
     velocities: np.ndarray
     timeseries: xr.Dataset
     stats: dict = field(default_factory=dict)
+    #: MD contact forces (``compress(..., contact_forces=True)``): a Dataset of md_contact_*
+    #: variables (:func:`hardpack.md.contacts.ContactAccumulator.result`), else None
+    contacts: xr.Dataset | None = None
 
     def save(self, packing_path, timeseries_path=None, config=None):
-        """Write the packing (with the stats as attributes) and optionally the time series."""
+        """Write the packing (with the stats as attributes, and the MD contact forces as extra
+        variables when they were accumulated) and optionally the time series."""
         from hardpack.io import save_packing, write_dataset
 
-        save_packing(self.packing, packing_path, attrs=self.stats, config=config,
+        extra = None if self.contacts is None else dict(self.contacts.data_vars)
+        save_packing(self.packing, packing_path, attrs=self.stats, extra=extra, config=config,
                      seed=self.stats.get("seed"))
         if timeseries_path is not None:
             write_dataset(self.timeseries, timeseries_path, config=config, seed=self.stats.get("seed"))
@@ -143,6 +175,7 @@ def timeseries_dataset(sim: Simulation, attrs: dict) -> xr.Dataset:
         "max_overlap": "largest relative overlap 1 - r/(a_i + a_j) at the end",
         "shell": "bounding-sphere shell / radius used", "neighbours": "mean neighbour-list length",
         "wall_time": "cumulative wall-clock seconds",
+        "growth_rate": "Gamma = (d<D>/dt)/sqrt(kT/m) used in the window",
     }
     data = {k: ("window", np.asarray(sim.records[k], dtype=float), {"description": units[k]})
             for k in RECORD_FIELDS}
@@ -169,21 +202,48 @@ def _stop_reason(stop: StopCriteria, sim: Simulation, started: float) -> str | N
     return None
 
 
+def _check_final_stage(growth_rate: float, final_growth_rate, switch_pressure, stop: StopCriteria) -> None:
+    if final_growth_rate is None:
+        return
+    if isinstance(final_growth_rate, bool) or not isinstance(final_growth_rate, (int, float, np.floating, np.integer)) \
+            or not (math.isfinite(final_growth_rate) and final_growth_rate > 0):
+        raise InvalidInputError(f"final_growth_rate must be a finite positive number, got {final_growth_rate!r}")
+    if not growth_rate > 0:
+        raise InvalidInputError("a final (slow) growth stage needs a positive growth_rate for the first stage")
+    if isinstance(switch_pressure, bool) or not isinstance(switch_pressure, (int, float, np.floating, np.integer)) \
+            or not (math.isfinite(switch_pressure) and switch_pressure > 1):
+        raise InvalidInputError(f"switch_pressure must be a finite number > 1, got {switch_pressure!r}")
+    if stop.max_pressure is not None and switch_pressure >= stop.max_pressure:
+        raise InvalidInputError(
+            f"switch_pressure {switch_pressure:g} is not below max_pressure {stop.max_pressure:g}: the "
+            "final growth stage would never run (lower switch_pressure or drop final_growth_rate)"
+        )
+
+
 def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria | None = None,
              checkpoint=None, progress=None, *, window: float | None = None,
              checkpoint_interval: float = 300.0, progress_interval: float = 10.0,
-             overlap_tol: float = DEFAULT_OVERLAP_TOL) -> CompressResult:
+             overlap_tol: float = DEFAULT_OVERLAP_TOL, final_growth_rate: float | None = None,
+             switch_pressure: float = 1e3, contact_forces: bool = False,
+             contact_windows: int = 10) -> CompressResult:
     """LS compression of ``packing`` at growth rate ``growth_rate`` (Gamma, module docstring).
 
     seed: initial Maxwell-Boltzmann velocities from numpy default_rng(seed) (the only randomness).
     stop: :class:`StopCriteria` (default: reduced pressure 1e12).
     checkpoint: path of an atomic checkpoint written at synchronisation points every
-    ``checkpoint_interval`` seconds; if it exists (same packing, rate, seed, window) the run
-    resumes from it and ends bit-identical to an uninterrupted run. Removed on success.
+    ``checkpoint_interval`` seconds; if it exists (same packing, rates, seed, window, contact
+    options) the run resumes from it and ends bit-identical to an uninterrupted run. Removed on
+    success.
     progress: callable receiving each window's record (dict); progress lines also go to the
     ``hardpack.md`` logger every ``progress_interval`` seconds.
-    window: collisions per particle between synchronisations (default :func:`default_window`).
+    window: collisions per particle between synchronisations (default :func:`default_window` of
+    the rate of the current stage).
     overlap_tol: relative overlap tolerance checked at every synchronisation and at the end.
+    final_growth_rate, switch_pressure: two-stage protocol (module docstring): from the first
+    window whose reduced pressure reaches ``switch_pressure`` on, grow at ``final_growth_rate``.
+    contact_forces: accumulate the per-pair collision impulses over the last ``contact_windows``
+    windows (:mod:`hardpack.md.contacts`); ``result.contacts`` then holds the time-averaged
+    contact forces and :meth:`CompressResult.save` stores them with the packing.
     """
     check_packing(packing)
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
@@ -193,29 +253,42 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
         raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
     stop = StopCriteria() if stop is None else stop
     stop.check(float(growth_rate), packing.phi)
-    window = default_window(growth_rate, packing.dim) if window is None else float(window)
-    if not (math.isfinite(window) and window > 0):
+    _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)
+    if window is not None and not (math.isfinite(window) and window > 0):
         raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
+    if contact_forces and (isinstance(contact_windows, bool) or int(contact_windows) != contact_windows
+                           or contact_windows < 1):
+        raise InvalidInputError(f"contact_windows must be a positive integer, got {contact_windows!r}")
+
+    def stage_window(rate: float) -> float:
+        return default_window(rate, packing.dim) if window is None else float(window)
 
     sim = Simulation(packing, maxwell_boltzmann(packing.n_particles, packing.dim, seed),
-                     growth_rate, overlap_tol=overlap_tol)
+                     growth_rate, overlap_tol=overlap_tol,
+                     contact_windows=int(contact_windows) if contact_forces else 0)
     fp = ckpt.fingerprint(packing, growth_rate=float(growth_rate), seed=int(seed), window=window,
-                          overlap_tol=overlap_tol)
+                          overlap_tol=overlap_tol, final_growth_rate=final_growth_rate,
+                          switch_pressure=float(switch_pressure) if final_growth_rate else None,
+                          contact_windows=int(contact_windows) if contact_forces else 0)
     if checkpoint is not None:
         state = ckpt.load(checkpoint, fp)
         if state is not None:
             sim.restore(state)
             log.info("resumed from %s at window %d (%d collisions)", checkpoint, sim.windows,
                      sim.collisions)
-    coll_per_window = max(1, round(window * sim.n))
     started = time.perf_counter()
     last_ckpt = last_log = started
     last_coll = sim.collisions
     while (reason := _stop_reason(stop, sim, started)) is None:
-        budget = coll_per_window
+        budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
         if stop.max_collisions is not None:
             budget = min(budget, int(stop.max_collisions) - sim.collisions)
         record = sim.run_window(budget, stop.target_phi)
+        if final_growth_rate is not None and sim.growth_rate != final_growth_rate \
+                and record["Z"] >= switch_pressure:
+            sim.growth_rate = float(final_growth_rate)
+            log.info("Z=%.4g >= %.4g after %d collisions: growth rate now %g", record["Z"],
+                     switch_pressure, sim.collisions, final_growth_rate)
         if progress is not None:
             progress(record)
         now = time.perf_counter()
@@ -232,19 +305,41 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     final = sim.packing()
     report = final.overlap_report(overlap_tol)
     last = {k: (sim.records[k][-1] if sim.records[k] else float("nan")) for k in ("Z", "phi_J_est")}
+    rates = np.asarray(sim.records["growth_rate"])
+    colls = np.asarray(sim.records["collisions"])
+    first_slow = np.flatnonzero(rates != growth_rate) if final_growth_rate is not None else []
+    switch_coll = (int(colls[first_slow[0] - 1]) if first_slow[0] > 0 else 0) if len(first_slow) else None
     stats = {
-        "protocol": "lubachevsky_stillinger", "growth_rate": float(growth_rate), "seed": int(seed),
+        "protocol": "lubachevsky_stillinger" if final_growth_rate is None
+        else "lubachevsky_stillinger_two_stage",
+        "growth_rate": float(growth_rate), "seed": int(seed),
         "stop_reason": reason, "Z": float(last["Z"]), "phi": float(final.phi),
         "phi_J_est": float(last["phi_J_est"]), "collisions": int(sim.collisions),
         "events": int(sim.events), "windows": int(sim.windows), "md_time": float(sim.time),
-        "wall_time": float(sim.wall_time), "window_collisions_per_particle": window,
-        "overlap_tol": overlap_tol, "max_overlap": float(report.overlap),
+        "wall_time": float(sim.wall_time), "window_collisions_per_particle": stage_window(growth_rate),
+        "overlap_tol": overlap_tol,
+        # largest 1 - r/(a_i + a_j) over listed (near) pairs at the end: about minus the smallest
+        # relative gap, positive only for overlaps; the independent check is overlap_report's
+        "max_overlap": float(sim.records["max_overlap"][-1]) if sim.records["max_overlap"] else float("nan"),
         "n_overlapping": int(report.n_overlapping),
         "overlap_check": "passed" if report.n_overlapping == 0 else "failed",
         "mass": 1.0, "kT": 1.0,
     }
-    ts = timeseries_dataset(sim, {k: stats[k] for k in ("growth_rate", "seed", "stop_reason")}
-                            | {"N": sim.n, "d": sim.d})
+    if final_growth_rate is not None:
+        stats.update({
+            "final_growth_rate": float(final_growth_rate), "switch_pressure": float(switch_pressure),
+            "final_window_collisions_per_particle": stage_window(final_growth_rate),
+            # collisions when the slow stage began (None: Z never reached switch_pressure)
+            "switch_collisions": switch_coll,
+            "final_stage_collisions": None if switch_coll is None else int(sim.collisions) - switch_coll,
+        })
+    contacts = None
+    if contact_forces:
+        contacts = sim.contacts.result(final)
+        stats.update(contacts.attrs)
+    ts_attrs = {k: stats[k] for k in ("growth_rate", "seed", "stop_reason", "final_growth_rate",
+                                      "switch_pressure") if k in stats}
+    ts = timeseries_dataset(sim, ts_attrs | {"N": sim.n, "d": sim.d})
     if checkpoint is not None:
         ckpt.remove(checkpoint)
-    return CompressResult(final, sim.velocities(), ts, stats)
+    return CompressResult(final, sim.velocities(), ts, stats, contacts)

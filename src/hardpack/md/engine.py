@@ -8,15 +8,15 @@ persist across windows (positions are advanced, never re-wrapped, by a synchroni
 rebuilt completely (Alg. 9) after a spatial sort, when the particles have grown close to the
 bounding-radius cap, or when the requested skin no longer fits under it.
 
-If a neighbour list overflows its capacity, or a particle outgrows the cap, the window is rolled
-back to its starting positions and velocities and redone after a complete rebuild (with twice the
-capacity after an overflow). Every such decision depends only on the state and on the capacity,
-which the checkpoint stores, so a restarted run repeats the same sequence bit for bit.
+If a neighbour list or a grid cell overflows its capacity, or a particle outgrows the cap, the
+window is rolled back to its starting positions and velocities and redone after a complete
+rebuild (with twice the capacity after an overflow). Every such decision depends only on the
+state and on the capacities, which the checkpoint stores, so a restarted run repeats the same
+sequence bit for bit.
 """
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,8 +24,15 @@ import numpy as np
 from hardpack.errors import InvalidInputError
 from hardpack.md import kernel
 
-#: cells per particle above which the bounding-sphere grid is coarsened (dilute systems)
-MAX_CELLS_PER_PARTICLE = 4.0
+#: cells per particle of a level above which its grid is coarsened (dilute systems)
+MAX_CELLS_PER_PARTICLE = 2.0
+#: skins scale like (a_i + <a>)^-SKIN_SIZE_EXPONENT (see Engine.skin_factors)
+SKIN_SIZE_EXPONENT = 1.0
+#: ratio of the bounding radii spanned by one grid level (hierarchical grid for wide distributions)
+LEVEL_RATIO = 2.0
+#: cell width of a level in units of its bounding-radius cap: a rebuild scans the cells within
+#: R_i + rcap of the centre (3^d on its own level; width 1 with up to 5^d cells was 1.6x slower)
+CELL_WIDTH = 2.0
 #: head room of the cell width over the largest bounding sphere at the window start
 GRID_HEADROOM = 1.05
 #: smallest bounding skin (relative to the largest radius) before the box is declared too small
@@ -52,10 +59,6 @@ class WindowResult:
     mean_neighbours: float
 
 
-def _pow3(d: int) -> np.ndarray:
-    return 3 ** np.arange(d, dtype=np.int64)
-
-
 def _aligned_rows(n: int, width: int) -> np.ndarray:
     """Zeroed (n, width) float64 array whose data start on a 64-byte (cache-line) boundary."""
     buf = np.zeros(n * width + 8)
@@ -63,25 +66,32 @@ def _aligned_rows(n: int, width: int) -> np.ndarray:
     return buf[offset: offset + n * width].reshape(n, width)
 
 
+def _cell_capacity(occupancy: float) -> int:
+    """Initial slots per grid cell: the mean occupancy plus 4 Poisson standard deviations, plus 2
+    (a full cell doubles the capacity and redoes the window)."""
+    return int(np.ceil(occupancy + 4.0 * np.sqrt(occupancy) + 2.0))
+
+
+def image_shifts(codes, d: int) -> np.ndarray:
+    """Lattice shifts n in {-1, 0, 1}^d of neighbour-entry image codes sum_k (n_k + 1) 4^k (a
+    code with a digit 3 maps to n_k = 2; such codes never occur in the lists)."""
+    codes = np.asarray(codes, dtype=np.int64)
+    return (codes[..., None] >> (2 * np.arange(d))) % 4 - 1
+
+
 def image_vectors(box: np.ndarray) -> np.ndarray:
-    """Table of periodic shifts L * n for n in {-1, 0, 1}^d, indexed by sum (n_k + 1) 3^k."""
+    """Table of periodic shifts L * n indexed by the image code (:func:`image_shifts`)."""
     d = len(box)
-    codes = np.arange(3**d)
-    n = (codes[:, None] // _pow3(d)[None, :]) % 3 - 1
-    return n * box[None, :]
+    return image_shifts(np.arange(4**d), d) * box[None, :]
 
 
-def cell_neighbour_table(ncell: np.ndarray) -> np.ndarray:
-    """For every cell of an ncell[0] x ... grid (dimension 0 fastest), the distinct periodic
-    neighbour cells (offsets -1, 0, 1 per dimension, de-duplicated when ncell_k < 3)."""
-    per_dim = [sorted({o % n for o in (-1, 0, 1)}) for n in ncell]
-    offsets = np.array(list(itertools.product(*per_dim)), dtype=np.int64)  # (nst, d)
-    total = int(np.prod(ncell))
-    strides = np.cumprod(np.concatenate([[1], ncell[:-1]])).astype(np.int64)
-    idx = (np.arange(total)[:, None] // strides[None, :]) % ncell[None, :]  # (ncells, d)
-    nbr = (idx[:, None, :] + offsets[None, :, :]) % ncell[None, None, :]
-    table = (nbr * strides[None, None, :]).sum(axis=2)
-    return np.ascontiguousarray(table, dtype=np.int32)
+def grid_levels(bound_radii: np.ndarray) -> np.ndarray:
+    """Grid level of every particle: bounding radii in classes of ratio LEVEL_RATIO from the
+    smallest (level 0), so each level's cells fit its largest bounding sphere without holding
+    many much smaller ones (a hierarchical grid, Ogarko ch. 2.1; monodisperse and moderately
+    polydisperse systems get one level)."""
+    ratio = bound_radii / bound_radii.min()
+    return np.floor(np.log(ratio) / np.log(LEVEL_RATIO) + 1e-12).astype(np.int64)
 
 
 class Engine:
@@ -97,7 +107,6 @@ class Engine:
         self.P[:, d:2 * d] = velocities
         self.P[:, 2 * d + 1] = radii
         self.dims = tuple(range(d))  # its length is a compile-time constant in the kernels
-        self.pow3 = _pow3(d)
         self.imgvec = image_vectors(self.box)
         self.cnt = np.zeros(n, dtype=np.int32)  # 32-bit integers: less memory traffic
         self.ep = np.zeros(n, dtype=np.int32)
@@ -108,11 +117,12 @@ class Engine:
         self.bs = np.zeros((n, d + 1))  # bounding spheres: centre, radius
         self.nn = np.zeros(n, dtype=np.int32)
         self.mark = np.zeros(n, dtype=np.int8)
-        self.cell_of = np.zeros(n, dtype=np.int32)
-        self.nxt = np.zeros(n, dtype=np.int32)
-        self.prv = np.zeros(n, dtype=np.int32)
-        self._grid_key = None
-        self.rcap = 0.0
+        self.slot_of = np.zeros(n, dtype=np.int32)
+        self.cell_capacity = 0
+        #: smallest cell capacity of any grid (doubled after a full cell; part of the run state)
+        self.cell_floor = 1
+        self._no_log_pair = np.zeros((0, 2), dtype=np.int32)
+        self._no_log_val = np.zeros((0, d + 1))
         self.lists_valid = False  # neighbour lists, bounding spheres and grid match P
         self.last_duration = 0.0
         self.alloc_lists(capacity)
@@ -139,9 +149,10 @@ class Engine:
         return self.totals()[0]
 
     def sort_spatially(self) -> np.ndarray:
-        """Reorder particles along the cell grid (dimension 0 fastest) so that neighbours are close
-        in memory; returns the permutation applied (new index -> old index)."""
-        ncell = np.maximum(np.floor(self.box / (2.0 * self.radii.max())).astype(np.int64), 1)
+        """Reorder particles along a grid of cells one mean diameter wide (dimension 0 fastest)
+        so that neighbours are close in memory; returns the permutation applied (new index -> old
+        index). (A Morton order over finer cells was measured slightly slower in 3D.)"""
+        ncell = np.maximum(np.floor(self.box / (2.0 * self.radii.mean())).astype(np.int64), 1)
         g = np.floor(self.positions / self.box * ncell).astype(np.int64) % ncell
         strides = np.cumprod(np.concatenate([[1], ncell[:-1]]))
         order = np.argsort(g @ strides, kind="stable")
@@ -149,53 +160,96 @@ class Engine:
         self.lists_valid = False
         return order
 
+    def neighbours(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """Neighbour-list entries of particle i: partner indices and lattice shifts (k, d)."""
+        e = self.nb[i, : self.nn[i]].astype(np.int64)
+        return e >> (2 * self.d), image_shifts(e & ((1 << 2 * self.d) - 1), self.d)
+
     # ----------------------------------------------------------------- set-up helpers
     def alloc_lists(self, capacity: int) -> None:
-        """Neighbour lists of entries j * 3^d + image code: int32 (half the memory traffic) while
-        N 3^d fits, int64 beyond (e.g. N > 2.9e6 in d = 6)."""
+        """Neighbour lists of entries j << 2d | image code: int32 (half the memory traffic) while
+        N 4^d fits, int64 beyond (e.g. N > 5.2e5 in d = 6)."""
         self.capacity = int(capacity)
-        dtype = np.int32 if self.n * 3**self.d < 2**31 else np.int64
+        dtype = np.int32 if self.n * 4**self.d < 2**31 else np.int64
         self.nb = np.zeros((self.n, self.capacity), dtype=dtype)
 
-    def _grid(self, rcap: float) -> None:
-        """Cell grid of bounding-sphere centres with cell width >= 2 rcap (>= 2 cells per side)."""
-        volume = float(np.prod(self.box))
-        min_width = max(2.0 * rcap, (volume / (MAX_CELLS_PER_PARTICLE * self.n)) ** (1.0 / self.d))
-        ncell = np.maximum(np.floor(self.box / min_width).astype(np.int64), 1)
-        key = tuple(ncell)
-        if key != self._grid_key:
-            self.ncell = ncell
-            self.cellnb = cell_neighbour_table(ncell)
-            #: bounding spheres examined per partial rebuild (cells searched x mean occupancy)
-            self.candidates = self.cellnb.shape[1] * self.n / self.cellnb.shape[0]
-            self.head = np.full(int(np.prod(ncell)), -1, dtype=np.int32)
-            self._grid_key = key
+    def alloc_cells(self, capacity: int) -> None:
+        """Slots for ``capacity`` bounding spheres per grid cell (centre and radius copies)."""
+        ncells = int(self.coff[-1])
+        self.cell_capacity = int(capacity)
+        self.ccount = np.zeros(ncells, dtype=np.int32)
+        self.cid = np.zeros(ncells * self.cell_capacity, dtype=np.int32)
+        self.cbs = np.zeros((ncells * self.cell_capacity, self.d + 1))
+
+    def skin_factors(self) -> np.ndarray:
+        """Relative skin of every particle, (2 <a> / (a_i + <a>))^2 (1 when all sizes are equal).
+
+        With equal masses all particles move equally fast, so particle i leaves its bounding
+        sphere at a rate ~ v / s_i whatever its size, and each exit costs about the same search;
+        but i collides at a rate ~ (a_i + <a>)^2 and each of its predictions scans a list of
+        ~ (a_i + <a>)^2 s_i neighbours. Minimising sum_i (1 / s_i + c (a_i + <a>)^4 s_i) gives
+        s_i ~ (a_i + <a>)^-2: thin skins for the large spheres, thick ones for the small."""
+        a = self.radii
+        mean = float(a.mean())
+        return (2.0 * mean / (a + mean)) ** SKIN_SIZE_EXPONENT
 
     def _new_bounds(self, skin: float) -> None:
-        """Choose the bounding-radius cap rcap for the coming rebuild (with head room for growth)
-        and the matching cell grid. rcap <= L_min / 4 keeps every pair to one periodic image
-        (L > 2 (R_i + R_j)); a box too small for even a thin skin is refused."""
-        amax = float(self.radii.max())
+        """Grid levels, their bounding-radius caps and cells for the coming complete rebuild.
+
+        Particles are put on levels by their bounding radius R = a + skin s_i (s_i from
+        :meth:`skin_factors`), in classes of ratio LEVEL_RATIO (one level unless the radii differ
+        by more than that). Level h caps the bounding radii of its particles at rcap_h =
+        max_h(a + skin s) GRID_HEADROOM (head room for growth) and has cells of width >= 2 rcap_h
+        (at most MAX_CELLS_PER_PARTICLE per particle of the level), so a particle's own level is
+        searched in 3^d cells and the other levels in the cells within R_i + rcap_l.
+        rcap <= L_min / 4 keeps every pair to one periodic image (L > 2 (R_i + R_j)); a box too
+        small for even a thin skin is refused."""
+        a = self.radii
+        amax = float(a.max())
         lmin = float(self.box.min())
-        self.rcap = min((amax + skin) * GRID_HEADROOM, 0.25 * lmin)
-        if self.rcap < amax * (1.0 + MIN_SHELL):
+        self.sfac = self.skin_factors()
+        bound = a + skin * self.sfac
+        if min(float(bound.max()) * GRID_HEADROOM, 0.25 * lmin) < amax * (1.0 + MIN_SHELL):
             raise InvalidInputError(
                 f"the periodic box is too small for these particles: the largest diameter "
                 f"{2 * amax:.4g} must stay below half the shortest box side {lmin:.4g} (so that a "
                 "pair touches through one periodic image only); use more particles or a larger box"
             )
-        self._grid(self.rcap)
+        lvl = grid_levels(bound)
+        nlev = int(lvl.max()) + 1
+        count = np.bincount(lvl, minlength=nlev)
+        self.rcap = np.minimum(np.array([bound[lvl == h].max() for h in range(nlev)]) * GRID_HEADROOM,
+                               0.25 * lmin)
+        ncl = np.maximum(np.floor(self.box[None, :] / (CELL_WIDTH * self.rcap[:, None])), 1).astype(np.int64)
+        for h in range(nlev):  # coarsen levels that would have many empty cells
+            excess = np.prod(ncl[h].astype(float)) / (MAX_CELLS_PER_PARTICLE * count[h])
+            if excess > 1.0:
+                ncl[h] = np.maximum(np.floor(ncl[h] / excess ** (1.0 / self.d)), 1).astype(np.int64)
+        self.lvl = lvl.astype(np.int32)
+        self.ncl = ncl
+        self.coff = np.concatenate([[0], np.cumsum(np.prod(ncl, axis=1))]).astype(np.int64)
+        cells = np.prod(ncl, axis=1).astype(float)
+        #: bounding spheres examined per partial rebuild (cells searched x occupancy, averaged)
+        span = np.minimum(np.ceil(2.0 * (self.rcap[:, None, None] + self.rcap[None, :, None])
+                                  * ncl[None, :, :] / self.box) + 1, ncl[None, :, :])
+        self.candidates = float(count @ (np.prod(span, axis=2) @ (count / cells)) / self.n)
+        occupancy = float((count / cells).max())
+        self.alloc_cells(max(_cell_capacity(occupancy), self.cell_floor))
+
+    def _room(self) -> float:
+        """Largest skin the caps allow every particle: min_i (rcap_h(i) - a_i) / s_i."""
+        return float(np.min((self.rcap[self.lvl] - self.radii) / self.sfac))
 
     def _grid_time(self, kappa: float, eff_skin: float) -> float:
-        """Time until the largest particle comes within a quarter skin of the radius cap."""
+        """Time until some particle comes within a quarter of its skin of its level's cap."""
         if kappa <= 0.0:
             return np.inf
-        amax = float(self.radii.max())
-        return ((self.rcap - 0.25 * eff_skin) / amax - 1.0) / kappa
+        a = self.radii
+        return float(np.min((self.rcap[self.lvl] - 0.25 * eff_skin * self.sfac) / a - 1.0) / kappa)
 
     # ----------------------------------------------------------------- one window
     def run_window(self, kappa: float, skin: float, coll_target: int, t_cap: float,
-                   rebuild: bool = False) -> WindowResult:
+                   rebuild: bool = False, log=None) -> WindowResult:
         """Run one window from a synchronisation point (all particles at t = 0) and synchronise
         again at its end, moving radii to their end-of-window size.
 
@@ -203,10 +257,13 @@ class Engine:
         (``rebuild``), after a spatial sort, or when the particles have grown too close to the
         bounding-radius cap (or the requested skin exceeds what the cap allows). Every
         decision depends only on the state, so a restarted run repeats it exactly.
+        ``log``: optional (pairs (M, 2) int32, values (M, d + 1)) arrays, M >= coll_target, that
+        receive the window's collisions (:func:`hardpack.md.kernel.run_events`).
         """
-        amax = float(self.radii.max())
+        if log is None:
+            log = (self._no_log_pair, self._no_log_val)
         if not rebuild and self.lists_valid:
-            eff_skin = min(skin, self.rcap - amax)
+            eff_skin = min(skin, self._room())
             rebuild = eff_skin < skin / SKIN_SLACK or \
                 self._grid_time(kappa, eff_skin) < 2.0 * self.last_duration
         else:
@@ -215,7 +272,7 @@ class Engine:
             self._new_bounds(skin)
         start = self.P.copy()
         while True:
-            eff_skin = min(skin, self.rcap - amax)
+            eff_skin = min(skin, self._room())
             cap = min(t_cap, self._grid_time(kappa, eff_skin))
             if kappa < 0.0:  # end shrinking windows before radii could vanish
                 cap = min(cap, 0.5 / -kappa)
@@ -223,14 +280,17 @@ class Engine:
             acc = np.array([0.0, 0.0, 0.0, self.kinetic_energy(), 0.0])
             iacc = np.zeros(kernel.N_COUNTERS, dtype=np.int64)
             status = kernel.run_events(
-                self.P, self.dims, self.box, kappa, eff_skin, self.rcap, self.imgvec, self.pow3,
-                self.ncell, self.cellnb, self.head, self.nxt, self.prv, self.cell_of,
+                self.P, self.dims, self.box, kappa, eff_skin, self.sfac, self.imgvec, self.lvl, self.rcap,
+                self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
                 self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
-                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild)
-            if status in (kernel.OVERFLOW, kernel.BOUND_TOO_SMALL):  # redo with a full rebuild
-                self.P[:] = start
+                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild, *log)
+            if status in (kernel.OVERFLOW, kernel.CELL_OVERFLOW, kernel.BOUND_TOO_SMALL):
+                self.P[:] = start  # redo the window after a full rebuild
                 if status == kernel.OVERFLOW:
                     self.alloc_lists(2 * self.capacity)
+                elif status == kernel.CELL_OVERFLOW:
+                    self.cell_floor = 2 * self.cell_capacity
+                    self.alloc_cells(self.cell_floor)
                 else:
                     self._new_bounds(skin)
                 rebuild = True

@@ -18,9 +18,13 @@ particle, lazy invalidation" form:
   The extra event "i leaves its bounding sphere" (``ep = EXIT``; the exit time solves
   |dr + v t| = R - a(t) with the radius growth included) rebuilds i's list only (Alg. 10)
   with a cell grid of bounding-sphere centres whose cell width is at least the largest
-  bounding-sphere diameter. Each list entry packs the neighbour j and its periodic image as
-  j * 3^d + code, code indexing ``imgvec`` (shifts in {-1, 0, 1}^d); the image stays valid because
-  a position is re-wrapped into the box only when its own list is rebuilt.
+  bounding-sphere diameter. Every cell stores copies of its bounding spheres contiguously
+  (``cbs``, slot s of cell c at c * ccap + s, partner index ``cid``; ``slot_of`` locates a
+  particle's slot), so a rebuild scans the 3^d cells as plain arrays instead of chasing linked
+  lists (the scan was latency bound). Each list entry packs the neighbour j and its periodic image as
+  j << 2d | code, code = sum_k (n_k + 1) 4^k indexing ``imgvec`` (shifts n in {-1, 0, 1}^d; bit
+  operations instead of an integer division in the innermost loop); the image stays valid
+  because a position is re-wrapped into the box only when its own list is rebuilt.
 - Time is measured from the last synchronisation (Alg. 3); radii are a_i(t) = a_i (1 + kappa t)
   with ONE relative growth rate kappa (radii grow in proportion to their size).
 
@@ -48,7 +52,10 @@ Kinetic energy changes by -v_n g (heating when growing). Collisions with v_n >= 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
@@ -59,12 +66,66 @@ DONE_TIME = 1  # the next event is later than t_cap (sync at t_cap)
 OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
 STUCK = 3  # no event can ever happen (nothing moves)
 BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
+CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
 
 # float accumulators, acc[...]
 A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE = 0, 1, 2, 3, 4
 # integer counters, iacc[...]
 I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE = 0, 1, 2, 3, 4
 N_COUNTERS = 5
+
+
+# --------------------------------------------------------------------------------- prefetch
+def _prefetch_intrinsic() -> str | None:
+    """Name of LLVM's prefetch intrinsic as this llvmlite spells pointers, or None.
+
+    The name is mangled by the pointer type: ``llvm.prefetch.p0`` with opaque pointers (LLVM >= 15
+    as numba uses it), ``llvm.prefetch.p0i8`` with typed pointers (older llvmlite). A tiny module
+    calling it must parse and verify with the LLVM numba ships; otherwise prefetching is left out
+    (the kernels then run without it, about 10 % slower, with identical results).
+    """
+    import llvmlite.binding as llvm
+
+    ptr = str(ir.IntType(8).as_pointer())
+    name = "llvm.prefetch.p0" if ptr == "ptr" else "llvm.prefetch.p0i8"
+    text = (f"declare void @{name}({ptr}, i32, i32, i32)\n"
+            f"define void @probe({ptr} %p) {{\n"
+            f"  call void @{name}({ptr} %p, i32 0, i32 3, i32 1)\n  ret void\n}}\n")
+    try:
+        llvm.parse_assembly(text).verify()
+    except Exception:  # any LLVM/llvmlite failure: run without prefetching
+        return None
+    return name
+
+
+PREFETCH = _prefetch_intrinsic()
+
+
+@intrinsic
+def prefetch_row(typingctx, arr, idx):
+    """Ask the CPU to fetch the cache line of arr[idx] (1-D) or arr[idx, 0] (2-D) (llvm.prefetch:
+    read, high temporal locality, data cache). A hint only: results are identical with or without
+    it, and it compiles to nothing when :data:`PREFETCH` is None."""
+    sig = types.void(arr, idx)
+
+    def codegen(context, builder, signature, args):
+        if PREFETCH is None:
+            return context.get_dummy_value()
+        aryty, idxty = signature.args
+        ary = context.make_array(aryty)(context, builder, args[0])
+        row = context.cast(builder, args[1], idxty, types.intp)
+        zero = context.get_constant(types.intp, 0)
+        ptr = cgutils.get_item_pointer(context, builder, aryty, ary, [row] + [zero] * (aryty.ndim - 1),
+                                       wraparound=False)
+        i8p = ir.IntType(8).as_pointer()
+        i32 = ir.IntType(32)
+        fn = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32]), PREFETCH)
+        builder.call(fn, [builder.bitcast(ptr, i8p), ir.Constant(i32, 0), ir.Constant(i32, 3),
+                          ir.Constant(i32, 1)])
+        return context.get_dummy_value()
+
+    return sig, codegen
 
 
 # --------------------------------------------------------------------------------- root finding
@@ -149,9 +210,9 @@ def _exit_root(dd, dv, vv, rrem, adot):
 
 # --------------------------------------------------------------------------------- event loop
 @njit(cache=True)
-def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head, nxt,
-               prv, cell_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
-               coll_target, t_cap, rebuild_lists):
+def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
+               slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
+               coll_target, t_cap, rebuild_lists, log_pair, log_val):
     """One window: reset the schedule at t = 0, then process events in time order until
     ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
 
@@ -159,7 +220,8 @@ def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head,
     out of the hot path): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
     NNL update of one particle (wrap, new bounding sphere, re-bin, list every overlapping bounding
     sphere already binned; together a complete update, Alg. 9); the bounding radius is
-    min(a_i(t) + skin, rcap), one absolute skin for all sizes. A partial update edits only the
+    min(a_i(t) + skin sfac_i, rcap_h) on grid level h = lvl[i] (size-dependent skin factors, see
+    :meth:`hardpack.md.engine.Engine.skin_factors`). A partial update edits only the
     lists of neighbours gained or lost (``mark`` flags the old ones), plus those of kept ones if the
     particle was wrapped back into the box (their image code changes). Without ``rebuild_lists``
     the lists, bounding spheres and grid of the previous window are kept (they stay valid across
@@ -170,25 +232,35 @@ def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head,
     ``acc`` holds float accumulators (A_T current time, A_VIRIAL sum of r_ij . J_ij, A_KEINT time
     integral of the kinetic energy, A_KE current kinetic energy, A_TKE time of the last KE
     update); ``iacc`` integer counters (collisions, events, stale events, exits, grazing skips).
+    If ``log_pair`` has rows, collision number c of the window is logged as log_pair[c] = (i, j)
+    and log_val[c] = (impulse J on j from i (d components), r_ij . J) (contact forces,
+    :mod:`hardpack.md.contacts`); pass (0, 2) / (0, d + 1) arrays to log nothing.
     Returns a status code (module constants).
     """
     d = len(dims)
     n = P.shape[0]
-    ncode = 3**d
+    cbits = 2 * d  # neighbour entry = j << cbits | image code (module docstring)
+    cmask = (1 << cbits) - 1
+    cback = cmask // 3 * 2  # digit-wise 2 - code: the image code of the reverse pair
     cap = nb.shape[1]
+    ccap = cid.shape[0] // ccount.shape[0]  # slots per cell
     invL = 1.0 / L
     xi = np.empty(d)
     vi = np.empty(d)
     rv = np.empty(d)
     upd = np.empty(2, dtype=np.int64)
     oldnb = np.empty(cap, dtype=np.int64)
+    nlev = ncl.shape[0]
+    clo = np.empty(d, dtype=np.int64)
+    cspan = np.empty(d, dtype=np.int64)
+    codo = np.empty(d, dtype=np.int64)
     mark[:] = 0
     hpos[:] = -1
     hsize = 0
     stage = n
     if rebuild_lists:
-        head[:] = -1
-        cell_of[:] = -1
+        ccount[:] = 0
+        slot_of[:] = -1
         nn[:] = 0
         stage = 0
     while True:
@@ -253,6 +325,13 @@ def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head,
                         P[i, d + k] += dv
                         P[j, d + k] -= dv
                     acc[A_VIRIAL] -= vn * dist
+                    c = iacc[I_COLL]
+                    if c < log_pair.shape[0]:
+                        log_pair[c, 0] = i
+                        log_pair[c, 1] = j
+                        for k in range(d):
+                            log_val[c, k] = -vn * rv[k]
+                        log_val[c, d] = -vn * dist
                     acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
                     acc[A_TKE] = t
                     acc[A_KE] -= vn * g
@@ -272,14 +351,15 @@ def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head,
             P[i, 2 * d] = t
             nold = nn[i]
             for m in range(nold):  # remember (and mark) the old neighbours
-                j = nb[i, m] // ncode
+                j = nb[i, m] >> cbits
                 oldnb[m] = j
                 mark[j] = 1
             nn[i] = 0
             wrapped = False
-            c = 0
+            h = lvl[i]
+            c = coff[h]
             stride = 1
-            for k in range(d):  # wrap into the box and find the new cell
+            for k in range(d):  # wrap into the box and find the new cell on i's level
                 x = P[i, k]
                 if x < 0.0 or x >= L[k]:
                     x -= L[k] * np.floor(x * invL[k])
@@ -289,80 +369,115 @@ def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head,
                     P[i, k] = x
                     wrapped = True
                 bs[i, k] = x
-                gk = int(x * invL[k] * ncell[k])
-                if gk >= ncell[k]:
-                    gk = ncell[k] - 1
+                gk = int(x * invL[k] * ncl[h, k])
+                if gk >= ncl[h, k]:
+                    gk = ncl[h, k] - 1
                 c += gk * stride
-                stride *= ncell[k]
+                stride *= ncl[h, k]
             a = P[i, 2 * d + 1] * (1.0 + kappa * t)
-            ri = a + skin
-            if ri > rcap:
-                ri = rcap
-                if a + 0.25 * skin >= rcap:
+            ri = a + skin * sfac[i]
+            if ri > rcap[h]:
+                ri = rcap[h]
+                if a + 0.25 * skin * sfac[i] >= rcap[h]:
                     acc[A_T] = t
                     return BOUND_TOO_SMALL
             bs[i, d] = ri
-            old = cell_of[i]
-            if c != old:
-                if old >= 0:  # unlink from the old cell
-                    pv = prv[i]
-                    nx = nxt[i]
-                    if pv >= 0:
-                        nxt[pv] = nx
-                    else:
-                        head[old] = nx
-                    if nx >= 0:
-                        prv[nx] = pv
-                h = head[c]  # link into the new one
-                nxt[i] = h
-                prv[i] = -1
-                if h >= 0:
-                    prv[h] = i
-                head[c] = i
-                cell_of[i] = c
-            for q in range(cellnb.shape[1]):  # list every overlapping bounding sphere
-                j = head[cellnb[c, q]]
-                while j >= 0:
-                    if j != i:
-                        code = 0
-                        d2 = 0.0
-                        for k in range(d):
-                            dx = bs[j, k] - bs[i, k]
-                            sh = 1
-                            if dx > 0.5 * L[k]:
-                                dx -= L[k]
-                                sh = 0
-                            elif dx < -0.5 * L[k]:
-                                dx += L[k]
-                                sh = 2
-                            code += sh * pow3[k]
-                            d2 += dx * dx
-                        s = ri + bs[j, d]
-                        if d2 < s * s:
-                            if nn[i] >= cap or nn[j] >= cap:
-                                acc[A_T] = t
-                                return OVERFLOW
-                            nb[i, nn[i]] = j * ncode + code
-                            nn[i] += 1
-                            back = i * ncode + (ncode - 1 - code)
-                            if mark[j] == 0:  # new neighbour
-                                nb[j, nn[j]] = back
-                                nn[j] += 1
-                            else:  # still a neighbour: j's entry changes only if i wrapped
-                                mark[j] = 0
-                                if wrapped:
-                                    for q2 in range(nn[j]):
-                                        if nb[j, q2] // ncode == i:
-                                            nb[j, q2] = back
-                                            break
-                    j = nxt[j]
+            slot = slot_of[i]  # move i's bounding sphere into cell c's slots
+            if slot < 0 or slot // ccap != c:
+                if ccount[c] >= ccap:
+                    acc[A_T] = t
+                    return CELL_OVERFLOW
+                if slot >= 0:  # leave the old cell: its last entry fills the hole
+                    old = slot // ccap
+                    last = old * ccap + ccount[old] - 1
+                    moved = cid[last]
+                    cid[slot] = moved
+                    for k in range(d + 1):
+                        cbs[slot, k] = cbs[last, k]
+                    slot_of[moved] = slot
+                    ccount[old] -= 1
+                slot = c * ccap + ccount[c]
+                ccount[c] += 1
+                cid[slot] = i
+                slot_of[i] = slot
+            for k in range(d + 1):
+                cbs[slot, k] = bs[i, k]
+            for lv in range(nlev):  # list every overlapping bounding sphere, level by level
+                beta = ri + rcap[lv]  # reach: R_i + R_j <= beta on level lv
+                ncells = 1
+                for k in range(d):  # the cells within beta of i's centre along each axis
+                    m = ncl[lv, k]
+                    lo = int(np.floor((bs[i, k] - beta) * invL[k] * m))
+                    span = int(np.floor((bs[i, k] + beta) * invL[k] * m)) - lo + 1
+                    if span >= m:  # all of them (no distance pruning along this axis)
+                        lo = 0
+                        span = m
+                    clo[k] = lo
+                    cspan[k] = span
+                    codo[k] = 0
+                    ncells *= span
+                for _ in range(ncells):
+                    gc = coff[lv]
+                    stride = 1
+                    gap2 = 0.0  # squared distance from i's centre to the cell
+                    for k in range(d):
+                        m = ncl[lv, k]
+                        u = clo[k] + codo[k]
+                        if cspan[k] < m:
+                            w = L[k] / m
+                            gap = max(u * w - bs[i, k], bs[i, k] - (u + 1) * w, 0.0)
+                            gap2 += gap * gap
+                        gc += (u % m) * stride
+                        stride *= m
+                    for k in range(d):  # odometer step
+                        codo[k] += 1
+                        if codo[k] < cspan[k]:
+                            break
+                        codo[k] = 0
+                    if gap2 >= beta * beta:  # no sphere of this cell can reach i's
+                        continue
+                    base = gc * ccap
+                    for sj in range(base, base + ccount[gc]):
+                        j = cid[sj]
+                        if j != i:
+                            code = 0
+                            d2 = 0.0
+                            for k in range(d):
+                                dx = cbs[sj, k] - bs[i, k]
+                                sh = 1
+                                if dx > 0.5 * L[k]:
+                                    dx -= L[k]
+                                    sh = 0
+                                elif dx < -0.5 * L[k]:
+                                    dx += L[k]
+                                    sh = 2
+                                code += sh << (2 * k)
+                                d2 += dx * dx
+                            s = ri + cbs[sj, d]
+                            if d2 < s * s:
+                                if nn[i] >= cap or nn[j] >= cap:
+                                    acc[A_T] = t
+                                    return OVERFLOW
+                                nb[i, nn[i]] = (j << cbits) | code
+                                nn[i] += 1
+                                back = (i << cbits) | (cback - code)
+                                if mark[j] == 0:  # new neighbour
+                                    nb[j, nn[j]] = back
+                                    nn[j] += 1
+                                else:  # still a neighbour: j's entry changes only if i wrapped
+                                    mark[j] = 0
+                                    if wrapped:
+                                        for q2 in range(nn[j]):
+                                            if nb[j, q2] >> cbits == i:
+                                                nb[j, q2] = back
+                                                break
             for m in range(nold):  # drop i from the lists of former neighbours
                 j = oldnb[m]
                 if mark[j] == 1:
                     mark[j] = 0
                     last = nn[j] - 1
                     for q2 in range(last + 1):
-                        if nb[j, q2] // ncode == i:
+                        if nb[j, q2] >> cbits == i:
                             nb[j, q2] = nb[j, last]
                             nn[j] = last
                             break
@@ -390,8 +505,8 @@ def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head,
             partner = EXIT if best < np.inf else NONE
             for m in range(nn[i]):
                 e = nb[i, m]
-                j = e // ncode
-                im = e - j * ncode
+                j = e >> cbits
+                im = e & cmask
                 dtj = t - P[j, 2 * d]
                 rr = 0.0
                 ru = 0.0
@@ -447,6 +562,23 @@ def run_events(P, dims, L, kappa, skin, rcap, imgvec, pow3, ncell, cellnb, head,
             heap[pos] = i
             hpos[i] = pos
 
+        if stage == 2 * n and hsize > 1:
+            # look ahead: start loading the rows the next events will need (their particles, the
+            # next particle's neighbours and its partner's neighbours); the loop is memory-latency
+            # bound from N ~ 1e4
+            for c2 in range(1, min(5, hsize)):
+                q = heap[c2]
+                prefetch_row(P, q)
+                prefetch_row(nb, q)
+            q = heap[0]
+            prefetch_row(bs, q)
+            for m in range(nn[q]):
+                prefetch_row(P, nb[q, m] >> cbits)
+            p = ep[q]
+            if p >= 0:
+                prefetch_row(P, p)
+                for m in range(nn[p]):
+                    prefetch_row(P, nb[p, m] >> cbits)
         if iacc[I_COLL] >= coll_target and npred == 2:
             acc[A_T] = t
             acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
@@ -481,13 +613,13 @@ def max_overlap(P, dims, imgvec, nb, nn):
     d = len(dims)
     worst = -np.inf
     count = 0
+    cbits = 2 * d
     for i in range(P.shape[0]):
-        ncode = 3**d
         for m in range(nn[i]):
-            j = nb[i, m] // ncode
+            j = nb[i, m] >> cbits
             if j < i:
                 continue
-            im = nb[i, m] - j * ncode
+            im = nb[i, m] & ((1 << cbits) - 1)
             d2 = 0.0
             for k in range(d):
                 dx = P[j, k] + imgvec[im, k] - P[i, k]

@@ -13,7 +13,7 @@ Units and conventions (used throughout :mod:`hardpack.md`):
 
 State saved at a synchronisation point that precedes a spatial sort and complete neighbour-list
 rebuild (positions, velocities, radii in the engine's order, the permutation to the caller's order,
-counters, the adaptive neighbour shell, the list capacity and the window records) determines the
+counters, the adaptive neighbour shell, the list and cell capacities and the window records) determines the
 rest of the run exactly, which makes checkpoint/resume bit-identical.
 """
 
@@ -26,6 +26,7 @@ import numpy as np
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
+from hardpack.md.contacts import ContactAccumulator
 from hardpack.md.engine import Engine
 
 #: initial bounding-sphere skin in units of the mean radius (R_i = a_i + shell <a>), its adaptive
@@ -40,7 +41,7 @@ SORT_EVERY = 16
 
 RECORD_FIELDS = (
     "time", "phi", "Z", "phi_J_est", "collisions", "kT", "kT_mean", "events", "stale", "exits",
-    "grazing", "max_overlap", "shell", "neighbours", "wall_time",
+    "grazing", "max_overlap", "shell", "neighbours", "wall_time", "growth_rate",
 )
 
 
@@ -81,7 +82,9 @@ class Simulation:
     """State of one run; :meth:`run_window` advances it by one synchronisation window."""
 
     def __init__(self, packing: Packing, velocities: np.ndarray, growth_rate: float,
-                 overlap_tol: float = DEFAULT_OVERLAP_TOL):
+                 overlap_tol: float = DEFAULT_OVERLAP_TOL, contact_windows: int = 0):
+        """contact_windows > 0 logs every collision and keeps the per-pair impulse sums of the
+        last ``contact_windows`` windows in :attr:`contacts` (:mod:`hardpack.md.contacts`)."""
         self.lattice = np.array(packing.lattice)
         self.species = packing.species
         self.box = np.diag(self.lattice).copy()
@@ -98,6 +101,8 @@ class Simulation:
         self.since_sort = SORT_EVERY  # sort (and rebuild the lists) before the first window
         self.wall_time = 0.0
         self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
+        self.contacts = ContactAccumulator(self.n, self.d, contact_windows) if contact_windows else None
+        self._log = None
 
     # ----------------------------------------------------------------- derived quantities
     @property
@@ -141,8 +146,16 @@ class Simulation:
             t_phi = ((target_phi / phi0) ** (1.0 / self.d) - 1.0) / kappa
             if t_phi >= 0.0:
                 t_cap = t_phi
-        res = eng.run_window(kappa, self.shell * sum_a / self.n, coll_target, t_cap, rebuild)
+        log = None
+        if self.contacts is not None:
+            if self._log is None or len(self._log[0]) < coll_target:
+                self._log = (np.zeros((coll_target, 2), dtype=np.int32), np.zeros((coll_target, self.d + 1)))
+            log = self._log
+        res = eng.run_window(kappa, self.shell * sum_a / self.n, coll_target, t_cap, rebuild, log)
         self.since_sort += 1
+        if log is not None:
+            m = res.collisions
+            self.contacts.add(self.perm[log[0][:m]], log[1][:m], res.duration, res.ke_integral)
         if res.max_overlap > self.overlap_tol:
             raise OverlapError(
                 f"{res.n_overlapping} pair(s) overlap at the end of window {self.windows}; the "
@@ -171,6 +184,7 @@ class Simulation:
             "kT": 2.0 * res.ke_end / (d * n), "kT_mean": kt_mean, "events": self.events, "stale": res.stale,
             "exits": res.exits, "grazing": res.grazing, "max_overlap": res.max_overlap, "shell": shell_used,
             "neighbours": res.mean_neighbours, "wall_time": self.wall_time,
+            "growth_rate": self.growth_rate,
         }
         for k in RECORD_FIELDS:
             self.records[k].append(record[k])
@@ -208,10 +222,13 @@ class Simulation:
             "P": self.engine.P.copy(), "perm": self.perm.copy(), "time": self.time,
             "collisions": self.collisions, "events": self.events, "windows": self.windows,
             "shell": self.shell, "wall_time": self.wall_time, "since_sort": self.since_sort,
-            "capacity": self.engine.capacity,
+            "capacity": self.engine.capacity, "cell_floor": self.engine.cell_floor,
+            "growth_rate": self.growth_rate,
         }
         for k, v in self.records.items():
             out["rec_" + k] = np.asarray(v, dtype=float)
+        if self.contacts is not None:
+            out.update(self.contacts.state())
         return out
 
     def restore(self, state: dict) -> None:
@@ -225,8 +242,12 @@ class Simulation:
         self.events = int(state["events"])
         self.windows = int(state["windows"])
         self.shell = float(state["shell"])
+        self.growth_rate = float(state["growth_rate"])
         self.since_sort = int(state["since_sort"])
         self.engine.alloc_lists(int(state["capacity"]))
+        self.engine.cell_floor = int(state["cell_floor"])
         self.engine.lists_valid = False
         self.wall_time = float(state["wall_time"])
         self.records = {k: list(np.asarray(state["rec_" + k], dtype=float)) for k in RECORD_FIELDS}
+        if self.contacts is not None:
+            self.contacts.restore(state)
