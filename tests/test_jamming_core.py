@@ -121,10 +121,17 @@ def test_small_disk_in_a_hole_is_a_rattler():
 
 
 # ---------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("delta", [-1e-3, 0.0, 1.0, 2.5, float("nan"), float("inf"), "abc", None])
+@pytest.mark.parametrize("delta", [-1e-3, 0.0, 1.0, 2.5, float("nan"), float("inf"), "abc", [0.1]])
 def test_nonsense_delta_refused(delta):
     with pytest.raises(InvalidInputError, match="delta"):
         verify(lattice_packing("square", 2), delta=delta)
+
+
+def test_sequential_test_that_cannot_fail_is_refused():
+    """Each LP of Algorithm 14 moves a particle by at most delta r_min (neighbour list), so with
+    delta = 1e-6 three LPs reach 1.5e-6 D, far below the 1e-3 threshold: refused, with the fix."""
+    with pytest.raises(InvalidInputError, match="could never report"):
+        verify(lattice_packing("square", 2), delta=1e-6, method="sequential")
 
 
 def test_overlapping_packing_refused():

@@ -35,11 +35,15 @@ def test_volume_step():
 
 def test_sliding_rows_unjam_square_lattice():
     """Square lattice with gaps 1e-3 D in a 2 x 1 cell: rows slide (Table 4.1, C = N), so the
-    random loads carry the disks far: mean displacement >> threshold."""
+    first load carries the free disk as far as the neighbour list allows (delta r = 0.1 D, half
+    of it relative to the median of the two disks), 50 times the gaps, far beyond the 1e-2
+    threshold: not jammed, and the test stops there (Alg. 14 step 10)."""
     p = _shrunk(lattice_packing("square", (2, 1)), 1e-3)
-    r = verify(p, delta=0.2, method="sequential", tests=("collective",), seed=1, threshold=1e-2)
+    r = verify(p, delta=0.2, method="sequential", tests=("collective",), seed=1, threshold=1e-2,
+               contact_delta=2e-3)
     assert not r.collective
-    assert max(r.collective_test.mean_displacement) > 0.05
+    assert max(r.collective_test.mean_displacement) == pytest.approx(0.05, rel=1e-3)
+    assert r.collective_test.n_lp == 1 and len(r.collective_test.mean_displacement) == 1
     r.collective_test.final.overlap_report()  # a valid packing (construction checks overlaps)
 
 
@@ -48,11 +52,19 @@ def test_triangular_with_gaps_is_jammed_within_the_gaps():
     gaps (strictly jammed lattice), so the sequential test reports displacements of the order
     of the gap, far below the 1e-2 threshold, in the collective and the strict test."""
     p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-4)
-    r = verify(p, delta=0.2, method="sequential", seed=2, threshold=1e-2)
+    r = verify(p, delta=0.2, method="sequential", seed=2, threshold=1e-2, contact_delta=1e-3)
     assert r.collective and r.strict
     for out in (r.collective_test, r.strict_test):
         assert max(out.max_displacement) < 1e-2
         assert len(out.mean_displacement) == 2 * out_loads(r)
+
+
+def test_all_rattlers_is_not_jammed():
+    """Gaps 1e-3 D but contacts counted only within 1e-6: every disk is a rattler at that
+    tolerance, nothing is left to jam (Alg. 13 step 3) -- never 'jammed' by default."""
+    p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-3)
+    r = verify(p, delta=0.2, method="sequential", seed=1)
+    assert r.rattler.all() and not r.collective and not r.strict
 
 
 def out_loads(r) -> int:

@@ -14,7 +14,7 @@ import sys
 
 from hardpack.errors import InvalidInputError
 from hardpack.jamming.result import CATEGORIES
-from hardpack.jamming.verify import DEFAULT_DELTA, METHODS, verify
+from hardpack.jamming.verify import DEFAULT_DELTA, METHODS, SEQUENTIAL_DELTA, verify
 
 #: attributes holding the generator's reduced pressure PV/(NkT); hardpack.md.compress stores it as "Z"
 PRESSURE_ATTRS = ("reduced_pressure", "pressure", "final_pressure", "Z")
@@ -28,8 +28,11 @@ def register(subparsers) -> None:
     )
     p.add_argument("packing", help="packing netCDF file (hardpack.io.save_packing)")
     p.add_argument("--out", required=True, help="output netCDF file for the verdict")
-    p.add_argument("--delta", type=float, default=DEFAULT_DELTA,
-                   help=f"relative gap tolerance for contacts, 0 < delta < 1 (default {DEFAULT_DELTA:g})")
+    p.add_argument("--delta", type=float, default=None,
+                   help=f"relative gap tolerance of the contact list, 0 < delta < 1 (default "
+                        f"{DEFAULT_DELTA:g} for the ideal method, {SEQUENTIAL_DELTA:g} for the "
+                        "sequential one, whose contacts for Z and forces stay at "
+                        f"{DEFAULT_DELTA:g})")
     p.add_argument("--seed", type=int, default=0, help="seed of the random loads (default 0)")
     p.add_argument("--method", choices=METHODS, default="ideal",
                    help="ideal: Algorithm 13 (default); sequential: Algorithm 14")
@@ -61,6 +64,14 @@ def run(args) -> int:
         return 2
     out = result.to_dataset()
     out.attrs["source"] = str(args.packing)
+    if "md_contact_force" in ds and result.forces.exists:
+        from hardpack.jamming.md_forces import compare_md_forces
+
+        cmp = compare_md_forces(result.network, result.forces.forces, result.network.among(~result.rattler), ds)
+        out.attrs.update(cmp.as_attrs())
+        print(f"MD contact forces: LP virial / MD collisional pressure = {cmp.pressure_ratio:.4f}, "
+              f"rms force difference {cmp.rms_relative:.3g} of the mean ({cmp.n_matched} of "
+              f"{cmp.n_lp_contacts} contacts matched)")
     write_dataset(out, args.out, seed=args.seed)
     print(result.summary())
     print(f"written {args.out}")

@@ -96,6 +96,14 @@ class ContactNetwork:
         n = self.n_particles
         return (np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep], minlength=n))
 
+    def subset(self, mask: np.ndarray) -> ContactNetwork:
+        """The network of the contacts in ``mask`` (boolean (M,) or indices)."""
+        return ContactNetwork(
+            i=self.i[mask], j=self.j[mask], shift=self.shift[mask], separation=self.separation[mask],
+            distance=self.distance[mask], contact_distance=self.contact_distance[mask],
+            positions=self.positions, lattice=self.lattice, delta=self.delta,
+        )
+
     def among(self, active: np.ndarray | None) -> np.ndarray:
         """Boolean mask of contacts whose both ends are ``active`` (all if None)."""
         if active is None:

@@ -47,8 +47,9 @@ import scipy.sparse.linalg as spla
 
 from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.isostatic import RigidBackbone
-from hardpack.jamming.lp import LPFailure, solve_lp
+from hardpack.jamming.highs import LPFailure, solve_lp
 from hardpack.jamming.rigidity import rigidity_transpose
+from hardpack.jamming.workingset import solve_working_set
 
 
 @dataclass(frozen=True)
@@ -126,6 +127,64 @@ def self_stress(net: ContactNetwork, backbone: np.ndarray) -> Forces:
     return Forces(forces, float(t), mu, imbalance, True)
 
 
+def jamming_point_forces(net: ContactNetwork, backbone: np.ndarray, contact_delta: float,
+                         box: float) -> tuple[ContactNetwork, Forces] | None:
+    """Forces of the jamming point nearest to a backbone that has no self-stress of its own.
+
+    A finite-pressure LS packing can be hypostatic at the contact tolerance (e.g. two contacts
+    short at delta = 1e-6 for N = 1000 in 3D: a floppy mode that the MD explores by ~1e-6 D and
+    that ends on near contacts at gaps 1e-6-1e-5). Then A f = 0, f >= 0 has no solution on the
+    contacts and LP 1 of the module docstring is infeasible. Its dual says why: the linearised
+    particles can all grow, ``max mu s.t. A^T dR >= mu D - h``, until near contacts close. On
+    the contact list ``net`` of a larger tolerance (the first coordination shell) the same LP
+    is bounded; its optimal f is the self-stress of the jamming point the packing is closest
+    to, supported on the contacts plus the near contacts that close there (for one floppy mode,
+    one at each end of it). As the pressure diverges the packing converges to that point, and
+    the time-averaged collision forces of the MD, which balance every particle, converge to
+    that self-stress -- which is why it is the one to compare with them
+    (:mod:`hardpack.jamming.md_forces`). Solved by :func:`solve_working_set` (the
+    variables are dR of the backbone minus an anchor and mu, columns (a_c, -D_c), gaps h_c;
+    its dual is LP 1: A f = 0, D^T f = 1, f >= 0, min h^T f).
+
+    Returns the network of the contacts within ``contact_delta`` plus the near contacts that
+    carry force, and the forces on it (mean 1 over its backbone contacts), or None if the LP
+    fails or no self-stress exists even on ``net`` (the growth reaches the LP box).
+    """
+    d = net.dim
+    contacts = net.among(backbone)
+    nb = int(backbone.sum())
+    if nb < 2 or not contacts.any():
+        return None
+    moving = backbone.copy()
+    moving[np.flatnonzero(backbone)[0]] = False
+    at = rigidity_transpose(net)[contacts][:, np.flatnonzero(np.repeat(moving, d))]
+    dist, h = net.contact_distance[contacts], net.gap[contacts]
+    g = sp.vstack([at.T, sp.csr_matrix(-dist[None, :])], format="csc")
+    nvar = g.shape[0]
+    c = np.zeros(nvar)
+    c[-1] = 1.0
+    upper = np.full(nvar, float(box))
+    upper[-1] = 1.0  # mu: relative growth of the diameters
+    sol = solve_working_set(g, h, c, upper)
+    if sol is None or np.abs(sol.x).max() >= (1.0 - 1e-9) * float(box) or sol.x[-1] >= 1.0 - 1e-9:
+        return None
+    f_all = np.zeros(net.n_contacts)
+    f_all[contacts] = np.maximum(sol.forces, 0.0)
+    rel_gap = net.distance / net.contact_distance - 1.0
+    keep = (rel_gap <= contact_delta) | (f_all > 1e-12 * f_all.max())
+    sub = net.subset(keep)
+    f = f_all[keep]
+    sub_contacts = sub.among(backbone)
+    a = backbone_rows(sub, backbone, sub_contacts)
+    loaded = polish(a, f[sub_contacts])
+    m = int(sub_contacts.sum())
+    loaded *= m / loaded.sum()
+    f[sub_contacts] = loaded
+    imbalance = np.zeros((net.n_particles, d))
+    imbalance[backbone] = (a @ loaded).reshape(-1, d)
+    return sub, Forces(f, float(loaded.min() / loaded.mean()), float(sol.x[-1]), imbalance, True)
+
+
 def _reduced_lps(null: np.ndarray, h: np.ndarray, dist: np.ndarray, uniform: np.ndarray):
     """LPs 1 and 2 of the module docstring with f = null @ alpha (a strictly positive self-stress
     ``uniform`` exists). Returns (f, min force / mean, mu*)."""
@@ -192,10 +251,15 @@ class Statics:
     pressure_free_volume: float  # (N_b - 1) / (N mu*), reduced pressure PV/(NkT)
 
 
-def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: float) -> Statics:
+def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: float,
+            counted: np.ndarray | None = None) -> Statics:
+    """Counts over the backbone contacts in ``counted`` (default all; :func:`verify` leaves out
+    the near contacts that only carry the forces of the nearest jamming point), pressures over
+    every contact with a force."""
     d, n = net.dim, net.n_particles
     contacts = net.among(backbone)
-    nb, mb = int(backbone.sum()), int(contacts.sum())
+    nb = int(backbone.sum())
+    mb = int((contacts if counted is None else contacts & counted).sum())
     nf = d * (nb - 1) if nb else 0
     nf_strict = nf + d * (d + 1) // 2 - 1 if nb else 0
     f = forces.forces[contacts]

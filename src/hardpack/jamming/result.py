@@ -124,6 +124,11 @@ class JammingResult:
                     f"{test} unjamming displacement / D: mean {u['mean']:.3g}, max {u['max']:.3g}"
                     f", strain {u['strain']:.3g}"
                 )
+        if "force_near_contacts" in p:
+            lines.append(
+                f"forces of the nearest jamming point: {p['force_near_contacts']} near contacts "
+                f"(within delta = {p['force_delta']:g}) close there and carry force"
+            )
         if self.forces.exists:
             lines.append(
                 f"forces: min/mean {self.forces.min_force:.3g}, max |imbalance| "

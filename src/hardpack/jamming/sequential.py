@@ -7,6 +7,8 @@ Donev dissertation sec. 4.6.2, seeds/000_chapters/ch04-05.txt L1678-L1814:
    large rattler displacements the text warns about, L1746-L1751);
 4. random load B (zero on rattlers);
 5. solve LP 4.10 (+ 4.17 for the strict test) for a linearised motion (dR, eps);
+   The LP box (|dr| <= box, footnote 8) is at most delta r_min, the trust region of the
+   linearised neighbour list: a longer LP motion could not be taken in step 6 anyway;
 6. move along it as far as possible: the largest tau such that no pair overlaps for
    t in [0, tau] (quadratic collision times of the straight-line motion, as in LS collision
    scheduling, L1754-L1774), no pair outside the contact list can collide (every particle
@@ -14,7 +16,15 @@ Donev dissertation sec. 4.6.2, seeds/000_chapters/ch04-05.txt L1678-L1814:
    R <- R + tau dR, Lambda <- (I + tau eps) Lambda, and the contact network is rebuilt;
 7. repeat 5-6 while some particle moved by more than beta D (at most ``max_steps`` LPs);
 9. the same with -B; 10. ``n_loads`` loads in all (the text used 3 loads x 2 directions x 3 LPs,
-   L2074-L2081).
+   L2074-L2081), and, as step 10 says, stop with "not jammed" as soon as the displacement
+   accumulated in a sequence exceeds the threshold (a valid packing that far from the start
+   certifies the verdict; the remaining loads could only add statistics).
+
+The contact list must reach beyond the gaps that matter: step 6 moves no particle by more than
+delta D_min / 2 per LP, so a sequence can never displace anything by more than
+max_steps delta D_min / 2 and a small delta makes the test unable to fail (:func:`verify`
+refuses such settings; Donev uses delta = 0.1-1, L1729-L1738). The LPs of one test are solved
+by :mod:`hardpack.jamming.workingset`, each warm-started from the previous one's basis.
 
 The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated over one loading
 sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
@@ -60,6 +70,7 @@ class SequentialOutcome:
     strain: np.ndarray | None = None  # (d, d) total strain of that sequence
     final: Packing | None = None  # the packing after all loads
     n_lp: int = 0
+    n_lp_highs: int = 0  # LPs HiGHS solved (the others: hardpack.jamming.workingset)
     seconds: float = 0.0
     method: str = "sequential"
 
@@ -140,6 +151,9 @@ def sequential_test(
     out.displacement = np.zeros(n)
     current = packing
     best = -1.0
+    warm = None  # the LPs of one test share their variables: each warm-starts the next
+    # LP box = the step's trust region: no LP motion beyond delta r_min can be taken (list_step)
+    box = min(box, delta * float(packing.radii.min()))
     for _ in range(n_loads):
         base = random_load(rng, moving, d)
         base_eps = random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None
@@ -152,8 +166,10 @@ def sequential_test(
                 mot = solve_motion(
                     net, moving, sign * base, fixed=rattlers, box=box,
                     cell_length=cell_length(current.lattice),
-                    strain_load=None if base_eps is None else sign * base_eps,
+                    strain_load=None if base_eps is None else sign * base_eps, warm=warm,
                 )
+                warm = mot.warm
+                out.n_lp_highs += mot.solver == "highs"
                 steps += 1
                 tau = min(
                     collision_step(net, mot.displacement, mot.strain),
@@ -167,6 +183,8 @@ def sequential_test(
                 total += step
                 if strict:
                     strain_total += tau * mot.strain
+                if _mean_size(total, moving, diameter) >= threshold:
+                    break  # step 10: unjammed beyond the threshold, the verdict is settled
                 if np.linalg.norm(step[moving], axis=1).max(initial=0.0) <= beta * diameter:
                     break
             out.n_lp += steps
@@ -182,10 +200,23 @@ def sequential_test(
             if mean > best:
                 best, out.motion = mean, rel
                 out.strain = strain_total if strict else None
-    out.jammed = bool(max(out.mean_displacement, default=0.0) < threshold)
+            if mean >= threshold:
+                break
+        if best >= threshold:
+            break
+    # no particle left to load: every one is a rattler, nothing is jammed (Alg. 13 step 3)
+    out.jammed = bool(moving.any() and max(out.mean_displacement, default=0.0) < threshold)
     out.final = current
     out.seconds = time.perf_counter() - t0
     return out
+
+
+def _mean_size(total: np.ndarray, moving: np.ndarray, diameter: float) -> float:
+    """Mean |dr_i| / D over the moving particles, relative to their componentwise median."""
+    if not moving.any():
+        return 0.0
+    rel = total[moving] - np.median(total[moving], axis=0)
+    return float(np.linalg.norm(rel, axis=1).mean() / diameter)
 
 
 def _advance(packing: Packing, net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None,

@@ -1,35 +1,45 @@
 """verify(packing): the full jamming verdict of a periodic sphere packing.
 
 Steps (Donev dissertation ch. 4, seeds/000_chapters/ch04-05.txt):
-1. contact network within the relative gap ``delta`` (Eq. 4.5), all periodic images;
+1. contact network within the relative gap ``delta`` (Eq. 4.5; sequential method:
+   ``contact_delta``), all periodic images;
 2. local test and iterative rattler removal (LP 4.15, Alg. 13 step 4) -- always run, since
    the other tests need a rattler-free packing;
 3. collective test (strain fixed) and strict test (strain with Tr eps <= 0), either with
    Algorithm 13 (``method="ideal"``: exact binary verdict for packings with tiny gaps) or
    Algorithm 14 (``method="sequential"``: random loading that moves the packing, for
    finite-rate packings with gaps; the verdict thresholds the mean displacement). The
-   strict test starts from the collectively jammed backbone when there is one;
+   strict test starts from the collectively jammed backbone when there is one; with the ideal
+   method, a packing without one is not strictly jammed either (strict implies collective,
+   L165-L166) and no strict LP is solved;
 4. self-stress forces, contact number, isostaticity and pressure of the backbone
-   (:mod:`hardpack.jamming.forces`).
+   (:mod:`hardpack.jamming.forces`); a backbone without a self-stress gets the forces of the
+   nearest jamming point (near contacts within ``force_delta`` that close there carry force).
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.jamming.contacts import check_delta, contact_network
-from hardpack.jamming.forces import self_stress, statics
+from hardpack.jamming.forces import jamming_point_forces, self_stress, statics
 from hardpack.jamming.ideal import ideal_test
 from hardpack.jamming.rattlers import remove_rattlers
 from hardpack.jamming.result import CATEGORIES, JammingResult
 from hardpack.jamming.sequential import sequential_test
 
 METHODS = ("ideal", "sequential")
+#: contact tolerance of the ideal test (LS packings at high pressure: contacts ~1e-12, the next
+#: neighbours ~1e-6 and beyond) and of the contacts counted for Z, isostaticity and forces
 DEFAULT_DELTA = 1e-6
+#: neighbour-list tolerance of the sequential test: Donev's 0.1-1 D (L1729-L1738), the first
+#: coordination shell; each LP may then move a particle by up to delta D_min / 2 = 0.05 D
+SEQUENTIAL_DELTA = 0.1
 
 
 def _positive(name: str, value, upper: float | None = None) -> float:
@@ -57,7 +67,7 @@ def _check_tests(tests) -> tuple[str, ...]:
 
 def verify(
     packing: Packing,
-    delta: float = DEFAULT_DELTA,
+    delta: float | None = None,
     tests=CATEGORIES,
     seed: int = 0,
     *,
@@ -70,40 +80,54 @@ def verify(
     beta: float = 0.01,
     md_pressure: float | None = None,
     contact_delta: float | None = None,
+    force_delta: float | None = None,
 ) -> JammingResult:
     """Classify ``packing`` as locally / collectively / strictly jammed (see the module docstring).
 
     Parameters
     ----------
-    delta : relative gap tolerance for contacts, 0 < delta < 1.
+    delta : relative gap tolerance for contacts, 0 < delta < 1; default DEFAULT_DELTA (1e-6)
+        for the ideal method and SEQUENTIAL_DELTA (0.1) for the sequential one, whose
+        neighbour list must reach the near contacts a loading sequence can close.
     tests : any of "local", "collective", "strict" (local always runs: the others need it).
     seed : seed of the random loads (results are reproducible for a given seed).
     method : "ideal" (Algorithm 13) or "sequential" (Algorithm 14).
     dr_large : displacement (absolute length) above which a particle counts as displaced in
-        the ideal test and the local test; default delta times the mean diameter
-        (Alg. 13 step 2, "delta D ~ dr_large").
+        the ideal test and the local test; default delta (sequential: contact_delta) times the
+        mean diameter (Alg. 13 step 2, "delta D ~ dr_large").
     box : bound on each displacement component in the LPs; default the mean diameter.
     threshold, n_loads, max_steps, beta : sequential test only (mean displacement / D above
         which the packing is called unjammed; loads; LPs per load direction; step size / D
         below which a loading sequence stops).
     md_pressure : reduced pressure PV/(NkT) measured by the generator, compared with the
         free-volume pressure from the forces.
-    contact_delta : gap tolerance of the contacts counted for Z, isostaticity and forces with
-        ``method="sequential"``, whose ``delta`` (0.01-1, Donev L1729-L1738) includes near
-        neighbours on purpose; default min(delta, 1e-6). The ideal method uses ``delta``.
+    contact_delta : gap tolerance of the contacts that define the rattlers (the local test),
+        Z, isostaticity and forces with ``method="sequential"``, whose ``delta`` (0.1-1, Donev
+        L1729-L1738) includes near neighbours on purpose; default min(delta, 1e-6). The ideal
+        method uses ``delta``. Rattlers stay fixed obstacles in the sequential LPs.
+    force_delta : when the backbone has no self-stress at the contact tolerance (a hypostatic
+        finite-pressure packing), the forces are those of the nearest jamming point, found on
+        the contacts within this tolerance (default SEQUENTIAL_DELTA, the first shell; see
+        :func:`hardpack.jamming.forces.jamming_point_forces`). The result's network then also
+        holds the near contacts that carry force; Z and the isostaticity counts leave them out.
     """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
             f"verify expects a hardpack Packing, got {type(packing).__name__}"
         )
-    delta = check_delta(delta)
-    tests = _check_tests(tests)
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
+    delta = check_delta((SEQUENTIAL_DELTA if method == "sequential" else DEFAULT_DELTA) if delta is None else delta)
+    tests = _check_tests(tests)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
     diameter = 2.0 * float(packing.radii.mean())
-    dr_large = delta * diameter if dr_large is None else _positive("dr_large", dr_large)
+    sequential = method == "sequential"
+    if sequential:
+        contact_delta = min(delta, DEFAULT_DELTA) if contact_delta is None else check_delta(contact_delta)
+    else:
+        contact_delta = delta
+    dr_large = contact_delta * diameter if dr_large is None else _positive("dr_large", dr_large)
     box = diameter if box is None else _positive("box", box)
     threshold = _positive("threshold", threshold)
     beta = _positive("beta", beta)
@@ -112,6 +136,15 @@ def verify(
             raise InvalidInputError(f"{name} must be a positive integer, got {value!r}")
     if md_pressure is not None:
         md_pressure = _positive("md_pressure", md_pressure)
+    reach = max_steps * delta * float(packing.radii.min()) / diameter
+    if method == "sequential" and reach < threshold:
+        raise InvalidInputError(
+            f"the sequential test with delta = {delta:g} and max_steps = {max_steps} can move a "
+            f"particle by at most max_steps * delta * r_min = {reach:.3g} D per loading sequence, "
+            f"below the threshold {threshold:g} D: it could never report 'not jammed'. Use a "
+            f"neighbour-list tolerance delta >= {threshold * diameter / (max_steps * packing.radii.min()):.3g} "
+            f"(Donev: 0.1-1, the default is {SEQUENTIAL_DELTA:g})"
+        )
     if dr_large >= box:
         raise InvalidInputError(
             f"dr_large = {dr_large:g} must be smaller than the LP box {box:g}, otherwise no "
@@ -121,7 +154,7 @@ def verify(
     rng = np.random.default_rng(int(seed))
     seconds = {}
     t0 = time.perf_counter()
-    net = contact_network(packing, delta)
+    net = contact_network(packing, contact_delta)
     seconds["contacts"] = time.perf_counter() - t0
     n = packing.n_particles
 
@@ -137,7 +170,12 @@ def verify(
         if "collective" in tests:
             collective = ideal_test(net, local_active, strict=False, dr_large=dr_large, **common)
             seconds["collective"] = collective.seconds
-        if "strict" in tests:
+        if "strict" in tests and collective is not None and not collective.jammed:
+            # strict jamming implies collective jamming (L165-L166): no LP needed
+            strict = replace(collective, test="strict", method="implied by the collective test",
+                             n_lp=0, seconds=0.0, loads=[])
+            seconds["strict"] = 0.0
+        elif "strict" in tests:
             start = collective.backbone if collective is not None and collective.jammed else local_active
             strict = ideal_test(net, start, strict=True, dr_large=dr_large, **common)
             seconds["strict"] = strict.seconds
@@ -151,18 +189,21 @@ def verify(
         if "strict" in tests:
             strict = sequential_test(packing, delta, strict=True, **kwargs)
             seconds["strict"] = strict.seconds
-        contact_delta = min(delta, DEFAULT_DELTA) if contact_delta is None else check_delta(contact_delta)
-        net = contact_network(packing, contact_delta)
-        backbone, _ = remove_rattlers(
-            net, np.ones(n, dtype=bool), dr_large=contact_delta * diameter, box=box, rng=rng
-        )
+        backbone = local_active
 
     t0 = time.perf_counter()
     forces = self_stress(net, backbone)
-    stat = statics(net, backbone, forces, packing.volume)
+    counted, near = None, {}
+    if not forces.exists and backbone.any():  # hypostatic at contact_delta: nearest jamming point
+        force_delta = max(SEQUENTIAL_DELTA, contact_delta) if force_delta is None else check_delta(force_delta)
+        found = jamming_point_forces(contact_network(packing, force_delta), backbone, contact_delta, box)
+        if found is not None:
+            net, forces = found
+            counted = net.distance / net.contact_distance - 1.0 <= contact_delta
+            near = {"force_delta": force_delta, "force_near_contacts": int((~counted).sum())}
+    stat = statics(net, backbone, forces, packing.volume, counted)
     seconds["forces"] = time.perf_counter() - t0
 
-    sequential = method == "sequential"
     params = {
         "method": method, "delta": delta, "dr_large": dr_large, "box": box, "seed": int(seed),
         "tests": list(tests), "mean_diameter": diameter,
@@ -171,6 +212,7 @@ def verify(
         "max_steps": max_steps if sequential else None,
         "beta": beta if sequential else None,
         "contact_delta": contact_delta if sequential else None,
+        **near,
     }
     return JammingResult(
         params=params, network=net, local=bool(local_active.any()),

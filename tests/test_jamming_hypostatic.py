@@ -1,0 +1,105 @@
+"""Hypostatic packings: the sequential test must unjam them, and their forces are those of the
+nearest jamming point; the working-set LP solver against HiGHS.
+
+References: a contact network with fewer than d(N-1) + 1 contacts cannot be jammed (Donev
+L534, Eq. 4.8); the honeycomb lattice (Z = 3 < 4) is not collectively jammed (Table 4.1). An
+isostatic network has a unique self-stress (Ch. 5, L2894-L2899), so when one of its contacts is
+opened by 1e-7 D the self-stress of the nearest jamming point must be exactly that one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_jamming_support import jammed_disks
+
+from hardpack.geometry.lattices import lattice_packing
+from hardpack.geometry.packing import Packing
+from hardpack.jamming import contact_network, remove_rattlers, rigidity_matrix, verify
+from hardpack.jamming.ideal import cell_length
+from hardpack.jamming.lp import random_load, random_strain_load, solve_motion
+
+
+def _opened(p: Packing, gap: float) -> tuple[Packing, int]:
+    """``p`` (exact isostatic contacts) with one backbone contact opened by ``gap`` and every
+    other contact kept exact to first order: the least-norm change of positions and radii with
+    A^T dx - (dr_i + dr_j) = gap e_k. The contact is one whose loss leaves every backbone disk
+    locally jammed. Returns the packing and the number of backbone disks."""
+    net = contact_network(p, 1e-9)
+    rng = np.random.default_rng(0)
+    backbone, _ = remove_rattlers(net, np.ones(p.n_particles, bool), dr_large=1e-9, box=1.0, rng=rng)
+    c = np.flatnonzero(net.among(backbone))
+    for k in c:
+        left, _ = remove_rattlers(net.subset(c[c != k]), backbone, dr_large=1e-9, box=1.0, rng=rng)
+        if left.sum() == backbone.sum():
+            break
+    n, d = p.n_particles, p.dim
+    radius_rows = np.zeros((c.size, n))
+    radius_rows[np.arange(c.size), net.i[c]] += 1.0
+    radius_rows[np.arange(c.size), net.j[c]] += 1.0
+    system = np.hstack([rigidity_matrix(net).toarray()[:, c].T, -radius_rows])
+    change = np.linalg.lstsq(system, np.where(c == k, gap, 0.0), rcond=None)[0]
+    radii = p.radii + change[n * d:]
+    radii[~backbone] *= 1 - 1e-4  # rattlers: room for their moved neighbours
+    return Packing(net.positions + change[: n * d].reshape(n, d), radii, p.lattice), int(backbone.sum())
+
+
+def test_forces_of_the_nearest_jamming_point_restore_the_open_contact():
+    """One contact of an isostatic disk packing opened by ~3e-7: at the contact tolerance 1e-8
+    the backbone is one contact short (no self-stress); the forces of the nearest jamming point
+    close exactly that contact and equal the unique self-stress of the full network to round-off."""
+    q, n_backbone = _opened(jammed_disks(), 1e-6)
+    full = verify(q, delta=1e-5, tests=("local",))
+    short = verify(q, delta=1e-8, tests=("local",))
+    assert full.statics.isostaticity_gap == 0 and short.statics.isostaticity_gap == -1
+    assert short.statics.n_backbone == n_backbone and short.params["force_near_contacts"] == 1
+    reference = {(i, j, tuple(s)): f for i, j, s, f in
+                 zip(full.network.i, full.network.j, full.network.shift, full.forces.forces)}
+    mine = short.network
+    expected = [reference[(i, j, tuple(s))] for i, j, s in zip(mine.i, mine.j, mine.shift)]
+    np.testing.assert_allclose(short.forces.forces, expected, atol=1e-12)
+    assert np.abs(short.forces.imbalance).max() < 1e-12
+
+
+def test_hypostatic_honeycomb_unjams_under_sequential_loading():
+    """Honeycomb (Z = 3: M = 1.5 N < 2 N - 1, hypostatic by construction) with gaps 1e-4 D: the
+    first load already moves the disks by ~0.03 D, 300 times the gaps and 30 times the
+    threshold: not collectively jammed."""
+    p = lattice_packing("honeycomb", (2, 2))
+    p = p.replace(radii=p.radii * (1 - 1e-4))
+    r = verify(p, method="sequential", seed=1, contact_delta=1e-3)
+    assert r.statics.isostaticity_gap < 0
+    assert not r.collective and max(r.collective_test.mean_displacement) > 0.01
+
+
+def test_jammed_disks_stay_within_their_gaps():
+    """The exactly jammed isostatic disks: no load moves the backbone by more than round-off in
+    the collective test (threshold 1e-3), while the fixed cell lets the strict test shear them
+    (Donev L2012-L2017: fixed-cell packings are not strictly jammed)."""
+    r = verify(jammed_disks(), method="sequential", seed=1)
+    assert r.collective and max(r.collective_test.mean_displacement) < 1e-8
+    assert not r.strict and r.strict_test.n_lp <= 3
+
+
+@pytest.mark.parametrize("strict", [False, True])
+def test_working_set_matches_highs(strict):
+    """The sparse-LU working-set solver (cold, and warm-started for the reversed load) returns the
+    optimum HiGHS finds for LP 4.10 on the first coordination shell of slightly opened jammed
+    disks (two independent solvers; the tolerance is HiGHS's 1e-10)."""
+    q, _ = _opened(jammed_disks(), 1e-3)
+    net = contact_network(q, 0.1)
+    rng = np.random.default_rng(5)
+    moving = np.ones(q.n_particles, bool)
+    load = random_load(rng, moving, 2)
+    length = cell_length(q.lattice)
+    eps = random_strain_load(rng, 2, length) * 1e-3 if strict else None
+    common = {"box": 0.05, "cell_length": length}
+    warm = None
+    for sign, solver in ((1.0, "highs" if strict else "working-set"), (-1.0, "working-set")):
+        strain = None if eps is None else sign * eps
+        exact = solve_motion(net, moving, sign * load, strain_load=strain, working_set=False, **common)
+        mine = solve_motion(net, moving, sign * load, strain_load=strain, warm=warm, **common)
+        assert mine.solver == solver  # a cold strict LP goes to HiGHS (solve_motion)
+        warm = mine.warm
+        assert mine.objective == pytest.approx(exact.objective, rel=1e-7)
+        np.testing.assert_allclose(mine.displacement, exact.displacement, atol=1e-8)
