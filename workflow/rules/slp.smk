@@ -1,12 +1,19 @@
-# Study 1 (SLP generator, Torquato & Jiao 2010): densest packings from N = 3^d random starts (Table II).
+# Study 1 (SLP generator, Torquato & Jiao 2010): densest packings from N = 3^d random starts
+# (Table II), MRJ-like packings beside the LS ensembles and in SLP-only systems (Table I), and the
+# 3D order map phi-T over influence radii and bound widths (Fig. 6).
 
-SLP_DENSEST = config.get("slp", {}).get("densest")
-if SLP_DENSEST and len(SLP_DENSEST["d"]) != len(SLP_DENSEST["init_phi"]):
-    raise ValueError("config: slp.densest.init_phi must have one entry per entry of slp.densest.d")
+SLP = config.get("slp", {})
+SLP_DENSEST = SLP.get("densest")
+SLP_DENSEST_RUNS = {run["d"]: run for run in SLP_DENSEST["runs"]} if SLP_DENSEST else {}
+if SLP_DENSEST and len(SLP_DENSEST_RUNS) != len(SLP_DENSEST["runs"]):
+    raise ValueError("config: slp.densest.runs lists a dimension twice")
 
 
-def slp_densest_init_phi(wildcards):
-    return SLP_DENSEST["init_phi"][SLP_DENSEST["d"].index(int(wildcards.d))]
+def slp_flags(settings):
+    """The `hardpack slp` options of one (alpha, bounds) setting."""
+    b = settings["bounds"]
+    return (f"--alpha {settings['alpha']} --strain-bound {b['strain']} --shear-bound {b['shear']}"
+            f" --displacement-bound {b['displacement']} --lp-method {settings.get('lp_method', 'highs-ipm')}")
 
 
 rule slp_densest_init:
@@ -14,7 +21,7 @@ rule slp_densest_init:
     output:
         "results/slp/densest/d{d}/init_seed{seed}.nc",
     params:
-        phi=slp_densest_init_phi,
+        phi=lambda w: SLP_DENSEST_RUNS[int(w.d)]["init_phi"],
     log:
         "results/logs/slp_densest_init/d{d}_seed{seed}.log",
     shell:
@@ -30,36 +37,43 @@ rule slp_densest:
         packing="results/slp/densest/d{d}/seed{seed}.nc",
         history="results/slp/densest/d{d}/history_seed{seed}.nc",
     params:
-        alpha=SLP_DENSEST["alpha"] if SLP_DENSEST else None,
-        bounds=SLP_DENSEST["bounds"] if SLP_DENSEST else None,
+        flags=slp_flags(SLP_DENSEST) if SLP_DENSEST else "",
     log:
         "results/logs/slp_densest/d{d}_seed{seed}.log",
     shell:
-        "hardpack slp --init {input} --out {output.packing} --history {output.history}"
-        " --alpha {params.alpha} --strain-bound {params.bounds[strain]}"
-        " --shear-bound {params.bounds[shear]} --displacement-bound {params.bounds[displacement]}"
+        "hardpack slp --init {input} --out {output.packing} --history {output.history} {params.flags}"
         " --attr d={wildcards.d} 2> {log}"
 
 
 rule slp_densest_summary:
     """Table II reproduced: one Dataset over (d, seed)."""
     input:
-        expand("results/slp/densest/d{d}/seed{seed}.nc", d=SLP_DENSEST["d"], seed=SLP_DENSEST["seeds"])
-        if SLP_DENSEST else [],
+        [f"results/slp/densest/d{d}/seed{seed}.nc" for d, run in SLP_DENSEST_RUNS.items() for seed in run["seeds"]],
     output:
         "results/slp/densest_summary.nc",
     log:
         "results/logs/slp_densest_summary.log",
     shell:
         "hardpack combine {input} --index d seed --variable n_steps --variable n_rejected"
-        " --variable wall_seconds --variable converged --out {output} 2> {log}"
+        " --variable wall_seconds --variable cpu_seconds --variable converged --out {output} 2> {log}"
 
 
-SLP_MRJ = config.get("slp", {}).get("mrj")
+SLP_MRJ = SLP.get("mrj")
+SLP_SYSTEMS = SLP_MRJ.get("systems", {}) if SLP_MRJ else {}
 if SLP_MRJ:
     for _name in SLP_MRJ["ensembles"]:
         if _name not in ENSEMBLES:
             raise ValueError(f"config: slp.mrj.ensembles names {_name!r}, which is not an ensemble")
+    for _name in SLP_SYSTEMS:
+        if _name in ENSEMBLES:
+            raise ValueError(f"config: slp.mrj.systems.{_name} has the name of an ensemble; rename it")
+MONODISPERSE = json.dumps({"kind": "monodisperse"})
+
+
+wildcard_constraints:
+    system="[A-Za-z][A-Za-z0-9_]*",
+    d=r"\d+",
+    k=r"\d+",
 
 
 rule slp_mrj_init:
@@ -87,14 +101,11 @@ rule slp_mrj:
         packing="results/ensembles/{ensemble}/slp/seed{seed}.nc",
         history="results/ensembles/{ensemble}/slp/history_seed{seed}.nc",
     params:
-        alpha=SLP_MRJ["alpha"] if SLP_MRJ else None,
-        bounds=SLP_MRJ["bounds"] if SLP_MRJ else None,
+        flags=slp_flags(SLP_MRJ) if SLP_MRJ else "",
     log:
         "results/logs/slp_mrj/{ensemble}_seed{seed}.log",
     shell:
-        "hardpack slp --init {input} --out {output.packing} --history {output.history}"
-        " --alpha {params.alpha} --strain-bound {params.bounds[strain]}"
-        " --shear-bound {params.bounds[shear]} --displacement-bound {params.bounds[displacement]} 2> {log}"
+        "hardpack slp --init {input} --out {output.packing} --history {output.history} {params.flags} 2> {log}"
 
 
 rule slp_mrj_summary:
@@ -109,8 +120,130 @@ rule slp_mrj_summary:
     log:
         "results/logs/slp_mrj_summary/{ensemble}.log",
     shell:
-        "hardpack combine {input} --index seed --variable n_steps --variable wall_seconds"
+        "hardpack combine {input} --index seed --variable n_steps --variable wall_seconds --variable cpu_seconds"
         " --attr ensemble={wildcards.ensemble} --attr distribution='{params.distribution}' --out {output} 2> {log}"
+
+
+rule slp_system_init:
+    """Dilute monodisperse RSA start of an SLP-only Table I system (a dimension without LS ensemble)."""
+    output:
+        "results/slp/mrj/{system}/init_seed{seed}.nc",
+    params:
+        n=lambda w: SLP_SYSTEMS[w.system]["N"],
+        d=lambda w: SLP_SYSTEMS[w.system]["d"],
+        phi=SLP_MRJ["init_phi"] if SLP_MRJ else None,
+    log:
+        "results/logs/slp_system_init/{system}_seed{seed}.log",
+    shell:
+        "hardpack init --n {params.n} --d {params.d} --phi {params.phi} --seed {wildcards.seed}"
+        " --attr ensemble={wildcards.system} --out {output} 2> {log}"
+
+
+rule slp_system:
+    """SLP (Table I settings) of one SLP-only system."""
+    input:
+        "results/slp/mrj/{system}/init_seed{seed}.nc",
+    output:
+        packing="results/slp/mrj/{system}/seed{seed}.nc",
+        history="results/slp/mrj/{system}/history_seed{seed}.nc",
+    params:
+        flags=slp_flags(SLP_MRJ) if SLP_MRJ else "",
+    log:
+        "results/logs/slp_system/{system}_seed{seed}.log",
+    shell:
+        "hardpack slp --init {input} --out {output.packing} --history {output.history} {params.flags} 2> {log}"
+
+
+rule verify_slp_system:
+    """LP jamming tests of one SLP-only packing (strict jamming expected: deforming cell)."""
+    input:
+        "results/slp/mrj/{system}/seed{seed}.nc",
+    output:
+        "results/slp/mrj/{system}/jamming_seed{seed}.nc",
+    log:
+        "results/logs/verify_slp_system/{system}_seed{seed}.log",
+    shell:
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+
+
+rule slp_system_summary:
+    """Densities (kind=slp) or jamming verdicts (kind=slp_jamming) of an SLP-only system over its seeds."""
+    input:
+        lambda w: expand("results/slp/mrj/{system}/{prefix}seed{seed}.nc", system=w.system,
+                         prefix="" if w.kind == "slp" else "jamming_", seed=SLP_SYSTEMS[w.system]["seeds"]),
+    output:
+        "results/slp/mrj/{system}/{kind}_summary.nc",
+    wildcard_constraints:
+        kind="slp|slp_jamming",
+    params:
+        variables=lambda w: ("--variable n_steps --variable wall_seconds --variable cpu_seconds" if w.kind == "slp" else
+                             "--variable z_mean --variable rattler_fraction --variable isostaticity_gap"
+                             " --variable local --variable collective --variable strict"),
+        distribution=MONODISPERSE,
+    log:
+        "results/logs/slp_system_summary/{system}_{kind}.log",
+    shell:
+        "hardpack combine {input} --index seed {params.variables} --attr ensemble={wildcards.system}"
+        " --attr distribution='{params.distribution}' --out {output} 2> {log}"
+
+
+SLP_ORDER = SLP.get("order_map")
+
+
+rule slp_order_map_init:
+    """Dilute 3D monodisperse start shared by every (alpha, bounds) setting of the order map."""
+    output:
+        "results/slp/order_map/init_seed{seed}.nc",
+    params:
+        n=SLP_ORDER["N"] if SLP_ORDER else None,
+        phi=SLP_ORDER["init_phi"] if SLP_ORDER else None,
+    log:
+        "results/logs/slp_order_map_init/seed{seed}.log",
+    shell:
+        "hardpack init --n {params.n} --d 3 --phi {params.phi} --seed {wildcards.seed} --out {output} 2> {log}"
+
+
+rule slp_order_map_run:
+    """SLP from one start with setting k of slp.order_map.settings."""
+    input:
+        "results/slp/order_map/init_seed{seed}.nc",
+    output:
+        "results/slp/order_map/s{k}_seed{seed}.nc",
+    params:
+        flags=lambda w: slp_flags(SLP_ORDER["settings"][int(w.k)]),
+    log:
+        "results/logs/slp_order_map/s{k}_seed{seed}.log",
+    shell:
+        "hardpack slp --init {input} --out {output} {params.flags} --attr setting={wildcards.k} 2> {log}"
+
+
+rule verify_slp_order_map:
+    """Strict-jamming verdict of one order-map packing."""
+    input:
+        "results/slp/order_map/s{k}_seed{seed}.nc",
+    output:
+        "results/slp/order_map/jamming_s{k}_seed{seed}.nc",
+    log:
+        "results/logs/verify_slp_order_map/s{k}_seed{seed}.log",
+    shell:
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+
+
+SLP_ORDER_RUNS = ([(k, seed) for k in range(len(SLP_ORDER["settings"])) for seed in SLP_ORDER["seeds"]]
+                  if SLP_ORDER else [])
+
+
+rule slp_order_map_summary:
+    """phi, translational order T, jamming verdict and settings of every order-map packing."""
+    input:
+        packings=[f"results/slp/order_map/s{k}_seed{seed}.nc" for k, seed in SLP_ORDER_RUNS],
+        verdicts=[f"results/slp/order_map/jamming_s{k}_seed{seed}.nc" for k, seed in SLP_ORDER_RUNS],
+    output:
+        "results/slp/order_map_summary.nc",
+    log:
+        "results/logs/slp_order_map_summary.log",
+    script:
+        "../scripts/slp_order_map.py"
 
 
 rule fig_slp_densest:
@@ -131,6 +264,7 @@ rule fig_slp_vs_ls:
     input:
         slp=expand("results/ensembles/{ensemble}/slp_summary.nc", ensemble=SLP_MRJ["ensembles"]) if SLP_MRJ else [],
         ls=expand("results/ensembles/{ensemble}/jammed_summary.nc", ensemble=SLP_MRJ["ensembles"]) if SLP_MRJ else [],
+        systems=expand("results/slp/mrj/{system}/slp_summary.nc", system=SLP_SYSTEMS),
     output:
         pdf="results/figures/slp_vs_ls.pdf",
         png="results/figures/slp_vs_ls.png",
@@ -140,9 +274,30 @@ rule fig_slp_vs_ls:
         "../scripts/plot_slp_vs_ls.py"
 
 
+rule fig_slp_order_map:
+    """Fig. 6: translational order T against phi of the SLP order-map packings."""
+    input:
+        "results/slp/order_map_summary.nc",
+    output:
+        pdf="results/figures/slp_order_map.pdf",
+        png="results/figures/slp_order_map.png",
+    log:
+        "results/logs/figures/slp_order_map.log",
+    script:
+        "../scripts/plot_slp_order_map.py"
+
+
 if SLP_DENSEST:
     FIGURES.append("results/figures/slp_densest.pdf")
     VALIDATION_INPUTS["slp_densest"] = ["results/slp/densest_summary.nc"]
 if SLP_MRJ:
     FIGURES.append("results/figures/slp_vs_ls.pdf")
-    VALIDATION_INPUTS["slp_mrj"] = expand("results/ensembles/{ensemble}/slp_summary.nc", ensemble=SLP_MRJ["ensembles"])
+    VALIDATION_INPUTS["slp_mrj"] = (
+        expand("results/ensembles/{ensemble}/slp_summary.nc", ensemble=SLP_MRJ["ensembles"])
+        + expand("results/slp/mrj/{system}/slp_summary.nc", system=SLP_SYSTEMS))
+    VALIDATION_INPUTS["slp_jamming"] = (
+        expand("results/ensembles/{ensemble}/slp_jamming_summary.nc", ensemble=SLP_MRJ["ensembles"])
+        + expand("results/slp/mrj/{system}/slp_jamming_summary.nc", system=SLP_SYSTEMS))
+if SLP_ORDER:
+    FIGURES.append("results/figures/slp_order_map.pdf")
+    VALIDATION_INPUTS["slp_order_map"] = ["results/slp/order_map_summary.nc"]

@@ -38,27 +38,66 @@ def plot_densest(summary):
 def plot_slp_vs_ls(pairs: dict):
     """Mean +- standard error of phi per ensemble for SLP and LS, with Table I where it applies.
 
-    ``pairs`` maps an ensemble name to (SLP summary, LS jammed summary) Datasets.
+    ``pairs`` maps an ensemble name to (SLP summary, LS jammed summary or None for an SLP-only
+    system) Datasets. Each name is labelled with its d and N.
     """
     fig, ax = figure()
     names = list(pairs)
     x = np.arange(len(names))
     for offset, which, color, label in ((-0.1, 0, "C0", "hardpack SLP"), (0.1, 1, "C1", "hardpack LS")):
-        phi = [pairs[n][which]["phi"].values for n in names]
+        keep = [k for k, n in enumerate(names) if pairs[n][which] is not None]
+        phi = [pairs[names[k]][which]["phi"].values for k in keep]
         mean = np.array([p.mean() for p in phi])
         sem = np.array([p.std(ddof=1) / np.sqrt(p.size) if p.size > 1 else 0.0 for p in phi])
-        ax.errorbar(x + offset, mean, yerr=sem, fmt="o", color=color, capsize=3, label=label)
+        ax.errorbar(x[keep] + offset, mean, yerr=sem, fmt="o", color=color, capsize=3, label=label)
+    labelled = False
     for k, n in enumerate(names):
         d = int(pairs[n][0]["d"].values[0]) if "d" in pairs[n][0] else None
         if d in TABLE_I:
             _, ls_pub, _, slp_pub, _ = TABLE_I[d]
             ax.errorbar(k - 0.25, slp_pub[0], yerr=slp_pub[1], fmt="s", mfc="none", color="C0", capsize=3,
-                        label="Torquato & Jiao SLP (Table I)" if k == 0 else None)
+                        label="Torquato & Jiao SLP (Table I)" if not labelled else None)
             ax.errorbar(k + 0.25, ls_pub[0], yerr=ls_pub[1], fmt="^", mfc="none", color="C1", capsize=3,
-                        label="Torquato & Jiao LS (Table I)" if k == 0 else None)
+                        label="Torquato & Jiao LS (Table I)" if not labelled else None)
+            labelled = True
     ax.set_xticks(x)
-    ax.set_xticklabels(names)
+    ax.set_xticklabels([f"{n}\nd={int(pairs[n][0]['d'].values[0])}, N={int(pairs[n][0]['N'].values[0])}"
+                        for n in names])
     ax.set_ylabel(r"jamming density $\phi_J$")
     ax.set_xlabel("ensemble")
     ax.legend()
+    return fig
+
+
+def plot_order_map(summary):
+    """Translational order T against phi (Fig. 6 of Torquato & Jiao), one marker per packing.
+
+    One colour and marker per SLP setting (alpha = gamma / D, bounds strain / shear / displacement,
+    LP solver); filled when the packing passed the strict jamming test. FCC (phi = 0.74048, T = 1)
+    and the paper's MRJ density 0.64 (L1620-1624) are marked for reference.
+    """
+    fig, ax = figure()
+    keys = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method")
+    settings = list(zip(*(summary[k].values.tolist() for k in keys)))
+    strict = summary["strict"].values.astype(bool)
+    phi, t = summary["phi"].values, summary["T"].values
+    for n, setting in enumerate(dict.fromkeys(settings)):
+        alpha, strain, shear, disp, method = setting
+        pick = np.array([s == setting for s in settings])
+        colour, marker = f"C{n % 10}", "os^Dv<>ph*"[n % 10]
+        label = (rf"$\gamma$ = {alpha:g} D, bounds {strain:g}/{shear:g}/{disp:g} D, "
+                 f"{method.removeprefix('highs-')}")
+        for jammed in (True, False):
+            sel = pick & (strict == jammed)
+            if sel.any():
+                ax.scatter(phi[sel], t[sel], s=24, marker=marker, edgecolors=colour,
+                           facecolors=colour if jammed else "none",
+                           label=label + ("" if jammed else " (not strictly jammed)"))
+    ax.plot([np.pi / np.sqrt(18)], [1.0], "k*", ms=10, label="FCC")
+    ax.axvline(0.64, color="0.5", ls=":", lw=1, label=r"MRJ $\phi$ = 0.64 (paper)")
+    ax.set_xlabel(r"packing density $\phi$")
+    ax.set_ylabel("translational order T")
+    n = summary.attrs.get("N", "?")
+    ax.set_title(f"SLP jammed packings, d = 3, N = {n}: {summary.sizes['packing']} packings")
+    ax.legend(fontsize=5.5, loc="upper left")
     return fig

@@ -8,7 +8,7 @@ import scipy
 
 from hardpack.io import load_dataset, load_packing, save_packing, write_dataset
 from hardpack.slp.driver import run_slp
-from hardpack.slp.lp import Bounds
+from hardpack.slp.lp import METHODS, Bounds
 
 log = logging.getLogger(__name__)
 
@@ -18,16 +18,17 @@ def cmd_slp(args) -> int:
     start = load_packing(args.init)
     bounds = Bounds(args.strain_bound, args.shear_bound, args.displacement_bound)
     result = run_slp(start, args.alpha, bounds, deforming=not args.isotropic, tol=args.tol,
-                     max_steps=args.max_steps)
+                     max_steps=args.max_steps, method=args.lp_method)
     params = {
         "generator": "slp", "alpha": args.alpha, "strain_bound": args.strain_bound,
         "shear_bound": args.shear_bound, "displacement_bound": args.displacement_bound,
         "cell": "isotropic" if args.isotropic else "deforming", "tol": args.tol,
+        "lp_method": args.lp_method,
     }
     attrs = dict(args.attr or [])
     attrs.update(params, init=str(args.init), converged=result.converged, n_steps=result.n_steps,
                  n_rejected=result.n_rejected, jamming_claim=result.jamming_claim,
-                 wall_seconds=result.wall_seconds, lp_solver=f"scipy {scipy.__version__} HiGHS")
+                 wall_seconds=result.wall_seconds, cpu_seconds=result.cpu_seconds, lp_solver=f"scipy {scipy.__version__} HiGHS ({args.lp_method})")
     init_attrs = load_dataset(args.init).attrs
     for key in ("seed", "ensemble", "distribution", "distribution_params", "init_phi"):
         if key in init_attrs:
@@ -54,7 +55,10 @@ def register(subparsers) -> None:
                    help="|u| bound per component in units of the mean diameter")
     p.add_argument("--isotropic", action="store_true",
                    help="isotropic shrink only (collectively, not strictly, jammed end states)")
-    p.add_argument("--tol", type=float, default=1e-8, help="stop when the predicted density gain is below this")
+    p.add_argument("--lp-method", choices=METHODS, default="highs-ipm",
+                   help="HiGHS solver (interior point with crossover: fastest on these degenerate LPs)")
+    p.add_argument("--tol", type=float, default=1e-10,
+                   help="stop when the predicted density gain is below this (paper: 1e-8; see hardpack.slp.driver)")
     p.add_argument("--max-steps", type=int, default=2000, help="maximum number of LPs")
     p.add_argument("--attr", action="append", type=lambda t: tuple(t.split("=", 1)), metavar="KEY=VALUE")
     p.set_defaults(func=cmd_slp)

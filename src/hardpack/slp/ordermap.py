@@ -1,0 +1,54 @@
+"""The phi-T order map of SLP packings (Torquato & Jiao 2010, Fig. 6 and sec. VI, L1569-1630).
+
+One row per packing: density phi (rattlers included, as in Fig. 6, L1753-1757), translational
+order metric T (:func:`hardpack.structure.order.translational_order`, FCC reference at the same
+density, our shell convention: T = 1 for FCC, ~0 for an ideal gas), the SLP settings that made
+it (influence radius alpha = gamma / D, bound widths, LP solver) and its jamming verdict
+(:func:`hardpack.jamming.verify` output written by ``hardpack verify``).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.io import load_dataset, load_packing
+from hardpack.structure.order import translational_order
+
+SETTINGS = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method", "seed")
+VERDICT = ("strict", "collective", "z_mean", "rattler_fraction")
+
+
+def order_map_summary(packing_paths, verdict_paths) -> xr.Dataset:
+    """phi, T, settings and verdict of each packing; ``verdict_paths[k]`` judges ``packing_paths[k]``."""
+    packing_paths, verdict_paths = list(packing_paths), list(verdict_paths)
+    if not packing_paths or len(packing_paths) != len(verdict_paths):
+        raise InvalidInputError(
+            f"order map: need one verdict per packing, got {len(packing_paths)} packings and "
+            f"{len(verdict_paths)} verdicts")
+    rows = {name: [] for name in ("phi", "T", *SETTINGS, *VERDICT)}
+    sizes = set()
+    for path, verdict_path in zip(packing_paths, verdict_paths):
+        ds, verdict = load_dataset(path, kind="packing"), load_dataset(verdict_path, kind="jamming")
+        source = verdict.attrs.get("source")
+        if source is not None and os.path.normpath(source) != os.path.normpath(str(path)):
+            raise InvalidInputError(f"{verdict_path} judges {source}, not {path}")
+        packing = load_packing(path)
+        if packing.dim != 3:
+            raise InvalidInputError(f"{path}: the order map is 3D (FCC reference), got d = {packing.dim}")
+        sizes.add(packing.n_particles)
+        rows["phi"].append(packing.phi)
+        rows["T"].append(translational_order(packing))
+        for name in SETTINGS:
+            rows[name].append(ds.attrs[name])
+        for name in VERDICT:
+            rows[name].append(verdict.attrs[name])
+    data = {name: ("packing", np.asarray(values)) for name, values in rows.items()}
+    attrs = {"hardpack_kind": "slp_order_map",
+             "T_convention": "hardpack.structure.order.translational_order defaults (7 FCC shells)"}
+    if len(sizes) == 1:
+        attrs["N"] = sizes.pop()
+    return xr.Dataset(data, attrs=attrs)
