@@ -1,5 +1,8 @@
-"""``hardpack eos-equivalents``: moments and bi-/tridisperse equivalents of a distribution family.
+"""``hardpack eos-equivalents``: moments and bi-/tridisperse equivalents of a distribution family;
+``hardpack eos-jam`` / ``eos-fluid`` / ``eos-summary``: the runs of the EOS-vs-moments study
+(:mod:`hardpack.eos.study`).
 
+eos-equivalents:
 Writes one netCDF Dataset (``hardpack_kind = "eos_equivalents"``) over the family parameter
 (omega for uniform_size / uniform_volume / power_law, sigma for lognormal): O1, O2, delta,
 skewness, kurtosis, the bidisperse equivalent (n1, R; Table 3.1) and the maximally equivalent
@@ -8,6 +11,7 @@ tridisperse system (n1, n2, delta1, delta2 and radii a1 >= a2 >= a3 in units of 
 
 from __future__ import annotations
 
+import json
 import logging
 
 import numpy as np
@@ -83,7 +87,101 @@ def cmd_equivalents(args) -> int:
     return 0
 
 
+def _json_spec(text: str) -> dict:
+    try:
+        spec = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InvalidInputError(f"--distribution is not valid JSON ({exc}): {text!r}") from None
+    return spec
+
+
+def _check_outputs(systems, outputs):
+    if len(systems) != len(outputs):
+        raise InvalidInputError(f"give one --out per --systems entry ({len(systems)} systems, {len(outputs)} outputs)")
+
+
+def cmd_jam(args) -> int:
+    """Jam a distribution and/or its bi- and tridisperse equivalents (two-stage LS compression)."""
+    from hardpack.eos.study import JamProtocol, jam
+
+    spec = _json_spec(args.distribution)
+    _check_outputs(args.systems, args.out)
+    protocol = JamProtocol(n=args.n, init_phi=args.init_phi, growth_rate=args.growth_rate,
+                           switch_pressure=args.switch_pressure, final_growth_rate=args.final_growth_rate,
+                           max_pressure=args.max_pressure)
+    for system, out in zip(args.systems, args.out):
+        result = jam(spec, system, args.seed, protocol)
+        result.save(out, config={"distribution": spec, "system": system, "seed": args.seed,
+                                 **{k: getattr(protocol, k) for k in protocol.__dataclass_fields__}})
+        s = result.stats
+        log.info("%s %s seed %d: phi_J = %.6f (Z = %.3g, %d collisions, %.1f s CPU, crystallinity %.3f)",
+                 args.distribution, system, args.seed, s["phi"], s["Z"], s["collisions"], s["cpu_time"],
+                 s["crystallinity"])
+    return 0
+
+
+def cmd_fluid(args) -> int:
+    """Equilibrium Z(phi) of a distribution and its equivalents against BMCSL (one netCDF file)."""
+    from hardpack.eos.study import fluid_dataset, fluid_pressure
+    from hardpack.io import write_dataset
+
+    spec = _json_spec(args.distribution)
+    rows = []
+    for system in args.systems:
+        for phi in args.phi:
+            row = fluid_pressure(spec, system, phi, args.seed, n=args.n, collisions=args.collisions)
+            log.info("%s %s phi = %.3f: Z = %.4f +- %.4f, BMCSL %.4f (%+.2f %%)", args.distribution, system,
+                     phi, row["Z"], row["Z_err"], row["Z_bmcsl"], 100 * row["rel_dev"])
+            rows.append(row)
+    write_dataset(fluid_dataset(rows), args.out, seed=args.seed,
+                  config={"distribution": spec, "systems": args.systems, "phi": args.phi, "n": args.n,
+                          "collisions": args.collisions})
+    return 0
+
+
+def cmd_summary(args) -> int:
+    """Combine the study's jammed packings (one family) or fluid files into one summary Dataset."""
+    from hardpack.eos.study import fluid_summary, jam_summary
+    from hardpack.io import load_dataset, write_dataset
+
+    datasets = [load_dataset(p) for p in args.files]
+    ds = jam_summary(datasets) if args.kind == "jam" else fluid_summary(datasets)
+    write_dataset(ds, args.out)
+    log.info("wrote %s from %d files", args.out, len(datasets))
+    return 0
+
+
 def register(subparsers) -> None:
+    p = subparsers.add_parser("eos-jam", help=cmd_jam.__doc__)
+    p.add_argument("--distribution", required=True,
+                   help='size distribution as JSON, e.g. \'{"kind": "uniform_volume", "omega": 4}\'')
+    p.add_argument("--systems", nargs="+", default=["poly", "bi", "tri"], choices=["poly", "bi", "tri"])
+    p.add_argument("--seed", type=int, required=True, help="seed of the RSA start and the velocities")
+    p.add_argument("--n", type=int, default=1000, help="number of particles (default 1000)")
+    p.add_argument("--init-phi", type=float, default=0.2, help="RSA start density (default 0.2)")
+    p.add_argument("--growth-rate", type=float, default=0.02, help="Gamma of the first stage (default 0.02)")
+    p.add_argument("--switch-pressure", type=float, default=1e3, help="Z of the switch (default 1e3)")
+    p.add_argument("--final-growth-rate", type=float, default=0.002, help="Gamma of the final stage (default 0.002)")
+    p.add_argument("--max-pressure", type=float, default=1e12, help="final Z (default 1e12)")
+    p.add_argument("--out", nargs="+", required=True, help="one packing netCDF per system")
+    p.set_defaults(func=cmd_jam)
+
+    p = subparsers.add_parser("eos-fluid", help=cmd_fluid.__doc__)
+    p.add_argument("--distribution", required=True, help="size distribution as JSON")
+    p.add_argument("--systems", nargs="+", default=["poly", "bi", "tri"], choices=["poly", "bi", "tri"])
+    p.add_argument("--phi", type=float, nargs="+", required=True, help="volume fractions (< 0.6)")
+    p.add_argument("--seed", type=int, required=True)
+    p.add_argument("--n", type=int, default=500, help="number of particles (default 500)")
+    p.add_argument("--collisions", type=int, default=400_000, help="collisions averaged per run")
+    p.add_argument("--out", required=True, help="output netCDF (system x phi)")
+    p.set_defaults(func=cmd_fluid)
+
+    p = subparsers.add_parser("eos-summary", help=cmd_summary.__doc__)
+    p.add_argument("--kind", choices=["jam", "fluid"], required=True)
+    p.add_argument("files", nargs="+", help="eos-jam packings of one family, or eos-fluid files")
+    p.add_argument("--out", required=True, help="summary netCDF")
+    p.set_defaults(func=cmd_summary)
+
     p = subparsers.add_parser("eos-equivalents", help=cmd_equivalents.__doc__)
     p.add_argument("--kind", required=True, choices=sorted(FAMILIES), help="distribution family")
     p.add_argument("--values", type=float, nargs="+", required=True, help="omega (or sigma for lognormal) values")

@@ -1,0 +1,235 @@
+"""Polydisperse systems and their moment-matched equivalents: jamming and fluid-EOS runs (Ogarko ch. 3).
+
+A *system* is a size distribution (spec as in :func:`hardpack.distributions.from_spec`) in one of
+three forms (:data:`SYSTEMS`):
+
+- ``poly``: the distribution itself (systematic sampling, L4469-4474);
+- ``bi``: its equivalent bidisperse mixture, same <a^0>..<a^3> (Eqs. 3.20-3.21, Table 3.1);
+- ``tri``: its maximally equivalent tridisperse mixture, same <a^0>..<a^5> (ch. 3.2, Tables 3.3-3.4).
+
+:func:`jam` grows a random start to jamming with the LS engine (two stages, see :class:`JamProtocol`)
+and :func:`fluid_pressure` measures the equilibrium reduced pressure Z at fixed phi and compares it with
+BMCSL (Eq. 3.9) for the realised radii. Both run in 3D in a periodic cube with masses 1, kT = 1.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import xarray as xr
+
+from hardpack.distributions import Distribution, from_spec
+from hardpack.eos import moments as mo
+from hardpack.eos.theory import bmcsl
+from hardpack.errors import InvalidInputError
+
+SYSTEMS = ("poly", "bi", "tri")
+#: the width parameter of each family of the study (omega = a_max/a_min, sigma of ln a)
+WIDTH = {"uniform_size": "omega", "uniform_volume": "omega", "power_law": "omega", "lognormal": "sigma"}
+
+
+def width_of(spec: dict) -> tuple[str, float]:
+    """(family, width) of a distribution spec, e.g. ("uniform_volume", 10.0)."""
+    if not isinstance(spec, dict) or spec.get("kind") not in WIDTH:
+        raise InvalidInputError(f"the study needs a distribution of kind {sorted(WIDTH)}, got {spec!r}")
+    return spec["kind"], float(spec[WIDTH[spec["kind"]]])
+
+
+def system_distribution(spec: dict, system: str) -> Distribution:
+    """The distribution ``spec`` as the ``system`` (poly, bi or tri), all with the same <a>."""
+    if system not in SYSTEMS:
+        raise InvalidInputError(f"system must be one of {SYSTEMS}, got {system!r}")
+    dist = from_spec(spec)
+    if system == "bi":
+        return mo.equivalent_bidisperse(dist).mixture
+    if system == "tri":
+        return mo.equivalent_tridisperse(dist).mixture
+    return dist
+
+
+@dataclass(frozen=True)
+class JamProtocol:
+    """LS compression from an RSA start at ``init_phi``: growth rate ``growth_rate`` until the window
+    pressure reaches ``switch_pressure``, then ``final_growth_rate`` until ``max_pressure``
+    (hardpack.md.compress's two-stage protocol; Gamma as defined there).
+
+    Ogarko grows at one constant rate (L4395-4430); the jamming density depends on the rate (it rises
+    by <= 1 % as Gamma decreases, L4961-4970), so poly and equivalent systems are compared at the
+    same protocol and N only.
+    """
+
+    n: int = 1000
+    init_phi: float = 0.2
+    growth_rate: float = 0.02
+    switch_pressure: float = 1e3
+    final_growth_rate: float = 0.002
+    max_pressure: float = 1e12
+
+    def __post_init__(self):
+        if int(self.n) != self.n or self.n < 2:
+            raise InvalidInputError(f"n must be an integer >= 2, got {self.n!r}")
+        for name in ("growth_rate", "final_growth_rate"):
+            if not (math.isfinite(getattr(self, name)) and getattr(self, name) > 0):
+                raise InvalidInputError(f"{name} must be a positive number, got {getattr(self, name)!r}")
+        if not 1 < self.switch_pressure < self.max_pressure:
+            raise InvalidInputError(
+                f"need 1 < switch_pressure < max_pressure, got {self.switch_pressure} and {self.max_pressure}"
+            )
+
+
+def large_species_crystallinity(packing, solid: np.ndarray) -> float:
+    """Fraction of solid-like particles among those larger than the mean radius (the large species of
+    a bidisperse mixture; crystallisation of that species breaks the bidisperse equivalence, L4862-4865)."""
+    large = packing.radii > packing.radii.mean()
+    return float(solid[large].mean()) if large.any() else math.nan
+
+
+def jam(spec: dict, system: str, seed: int, protocol: JamProtocol = JamProtocol()):
+    """Jam one system: RSA start (seed), then the two-stage LS compression (velocities from seed).
+
+    Returns the :class:`hardpack.md.CompressResult` with ``stats`` extended by the study's attributes
+    (family, width, system, O1, O2, cpu_time, crystallinity and that of the large particles).
+    """
+    from hardpack.initial import random_packing
+    from hardpack.md import StopCriteria, compress
+    from hardpack.structure.order import crystallinity
+
+    family, width = width_of(spec)
+    dist = system_distribution(spec, system)
+    start = time.process_time()
+    packing = random_packing(protocol.n, 3, dist, protocol.init_phi, seed)
+    result = compress(packing, protocol.growth_rate, seed, stop=StopCriteria(max_pressure=protocol.max_pressure),
+                      final_growth_rate=protocol.final_growth_rate, switch_pressure=protocol.switch_pressure)
+    cpu = time.process_time() - start
+    solid = crystallinity(result.packing)["solid"].values
+    o1, o2 = mo.dimensionless_moments(result.packing.radii)
+    result.stats.update(
+        family=family, width=width, system=system, O1=o1, O2=o2, cpu_time=cpu, init_phi=protocol.init_phi,
+        crystallinity=float(solid.mean()), crystallinity_large=large_species_crystallinity(result.packing, solid),
+        study_protocol=str(asdict(protocol)),
+    )
+    return result
+
+
+def fluid_pressure(spec: dict, system: str, phi: float, seed: int, n: int = 500, collisions: int = 400_000,
+                   prep_rate: float = 0.1) -> dict:
+    """Equilibrium Z at volume fraction ``phi`` (NVE event-driven MD, block error bar) and BMCSL.
+
+    RSA start at min(phi, 0.2), LS growth at ``prep_rate`` exactly to phi, then
+    :func:`hardpack.md.equilibrate` over ``collisions`` collisions (a quarter more are discarded first).
+    BMCSL (Eq. 3.9) uses O1, O2 of the realised radii, so the comparison is free of sampling error;
+    Ogarko finds Z within 1 % of BMCSL for phi < 0.54 (L4494-4502, L5707-5710).
+    """
+    from hardpack.initial import random_packing
+    from hardpack.md import StopCriteria, compress, equilibrate
+
+    if not 0 < phi < 0.6:
+        raise InvalidInputError(f"fluid phi must lie in (0, 0.6), got {phi}")
+    family, width = width_of(spec)
+    dist = system_distribution(spec, system)
+    start = time.process_time()
+    packing = random_packing(n, 3, dist, min(phi, 0.2), seed)
+    if phi > packing.phi * (1 + 1e-9):  # (a target within round-off of the start overshoots in compress)
+        packing = compress(packing, prep_rate, seed, stop=StopCriteria(max_pressure=None, target_phi=phi)).packing
+    if abs(packing.phi - phi) > 1e-9 * phi:
+        raise RuntimeError(f"preparation reached phi = {packing.phi}, not the requested {phi}")
+    res = equilibrate(packing, seed, collisions)
+    o1, o2 = mo.dimensionless_moments(packing.radii)
+    z_theory = float(bmcsl(res.phi, o1, o2))
+    return dict(family=family, width=width, system=system, phi=res.phi, Z=res.Z, Z_err=res.Z_err,
+                Z_bmcsl=z_theory, rel_dev=res.Z / z_theory - 1, O1=o1, O2=o2, N=n, seed=seed,
+                collisions=res.collisions, cpu_time=time.process_time() - start)
+
+
+# --- summaries -------------------------------------------------------------------------------------
+
+JAM_VARIABLES = ("phi", "Z", "collisions", "cpu_time", "crystallinity", "crystallinity_large", "O1", "O2")
+
+
+def jam_summary(packings) -> xr.Dataset:
+    """Jammed packings of one family (Datasets written by ``hardpack eos-jam``) as one Dataset over
+    (width, system, seed): phi_J (the final phi; phi_J - phi ~ 3 phi / Z <= 1e-11 at Z = 1e12) and
+    the run statistics. Missing combinations are NaN."""
+    packings = list(packings)
+    if not packings:
+        raise InvalidInputError("jam_summary needs at least one packing")
+    families = {ds.attrs.get("family") for ds in packings}
+    if len(families) != 1 or None in families:
+        raise InvalidInputError(f"jam_summary combines the packings of one family, got families {families}")
+    widths = sorted({float(ds.attrs["width"]) for ds in packings})
+    seeds = sorted({int(ds.attrs["seed"]) for ds in packings})
+    systems = [s for s in SYSTEMS if any(ds.attrs["system"] == s for ds in packings)]
+    shape = (len(widths), len(systems), len(seeds))
+    data = {name: np.full(shape, np.nan) for name in JAM_VARIABLES}
+    for ds in packings:
+        at = (widths.index(float(ds.attrs["width"])), systems.index(ds.attrs["system"]),
+              seeds.index(int(ds.attrs["seed"])))
+        for name in JAM_VARIABLES:
+            data[name][at] = float(ds.attrs[name])
+    dims = ("width", "system", "seed")
+    out = xr.Dataset({("phi_J" if k == "phi" else k): (dims, v) for k, v in data.items()},
+                     coords={"width": widths, "system": systems, "seed": seeds})
+    first = packings[0].attrs
+    out.attrs.update(hardpack_kind="eos_jam_summary", family=families.pop(), width_name=WIDTH[first["family"]],
+                     N=int(packings[0].sizes["particle"]), study_protocol=first["study_protocol"])
+    return out
+
+
+def fluid_dataset(rows: list[dict]) -> xr.Dataset:
+    """Fluid runs of one distribution (dicts from :func:`fluid_pressure`) over (system, phi)."""
+    if not rows:
+        raise InvalidInputError("no fluid runs given")
+    systems = [s for s in SYSTEMS if any(r["system"] == s for r in rows)]
+    phis = sorted({round(r["phi"], 12) for r in rows})
+    names = ("Z", "Z_err", "Z_bmcsl", "O1", "O2", "cpu_time")
+    data = {k: np.full((len(systems), len(phis)), np.nan) for k in names}
+    for r in rows:
+        at = (systems.index(r["system"]), phis.index(round(r["phi"], 12)))
+        for k in names:
+            data[k][at] = r[k]
+    ds = xr.Dataset({k: (("system", "phi"), v) for k, v in data.items()}, coords={"system": systems, "phi": phis})
+    ds["rel_dev"] = ds["Z"] / ds["Z_bmcsl"] - 1
+    ds.attrs.update(hardpack_kind="eos_fluid", family=rows[0]["family"], width=rows[0]["width"], N=rows[0]["N"],
+                    seed=rows[0]["seed"], collisions=rows[0]["collisions"])
+    return ds
+
+
+def fluid_summary(datasets) -> xr.Dataset:
+    """Fluid datasets of several distributions as one Dataset over (case, system, phi); case labels
+    are "family:width"."""
+    datasets = list(datasets)
+    if not datasets:
+        raise InvalidInputError("fluid_summary needs at least one fluid dataset")
+    labels = [f"{ds.attrs['family']}:{float(ds.attrs['width']):g}" for ds in datasets]
+    if len(set(labels)) != len(labels):
+        raise InvalidInputError(f"duplicate fluid cases {labels}")
+    bare = [ds.copy() for ds in datasets]
+    for ds in bare:
+        ds.attrs = {}
+    out = xr.concat(bare, dim="case", join="outer")
+    out = out.assign_coords(case=labels, family=("case", [ds.attrs["family"] for ds in datasets]),
+                            width=("case", [float(ds.attrs["width"]) for ds in datasets]),
+                            N=("case", [int(ds.attrs["N"]) for ds in datasets]))
+    out.attrs = {"hardpack_kind": "eos_fluid_summary"}
+    return out
+
+
+def seed_statistics(summary: xr.Dataset) -> xr.Dataset:
+    """Mean and standard error over seeds of phi_J per (width, system), and the relative deviation of
+    each system from the polydisperse one, dev = phi_J(system)/phi_J(poly) - 1 (ratio of seed means;
+    errors added in quadrature). Seeds of different systems are independent runs (different radii)."""
+    phi = summary["phi_J"]
+    count = phi.count("seed")
+    mean = phi.mean("seed")
+    sem = phi.std("seed", ddof=1) / np.sqrt(count)
+    sem = sem.where(count > 1)
+    poly_mean, poly_sem = mean.sel(system="poly"), sem.sel(system="poly")
+    dev = mean / poly_mean - 1
+    dev_sem = (mean / poly_mean) * np.sqrt((sem / mean) ** 2 + (poly_sem / poly_mean) ** 2)
+    out = xr.Dataset({"phi_J_mean": mean, "phi_J_sem": sem, "n_seeds": count, "dev": dev, "dev_sem": dev_sem,
+                      "crystallinity_large": summary["crystallinity_large"].mean("seed")})
+    out.attrs = dict(summary.attrs)
+    return out

@@ -1,0 +1,133 @@
+# Study (issue 6): EOS and jamming density of polydisperse spheres vs their moment-matched bi- and
+# tridisperse equivalents (Ogarko ch. 3). One job per (family, width, seed) jams the polydisperse
+# system and both equivalents with the same protocol and N; one job per (family, width) measures the
+# fluid Z(phi) of the three against BMCSL. Summaries, figures and validation rows follow.
+
+POLY = config.get("polydisperse", {})
+POLY_JAM = POLY.get("jam", {})
+POLY_FLUID = POLY.get("fluid", {})
+POLY_SYSTEMS = ["poly", "bi", "tri"]
+POLY_WIDTH_NAME = {"uniform_size": "omega", "uniform_volume": "omega", "lognormal": "sigma"}
+
+
+def _poly_width(value):
+    return f"{float(value):g}"
+
+
+def _poly_spec(family, width):
+    return json.dumps({"kind": family, POLY_WIDTH_NAME[family]: float(width)})
+
+
+def _poly_jam_files(family):
+    return expand("results/polydisperse/jammed/{family}/w{width}/seed{seed}_{system}.nc", family=family,
+                  width=[_poly_width(w) for w in POLY_JAM["widths"][family]], seed=POLY_JAM["seeds"],
+                  system=POLY_SYSTEMS)
+
+
+POLY_FAMILY = "uniform_size|uniform_volume|lognormal"
+POLY_WIDTH = r"[0-9]+(\.[0-9]+)?"
+
+
+rule poly_jam:
+    """Two-stage LS compression of the polydisperse system and its bi- and tridisperse equivalents."""
+    output:
+        expand("results/polydisperse/jammed/{{family}}/w{{width}}/seed{{seed}}_{system}.nc", system=POLY_SYSTEMS),
+    params:
+        spec=lambda w: _poly_spec(w.family, w.width),
+        n=POLY_JAM.get("N"),
+        init_phi=POLY_JAM.get("init_phi"),
+        growth_rate=POLY_JAM.get("growth_rate"),
+        switch_pressure=POLY_JAM.get("switch_pressure"),
+        final_growth_rate=POLY_JAM.get("final_growth_rate"),
+        max_pressure=POLY_JAM.get("max_pressure"),
+    wildcard_constraints:
+        family=POLY_FAMILY,
+        width=POLY_WIDTH,
+    log:
+        "results/logs/poly_jam/{family}_w{width}_seed{seed}.log",
+    shell:
+        "hardpack eos-jam --distribution '{params.spec}' --systems poly bi tri --seed {wildcards.seed}"
+        " --n {params.n} --init-phi {params.init_phi} --growth-rate {params.growth_rate}"
+        " --switch-pressure {params.switch_pressure} --final-growth-rate {params.final_growth_rate}"
+        " --max-pressure {params.max_pressure} --out {output} 2> {log}"
+
+
+rule poly_jam_summary:
+    """phi_J over (width, system, seed) for one family."""
+    input:
+        lambda w: _poly_jam_files(w.family),
+    output:
+        "results/polydisperse/phij_{family}.nc",
+    wildcard_constraints:
+        family=POLY_FAMILY,
+    log:
+        "results/logs/poly_jam_summary/{family}.log",
+    shell:
+        "hardpack eos-summary --kind jam {input} --out {output} 2> {log}"
+
+
+rule poly_fluid:
+    """Equilibrium Z(phi) of the distribution and its equivalents, against BMCSL."""
+    output:
+        "results/polydisperse/fluid/{family}_w{width}.nc",
+    params:
+        spec=lambda w: _poly_spec(w.family, w.width),
+        phi=" ".join(str(p) for p in POLY_FLUID.get("phi", [])),
+        n=POLY_FLUID.get("N"),
+        collisions=POLY_FLUID.get("collisions"),
+        seed=POLY_FLUID.get("seed"),
+    wildcard_constraints:
+        family=POLY_FAMILY,
+        width=POLY_WIDTH,
+    log:
+        "results/logs/poly_fluid/{family}_w{width}.log",
+    shell:
+        "hardpack eos-fluid --distribution '{params.spec}' --systems poly bi tri --phi {params.phi}"
+        " --n {params.n} --collisions {params.collisions} --seed {params.seed} --out {output} 2> {log}"
+
+
+rule poly_fluid_summary:
+    """All fluid cases in one Dataset (case, system, phi)."""
+    input:
+        [f"results/polydisperse/fluid/{family}_w{_poly_width(w)}.nc"
+         for family, widths in POLY_FLUID.get("widths", {}).items() for w in widths],
+    output:
+        "results/polydisperse/fluid_summary.nc",
+    log:
+        "results/logs/poly_fluid_summary.log",
+    shell:
+        "hardpack eos-summary --kind fluid {input} --out {output} 2> {log}"
+
+
+rule fig_phij_vs_omega:
+    """phi_J vs omega (sigma) for poly / bi / tri with the published fits, and relative deviations."""
+    input:
+        expand("results/polydisperse/phij_{family}.nc", family=list(POLY_JAM.get("widths", {}))),
+    output:
+        pdf="results/figures/phij_vs_omega.pdf",
+        png="results/figures/phij_vs_omega.png",
+    log:
+        "results/logs/figures/phij_vs_omega.log",
+    script:
+        "../scripts/plot_poly_phij.py"
+
+
+rule fig_eos_vs_bmcsl:
+    """Fluid Z vs phi against BMCSL (and Ogarko's Z_OL) for every distribution and its equivalents."""
+    input:
+        "results/polydisperse/fluid_summary.nc",
+    output:
+        pdf="results/figures/eos_vs_bmcsl.pdf",
+        png="results/figures/eos_vs_bmcsl.png",
+    log:
+        "results/logs/figures/eos_vs_bmcsl.log",
+    script:
+        "../scripts/plot_poly_eos.py"
+
+
+if POLY:
+    FIGURES.append("results/figures/phij_vs_omega.pdf")
+    FIGURES.append("results/figures/eos_vs_bmcsl.pdf")
+    VALIDATION_INPUTS["polydisperse"] = expand("results/polydisperse/phij_{family}.nc",
+                                               family=list(POLY_JAM["widths"])) + [
+        "results/polydisperse/fluid_summary.nc"]
