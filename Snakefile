@@ -23,6 +23,8 @@ for _name, _ens in config["ensembles"].items():
 
 ENSEMBLES = config["ensembles"]
 
+report: "workflow/report/workflow.rst"
+
 # Registries the study files fill: the figures `rule all` builds, and the summaries the validation
 # report reads, by row-builder name (hardpack.validation.cli.ROW_BUILDERS) -> list of paths.
 FIGURES = []

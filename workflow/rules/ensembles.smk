@@ -42,7 +42,7 @@ rule fig_size_distributions:
         expand("results/ensembles/{ensemble}/init_summary.nc", ensemble=ENSEMBLES),
     output:
         pdf="results/figures/size_distributions.pdf",
-        png="results/figures/size_distributions.png",
+        png=report("results/figures/size_distributions.png", caption="../report/size_distributions.rst", category="1 generation"),
     params:
         distributions={name: ens["distribution"] for name, ens in ENSEMBLES.items()},
     log:

@@ -2,16 +2,31 @@
 # forces, isostaticity; plus an ensemble summary.
 
 
+def lp_mem_mb(wildcards):
+    return 1000 + ENSEMBLES[wildcards.ensemble]["N"]
+
+
+def lp_runtime(wildcards):
+    """Minutes: collective + strict tests take ~10 s at N = 1000 (benchmarks/bench_jamming.py)."""
+    return 10 + ENSEMBLES[wildcards.ensemble]["N"] // 200
+
+
 rule verify_jamming:
-    """LP jamming tests of one LS packing."""
+    """LP jamming tests of one LS packing by sequential random loading (Donev Algorithm 14, meant for
+    finite-rate LS packings: their near-contacts at gaps ~1e-6..1e-5 block the few floppy modes the
+    linearised ideal test of the delta-contact network would report)."""
     input:
         "results/ensembles/{ensemble}/jammed/seed{seed}.nc",
     output:
         "results/ensembles/{ensemble}/jamming/seed{seed}.nc",
+    threads: 1
+    resources:
+        mem_mb=lp_mem_mb,
+        runtime=lp_runtime,
     log:
         "results/logs/verify_jamming/{ensemble}_seed{seed}.log",
     shell:
-        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential > {log} 2>&1"
 
 
 rule verify_jamming_slp:
@@ -20,6 +35,10 @@ rule verify_jamming_slp:
         "results/ensembles/{ensemble}/slp/seed{seed}.nc",
     output:
         "results/ensembles/{ensemble}/slp_jamming/seed{seed}.nc",
+    threads: 1
+    resources:
+        mem_mb=lp_mem_mb,
+        runtime=lp_runtime,
     log:
         "results/logs/verify_jamming_slp/{ensemble}_seed{seed}.log",
     shell:
@@ -58,7 +77,7 @@ rule fig_jamming_vs_d:
         verdicts=expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=MONODISPERSE),
     output:
         pdf="results/figures/jamming_vs_d.pdf",
-        png="results/figures/jamming_vs_d.png",
+        png=report("results/figures/jamming_vs_d.png", caption="../report/jamming_vs_d.rst", category="2 jamming"),
     log:
         "results/logs/figures/jamming_vs_d.log",
     script:

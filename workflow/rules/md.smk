@@ -2,6 +2,15 @@
 # per (ensemble, seed), and the ensemble summary of jamming densities.
 
 
+def ls_mem_mb(wildcards):
+    return 500 + ENSEMBLES[wildcards.ensemble]["N"] // 5
+
+
+def ls_runtime(wildcards):
+    """Minutes: the slow final stage costs ~N / 20 minutes on one core (3D, Gamma_f = 1e-4)."""
+    return 30 + ENSEMBLES[wildcards.ensemble]["N"] // 10
+
+
 rule compress:
     """LS compression of one start configuration to the configured reduced pressure.
 
@@ -18,6 +27,10 @@ rule compress:
         final=lambda w: "--final-growth-rate {final_growth_rate} --switch-pressure {switch_pressure}".format(
             **ENSEMBLES[w.ensemble]) if "final_growth_rate" in ENSEMBLES[w.ensemble] else "",
         checkpoint="results/ensembles/{ensemble}/checkpoints/seed{seed}.ckpt",
+    threads: 1
+    resources:
+        mem_mb=ls_mem_mb,
+        runtime=ls_runtime,
     log:
         "results/logs/compress/{ensemble}_seed{seed}.log",
     shell:
@@ -71,6 +84,10 @@ rule compress_rate:
     params:
         max_pressure=lambda w: ENSEMBLES[w.ensemble]["max_pressure"],
         checkpoint="results/rates/{ensemble}/gamma{gamma}/seed{seed}.ckpt",
+    threads: 1
+    resources:
+        mem_mb=ls_mem_mb,
+        runtime=ls_runtime,
     log:
         "results/logs/compress_rate/{ensemble}_gamma{gamma}_seed{seed}.log",
     shell:
@@ -86,7 +103,7 @@ rule fig_rates:
         rate_timeseries,
     output:
         pdf="results/figures/ls_rates_{kind}.pdf",
-        png="results/figures/ls_rates_{kind}.png",
+        png=report("results/figures/ls_rates_{kind}.png", caption="../report/ls_rates.rst", category="1 generation"),
     wildcard_constraints:
         kind="phij|eos",
     log:

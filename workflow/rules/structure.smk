@@ -8,6 +8,10 @@ rule structure:
         jamming="results/ensembles/{ensemble}/jamming/seed{seed}.nc",
     output:
         "results/ensembles/{ensemble}/structure/seed{seed}.nc",
+    threads: 1
+    resources:
+        mem_mb=lambda w: 1000 + ENSEMBLES[w.ensemble]["N"],
+        runtime=lambda w: 10 + ENSEMBLES[w.ensemble]["N"] // 500,
     log:
         "results/logs/structure/{ensemble}_seed{seed}.log",
     shell:
@@ -23,7 +27,7 @@ rule fig_structure:
         STRUCTURE_FILES,
     output:
         pdf="results/figures/structure_{kind}.pdf",
-        png="results/figures/structure_{kind}.png",
+        png=report("results/figures/structure_{kind}.png", caption="../report/structure.rst", category="5 structure"),
     wildcard_constraints:
         kind="g2|zl|sk|channels",
     params:

@@ -13,11 +13,17 @@ from hardpack.errors import InvalidInputError
 from hardpack.io import load_dataset, write_dataset
 from hardpack.io.atomic import write_text
 from hardpack.validation.analytic import hgrid_rows, moment_table_rows
-from hardpack.validation.freeenergy import bcmd_rows
+from hardpack.validation.freeenergy import (
+    bcmd_rows,
+    density_rows,
+    ladder_rows,
+    simplex_rows,
+)
 from hardpack.validation.jamming import jamming_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
+from hardpack.validation.polydisperse import polydisperse_rows
 from hardpack.validation.rows import to_dataset, to_markdown
-from hardpack.validation.slp import densest_rows
+from hardpack.validation.slp import densest_rows, mrj_jamming_rows, order_map_rows
 from hardpack.validation.structure import structure_rows
 
 log = logging.getLogger(__name__)
@@ -27,9 +33,15 @@ ROW_BUILDERS = {
     "ls": ls_rows,
     "slp_mrj": slp_mrj_rows,
     "slp_densest": lambda datasets: [row for ds in datasets for row in densest_rows(ds)],
+    "slp_jamming": mrj_jamming_rows,
+    "slp_order_map": lambda datasets: [row for ds in datasets for row in order_map_rows(ds)],
     "jamming": jamming_rows,
     "structure": structure_rows,
     "bcmd": lambda datasets: bcmd_rows({ds.attrs["state"]: ds for ds in datasets}),
+    "bcmd_density": lambda datasets: density_rows(**{ds.attrs["state"]: ds for ds in datasets}),
+    "bcmd_simplex": lambda datasets: [row for ds in datasets for row in simplex_rows(ds)],
+    "bcmd_ladder": lambda datasets: [row for ds in datasets for row in ladder_rows(ds)],
+    "polydisperse": polydisperse_rows,
 }
 
 
