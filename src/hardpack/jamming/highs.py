@@ -24,12 +24,18 @@ ATTEMPTS = (("highs-ds", HIGHS_OPTIONS), ("highs-ipm", HIGHS_OPTIONS), ("highs-d
 def solve_lp(c, *, method: str = "highs-ds", options: dict | None = None, **kwargs):
     """scipy.optimize.linprog with HiGHS, retried with the other ATTEMPTS when HiGHS reports
     numerical trouble or a limit (status 1 or 4). ``options`` are added to every attempt's.
-    Returns the optimal result; raises LPFailure for an infeasible or unbounded LP (status 2,
-    3) or after the last attempt."""
+    An infeasible or unbounded verdict (status 2, 3) is confirmed without presolve: with the
+    tight tolerances HiGHS's presolve has declared feasible LPs infeasible (the local jamming
+    LP 4.15 of an SLP crystal, for which dr = 0 is feasible; tests/test_jamming_highs.py).
+    Returns the optimal result; raises LPFailure for a confirmed infeasible or unbounded LP or
+    after the last attempt."""
     attempts = [(m, o) for m, o in ATTEMPTS if m == method] + [a for a in ATTEMPTS if a[0] != method]
     res = None
     for m, base in attempts:
-        res = linprog(c, method=m, options={**base, **(options or {})}, **kwargs)
+        opts = {**base, **(options or {})}
+        res = linprog(c, method=m, options=opts, **kwargs)
+        if res.status in (2, 3) and opts.get("presolve", True):
+            res = linprog(c, method=m, options={**opts, "presolve": False}, **kwargs)
         if res.status in (0, 2, 3):
             break
     if res.status == 0:
