@@ -83,3 +83,21 @@ def test_table_i_jamming_rows_judge_rattlers_contacts_and_strictness():
     # d = 5: only the rattler fraction (0.006 +- 0.002) and strictness rows
     rows = mrj_jamming_rows([_jamming_summary(5, 243, [0.0041], [1])])
     assert len(rows) == 2 and rows[0].published == 0.006 and all(r.passed for r in rows)
+
+
+def test_cli_writes_a_jammed_packing_with_its_protocol(tmp_path):
+    """`hardpack slp` (Table II settings, d = 2, N = 9) reaches the triangular lattice and records
+    the settings, the LP solver and the cost in the packing's attributes."""
+    from hardpack.cli import main
+    from hardpack.io import load_dataset
+
+    init, out, history = tmp_path / "init.nc", tmp_path / "slp.nc", tmp_path / "history.nc"
+    assert main(["init", "--n", "9", "--d", "2", "--phi", "0.45", "--seed", "3", "--out", str(init)]) == 0
+    assert main(["slp", "--init", str(init), "--out", str(out), "--history", str(history), "--alpha", "3.5",
+                 "--strain-bound", "0.01", "--shear-bound", "0.01", "--displacement-bound", "0.05",
+                 "--lp-method", "highs-ds"]) == 0
+    attrs = load_dataset(out, kind="packing").attrs
+    assert attrs["phi"] == pytest.approx(math.pi / math.sqrt(12), abs=1e-6)
+    assert attrs["lp_method"] == "highs-ds" and attrs["converged"] == 1 and attrs["seed"] == 3
+    assert attrs["cpu_seconds"] > 0 and attrs["jamming_claim"] == "strict"
+    assert load_dataset(history, kind="slp_history")["accepted"].values[-1] == 1

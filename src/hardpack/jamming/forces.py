@@ -46,8 +46,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from hardpack.jamming.contacts import ContactNetwork
-from hardpack.jamming.isostatic import RigidBackbone
 from hardpack.jamming.highs import LPFailure, solve_lp
+from hardpack.jamming.isostatic import RigidBackbone
 from hardpack.jamming.rigidity import rigidity_transpose
 from hardpack.jamming.workingset import solve_working_set
 

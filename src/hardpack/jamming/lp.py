@@ -15,9 +15,10 @@ the callers remove (componentwise median), and no dense pinning row is needed.
 
 Solvers: :mod:`hardpack.jamming.workingset` (sparse LU of the contact core + a small LP,
 exact; 10-30 times faster than HiGHS on jammed packings, and warm-started from the previous LP
-of a test via ``warm``) first, HiGHS on the full LP when the working set gives up and for a
-strict LP without a warm start (its optimum lies far from the contact core, where the
-working set is slower than HiGHS's simplex). HiGHS solves the dual, the force formulation
+of a test via ``warm``) first. A strict LP without a warm start goes through a continuation in
+the strain bound (:func:`_strain_continuation`): its optimum shears a fixed-cell packing until
+hundreds of near contacts close, far from the contact core where a cold working set starts.
+HiGHS solves the full LP when the working set gives up, in the dual, force formulation
 (Eq. 4.12, L626-L653) with the box turned into penalised slack loads:
 
     min h^T f + box 1^T (z+ + z-)  s.t.  -A f [+ p Tr] + z+ - z- = (B, b_eps),  f, p, z >= 0,
@@ -39,13 +40,13 @@ import scipy.sparse as sp
 
 from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.highs import HIGHS_OPTIONS, LPFailure, solve_lp
-from hardpack.jamming.workingset import WarmStart, solve_working_set
 from hardpack.jamming.rigidity import (
     n_strain,
     rigidity_transpose,
     strain_pairs,
     strain_tensor,
 )
+from hardpack.jamming.workingset import WarmStart, solve_working_set
 
 
 @dataclass(frozen=True)
@@ -120,7 +121,10 @@ def solve_motion(
         keys = np.vstack([keys, np.full((1, keys.shape[1]), -1)])  # the trace column
     sol = None
     if working_set and (warm is not None or not strict):
-        sol = solve_working_set(g, h, c, upper, start=None if warm is None else warm.locate(keys, nvar))
+        sol = solve_working_set(g, h, c, upper, start=None if warm is None else warm.locate(keys, nvar),
+                                boxed=np.arange(n_pos, nvar))
+    elif working_set:
+        sol = _strain_continuation(g, h, c, upper, n_pos, keys)
     solver = "working-set" if sol is not None else "highs"
     if sol is not None:
         x, f, objective, warm = sol.x, sol.forces, sol.objective, WarmStart.of(sol, keys)
@@ -135,6 +139,22 @@ def solve_motion(
     forces = np.zeros(net.n_contacts)
     forces[use] = f[: int(use.sum())]
     return Motion(disp, eps, forces, objective, time.perf_counter() - t0, warm, solver)
+
+
+def _strain_continuation(g, h, c, upper, n_pos, keys, factor: float = 10.0, stages: int = 5):
+    """A strict LP without a warm start: the working set is solved for strain bounds
+    ``factor**-stages`` times the final one, then ``factor`` times larger each stage, each
+    warm-started from the previous optimum. Small strains close few near contacts, so every
+    stage starts close to its optimum; the last one is the LP itself. None if a stage fails."""
+    sol = None
+    for stage in range(stages, -1, -1):
+        bound = upper.copy()
+        bound[n_pos:] /= factor**stage
+        start = None if sol is None else WarmStart.of(sol, keys).locate(keys, upper.size)
+        sol = solve_working_set(g, h, c, bound, start=start, boxed=np.arange(n_pos, upper.size))
+        if sol is None:
+            return None
+    return sol
 
 
 def _highs_motion(g: sp.csc_matrix, h: np.ndarray, c: np.ndarray, upper: np.ndarray):

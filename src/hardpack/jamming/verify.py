@@ -192,15 +192,21 @@ def verify(
         backbone = local_active
 
     t0 = time.perf_counter()
-    forces = self_stress(net, backbone)
+    d, nb = packing.dim, int(backbone.sum())
+    # hypostatic by count: straight to the nearest jamming point, whose LP also finds a
+    # self-stress of the contacts themselves if there is one (their gaps cost least)
+    hypostatic = int(net.among(backbone).sum()) < d * (nb - 1) + 1
+    forces = None if hypostatic else self_stress(net, backbone)
     counted, near = None, {}
-    if not forces.exists and backbone.any():  # hypostatic at contact_delta: nearest jamming point
+    if (forces is None or not forces.exists) and backbone.any():  # the nearest jamming point
         force_delta = max(SEQUENTIAL_DELTA, contact_delta) if force_delta is None else check_delta(force_delta)
         found = jamming_point_forces(contact_network(packing, force_delta), backbone, contact_delta, box)
         if found is not None:
             net, forces = found
             counted = net.distance / net.contact_distance - 1.0 <= contact_delta
             near = {"force_delta": force_delta, "force_near_contacts": int((~counted).sum())}
+    if forces is None:
+        forces = self_stress(net, backbone)
     stat = statics(net, backbone, forces, packing.volume, counted)
     seconds["forces"] = time.perf_counter() - t0
 

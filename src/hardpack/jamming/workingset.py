@@ -207,6 +207,7 @@ def solve_working_set(
     upper: np.ndarray,
     *,
     start: tuple[np.ndarray, np.ndarray] | None = None,
+    boxed: np.ndarray | None = None,
     max_working: int | None = None,
     max_rounds: int = 12,
     tol: float | None = None,
@@ -215,6 +216,8 @@ def solve_working_set(
 
     ``start``: (basis, working set) of unified column indices from a similar LP (e.g.
     :meth:`WarmStart.locate`); the basis is completed with the smallest gaps and repaired.
+    ``boxed``: variables whose two box columns are always in the working set (e.g. the
+    strain, which the contacts of a fixed-cell packing do not bound).
     When the working set would exceed ``max_working`` columns (default 100 + n / 20), the
     basis moves to the current optimum instead (new LU) and the working set restarts from the
     columns closest to entering plus the violated ones.
@@ -243,6 +246,8 @@ def solve_working_set(
         basis = np.concatenate([basis, spare[: n - basis.size]])
     # 2. working set: the start's, the next K0 smallest gaps, partners of box columns in S
     pending = np.concatenate([extra, candidates]).astype(np.int64)
+    boxed = np.zeros(0, dtype=np.int64) if boxed is None else np.asarray(boxed, dtype=np.int64)
+    always = np.concatenate([m + boxed, m + n + boxed])
     factorise = True
     for rounds in range(1, max_rounds + 1):
         if factorise:
@@ -251,7 +256,7 @@ def solve_working_set(
                 return None
             in_set = np.zeros(m + 2 * n, dtype=bool)
             in_set[basis] = True
-            partners = np.concatenate([cols.partner(basis[basis >= m]), replaced])
+            partners = np.concatenate([cols.partner(basis[basis >= m]), replaced, always])
             fresh = pending[~in_set[pending]]
             _, first = np.unique(fresh, return_index=True)
             fresh = fresh[np.sort(first)]

@@ -17,11 +17,14 @@ particle, lazy invalidation" form:
   not overlap cannot collide, so collisions are predicted only against the list ``nb[i, :nn[i]]``.
   The extra event "i leaves its bounding sphere" (``ep = EXIT``; the exit time solves
   |dr + v t| = R - a(t) with the radius growth included) rebuilds i's list only (Alg. 10)
-  with a cell grid of bounding-sphere centres whose cell width is at least the largest
-  bounding-sphere diameter. Every cell stores copies of its bounding spheres contiguously
-  (``cbs``, slot s of cell c at c * ccap + s, partner index ``cid``; ``slot_of`` locates a
-  particle's slot), so a rebuild scans the 3^d cells as plain arrays instead of chasing linked
-  lists (the scan was latency bound). Each list entry packs the neighbour j and its periodic image as
+  with a hierarchical grid of bounding-sphere centres (Ogarko ch. 2.1): level h holds the
+  spheres whose bounding radius is capped at ``rcap[h]``, in ``ncl[h]`` cells per side of width
+  >= 2 rcap[h] (flat cell index offset ``coff[h]``), and a rebuild visits, level by level, the
+  cells within R_i + rcap[l] of i's centre (3^d on its own level; monodisperse systems have one
+  level), skipping cells out of reach. Every cell stores copies of its bounding spheres
+  contiguously (``cbs``, slot s of cell c at c * ccap + s, partner index ``cid``; ``slot_of``
+  locates a particle's slot), so the scan reads plain arrays instead of chasing linked lists
+  (it was latency bound). Each list entry packs the neighbour j and its periodic image as
   j << 2d | code, code = sum_k (n_k + 1) 4^k indexing ``imgvec`` (shifts n in {-1, 0, 1}^d; bit
   operations instead of an integer division in the innermost loop); the image stays valid
   because a position is re-wrapped into the box only when its own list is rebuilt.
@@ -93,7 +96,7 @@ def _prefetch_intrinsic() -> str | None:
             f"  call void @{name}({ptr} %p, i32 0, i32 3, i32 1)\n  ret void\n}}\n")
     try:
         llvm.parse_assembly(text).verify()
-    except Exception:  # any LLVM/llvmlite failure: run without prefetching
+    except Exception:  # noqa: BLE001 - any LLVM/llvmlite failure: run without prefetching
         return None
     return name
 
@@ -218,8 +221,9 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
 
     Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
     out of the hot path): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
-    NNL update of one particle (wrap, new bounding sphere, re-bin, list every overlapping bounding
-    sphere already binned; together a complete update, Alg. 9); the bounding radius is
+    NNL update of one particle (wrap, new bounding sphere, re-bin on its grid level, list every
+    overlapping bounding sphere already binned; together a complete update, Alg. 9); the
+    bounding radius is
     min(a_i(t) + skin sfac_i, rcap_h) on grid level h = lvl[i] (size-dependent skin factors, see
     :meth:`hardpack.md.engine.Engine.skin_factors`). A partial update edits only the
     lists of neighbours gained or lost (``mark`` flags the old ones), plus those of kept ones if the

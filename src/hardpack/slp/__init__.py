@@ -2,5 +2,6 @@
 
 from hardpack.slp.driver import SLPResult, run_slp
 from hardpack.slp.lp import Bounds, solve_step
+from hardpack.slp.ordermap import order_map_summary
 
-__all__ = ["Bounds", "SLPResult", "run_slp", "solve_step"]
+__all__ = ["Bounds", "SLPResult", "order_map_summary", "run_slp", "solve_step"]
