@@ -3,18 +3,11 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from hardpack.plots.style import figure
 from hardpack.validation.packings import LS_TARGETS
-
-
-def _mean_sem(values):
-    v = np.asarray(values, float)
-    v = v[np.isfinite(v)]
-    return (float(v.mean()), float(v.std(ddof=1) / math.sqrt(v.size)) if v.size > 1 else 0.0) if v.size else (math.nan, 0.0)
+from hardpack.validation.rows import mean_sem
 
 
 def plot_jamming_vs_d(jammed: list, verdicts: list):
@@ -23,7 +16,7 @@ def plot_jamming_vs_d(jammed: list, verdicts: list):
     fig, (left, right) = figure(1, 2, figsize=(7.0, 3.0))
     for s in jammed:
         d = int(s["d"].values.ravel()[0])
-        mean, sem = _mean_sem(s["phi"].values)
+        mean, sem = mean_sem(s["phi"].values)
         left.errorbar([d], [mean], [sem], fmt="o", color="C0",
                       label=f"LS, N = {int(s['N'].values.ravel()[0])}" if s is jammed[0] else None)
     pub = sorted((d, v[0]) for (kind, d), v in LS_TARGETS.items() if kind == "monodisperse")
@@ -36,7 +29,7 @@ def plot_jamming_vs_d(jammed: list, verdicts: list):
     for s in verdicts:
         d = int(s["d"].values.ravel()[0])
         dims.append(d)
-        mean, sem = _mean_sem(s["z_mean"].values)
+        mean, sem = mean_sem(s["z_mean"].values)
         right.errorbar([d], [mean], [sem], fmt="o", color="C1",
                        label="LS, rattlers removed" if s is verdicts[0] else None)
     if dims:

@@ -7,7 +7,15 @@ import math
 from hardpack.distributions import LogNormal, uniform_size, uniform_volume
 from hardpack.eos import moments as mo
 from hardpack.eos.published import (
-    FIG_2_15, ONE_UNIT, TABLE_31_US, TABLE_31_UV, TABLE_33, TABLE_34, matches_printed, rows, ulp,
+    FIG_2_15,
+    ONE_UNIT,
+    TABLE_31_US,
+    TABLE_31_UV,
+    TABLE_33,
+    TABLE_34,
+    matches_printed,
+    rows,
+    ulp,
 )
 from hardpack.validation.rows import Row
 

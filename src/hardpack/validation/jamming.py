@@ -17,19 +17,11 @@ import math
 import numpy as np
 
 from hardpack.validation.packings import system_key
-from hardpack.validation.rows import Row, within
+from hardpack.validation.rows import Row, mean_sem, within
 
 CH9 = "Donev dissertation ch. 9 (seed 000, ch07-09)"
 CH4 = "Donev dissertation ch. 4 (seed 000, ch04-05)"
 
-
-def _mean_sem(values) -> tuple[float, float]:
-    values = np.asarray(values, float)
-    values = values[np.isfinite(values)]
-    if values.size == 0:
-        return math.nan, math.nan
-    sem = values.std(ddof=1) / math.sqrt(values.size) if values.size > 1 else math.nan
-    return float(values.mean()), sem
 
 
 def jamming_rows(summaries) -> list[Row]:
@@ -41,14 +33,14 @@ def jamming_rows(summaries) -> list[Row]:
             continue
         name, d = s.attrs.get("ensemble", "?"), key[1]
         size = f"N = {int(s['N'].values[0])}, {s.sizes['sample']} seeds"
-        z, z_sem = _mean_sem(s["z_mean"].values)
+        z, z_sem = mean_sem(s["z_mean"].values)
         out.append(Row("jamming (LP verdicts)", f"{name}: contact number after rattlers, {key[0]} d = {d}",
                        f"{CH9} L1659-1661 (isostatic Z = 2d)", 2.0 * d, z, z_sem, 0.05,
                        "issue band; a finite isostatic backbone has 2d(1 - 1/N_b) + 2/N_b",
                        within(z, 2.0 * d, 0.05, z_sem),
                        f"{size}; isostaticity gaps {', '.join(str(int(g)) for g in s['isostaticity_gap'].values)}"))
         if key == ("monodisperse", 3):
-            r, r_sem = _mean_sem(s["rattler_fraction"].values)
+            r, r_sem = mean_sem(s["rattler_fraction"].values)
             out.append(Row("jamming (LP verdicts)", f"{name}: rattler fraction, monodisperse d = 3",
                            f"{CH9} L1659-1661", 0.022, r, r_sem, 0.008, "issue: at most 3 %",
                            within(r, 0.022, 0.008, r_sem), size))

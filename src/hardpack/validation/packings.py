@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from hardpack.slp.published import MRJ_2D_POLYDISPERSE, TABLE_I, TABLE_I_LINES
-from hardpack.validation.rows import Row, within
+from hardpack.validation.rows import Row, mean_sem, within
 
 DONEV = "Donev dissertation (seed 000)"
 # published LS jamming densities: (value, printed error, source)
@@ -42,11 +42,6 @@ def system_key(summary) -> tuple | None:
     return None
 
 
-def _mean_sem(values) -> tuple[float, float]:
-    values = np.asarray(values, float)
-    sem = values.std(ddof=1) / math.sqrt(values.size) if values.size > 1 else math.nan
-    return float(values.mean()), sem
-
 
 def ls_rows(summaries) -> list[Row]:
     """Mean final phi (reduced pressure >= max_pressure) of each recognised LS ensemble."""
@@ -56,7 +51,7 @@ def ls_rows(summaries) -> list[Row]:
         if key not in LS_TARGETS:
             continue
         value, err, source = LS_TARGETS[key]
-        mean, sem = _mean_sem(s["phi"].values)
+        mean, sem = mean_sem(s["phi"].values)
         tol = LS_TOLERANCE[key[1]]
         rate = float(np.asarray(s["growth_rate"].values).ravel()[0]) if "growth_rate" in s else math.nan
         out.append(Row(
@@ -86,7 +81,7 @@ def slp_mrj_rows(summaries) -> list[Row]:
             source = f"Torquato & Jiao 2010 (seed 003) {MRJ_2D_POLYDISPERSE['lines']}"
         else:
             continue
-        mean, sem = _mean_sem(s["phi"].values)
+        mean, sem = mean_sem(s["phi"].values)
         out.append(Row(
             "SLP MRJ-like packings (Table I)", f"{s.attrs.get('ensemble', '?')}: SLP phi, {key[0]} d = {key[1]}",
             source, value, mean, sem, 0.01,

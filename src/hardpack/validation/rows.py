@@ -29,6 +29,17 @@ class Row:
     detail: str = ""
 
 
+def mean_sem(values) -> tuple[float, float]:
+    """Mean and standard error (sample std / sqrt(n)) of the finite values: (NaN, NaN) when there
+    are none, NaN error for a single value (one seed has no spread to quote)."""
+    values = np.asarray(list(values), float)
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return math.nan, math.nan
+    sem = values.std(ddof=1) / math.sqrt(values.size) if values.size > 1 else math.nan
+    return float(values.mean()), float(sem)
+
+
 def within(reproduced: float, published: float, tolerance: float, uncertainty: float = math.nan) -> bool:
     """|reproduced - published| <= tolerance (+ 2 sigma of the reproduced value when it has one)."""
     slack = tolerance + (2 * uncertainty if math.isfinite(uncertainty) else 0.0)

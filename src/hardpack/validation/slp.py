@@ -6,7 +6,13 @@ import math
 
 import numpy as np
 
-from hardpack.slp.published import MRJ_2D_POLYDISPERSE, TABLE_I, TABLE_I_LINES, TABLE_II, TABLE_II_LINES
+from hardpack.slp.published import (
+    MRJ_2D_POLYDISPERSE,
+    TABLE_I,
+    TABLE_I_LINES,
+    TABLE_II,
+    TABLE_II_LINES,
+)
 from hardpack.validation.packings import system_key
 from hardpack.validation.rows import Row, within
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hardpack.validation.rows import Row, within
+from hardpack.validation.rows import Row, mean_sem, within
 
 CH9 = "Donev dissertation ch. 9 (seed 000, ch07-09)"
 CH10 = "Donev dissertation ch. 10 (seed 000, ch10-14)"
@@ -39,13 +39,6 @@ def _ensemble(ds) -> str:
     return parts[-3] if len(parts) >= 3 else "packings"
 
 
-def _mean_sem(values) -> tuple[float, float]:
-    values = np.asarray([v for v in values if math.isfinite(v)], float)
-    if values.size == 0:
-        return math.nan, math.nan
-    sem = values.std(ddof=1) / math.sqrt(values.size) if values.size > 1 else math.nan
-    return float(values.mean()), sem
-
 
 def _peak(x, g, lo, hi) -> float:
     inside = (x >= lo) & (x <= hi)
@@ -55,13 +48,13 @@ def _peak(x, g, lo, hi) -> float:
 def _rows(name: str, members: list) -> list[Row]:
     n, seeds = int(members[0].attrs["n_particles"]), len(members)
     size = f"N = {n}, {seeds} seeds"
-    alpha, alpha_sem = _mean_sem(float(m["alpha"]) for m in members)
+    alpha, alpha_sem = mean_sem(float(m["alpha"]) for m in members)
     window = members[0].attrs.get("alpha_window", [math.nan, math.nan])
     x = members[0]["x"].values
     g2 = np.mean([m["g2_scaled"].values for m in members], axis=0)
     at_sqrt3, at_2 = _peak(x, g2, 1.62, 1.85), _peak(x, g2, 1.9, 2.1)
     below, above = g2[np.searchsorted(x, 2.0) - 1], float(np.mean(g2[(x > 2.0) & (x < 2.05)]))
-    s0, s0_sem = _mean_sem(float(m["S0"]) for m in members)
+    s0, s0_sem = mean_sem(float(m["S0"]) for m in members)
     phi = float(np.mean([m.attrs["phi"] for m in members]))
     return [
         Row("structure", f"{name}: near-contact exponent alpha, rattlers removed", f"{CH9} L1788-1789",
