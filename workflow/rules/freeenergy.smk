@@ -35,6 +35,10 @@ rule bcmd_fcc:
         size=lambda w: "--phi 0.545 --dmu-max 1 --theta 1" if w.state == "melting"
         else "--delta 1e-6 --dmu-max 1e-5 --theta 0.5",
         gamma0=FREEENERGY["gamma0"] if FREEENERGY else None,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=20,
     log:
         "results/logs/bcmd_fcc/{state}_reps{reps}_seed{seed}.log",
     shell:
@@ -65,7 +69,7 @@ rule fig_bcmd_fcc:
         expand("results/freeenergy/{state}_summary.nc", state=["melting", "jamming"]),
     output:
         pdf="results/figures/bcmd_fcc.pdf",
-        png="results/figures/bcmd_fcc.png",
+        png=report("results/figures/bcmd_fcc.png", caption="../report/bcmd_fcc.rst", category="4 free energies"),
     log:
         "results/logs/figures/bcmd_fcc.log",
     script:
@@ -81,6 +85,10 @@ rule bcmd_fcc_density:
     params:
         dmu_max=lambda w: fcc_dmu_max(w.phi),
         gamma0=FREEENERGY["gamma0"] if FREEENERGY else None,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=20,
     log:
         "results/logs/bcmd_fcc_density/reps{reps}_phi{phi}_seed{seed}.log",
     shell:
@@ -96,6 +104,10 @@ rule fcc_eos:
         "results/freeenergy/eos/fcc_reps{reps}_phi{phi}.nc",
     params:
         collisions=FREEENERGY["density"]["eos_collisions"] if FREEENERGY else None,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=20,
     log:
         "results/logs/fcc_eos/reps{reps}_phi{phi}.log",
     shell:
@@ -136,7 +148,7 @@ rule fig_bcmd_density:
         eos="results/freeenergy/density_eos_summary.nc",
     output:
         pdf="results/figures/bcmd_fcc_density.pdf",
-        png="results/figures/bcmd_fcc_density.png",
+        png=report("results/figures/bcmd_fcc_density.png", caption="../report/bcmd_fcc_density.rst", category="4 free energies"),
     log:
         "results/logs/figures/bcmd_fcc_density.log",
     script:
@@ -154,6 +166,10 @@ rule bcmd_simplex:
         frozen="particle|cm",
     params:
         s=FREEENERGY["simplex"] if FREEENERGY else None,
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=30,
     log:
         "results/logs/bcmd_simplex/{ensemble}_seed{seed}_{frozen}.log",
     shell:
@@ -185,6 +201,10 @@ rule bcmd_ladder:
     """The cheap BCMD checks against exact values (disjoint cells, billiard, simplex formula)."""
     output:
         "results/freeenergy/ladder.nc",
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=10,
     log:
         "results/logs/bcmd_ladder.log",
     shell:

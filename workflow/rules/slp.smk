@@ -38,6 +38,10 @@ rule slp_densest:
         history="results/slp/densest/d{d}/history_seed{seed}.nc",
     params:
         flags=slp_flags(SLP_DENSEST) if SLP_DENSEST else "",
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=30,
     log:
         "results/logs/slp_densest/d{d}_seed{seed}.log",
     shell:
@@ -102,6 +106,10 @@ rule slp_mrj:
         history="results/ensembles/{ensemble}/slp/history_seed{seed}.nc",
     params:
         flags=slp_flags(SLP_MRJ) if SLP_MRJ else "",
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=60,
     log:
         "results/logs/slp_mrj/{ensemble}_seed{seed}.log",
     shell:
@@ -148,6 +156,10 @@ rule slp_system:
         history="results/slp/mrj/{system}/history_seed{seed}.nc",
     params:
         flags=slp_flags(SLP_MRJ) if SLP_MRJ else "",
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=60,
     log:
         "results/logs/slp_system/{system}_seed{seed}.log",
     shell:
@@ -160,6 +172,10 @@ rule verify_slp_system:
         "results/slp/mrj/{system}/seed{seed}.nc",
     output:
         "results/slp/mrj/{system}/jamming_seed{seed}.nc",
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=20,
     log:
         "results/logs/verify_slp_system/{system}_seed{seed}.log",
     shell:
@@ -211,6 +227,10 @@ rule slp_order_map_run:
         "results/slp/order_map/s{k}_seed{seed}.nc",
     params:
         flags=lambda w: slp_flags(SLP_ORDER["settings"][int(w.k)]),
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=20,
     log:
         "results/logs/slp_order_map/s{k}_seed{seed}.log",
     shell:
@@ -223,6 +243,10 @@ rule verify_slp_order_map:
         "results/slp/order_map/s{k}_seed{seed}.nc",
     output:
         "results/slp/order_map/jamming_s{k}_seed{seed}.nc",
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
     log:
         "results/logs/verify_slp_order_map/s{k}_seed{seed}.log",
     shell:
@@ -252,7 +276,7 @@ rule fig_slp_densest:
         "results/slp/densest_summary.nc",
     output:
         pdf="results/figures/slp_densest.pdf",
-        png="results/figures/slp_densest.png",
+        png=report("results/figures/slp_densest.png", caption="../report/slp_densest.rst", category="6 SLP"),
     log:
         "results/logs/figures/slp_densest.log",
     script:
@@ -267,7 +291,7 @@ rule fig_slp_vs_ls:
         systems=expand("results/slp/mrj/{system}/slp_summary.nc", system=SLP_SYSTEMS),
     output:
         pdf="results/figures/slp_vs_ls.pdf",
-        png="results/figures/slp_vs_ls.png",
+        png=report("results/figures/slp_vs_ls.png", caption="../report/slp_vs_ls.rst", category="6 SLP"),
     log:
         "results/logs/figures/slp_vs_ls.log",
     script:
@@ -280,7 +304,7 @@ rule fig_slp_order_map:
         "results/slp/order_map_summary.nc",
     output:
         pdf="results/figures/slp_order_map.pdf",
-        png="results/figures/slp_order_map.png",
+        png=report("results/figures/slp_order_map.png", caption="../report/slp_order_map.rst", category="6 SLP"),
     log:
         "results/logs/figures/slp_order_map.log",
     script:
