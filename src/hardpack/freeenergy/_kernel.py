@@ -14,7 +14,7 @@ v_0..v_{d-1}, s_i)``, displacement and velocity at the particle's own last updat
 
 Events follow the md engine's scheme (one predicted event per particle in a 4-ary min-heap with
 the keys stored in heap order, lazy invalidation by the partner's collision counter); the
-contact-time roots are the md kernel's: pairs use ``_root`` (constant radii, g = 0, with its
+contact-time roots are the md kernel's: pairs use ``contact_root`` (constant radii, g = 0, with its
 early rejection against the best time so far); the cell wall solves the md bounding-sphere exit
 equation |dr + v s| = rho - adot s (adot = gamma R_i) in a form stable right after a bounce
 (:func:`_wall_root`).
@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hardpack.md.kernel import _root
+from hardpack.md.heap import heap_set
+from hardpack.md.kernel import contact_root
 
 WALL = -1  # event: the particle hits its cell wall
 NONE = -2  # nothing predicted
@@ -38,47 +39,6 @@ N_FLOAT = 2
 # integer counters
 C_EVENTS, C_WALL, C_PAIR, C_STALE = 0, 1, 2, 3
 N_INT = 4
-
-
-@njit(cache=True, inline="always")
-def heap_set(hkey, heap, hpos, hsize, i, key):
-    """Give item i the key ``key`` in a 4-ary min-heap whose keys are stored in heap order
-    (``hkey[k]`` is the key of ``heap[k]``, ``hpos[i]`` the slot of i, -1 if absent). An absent
-    item is appended first. Sifts up, then down; returns the new heap size."""
-    pos = hpos[i]
-    if pos < 0:
-        pos = hsize
-        hsize += 1
-    while pos > 0:  # sift up
-        parent = (pos - 1) >> 2
-        if hkey[parent] <= key:
-            break
-        hp = heap[parent]
-        hkey[pos] = hkey[parent]
-        heap[pos] = hp
-        hpos[hp] = pos
-        pos = parent
-    while True:  # sift down: smallest of up to 4 children
-        first = 4 * pos + 1
-        if first >= hsize:
-            break
-        ch = first
-        kc = hkey[first]
-        for c in range(first + 1, min(first + 4, hsize)):
-            if hkey[c] < kc:
-                kc = hkey[c]
-                ch = c
-        if kc >= key:
-            break
-        hc = heap[ch]
-        hkey[pos] = kc
-        heap[pos] = hc
-        hpos[hc] = pos
-        pos = ch
-    hkey[pos] = key
-    heap[pos] = i
-    hpos[i] = pos
-    return hsize
 
 
 @njit(cache=True, inline="always")
@@ -250,7 +210,7 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                     rr += r * r
                     ru += r * u
                     uu += u * u
-                tc = _root(rr, ru, uu, nb_sig[m], 0.0, best)
+                tc = contact_root(rr, ru, uu, nb_sig[m], 0.0, best)
                 if tc < best:
                     best = tc
                     partner = j

@@ -60,6 +60,8 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from hardpack.md.heap import heap_set
+
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
 
@@ -142,11 +144,11 @@ def pair_time(r, u, sig0, g):
         rr += r[k] * r[k]
         ru += r[k] * u[k]
         uu += u[k] * u[k]
-    return _root(rr, ru, uu, sig0, g, np.inf)
+    return contact_root(rr, ru, uu, sig0, g, np.inf)
 
 
 @njit(cache=True, inline="always")
-def _root(rr, ru, uu, sig0, g, tmax):
+def contact_root(rr, ru, uu, sig0, g, tmax):
     """First contact time in [0, tmax), else inf (module docstring). When A >= 0 the root is at
     least C / (-2B), which rejects most pairs before the square root."""
     b = ru - sig0 * g
@@ -220,7 +222,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
 
     Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
-    out of the hot path): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
+    out of the hot path; the heap update is :func:`hardpack.md.heap.heap_set`, inlined): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
     NNL update of one particle (wrap, new bounding sphere, re-bin on its grid level, list every
     overlapping bounding sphere already binned; together a complete update, Alg. 9); the
     bounding radius is
@@ -523,7 +525,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                     ru += r * u
                     uu += u * u
                 s = ai + P[j, 2 * d + 1]
-                tc = _root(rr, ru, uu, s * grow, s * kappa, best)
+                tc = contact_root(rr, ru, uu, s * grow, s * kappa, best)
                 if tc < best:
                     best = tc
                     partner = j
@@ -531,40 +533,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
             ep[i] = partner
             if partner >= 0:
                 ec[i] = cnt[partner]
-            pos = hpos[i]
-            if pos < 0:  # first insertion (schedule reset)
-                pos = hsize
-                hsize += 1
-            while pos > 0:  # sift up
-                parent = (pos - 1) >> 2
-                if hkey[parent] <= key:
-                    break
-                hp = heap[parent]
-                hkey[pos] = hkey[parent]
-                heap[pos] = hp
-                hpos[hp] = pos
-                pos = parent
-            while True:  # sift down: smallest of up to 4 children
-                first = 4 * pos + 1
-                if first >= hsize:
-                    break
-                ch = first
-                kc = hkey[first]
-                last = min(first + 4, hsize)
-                for c2 in range(first + 1, last):
-                    if hkey[c2] < kc:
-                        kc = hkey[c2]
-                        ch = c2
-                if kc >= key:
-                    break
-                hc = heap[ch]
-                hkey[pos] = kc
-                heap[pos] = hc
-                hpos[hc] = pos
-                pos = ch
-            hkey[pos] = key
-            heap[pos] = i
-            hpos[i] = pos
+            hsize = heap_set(hkey, heap, hpos, hsize, i, key)
 
         if stage == 2 * n and hsize > 1:
             # look ahead: start loading the rows the next events will need (their particles, the
