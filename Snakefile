@@ -41,6 +41,7 @@ include: "workflow/rules/jamming.smk"
 include: "workflow/rules/structure.smk"
 include: "workflow/rules/slp.smk"
 include: "workflow/rules/freeenergy.smk"
+include: "workflow/rules/polydisperse.smk"
 include: "workflow/rules/validation.smk"
 
 

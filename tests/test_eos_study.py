@@ -74,6 +74,17 @@ def test_tridisperse_jams_like_polydisperse():
     assert 0.96 * fit < phi["poly"] < 1.005 * fit
 
 
+@pytest.mark.parametrize("spec", [{"kind": "uniform_volume", "omega": 10}, {"kind": "lognormal", "sigma": 0.5}])
+def test_wide_tridisperse_equivalents_run(spec):
+    """The widest configured tridisperse equivalents (radii a1 : a3 = 6.1 and 6.4, with a gap of more
+    than a factor 2 between neighbouring species) must run in the engine: a short NVE fluid run at
+    phi = 0.3 (N = 1000, the config's smallest N for UV omega = 10). Ogarko's study needs them
+    (Tables 3.3-3.4, Fig. 3.12); the engine's grid levels must not assume that every radius class
+    between the smallest and the largest is occupied."""
+    row = study.fluid_pressure(spec, "tri", 0.3, seed=1, n=1000, collisions=2000)
+    assert np.isfinite(row["Z"]) and row["Z"] > 1
+
+
 def _jam_packing(width, system, seed, phi, family="uniform_size"):
     """A fake eos-jam output: only the attributes the summary reads."""
     ds = xr.Dataset({"radius": ("particle", np.ones(10))})

@@ -1,4 +1,4 @@
-# Study (issue 6): EOS and jamming density of polydisperse spheres vs their moment-matched bi- and
+# Study 3 (issue 6): EOS and jamming density of polydisperse spheres vs their moment-matched bi- and
 # tridisperse equivalents (Ogarko ch. 3). One job per (family, width, seed) jams the polydisperse
 # system and both equivalents with the same protocol and N; one job per (family, width) measures the
 # fluid Z(phi) of the three against BMCSL. Summaries, figures and validation rows follow.
@@ -28,6 +28,22 @@ POLY_FAMILY = "uniform_size|uniform_volume|lognormal"
 POLY_WIDTH = r"[0-9]+(\.[0-9]+)?"
 
 
+def poly_jam_mem_mb(wildcards):
+    return 500 + POLY_JAM["N"] // 5
+
+
+def poly_jam_runtime(wildcards):
+    """Minutes for the three systems. Measured: 3-11 CPU s per system at N = 500 (US omega = 2 and 10,
+    final Gamma = 0.002); the budget is ~100x that, for loaded machines and wide UV distributions."""
+    return 10 + 3 * POLY_JAM["N"] // 100
+
+
+def poly_fluid_runtime(wildcards):
+    """Minutes: 3 systems x len(phi) runs of `collisions` collisions at ~1e6 collisions per CPU second."""
+    runs = 3 * len(POLY_FLUID["phi"])
+    return 10 + runs * (POLY_FLUID["collisions"] + 50 * POLY_FLUID["N"]) // 2_000_000
+
+
 rule poly_jam:
     """Two-stage LS compression of the polydisperse system and its bi- and tridisperse equivalents."""
     output:
@@ -43,6 +59,10 @@ rule poly_jam:
     wildcard_constraints:
         family=POLY_FAMILY,
         width=POLY_WIDTH,
+    threads: 1
+    resources:
+        mem_mb=poly_jam_mem_mb,
+        runtime=poly_jam_runtime,
     log:
         "results/logs/poly_jam/{family}_w{width}_seed{seed}.log",
     shell:
@@ -79,6 +99,10 @@ rule poly_fluid:
     wildcard_constraints:
         family=POLY_FAMILY,
         width=POLY_WIDTH,
+    threads: 1
+    resources:
+        mem_mb=lambda w: 500 + POLY_FLUID["N"] // 5,
+        runtime=poly_fluid_runtime,
     log:
         "results/logs/poly_fluid/{family}_w{width}.log",
     shell:
@@ -105,7 +129,8 @@ rule fig_phij_vs_omega:
         expand("results/polydisperse/phij_{family}.nc", family=list(POLY_JAM.get("widths", {}))),
     output:
         pdf="results/figures/phij_vs_omega.pdf",
-        png="results/figures/phij_vs_omega.png",
+        png=report("results/figures/phij_vs_omega.png", caption="../report/polydisperse_phij.rst",
+                   category="3 polydisperse"),
     log:
         "results/logs/figures/phij_vs_omega.log",
     script:
@@ -118,16 +143,17 @@ rule fig_eos_vs_bmcsl:
         "results/polydisperse/fluid_summary.nc",
     output:
         pdf="results/figures/eos_vs_bmcsl.pdf",
-        png="results/figures/eos_vs_bmcsl.png",
+        png=report("results/figures/eos_vs_bmcsl.png", caption="../report/polydisperse_eos.rst",
+                   category="3 polydisperse"),
     log:
         "results/logs/figures/eos_vs_bmcsl.log",
     script:
         "../scripts/plot_poly_eos.py"
 
 
-if POLY:
+if POLY_JAM.get("widths"):
     FIGURES.append("results/figures/phij_vs_omega.pdf")
+    VALIDATION_INPUTS["polydisperse"] = expand("results/polydisperse/phij_{family}.nc", family=list(POLY_JAM["widths"]))
+if POLY_FLUID.get("widths"):
     FIGURES.append("results/figures/eos_vs_bmcsl.pdf")
-    VALIDATION_INPUTS["polydisperse"] = expand("results/polydisperse/phij_{family}.nc",
-                                               family=list(POLY_JAM["widths"])) + [
-        "results/polydisperse/fluid_summary.nc"]
+    VALIDATION_INPUTS.setdefault("polydisperse", []).append("results/polydisperse/fluid_summary.nc")

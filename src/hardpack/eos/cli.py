@@ -19,11 +19,10 @@ import xarray as xr
 
 from hardpack.distributions import from_spec
 from hardpack.eos import moments as mo
+from hardpack.eos.study import WIDTH as FAMILIES
 from hardpack.errors import InvalidInputError
 
 log = logging.getLogger(__name__)
-
-FAMILIES = {"uniform_size": "omega", "uniform_volume": "omega", "power_law": "omega", "lognormal": "sigma"}
 
 
 def equivalents_dataset(kind: str, values, alpha: float | None = None) -> xr.Dataset:

@@ -89,9 +89,12 @@ def grid_levels(bound_radii: np.ndarray) -> np.ndarray:
     """Grid level of every particle: bounding radii in classes of ratio LEVEL_RATIO from the
     smallest (level 0), so each level's cells fit its largest bounding sphere without holding
     many much smaller ones (a hierarchical grid, Ogarko ch. 2.1; monodisperse and moderately
-    polydisperse systems get one level)."""
+    polydisperse systems get one level). Empty classes are dropped (levels renumbered 0, 1, ...
+    over the occupied ones): a discrete distribution such as a tridisperse equivalent of a wide
+    one leaves gaps between its classes, and a level without particles has no grid."""
     ratio = bound_radii / bound_radii.min()
-    return np.floor(np.log(ratio) / np.log(LEVEL_RATIO) + 1e-12).astype(np.int64)
+    classes = np.floor(np.log(ratio) / np.log(LEVEL_RATIO) + 1e-12).astype(np.int64)
+    return np.unique(classes, return_inverse=True)[1].astype(np.int64).reshape(classes.shape)
 
 
 class Engine:
