@@ -50,7 +50,7 @@ def compare_md_forces(net: ContactNetwork, lp_forces: np.ndarray, backbone_conta
                       md) -> ForceComparison:
     """Compare LP forces (on the backbone contacts) with an MD contact-force Dataset ``md`` holding
     md_contact_{i, j, shift, force, virial} (module docstring)."""
-    n, d = net.n_particles, net.dim
+    n = net.n_particles
     md_index = {k: m for m, k in enumerate(_keys(md["md_contact_i"].values, md["md_contact_j"].values,
                                                    md["md_contact_shift"].values, n))}
     lp_keys = _keys(net.i, net.j, net.shift, n)

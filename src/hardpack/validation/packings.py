@@ -50,7 +50,7 @@ def ls_rows(summaries) -> list[Row]:
         key = system_key(s)
         if key not in LS_TARGETS:
             continue
-        value, err, source = LS_TARGETS[key]
+        value, _, source = LS_TARGETS[key]
         mean, sem = mean_sem(s["phi"].values)
         tol = LS_TOLERANCE[key[1]]
         rate = float(np.asarray(s["growth_rate"].values).ravel()[0]) if "growth_rate" in s else math.nan
@@ -74,10 +74,10 @@ def slp_mrj_rows(summaries) -> list[Row]:
         if key is None:
             continue
         if key[0] == "monodisperse" and key[1] in TABLE_I:
-            n_pub, _, _, (value, err), _ = TABLE_I[key[1]]
+            n_pub, _, _, (value, _), _ = TABLE_I[key[1]]
             source = f"Torquato & Jiao 2010 (seed 003) Table I, {TABLE_I_LINES}"
         elif key == ("us_omega2", 2):
-            value, err, n_pub = MRJ_2D_POLYDISPERSE["phi"], 0.0, 500
+            value, n_pub = MRJ_2D_POLYDISPERSE["phi"], 500
             source = f"Torquato & Jiao 2010 (seed 003) {MRJ_2D_POLYDISPERSE['lines']}"
         else:
             continue
