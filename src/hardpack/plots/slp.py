@@ -70,34 +70,51 @@ def plot_slp_vs_ls(pairs: dict):
 
 
 def plot_order_map(summary):
-    """Translational order T against phi (Fig. 6 of Torquato & Jiao), one marker per packing.
+    """Left: translational order T against phi (Fig. 6 of Torquato & Jiao), one marker per
+    packing. Right: phi against the influence radius gamma / D (the SLP densities vs influence
+    radius of the paper's sec. V), one marker per packing with the mean per radius.
 
     One colour and marker per SLP setting (alpha = gamma / D, bounds strain / shear / displacement,
-    LP solver); filled when the packing passed the strict jamming test. FCC (phi = 0.74048, T = 1)
-    and the paper's MRJ density 0.64 (L1620-1624) are marked for reference.
+    LP solver); filled when the packing passed the strict jamming test. Coinciding packings (e.g.
+    several seeds ending in the same crystal) are labelled with their count. FCC (phi = 0.74048,
+    T = 1) and the paper's MRJ density 0.64 (L1620-1624) are marked for reference.
     """
-    fig, ax = figure()
+    fig, (ax, ax_r) = figure(1, 2, figsize=(9.0, 3.8))
     keys = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method")
     settings = list(zip(*(summary[k].values.tolist() for k in keys)))
     strict = summary["strict"].values.astype(bool)
-    phi, t = summary["phi"].values, summary["T"].values
+    phi, t, alpha = summary["phi"].values, summary["T"].values, summary["alpha"].values
     for n, setting in enumerate(dict.fromkeys(settings)):
-        alpha, strain, shear, disp, method = setting
+        radius, strain, shear, disp, method = setting
         pick = np.array([s == setting for s in settings])
         colour, marker = f"C{n % 10}", "os^Dv<>ph*"[n % 10]
-        label = (rf"$\gamma$ = {alpha:g} D, bounds {strain:g}/{shear:g}/{disp:g} D, "
+        label = (rf"$\gamma$ = {radius:g} D, bounds {strain:g}/{shear:g}/{disp:g} D, "
                  f"{method.removeprefix('highs-')}")
+        offset = 0.04 * (n - 0.5 * (len(set(settings)) - 1))  # side by side on the right panel
         for jammed in (True, False):
             sel = pick & (strict == jammed)
             if sel.any():
-                ax.scatter(phi[sel], t[sel], s=24, marker=marker, edgecolors=colour,
-                           facecolors=colour if jammed else "none",
+                face = colour if jammed else "none"
+                ax.scatter(phi[sel], t[sel], s=24, marker=marker, edgecolors=colour, facecolors=face,
                            label=label + ("" if jammed else " (not strictly jammed)"))
+                ax_r.scatter(alpha[sel] + offset, phi[sel], s=18, marker=marker, edgecolors=colour,
+                             facecolors=face)
+    points, counts = np.unique(np.round(np.column_stack([phi, t]), 4), axis=0, return_counts=True)
+    for (x, y), count in zip(points, counts):
+        if count > 1:
+            ax.annotate(f"x{count}", (x, y), textcoords="offset points", xytext=(5, -9), fontsize=6)
+    radii = np.unique(alpha)
+    ax_r.plot(radii, [phi[alpha == r].mean() for r in radii], "k_", ms=16, mew=1.5, label="mean")
     ax.plot([np.pi / np.sqrt(18)], [1.0], "k*", ms=10, label="FCC")
     ax.axvline(0.64, color="0.5", ls=":", lw=1, label=r"MRJ $\phi$ = 0.64 (paper)")
+    ax_r.axhline(np.pi / np.sqrt(18), color="k", ls="--", lw=1, label="FCC / HCP")
+    ax_r.axhline(0.64, color="0.5", ls=":", lw=1, label="MRJ 0.64 (paper)")
     ax.set_xlabel(r"packing density $\phi$")
     ax.set_ylabel("translational order T")
+    ax_r.set_xlabel(r"influence radius $\gamma$ / D")
+    ax_r.set_ylabel(r"packing density $\phi$")
     n = summary.attrs.get("N", "?")
     ax.set_title(f"SLP jammed packings, d = 3, N = {n}: {summary.sizes['packing']} packings")
     ax.legend(fontsize=5.5, loc="upper left")
+    ax_r.legend(fontsize=6, loc="center right")
     return fig
