@@ -39,6 +39,12 @@ def disjoint_dmu(phi):
     return (PHI_CP / np.asarray(phi, float)) ** (1.0 / 3.0) - 1.0
 
 
+def distance_to_jamming(phi):
+    """delta = (phi_cp / phi)^(1/3) - 1: the relative growth of the diameters that jams FCC at
+    density phi (the crystal's free energy behaves as -3 ln delta - f_J as delta -> 0)."""
+    return (PHI_CP / np.asarray(phi, float)) ** (1.0 / 3.0) - 1.0
+
+
 def cell_offset(phi):
     """c(phi) = f_c(Delta mu_d) - f_ideal = 1 - ln phi - 3 ln Delta mu_d(phi): excess = c - Delta f."""
     phi = np.asarray(phi, float)

@@ -11,6 +11,7 @@ from hardpack.freeenergy.crystal import (
     PHI_CP,
     cell_limit_excess,
     cell_offset,
+    distance_to_jamming,
     eos_excess,
 )
 from hardpack.plots.style import figure
@@ -44,8 +45,9 @@ def plot_fcc_finite_size(summaries: dict):
 
 
 def plot_fcc_density(bcmd, eos):
-    """FCC free energy vs density: (a) excess over the ideal gas, (b) BCMD's Delta f =
-    f_c(Delta mu_d) - f, with the EOS integration of the engine's pressure from the published
+    """FCC free energy vs density: (a) excess over the ideal gas vs phi, (b) BCMD's Delta f =
+    f_c(Delta mu_d) - f vs the distance to jamming delta (log scale; f = -3 ln delta - f_J
+    + ..., so Delta f tends to the jamming constant as delta -> 0), with the EOS integration of the engine's pressure from the published
     melting value and the cell limit with the published jamming constant
     (hardpack.freeenergy.crystal)."""
     fig, (ax1, ax2) = figure(1, 2, figsize=(9.0, 3.6))
@@ -67,13 +69,14 @@ def plot_fcc_density(bcmd, eos):
     ax1.set_ylabel(r"excess free energy $f - f_{ideal}$ [$k_BT$]")
     ax1.set_ylim(top=1.1 * max(ex_b.max(), ex_e.max()))
     ax1.legend(loc="upper left", fontsize=6.5)
-    ax2.plot(fine, cell_offset(fine) - ex_e, "-", color="C1", label="EOS integral")
-    ax2.plot(phi_b, cell_offset(phi_b) - ex_b, "o", color="C0", ms=4, label="hardpack BCMD")
-    ax2.plot([MELTING_PHI], [cell_offset(MELTING_PHI) - MELTING_EXCESS], "*", color="C3", ms=9,
+    ax2.plot(distance_to_jamming(fine), cell_offset(fine) - ex_e, "-", color="C1", label="EOS integral")
+    ax2.plot(distance_to_jamming(phi_b), cell_offset(phi_b) - ex_b, "o", color="C0", ms=4, label="hardpack BCMD")
+    ax2.plot([distance_to_jamming(MELTING_PHI)], [cell_offset(MELTING_PHI) - MELTING_EXCESS], "*", color="C3", ms=9,
              label="published melting value")
-    ax2.plot([PHI_CP], [JAMMING_CONSTANT], "s", color="C2", ms=6,
-             label="published jamming limit (ch. 6 L1012)")
-    ax2.set_xlabel(r"$\phi$")
+    ax2.axhline(JAMMING_CONSTANT, color="C2", ls=":",
+                label=f"published jamming limit {JAMMING_CONSTANT} (ch. 6 L1012)")
+    ax2.set_xscale("log")
+    ax2.set_xlabel(r"distance to jamming $\delta = (\phi_{cp}/\phi)^{1/3} - 1$")
     ax2.set_ylabel(r"$\Delta f = f_c(\Delta\mu_d) - f$ [$k_BT$]")
     ax2.legend(loc="lower left", fontsize=6.5)
     fig.tight_layout()
