@@ -168,6 +168,8 @@ def _factorise(a: sp.csc_matrix):
         lu = spla.splu(a, permc_spec="COLAMD")
         probe = lu
     except RuntimeError:  # exactly singular: locate the dependent columns on a regularised copy
+        # (SuperLU's BLAS may print "On entry to DGEMV parameter number 2 had an illegal value"
+        # on its way to this error; the failed factor is discarded, so the message is harmless)
         lu = None
         scale = float(abs(a).max()) if a.nnz else 1.0
         probe = spla.splu(a + 1e-13 * scale * sp.identity(n, format="csc"), permc_spec="COLAMD")
