@@ -232,9 +232,10 @@ def _image_shift(cell, ncell, h, box, full, shift):
 
 
 @numba.njit(cache=True, inline="always")
-def _next_cell(cell, lo, hi):
-    """Odometer step over the d-dimensional cell range [lo, hi]; False when the range is done."""
-    for k in range(cell.shape[0]):
+def _next_cell(cell, lo, hi, first):
+    """Odometer step over axes first..d-1 of the cell range [lo, hi] (first = 1: the rows along
+    axis 0); False when the range is done."""
+    for k in range(first, cell.shape[0]):
         cell[k] += 1
         if cell[k] <= hi[k]:
             return True
@@ -265,7 +266,7 @@ def overlaps_any(x, r, pos, radii, box, ncell, head_offset, reach, head, nxt):
                 if r2 < s * s:
                     return True
                 q = nxt[q]
-            if not _next_cell(cell, lo, hi):
+            if not _next_cell(cell, lo, hi, 0):
                 break
     return False
 
@@ -323,17 +324,6 @@ def _scan(p, q0, q1, pos, radii, box, skin, shift, min_image, buf_i, buf_j, m):
             buf_j[m] = q
             m += 1
     return m
-
-
-@numba.njit(cache=True, inline="always")
-def _next_row(cell, lo, hi):
-    """Odometer step over axes 1..d-1 of the cell range [lo, hi]; False when the range is done."""
-    for k in range(1, cell.shape[0]):
-        cell[k] += 1
-        if cell[k] <= hi[k]:
-            return True
-        cell[k] = lo[k]
-    return False
 
 
 @numba.njit(cache=True)
@@ -419,7 +409,7 @@ def _pairs_kernel(pos, radii, level, box, ncell, head_offset, reach, skin, start
                         shift[0] = part_shift[t]
                         m = _scan(p, part_q[2 * t], part_q[2 * t + 1], pos, radii, box, skin, shift, min_image,
                                   buf_i, buf_j, m)
-                if not _next_row(cell, lo, hi):
+                if not _next_cell(cell, lo, hi, 1):
                     break
     return buf_i[:m].copy(), buf_j[:m].copy(), tests, visits
 
