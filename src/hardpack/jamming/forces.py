@@ -48,7 +48,7 @@ import scipy.sparse.linalg as spla
 from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.highs import LPFailure, solve_lp
 from hardpack.jamming.isostatic import RigidBackbone
-from hardpack.jamming.rigidity import rigidity_transpose
+from hardpack.jamming.rigidity import anchored_transpose, rigidity_transpose
 from hardpack.jamming.workingset import solve_working_set
 
 
@@ -155,9 +155,7 @@ def jamming_point_forces(net: ContactNetwork, backbone: np.ndarray, contact_delt
     nb = int(backbone.sum())
     if nb < 2 or not contacts.any():
         return None
-    moving = backbone.copy()
-    moving[np.flatnonzero(backbone)[0]] = False
-    at = rigidity_transpose(net)[contacts][:, np.flatnonzero(np.repeat(moving, d))]
+    _, at = anchored_transpose(net, backbone, contacts)
     dist, h = net.contact_distance[contacts], net.gap[contacts]
     g = sp.vstack([at.T, sp.csr_matrix(-dist[None, :])], format="csc")
     nvar = g.shape[0]

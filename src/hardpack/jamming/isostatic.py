@@ -37,7 +37,7 @@ import scipy.sparse.linalg as spla
 from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.lp import LPFailure, solve_lp
 from hardpack.jamming.rigidity import (
-    rigidity_transpose,
+    anchored_transpose,
     strain_coefficients,
     strain_pairs,
     strain_tensor,
@@ -69,9 +69,7 @@ class RigidBackbone:
         k = m - nf
         if nb < 2 or not 1 <= k <= MAX_SELF_STRESSES:
             return None
-        moving = backbone.copy()
-        moving[np.flatnonzero(backbone)[0]] = False
-        at = rigidity_transpose(net)[contacts][:, np.flatnonzero(np.repeat(moving, d))]
+        moving, at = anchored_transpose(net, backbone, contacts)
         a = at.T.tocsc()
         rng = np.random.default_rng(0)
         norms = np.asarray(abs(a).sum(axis=0)).ravel()

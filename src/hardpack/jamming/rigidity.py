@@ -78,6 +78,16 @@ def rigidity_transpose(net: ContactNetwork, strain: bool = False) -> sp.csr_matr
     return at
 
 
+def anchored_transpose(net: ContactNetwork, backbone: np.ndarray,
+                       contacts: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
+    """(moving, rows ``contacts`` of A^T restricted to the positions of the ``moving`` particles):
+    the ``backbone`` particles except the first one, which stays fixed (removes the d
+    translations of a periodic backbone)."""
+    moving = backbone.copy()
+    moving[np.flatnonzero(backbone)[0]] = False
+    return moving, rigidity_transpose(net)[contacts][:, np.flatnonzero(np.repeat(moving, net.dim))]
+
+
 def rigidity_matrix(net: ContactNetwork, strain: bool = False) -> sp.csc_matrix:
     """The rigidity matrix A, shape (N d [+ d(d+1)/2], M); see the module docstring."""
     return rigidity_transpose(net, strain).T.tocsc()
