@@ -117,6 +117,34 @@ def test_summary_statistics_and_validation_rows():
         study.jam_summary(packs + [_jam_packing(2.0, "poly", 3, 0.7, family="lognormal")])
 
 
+def test_crystallisation_rows_and_fit_precedence():
+    """Slow runs: the US bidisperse equivalent must crystallise (large-particle crystallinity >= 0.05)
+    at omega >= 5 and not at omega <= 4; poly and tri never. The family's fit rows then come from the
+    slow summary only (the fits were measured at slow rates)."""
+    def packs(bi_large_at_10):
+        out = []
+        for width, bi_large in ((4.0, 0.0), (10.0, bi_large_at_10)):
+            for system, large in (("poly", 0.0), ("bi", bi_large), ("tri", 0.004)):
+                ds = _jam_packing(width, system, 1, 0.675)
+                ds.attrs["crystallinity_large"] = large
+                out.append(ds)
+        return out
+
+    slow = study.jam_summary(packs(0.2), study="crystallisation")
+    fast = study.jam_summary(packs(0.0))
+    rows = {r.quantity: r for r in polydisperse_rows([fast, slow])}
+    crystal = "uniform_size omega={:g}: {} large-species crystallised (1) or not (0), slow compression"
+    assert rows[crystal.format(10, "bi")].passed and rows[crystal.format(10, "bi")].reproduced == 1.0
+    assert rows[crystal.format(4, "bi")].passed and rows[crystal.format(10, "tri")].passed
+    fits = [r for r in polydisperse_rows([fast, slow]) if r.quantity.endswith("vs published fit")]
+    assert len(fits) == 2 and all("crystallinity" not in r.detail for r in fits)
+    assert len([r for r in polydisperse_rows([fast]) if r.quantity.endswith("vs published fit")]) == 2
+    missed = {r.quantity: r for r in polydisperse_rows([study.jam_summary(packs(0.01), study="crystallisation")])}
+    assert not missed[crystal.format(10, "bi")].passed  # no breakdown seen: the row fails
+    with pytest.raises(InvalidInputError, match="study"):
+        study.jam_summary(packs(0.2), study="slow")
+
+
 def test_fluid_summary_rows():
     rows_in = [dict(family="uniform_volume", width=4.0, system=s, phi=p, Z=z * (1 + dev), Z_err=0.01,
                     Z_bmcsl=z, rel_dev=dev, O1=0.739, O2=0.632, N=500, seed=1, collisions=1000, cpu_time=1.0)

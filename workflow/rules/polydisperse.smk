@@ -1,10 +1,14 @@
 # Study 3 (issue 6): EOS and jamming density of polydisperse spheres vs their moment-matched bi- and
 # tridisperse equivalents (Ogarko ch. 3). One job per (family, width, seed) jams the polydisperse
 # system and both equivalents with the same protocol and N; one job per (family, width) measures the
-# fluid Z(phi) of the three against BMCSL. Summaries, figures and validation rows follow.
+# fluid Z(phi) of the three against BMCSL. The same jobs with a slow final stage ("crystallisation")
+# look for the large-species crystallisation of the bidisperse equivalents (Ogarko L4851-4865).
+# Summaries, figures and validation rows follow.
 
 POLY = config.get("polydisperse", {})
 POLY_JAM = POLY.get("jam", {})
+#: jam protocols by output folder: the equivalence runs and the slow crystallisation runs
+POLY_PROTOCOLS = {"jammed": POLY_JAM, "crystallisation": POLY.get("crystallisation", {})}
 POLY_FLUID = POLY.get("fluid", {})
 POLY_SYSTEMS = ["poly", "bi", "tri"]
 POLY_WIDTH_NAME = {"uniform_size": "omega", "uniform_volume": "omega", "lognormal": "sigma"}
@@ -18,9 +22,10 @@ def _poly_spec(family, width):
     return json.dumps({"kind": family, POLY_WIDTH_NAME[family]: float(width)})
 
 
-def _poly_jam_files(family):
-    return expand("results/polydisperse/jammed/{family}/w{width}/seed{seed}_{system}.nc", family=family,
-                  width=[_poly_width(w) for w in POLY_JAM["widths"][family]], seed=POLY_JAM["seeds"],
+def _poly_jam_files(protocol, family):
+    runs = POLY_PROTOCOLS[protocol]
+    return expand("results/polydisperse/{protocol}/{family}/w{width}/seed{seed}_{system}.nc", protocol=protocol,
+                  family=family, width=[_poly_width(w) for w in runs["widths"][family]], seed=runs["seeds"],
                   system=POLY_SYSTEMS)
 
 
@@ -29,13 +34,15 @@ POLY_WIDTH = r"[0-9]+(\.[0-9]+)?"
 
 
 def poly_jam_mem_mb(wildcards):
-    return 500 + POLY_JAM["N"] // 5
+    return 500 + POLY_PROTOCOLS[wildcards.protocol]["N"] // 5
 
 
 def poly_jam_runtime(wildcards):
     """Minutes for the three systems. Measured: 3-11 CPU s per system at N = 500 (US omega = 2 and 10,
-    final Gamma = 0.002); the budget is ~100x that, for loaded machines and wide UV distributions."""
-    return 10 + 3 * POLY_JAM["N"] // 100
+    final Gamma = 0.002), 6-7 CPU min at final Gamma = 2e-5; the collisions grow as N / Gamma, and the
+    budget is ~20x the measured time at Gamma = 0.002, for loaded machines and wide UV distributions."""
+    runs = POLY_PROTOCOLS[wildcards.protocol]
+    return 10 + int(3 * runs["N"] // 100 * max(1.0, 0.002 / runs["final_growth_rate"]))
 
 
 def poly_fluid_runtime(wildcards):
@@ -47,16 +54,18 @@ def poly_fluid_runtime(wildcards):
 rule poly_jam:
     """Two-stage LS compression of the polydisperse system and its bi- and tridisperse equivalents."""
     output:
-        expand("results/polydisperse/jammed/{{family}}/w{{width}}/seed{{seed}}_{system}.nc", system=POLY_SYSTEMS),
+        expand("results/polydisperse/{{protocol}}/{{family}}/w{{width}}/seed{{seed}}_{system}.nc",
+               system=POLY_SYSTEMS),
     params:
         spec=lambda w: _poly_spec(w.family, w.width),
-        n=POLY_JAM.get("N"),
-        init_phi=POLY_JAM.get("init_phi"),
-        growth_rate=POLY_JAM.get("growth_rate"),
-        switch_pressure=POLY_JAM.get("switch_pressure"),
-        final_growth_rate=POLY_JAM.get("final_growth_rate"),
-        max_pressure=POLY_JAM.get("max_pressure"),
+        n=lambda w: POLY_PROTOCOLS[w.protocol]["N"],
+        init_phi=lambda w: POLY_PROTOCOLS[w.protocol]["init_phi"],
+        growth_rate=lambda w: POLY_PROTOCOLS[w.protocol]["growth_rate"],
+        switch_pressure=lambda w: POLY_PROTOCOLS[w.protocol]["switch_pressure"],
+        final_growth_rate=lambda w: POLY_PROTOCOLS[w.protocol]["final_growth_rate"],
+        max_pressure=lambda w: POLY_PROTOCOLS[w.protocol]["max_pressure"],
     wildcard_constraints:
+        protocol="|".join(POLY_PROTOCOLS),
         family=POLY_FAMILY,
         width=POLY_WIDTH,
     threads: 1
@@ -64,7 +73,7 @@ rule poly_jam:
         mem_mb=poly_jam_mem_mb,
         runtime=poly_jam_runtime,
     log:
-        "results/logs/poly_jam/{family}_w{width}_seed{seed}.log",
+        "results/logs/poly_jam/{protocol}/{family}_w{width}_seed{seed}.log",
     shell:
         "hardpack eos-jam --distribution '{params.spec}' --systems poly bi tri --seed {wildcards.seed}"
         " --n {params.n} --init-phi {params.init_phi} --growth-rate {params.growth_rate}"
@@ -75,7 +84,7 @@ rule poly_jam:
 rule poly_jam_summary:
     """phi_J over (width, system, seed) for one family."""
     input:
-        lambda w: _poly_jam_files(w.family),
+        lambda w: _poly_jam_files("jammed", w.family),
     output:
         "results/polydisperse/phij_{family}.nc",
     wildcard_constraints:
@@ -84,6 +93,20 @@ rule poly_jam_summary:
         "results/logs/poly_jam_summary/{family}.log",
     shell:
         "hardpack eos-summary --kind jam {input} --out {output} 2> {log}"
+
+
+rule poly_crystallisation_summary:
+    """The slow runs of one family: phi_J and large-species crystallinity over (width, system, seed)."""
+    input:
+        lambda w: _poly_jam_files("crystallisation", w.family),
+    output:
+        "results/polydisperse/crystallisation_{family}.nc",
+    wildcard_constraints:
+        family=POLY_FAMILY,
+    log:
+        "results/logs/poly_jam_summary/crystallisation_{family}.log",
+    shell:
+        "hardpack eos-summary --kind crystallisation {input} --out {output} 2> {log}"
 
 
 rule poly_fluid:
@@ -154,6 +177,9 @@ rule fig_eos_vs_bmcsl:
 if POLY_JAM.get("widths"):
     FIGURES.append("results/figures/phij_vs_omega.pdf")
     VALIDATION_INPUTS["polydisperse"] = expand("results/polydisperse/phij_{family}.nc", family=list(POLY_JAM["widths"]))
+if POLY_PROTOCOLS["crystallisation"].get("widths"):
+    VALIDATION_INPUTS.setdefault("polydisperse", []).extend(
+        expand("results/polydisperse/crystallisation_{family}.nc", family=list(POLY_PROTOCOLS["crystallisation"]["widths"])))
 if POLY_FLUID.get("widths"):
     FIGURES.append("results/figures/eos_vs_bmcsl.pdf")
     VALIDATION_INPUTS.setdefault("polydisperse", []).append("results/polydisperse/fluid_summary.nc")

@@ -139,12 +139,13 @@ def cmd_fluid(args) -> int:
 
 
 def cmd_summary(args) -> int:
-    """Combine the study's jammed packings (one family) or fluid files into one summary Dataset."""
+    """Combine the study's jammed packings (one family; ``jam``: the equivalence runs,
+    ``crystallisation``: the slow runs) or fluid files into one summary Dataset."""
     from hardpack.eos.study import fluid_summary, jam_summary
     from hardpack.io import load_dataset, write_dataset
 
     datasets = [load_dataset(p) for p in args.files]
-    ds = jam_summary(datasets) if args.kind == "jam" else fluid_summary(datasets)
+    ds = fluid_summary(datasets) if args.kind == "fluid" else jam_summary(datasets, study=args.kind)
     write_dataset(ds, args.out)
     log.info("wrote %s from %d files", args.out, len(datasets))
     return 0
@@ -176,7 +177,8 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_fluid)
 
     p = subparsers.add_parser("eos-summary", help=cmd_summary.__doc__)
-    p.add_argument("--kind", choices=["jam", "fluid"], required=True)
+    p.add_argument("--kind", choices=["jam", "crystallisation", "fluid"], required=True,
+                   help="jam: equivalence runs; crystallisation: slow runs (same files); fluid: eos-fluid files")
     p.add_argument("files", nargs="+", help="eos-jam packings of one family, or eos-fluid files")
     p.add_argument("--out", required=True, help="summary netCDF")
     p.set_defaults(func=cmd_summary)

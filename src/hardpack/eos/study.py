@@ -149,10 +149,17 @@ def fluid_pressure(spec: dict, system: str, phi: float, seed: int, n: int = 500,
 JAM_VARIABLES = ("phi", "Z", "collisions", "cpu_time", "crystallinity", "crystallinity_large", "O1", "O2")
 
 
-def jam_summary(packings) -> xr.Dataset:
+JAM_STUDIES = ("jam", "crystallisation")
+
+
+def jam_summary(packings, study: str = "jam") -> xr.Dataset:
     """Jammed packings of one family (Datasets written by ``hardpack eos-jam``) as one Dataset over
     (width, system, seed): phi_J (the final phi; phi_J - phi ~ 3 phi / Z <= 1e-11 at Z = 1e12) and
-    the run statistics. Missing combinations are NaN."""
+    the run statistics. Missing combinations are NaN. ``study`` (attribute) tells the validation
+    what the runs test: "jam", the equivalence of the mixtures at one protocol, or
+    "crystallisation", the slow runs for the large-species crystallisation of Ogarko L4862-4865."""
+    if study not in JAM_STUDIES:
+        raise InvalidInputError(f"study must be one of {JAM_STUDIES}, got {study!r}")
     packings = list(packings)
     if not packings:
         raise InvalidInputError("jam_summary needs at least one packing")
@@ -174,7 +181,7 @@ def jam_summary(packings) -> xr.Dataset:
                      coords={"width": widths, "system": systems, "seed": seeds})
     first = packings[0].attrs
     out.attrs.update(hardpack_kind="eos_jam_summary", family=families.pop(), width_name=WIDTH[first["family"]],
-                     N=int(packings[0].sizes["particle"]), study_protocol=first["study_protocol"])
+                     N=int(packings[0].sizes["particle"]), study_protocol=first["study_protocol"], study=study)
     return out
 
 
