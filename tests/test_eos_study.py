@@ -145,6 +145,22 @@ def test_crystallisation_rows_and_fit_precedence():
         study.jam_summary(packs(0.2), study="slow")
 
 
+def test_crystallisation_figure_shows_each_seed_and_the_threshold():
+    from hardpack.plots.eos import plot_crystallisation
+
+    packs = []
+    for seed, large in ((1, 0.1), (2, 0.3)):
+        for system in ("poly", "bi", "tri"):
+            ds = _jam_packing(10.0, system, seed, 0.675)
+            ds.attrs["crystallinity_large"] = large if system == "bi" else 0.0
+            packs.append(ds)
+    fig = plot_crystallisation(study.jam_summary(packs, study="crystallisation"), threshold=0.05)
+    right = fig.axes[1]
+    assert right.get_ylim()[1] >= 0.3  # every seed visible
+    assert any(np.allclose(line.get_ydata(), 0.05) for line in right.get_lines())
+    assert np.allclose(right.get_lines()[2].get_ydata(), 0.2)  # bi: mean over the seeds
+
+
 def test_fluid_summary_rows():
     rows_in = [dict(family="uniform_volume", width=4.0, system=s, phi=p, Z=z * (1 + dev), Z_err=0.01,
                     Z_bmcsl=z, rel_dev=dev, O1=0.739, O2=0.632, N=500, seed=1, collisions=1000, cpu_time=1.0)

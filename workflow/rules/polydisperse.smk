@@ -174,9 +174,25 @@ rule fig_eos_vs_bmcsl:
         "../scripts/plot_poly_eos.py"
 
 
+rule fig_crystallisation:
+    """Slow runs: phi_J and the large-species crystallinity vs omega (uniform size)."""
+    input:
+        "results/polydisperse/crystallisation_uniform_size.nc",
+    output:
+        pdf="results/figures/crystallisation_vs_omega.pdf",
+        png=report("results/figures/crystallisation_vs_omega.png",
+                   caption="../report/polydisperse_crystallisation.rst", category="3 polydisperse"),
+    log:
+        "results/logs/figures/crystallisation_vs_omega.log",
+    script:
+        "../scripts/plot_poly_crystallisation.py"
+
+
 if POLY_JAM.get("widths"):
     FIGURES.append("results/figures/phij_vs_omega.pdf")
     VALIDATION_INPUTS["polydisperse"] = expand("results/polydisperse/phij_{family}.nc", family=list(POLY_JAM["widths"]))
+if POLY_PROTOCOLS["crystallisation"].get("widths", {}).get("uniform_size"):
+    FIGURES.append("results/figures/crystallisation_vs_omega.pdf")
 if POLY_PROTOCOLS["crystallisation"].get("widths"):
     VALIDATION_INPUTS.setdefault("polydisperse", []).extend(
         expand("results/polydisperse/crystallisation_{family}.nc", family=list(POLY_PROTOCOLS["crystallisation"]["widths"])))

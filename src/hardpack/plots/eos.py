@@ -65,6 +65,41 @@ def plot_phij_vs_width(summaries):
     return fig
 
 
+def plot_crystallisation(summary, threshold: float):
+    """Slow runs (Ogarko L4851-4865): left, phi_J vs omega of poly / bi / tri with the published fit;
+    right, the q6 crystallinity of the large particles (mean over seeds, each seed a small marker)
+    with the ``threshold`` the validation counts as partial crystallisation."""
+    stats = seed_statistics(summary)
+    family = summary.attrs["family"]
+    widths = stats["width"].values
+    fig, (left, right) = figure(1, 2, figsize=(8.0, 3.4), layout="constrained")
+    for system in stats["system"].values:
+        marker, color, label = SYSTEM_STYLE[str(system)]
+        s = stats.sel(system=system)
+        left.errorbar(widths, s["phi_J_mean"], yerr=s["phi_J_sem"].fillna(0), fmt=marker + "-", color=color,
+                      mfc="none", ms=4, capsize=2, label=label)
+        right.plot(widths, s["crystallinity_large"], marker + "-", color=color, mfc="none", ms=5, label=label)
+        per_seed = summary["crystallinity_large"].sel(system=system).values
+        right.plot(np.repeat(widths, per_seed.shape[1]), per_seed.ravel(), marker, color=color, ms=2, alpha=0.5)
+    fit, fit_label = FITS[family]
+    grid = np.linspace(widths.min(), widths.max(), 200)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        left.plot(grid, fit(grid), "--", color="0.4", lw=1, label="Ogarko fit, " + fit_label)
+    right.axhline(threshold, color="0.4", ls=":", lw=1, label=f"partial crystallisation ({threshold:g})")
+    for ax in (left, right):
+        ax.set_xlabel(r"$\omega = a_{\max}/a_{\min}$")
+    left.set_ylabel(r"$\phi_J$")
+    right.set_ylabel("large-particle crystallinity")
+    right.set_ylim(0.0, max(2.0 * threshold, 1.15 * float(np.nanmax(summary["crystallinity_large"].values))))
+    seeds = summary.sizes["seed"]
+    left.set_title(f"{FAMILY_LABEL[family]}, slow compression, N = {summary.attrs['N']}, {seeds} seed"
+                   f"{'s' if seeds > 1 else ''}", fontsize=8)
+    left.legend(loc="lower right", fontsize=6)
+    right.legend(loc="upper left", fontsize=6)
+    return fig
+
+
 def plot_eos_vs_bmcsl(fluid):
     """Left: Z vs phi (simulation markers, BMCSL lines) per distribution; right: Z/Z_BMCSL - 1 in percent
     with the +-1 % band and Ogarko's Z_OL (Eq. 3.13) relative to BMCSL as dashed lines."""
