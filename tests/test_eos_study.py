@@ -141,6 +141,9 @@ def test_crystallisation_rows_and_fit_precedence():
     assert len([r for r in polydisperse_rows([fast]) if r.quantity.endswith("vs published fit")]) == 2
     missed = {r.quantity: r for r in polydisperse_rows([study.jam_summary(packs(0.01), study="crystallisation")])}
     assert not missed[crystal.format(10, "bi")].passed  # no breakdown seen: the row fails
+    crossover = [_jam_packing(5.0, system, 1, 0.675) for system in ("poly", "bi", "tri")]
+    quantities = {r.quantity for r in polydisperse_rows([study.jam_summary(crossover, study="crystallisation")])}
+    assert crystal.format(5, "tri") in quantities and crystal.format(5, "bi") not in quantities
     with pytest.raises(InvalidInputError, match="study"):
         study.jam_summary(packs(0.2), study="slow")
 

@@ -98,10 +98,16 @@ def _fit_rows(stats, family, protocol) -> list[Row]:
 
 
 def crystallisation_rows(summary) -> list[Row]:
-    """Slow runs (Ogarko L4851-4865, L5759-5763): the large species of the bidisperse equivalent of a
-    uniform-size distribution partly crystallises for omega >= 5 and not for omega <= 4; the maximal
-    tridisperse equivalent and the polydisperse system do not crystallise; and phi_J against the
-    published fit, which was measured at such slow rates.
+    """Slow runs (Ogarko L4851-4865, L5074-5088, L5759-5763, L6831-6834): the large species of the
+    bidisperse equivalent of a uniform-size distribution partly crystallises for omega > 5 and not for
+    omega <= 4; the maximal tridisperse equivalent and the polydisperse system do not crystallise; and
+    phi_J against the published fit, which was measured at such slow rates.
+
+    The text puts the onset at "omega >= 5 (R_bi >= 2.25)" once (L4862) and at "omega > 5" twice
+    (L5763, L6834); its equimolar bidisperse regimes are amorphous up to R_bi = 2.06 and a crystal of
+    large particles from R_bi = 2.40 (L5074-5088). The US equivalents have R_bi = 2.06, 2.25, 2.40,
+    2.79 at omega = 4, 5, 6, 10 (equal numbers), so 4 < omega <= 5 is the crossover: no bidisperse
+    row there.
 
     Crystallised = large-particle q6 crystallinity (:func:`hardpack.eos.study.large_species_crystallinity`)
     of at least CRYSTALLISED, averaged over seeds. Random jammed packings give 0.000-0.004 in every
@@ -114,10 +120,12 @@ def crystallisation_rows(summary) -> list[Row]:
         for system in stats["system"].values:
             s = stats.sel(width=width, system=system)
             value = float(s["crystallinity_large"])
-            expected = system == "bi" and family == "uniform_size" and width >= 5
+            expected = system == "bi" and family == "uniform_size" and width > 5
             if system == "bi":
+                if family == "uniform_size" and 4 < width <= 5:
+                    continue  # the crossover (docstring)
                 why = ("bidisperse equivalents of US distributions: partial crystallisation of the large species "
-                       "for omega >= 5 (R_bi >= 2.25), none for 1.22 <= omega <= 4")
+                       "for omega > 5 (R_bi >= 2.40), none for 1.22 <= omega <= 4 (R_bi <= 2.06)")
             else:
                 why = f"no crystallisation of the {system}disperse system for omega >= 1.4"
             out.append(Row(
