@@ -81,32 +81,26 @@ rule poly_jam:
         " --max-pressure {params.max_pressure} --out {output} 2> {log}"
 
 
+#: summary file prefix -> (protocol folder of the runs, `hardpack eos-summary --kind`)
+POLY_SUMMARIES = {"phij": ("jammed", "jam"), "crystallisation": ("crystallisation", "crystallisation")}
+
+
 rule poly_jam_summary:
-    """phi_J over (width, system, seed) for one family."""
+    """phi_J (and large-species crystallinity) over (width, system, seed) for one family: the
+    equivalence runs (phij_*) or the slow runs (crystallisation_*)."""
     input:
-        lambda w: _poly_jam_files("jammed", w.family),
+        lambda w: _poly_jam_files(POLY_SUMMARIES[w.summary][0], w.family),
     output:
-        "results/polydisperse/phij_{family}.nc",
+        "results/polydisperse/{summary}_{family}.nc",
+    params:
+        kind=lambda w: POLY_SUMMARIES[w.summary][1],
     wildcard_constraints:
+        summary="|".join(POLY_SUMMARIES),
         family=POLY_FAMILY,
     log:
-        "results/logs/poly_jam_summary/{family}.log",
+        "results/logs/poly_jam_summary/{summary}_{family}.log",
     shell:
-        "hardpack eos-summary --kind jam {input} --out {output} 2> {log}"
-
-
-rule poly_crystallisation_summary:
-    """The slow runs of one family: phi_J and large-species crystallinity over (width, system, seed)."""
-    input:
-        lambda w: _poly_jam_files("crystallisation", w.family),
-    output:
-        "results/polydisperse/crystallisation_{family}.nc",
-    wildcard_constraints:
-        family=POLY_FAMILY,
-    log:
-        "results/logs/poly_jam_summary/crystallisation_{family}.log",
-    shell:
-        "hardpack eos-summary --kind crystallisation {input} --out {output} 2> {log}"
+        "hardpack eos-summary --kind {params.kind} {input} --out {output} 2> {log}"
 
 
 rule poly_fluid:

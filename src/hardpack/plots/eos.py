@@ -22,6 +22,22 @@ FITS = {"uniform_size": (theory.phij_fit_uniform_size, r"Eq. 3.15 ($\Gamma_O = 8
         "lognormal": (theory.phij_fit_lognormal, r"Eq. 3.52 ($\Gamma_O = 16\times10^{-3}$)")}
 
 
+def _errorbar(ax, widths, system, mean, sem):
+    """One system's seed means +- standard errors in its house style."""
+    marker, color, label = SYSTEM_STYLE[str(system)]
+    ax.errorbar(widths, mean, yerr=sem.fillna(0), fmt=marker + "-", color=color, mfc="none", ms=4, capsize=2,
+                label=label)
+
+
+def _plot_fit(ax, family, widths):
+    """Ogarko's published phi_J fit of the family over the plotted widths."""
+    fit, fit_label = FITS[family]
+    grid = np.linspace(widths.min(), widths.max(), 200)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ax.plot(grid, fit(grid), "--", color="0.4", lw=1, label="Ogarko fit, " + fit_label)
+
+
 def plot_phij_vs_width(summaries):
     """Top row: phi_J (mean +- standard error over seeds) vs omega (sigma) per family, with the published
     fit; bottom row: phi_J(equivalent)/phi_J(poly) - 1 in percent with the +-1 % band."""
@@ -34,18 +50,11 @@ def plot_phij_vs_width(summaries):
         widths = stats["width"].values
         top, bottom = axes[0, col], axes[1, col]
         for system in stats["system"].values:
-            marker, color, label = SYSTEM_STYLE[str(system)]
             s = stats.sel(system=system)
-            top.errorbar(widths, s["phi_J_mean"], yerr=s["phi_J_sem"].fillna(0), fmt=marker + "-", color=color,
-                         mfc="none", ms=4, capsize=2, label=label)
+            _errorbar(top, widths, system, s["phi_J_mean"], s["phi_J_sem"])
             if system != "poly":
-                bottom.errorbar(widths, 100 * s["dev"], yerr=100 * s["dev_sem"].fillna(0), fmt=marker + "-",
-                                color=color, mfc="none", ms=4, capsize=2, label=label)
-        fit, fit_label = FITS[family]
-        grid = np.linspace(widths.min(), widths.max(), 200)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            top.plot(grid, fit(grid), "--", color="0.4", lw=1, label="Ogarko fit, " + fit_label)
+                _errorbar(bottom, widths, system, 100 * s["dev"], 100 * s["dev_sem"])
+        _plot_fit(top, family, widths)
         bottom.axhspan(-1, 1, color="0.85", zorder=0)
         bottom.axhline(0, color="k", lw=0.6)
         name = summary.attrs["width_name"]
@@ -76,16 +85,11 @@ def plot_crystallisation(summary, threshold: float):
     for system in stats["system"].values:
         marker, color, label = SYSTEM_STYLE[str(system)]
         s = stats.sel(system=system)
-        left.errorbar(widths, s["phi_J_mean"], yerr=s["phi_J_sem"].fillna(0), fmt=marker + "-", color=color,
-                      mfc="none", ms=4, capsize=2, label=label)
+        _errorbar(left, widths, system, s["phi_J_mean"], s["phi_J_sem"])
         right.plot(widths, s["crystallinity_large"], marker + "-", color=color, mfc="none", ms=5, label=label)
         per_seed = summary["crystallinity_large"].sel(system=system).values
         right.plot(np.repeat(widths, per_seed.shape[1]), per_seed.ravel(), marker, color=color, ms=2, alpha=0.5)
-    fit, fit_label = FITS[family]
-    grid = np.linspace(widths.min(), widths.max(), 200)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        left.plot(grid, fit(grid), "--", color="0.4", lw=1, label="Ogarko fit, " + fit_label)
+    _plot_fit(left, family, widths)
     right.axhline(threshold, color="0.4", ls=":", lw=1, label=f"partial crystallisation ({threshold:g})")
     for ax in (left, right):
         ax.set_xlabel(r"$\omega = a_{\max}/a_{\min}$")
