@@ -9,7 +9,12 @@ Gamma = 1e-2 to a reduced pressure of 1e3, then ``--gamma`` to 1e12) and cached 
 
     python benchmarks/bench_jamming.py --n 1000 --gamma 1e-4 --repeat 3
     python benchmarks/bench_jamming.py --packing a.nc b.nc --delta 1e-6
-    python benchmarks/bench_jamming.py --packing n1250.nc --tile 2 --method sequential  # N = 1e4
+    python benchmarks/bench_jamming.py --packing n10000.nc --repeat 1             # N = 1e4
+    python benchmarks/bench_jamming.py --packing n1250.nc --tile 2 --method sequential  # scaling
+
+A tiled packing is for scaling only: its tile^3 copies may move against each other, so a tiled
+isostatic 3D packing is hypostatic (8 (3 N_b - 2) contacts against 3 (8 N_b - 1) degrees of
+freedom for tile = 2: 13 floppy modes) and not collectively jammed.
 
 Besides wall-clock medians it prints the CPU seconds of the process (the machine is shared: on a
 loaded machine wall time can be several times the CPU time) and, per test, the number of LPs
@@ -84,7 +89,7 @@ def main(argv=None) -> int:
     ap.add_argument("--method", default="ideal", choices=("ideal", "sequential"),
                     help="Algorithm 13 (ideal) or 14 (sequential random loading, for LS packings)")
     ap.add_argument("--tile", type=int, default=1,
-                    help="verify the packing repeated tile^3 times (a jammed N = 1e4 from N = 1250)")
+                    help="verify the packing repeated tile^3 times (scaling only: not jammed, see above)")
     args = ap.parse_args(argv)
     paths = list(args.packing) + [make_packing(n, args.gamma, args.seed, args.cache) for n in args.n]
     for path in paths:

@@ -81,6 +81,22 @@ def test_jammed_disks_stay_within_their_gaps():
     assert not r.strict and r.strict_test.n_lp <= 3
 
 
+def test_tiled_isostatic_packing_is_hypostatic_and_not_collectively_jammed():
+    """Four periodic copies of the isostatic disks keep every contact (4 M_b = 4 (2 N_b - 1))
+    but gain degrees of freedom (2 (4 N_b - 1)): three contacts short of d(N-1) + 1 (Eq. 4.8),
+    so the copies can move against each other and the ideal test (Algorithm 13) must unjam the
+    tiled packing, while the original is collectively jammed. The counting is exact; it is why
+    benchmarks of jamming tests may tile a packing for scaling but not for a jammed verdict."""
+    p = jammed_disks()
+    one = verify(p, tests=("local", "collective"), seed=2)
+    tiled = verify(p.tiled(2), tests=("local", "collective"), seed=2)
+    assert one.collective and one.statics.isostaticity_gap == 0
+    assert tiled.statics.n_backbone == 4 * one.statics.n_backbone
+    assert tiled.statics.isostaticity_gap == -3
+    assert not tiled.collective
+    assert tiled.collective_test.max_displacement > 1e3 * tiled.params["dr_large"]
+
+
 @pytest.mark.parametrize("strict", [False, True])
 def test_working_set_matches_highs(strict):
     """The sparse-LU working-set solver (cold -- for the strict LP through the strain
