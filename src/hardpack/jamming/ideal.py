@@ -25,6 +25,7 @@ stops with "not strictly jammed".
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass, field
 
@@ -34,6 +35,8 @@ from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.isostatic import RigidBackbone
 from hardpack.jamming.lp import random_strain_load, solve_motion
 from hardpack.jamming.rattlers import neighbours_of, remove_rattlers
+
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -119,6 +122,8 @@ def ideal_test(
                 "max": float(size[active].max()), "mean": float(size[active].mean()),
                 "removed": int(moved.sum()), "strain": float(strain_size),
             })
+            log.info("%s test, LP %d: %d particles, max displacement %.3g, %d displaced by >= %.3g",
+                     out.test, out.n_lp, int(active.sum()), out.loads[-1]["max"], int(moved.sum()), dr_large)
             if (moved.any() or strain_size >= dr_large) and not out.motion.any():
                 out.motion, out.strain = rel, eps
             if strain_size >= dr_large:  # the cell itself deforms: no strictly jammed subpacking

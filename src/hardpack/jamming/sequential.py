@@ -41,6 +41,7 @@ current distance and D_ij, which never lets overlaps grow beyond the packing tol
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass, field
 
@@ -51,6 +52,8 @@ from hardpack.geometry.packing import Packing
 from hardpack.jamming.contacts import ContactNetwork, contact_network
 from hardpack.jamming.ideal import cell_length
 from hardpack.jamming.lp import random_load, random_strain_load, solve_motion
+
+log = logging.getLogger(__name__)
 
 #: relative approach allowed for pairs in contact (see the module docstring)
 APPROACH_SLACK = 1e-11
@@ -171,6 +174,8 @@ def sequential_test(
                 warm = mot.warm
                 out.n_lp_highs += mot.solver == "highs"
                 steps += 1
+                log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, len(out.steps) // 2 + 1,
+                         "+" if sign > 0 else "-", steps, mot.solver, mot.seconds)
                 tau = min(
                     collision_step(net, mot.displacement, mot.strain),
                     list_step(net, current.radii, mot.displacement, mot.strain),
@@ -197,6 +202,8 @@ def sequential_test(
             out.steps.append(steps)
             out.strain_norm.append(float(np.linalg.norm(strain_total, 2)))
             out.displacement = np.maximum(out.displacement, size)
+            log.info("%s test: loading sequence %d moved the particles by %.3g D on average "
+                     "(threshold %.3g D)", out.test, len(out.steps), mean, threshold)
             if mean > best:
                 best, out.motion = mean, rel
                 out.strain = strain_total if strict else None

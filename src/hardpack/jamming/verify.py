@@ -19,6 +19,7 @@ Steps (Donev dissertation ch. 4, seeds/000_chapters/ch04-05.txt):
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import replace
 
@@ -32,6 +33,8 @@ from hardpack.jamming.ideal import ideal_test
 from hardpack.jamming.rattlers import remove_rattlers
 from hardpack.jamming.result import CATEGORIES, JammingResult
 from hardpack.jamming.sequential import sequential_test
+
+log = logging.getLogger(__name__)
 
 METHODS = ("ideal", "sequential")
 #: contact tolerance of the ideal test (LS packings at high pressure: contacts ~1e-12, the next
@@ -163,6 +166,8 @@ def verify(
         net, np.ones(n, dtype=bool), dr_large=dr_large, box=box, rng=rng
     )
     seconds["local"] = time.perf_counter() - t0
+    log.info("%d contacts within %g; local test: %d of %d particles are rattlers (%.1f s)",
+             net.n_contacts, contact_delta, int((~local_active).sum()), n, seconds["local"])
 
     collective = strict = None
     common = {"box": box, "rng": rng}
@@ -191,6 +196,7 @@ def verify(
             seconds["strict"] = strict.seconds
         backbone = local_active
 
+    log.info("contact forces of the %d-particle backbone", int(backbone.sum()))
     t0 = time.perf_counter()
     d, nb = packing.dim, int(backbone.sum())
     # hypostatic by count: straight to the nearest jamming point, whose LP also finds a
