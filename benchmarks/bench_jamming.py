@@ -14,7 +14,7 @@ Gamma = 1e-2 to a reduced pressure of 1e3, then ``--gamma`` to 1e12) and cached 
 
 A tiled packing is for scaling only: its tile^3 copies may move against each other, so a tiled
 isostatic 3D packing is hypostatic (8 (3 N_b - 2) contacts against 3 (8 N_b - 1) degrees of
-freedom for tile = 2: 13 floppy modes) and not collectively jammed.
+freedom for tile = 2: at least 13 floppy modes) and not collectively jammed.
 
 Besides wall-clock medians it prints the CPU seconds of the process (the machine is shared: on a
 loaded machine wall time can be several times the CPU time) and, per test, the number of LPs
