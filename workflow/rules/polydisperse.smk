@@ -39,8 +39,9 @@ def poly_jam_mem_mb(wildcards):
 
 def poly_jam_runtime(wildcards):
     """Minutes for the three systems. Measured: 3-11 CPU s per system at N = 500 (US omega = 2 and 10,
-    final Gamma = 0.002), 6-7 CPU min at final Gamma = 2e-5 and 13-18 at 1e-5; the collisions grow as N / Gamma, and the
-    budget is ~20x the measured time at Gamma = 0.002, for loaded machines and wide UV distributions."""
+    final Gamma = 0.002), 6-7 CPU min at final Gamma = 2e-5 and 13-18 at 1e-5; the collisions grow as
+    N / Gamma, and the budget is ~20x the measured time at Gamma = 0.002, for loaded machines and wide
+    UV distributions."""
     runs = POLY_PROTOCOLS[wildcards.protocol]
     return 10 + int(3 * runs["N"] // 100 * max(1.0, 0.002 / runs["final_growth_rate"]))
 

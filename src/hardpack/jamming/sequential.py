@@ -157,7 +157,7 @@ def sequential_test(
     warm = None  # the LPs of one test share their variables: each warm-starts the next
     # LP box = the step's trust region: no LP motion beyond delta r_min can be taken (list_step)
     box = min(box, delta * float(packing.radii.min()))
-    for _ in range(n_loads):
+    for load_index in range(1, n_loads + 1):
         base = random_load(rng, moving, d)
         base_eps = random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None
         for sign in (1.0, -1.0):
@@ -174,7 +174,7 @@ def sequential_test(
                 warm = mot.warm
                 out.n_lp_highs += mot.solver == "highs"
                 steps += 1
-                log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, len(out.steps) // 2 + 1,
+                log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, load_index,
                          "+" if sign > 0 else "-", steps, mot.solver, mot.seconds)
                 tau = min(
                     collision_step(net, mot.displacement, mot.strain),
