@@ -50,9 +50,27 @@ def test_order_map_puts_fcc_at_t_one_and_the_glass_below(order_map):
     assert summary["phi"].values[1] < 0.70 and summary["T"].values[1] < 0.8
     assert summary["strict"].values.tolist() == [1, 1]
     assert summary["alpha"].values.tolist() == [3.5, 3.5]
+    assert summary["N"].values.tolist() == [32, 27]
     rows = order_map_rows(summary)
-    assert rows[0].passed and rows[2].passed  # the densest is FCC; all strictly jammed
+    assert rows[0].passed and rows[3].passed  # the densest is FCC; all strictly jammed
     assert rows[1].reproduced == pytest.approx(summary["phi"].values[1])  # the least dense one
+    assert rows[2].reproduced == pytest.approx(FCC - 0.64) and not rows[2].passed  # nothing in between
+
+
+def test_order_map_gap_is_the_widest_empty_density_interval_between_mrj_and_fcc():
+    """Densities 0.60 (below the range, ignored), 0.655, 0.67, 0.70, 0.715, 0.73 and FCC: the
+    widest empty interval of [0.64, 0.74048] is 0.67-0.70 (0.03 > 0.02, fails); one more packing
+    at 0.685 halves it (0.015, passes)."""
+    def rows_for(phi):
+        k = len(phi)
+        summary = xr.Dataset({"phi": ("packing", phi), "T": ("packing", np.zeros(k)),
+                              "strict": ("packing", np.ones(k, int)), "N": ("packing", [64] * k)})
+        return order_map_rows(summary)[2]
+
+    sparse = rows_for([0.60, 0.655, 0.67, 0.70, 0.715, 0.73, FCC])
+    assert sparse.reproduced == pytest.approx(0.03) and not sparse.passed
+    filled = rows_for([0.60, 0.655, 0.67, 0.685, 0.70, 0.715, 0.73, FCC])
+    assert filled.reproduced == pytest.approx(0.015) and filled.passed
 
 
 def test_order_map_refuses_a_verdict_of_another_packing(order_map):

@@ -206,23 +206,27 @@ rule slp_system_summary:
 SLP_ORDER = SLP.get("order_map")
 
 
+def order_map_n(k):
+    """Cell size N of order-map setting k: its own ``N`` or the map's default."""
+    return SLP_ORDER["settings"][int(k)].get("N", SLP_ORDER["N"])
+
+
 rule slp_order_map_init:
-    """Dilute 3D monodisperse start shared by every (alpha, bounds) setting of the order map."""
+    """Dilute 3D monodisperse start of N spheres, shared by every setting of that N."""
     output:
-        "results/slp/order_map/init_seed{seed}.nc",
+        "results/slp/order_map/init_n{n}_seed{seed}.nc",
     params:
-        n=SLP_ORDER["N"] if SLP_ORDER else None,
         phi=SLP_ORDER["init_phi"] if SLP_ORDER else None,
     log:
-        "results/logs/slp_order_map_init/seed{seed}.log",
+        "results/logs/slp_order_map_init/n{n}_seed{seed}.log",
     shell:
-        "hardpack init --n {params.n} --d 3 --phi {params.phi} --seed {wildcards.seed} --out {output} 2> {log}"
+        "hardpack init --n {wildcards.n} --d 3 --phi {params.phi} --seed {wildcards.seed} --out {output} 2> {log}"
 
 
 rule slp_order_map_run:
     """SLP from one start with setting k of slp.order_map.settings."""
     input:
-        "results/slp/order_map/init_seed{seed}.nc",
+        lambda w: f"results/slp/order_map/init_n{order_map_n(w.k)}_seed{w.seed}.nc",
     output:
         "results/slp/order_map/s{k}_seed{seed}.nc",
     params:

@@ -80,15 +80,15 @@ def plot_order_map(summary):
     T = 1) and the paper's MRJ density 0.64 (L1620-1624) are marked for reference.
     """
     fig, (ax, ax_r) = figure(1, 2, figsize=(9.0, 3.8))
-    keys = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method")
+    keys = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method", "N")
     settings = list(zip(*(summary[k].values.tolist() for k in keys)))
     strict = summary["strict"].values.astype(bool)
     phi, t, alpha = summary["phi"].values, summary["T"].values, summary["alpha"].values
     for n, setting in enumerate(dict.fromkeys(settings)):
-        radius, strain, shear, disp, method = setting
+        radius, strain, shear, disp, method, size = setting
         pick = np.array([s == setting for s in settings])
         colour, marker = f"C{n % 10}", "os^Dv<>ph*"[n % 10]
-        label = (rf"$\gamma$ = {radius:g} D, bounds {strain:g}/{shear:g}/{disp:g} D, "
+        label = (rf"N = {size}, $\gamma$ = {radius:g} D, bounds {strain:g}/{shear:g}/{disp:g} D, "
                  f"{method.removeprefix('highs-')}")
         offset = 0.04 * (n - 0.5 * (len(set(settings)) - 1))  # side by side on the right panel
         for jammed in (True, False):
@@ -113,8 +113,8 @@ def plot_order_map(summary):
     ax.set_ylabel("translational order T")
     ax_r.set_xlabel(r"influence radius $\gamma$ / D")
     ax_r.set_ylabel(r"packing density $\phi$")
-    n = summary.attrs.get("N", "?")
-    ax.set_title(f"SLP jammed packings, d = 3, N = {n}: {summary.sizes['packing']} packings")
+    sizes = ", ".join(str(n) for n in np.unique(summary["N"].values))
+    ax.set_title(f"SLP jammed packings, d = 3, N = {sizes}: {summary.sizes['packing']} packings")
     ax.legend(fontsize=5.5, loc="upper left")
     ax_r.legend(fontsize=6, loc="center right")
     return fig

@@ -1,6 +1,7 @@
 """The phi-T order map of SLP packings (Torquato & Jiao 2010, Fig. 6 and sec. VI, L1569-1630).
 
-One row per packing: density phi (rattlers included, as in Fig. 6, L1753-1757), translational
+One row per packing: density phi (rattlers included, as in Fig. 6, L1753-1757), its number of
+spheres N (settings may use different cell sizes: small cells crystallise partly), translational
 order metric T (:func:`hardpack.structure.order.translational_order`, FCC reference at the same
 density, our shell convention: T = 1 for FCC, ~0 for an ideal gas), the SLP settings that made
 it (influence radius alpha = gamma / D, bound widths, LP solver) and its jamming verdict
@@ -29,8 +30,7 @@ def order_map_summary(packing_paths, verdict_paths) -> xr.Dataset:
         raise InvalidInputError(
             f"order map: need one verdict per packing, got {len(packing_paths)} packings and "
             f"{len(verdict_paths)} verdicts")
-    rows = {name: [] for name in ("phi", "T", *SETTINGS, *VERDICT)}
-    sizes = set()
+    rows = {name: [] for name in ("phi", "N", "T", *SETTINGS, *VERDICT)}
     for path, verdict_path in zip(packing_paths, verdict_paths):
         ds, verdict = load_dataset(path, kind="packing"), load_dataset(verdict_path, kind="jamming")
         source = verdict.attrs.get("source")
@@ -39,8 +39,8 @@ def order_map_summary(packing_paths, verdict_paths) -> xr.Dataset:
         packing = load_packing(path)
         if packing.dim != 3:
             raise InvalidInputError(f"{path}: the order map is 3D (FCC reference), got d = {packing.dim}")
-        sizes.add(packing.n_particles)
         rows["phi"].append(packing.phi)
+        rows["N"].append(packing.n_particles)
         rows["T"].append(translational_order(packing))
         for name in SETTINGS:
             rows[name].append(ds.attrs[name])
@@ -49,6 +49,4 @@ def order_map_summary(packing_paths, verdict_paths) -> xr.Dataset:
     data = {name: ("packing", np.asarray(values)) for name, values in rows.items()}
     attrs = {"hardpack_kind": "slp_order_map",
              "T_convention": "hardpack.structure.order.translational_order defaults (7 FCC shells)"}
-    if len(sizes) == 1:
-        attrs["N"] = sizes.pop()
     return xr.Dataset(data, attrs=attrs)
