@@ -17,15 +17,16 @@ def slp_flags(settings):
 
 
 rule slp_densest_init:
-    """RSA start of 3^d spheres for one Table II run."""
+    """RSA start of N = 3^d spheres (the paper's size, or the run's own N) for one Table II run."""
     output:
         "results/slp/densest/d{d}/init_seed{seed}.nc",
     params:
+        n=lambda w: SLP_DENSEST_RUNS[int(w.d)].get("N", 3 ** int(w.d)),
         phi=lambda w: SLP_DENSEST_RUNS[int(w.d)]["init_phi"],
     log:
         "results/logs/slp_densest_init/d{d}_seed{seed}.log",
     shell:
-        "hardpack init --n $((3**{wildcards.d})) --d {wildcards.d} --phi {params.phi}"
+        "hardpack init --n {params.n} --d {wildcards.d} --phi {params.phi}"
         " --seed {wildcards.seed} --attr d={wildcards.d} --out {output} 2> {log}"
 
 
