@@ -116,5 +116,5 @@ def plot_order_map(summary):
     sizes = ", ".join(str(n) for n in np.unique(summary["N"].values))
     ax.set_title(f"SLP jammed packings, d = 3, N = {sizes}: {summary.sizes['packing']} packings")
     ax.legend(fontsize=5.5, loc="upper left")
-    ax_r.legend(fontsize=6, loc="center right")
+    ax_r.legend(fontsize=6, loc="best")
     return fig
