@@ -30,7 +30,11 @@ rule verify_jamming:
 
 
 rule verify_jamming_slp:
-    """LP jamming tests of one SLP packing (strict jamming expected: deforming cell)."""
+    """LP jamming tests of one SLP packing (strict jamming expected: deforming cell). SLP stops when no LP step gains density, which can leave near contacts at gaps 1e-6..1e-4 D
+    that block the floppy modes of the delta-contact network; the ideal test ignores them, so SLP
+    packings are verified by sequential loading like LS packings (measured: a 6D N = 250 SLP
+    packing with 18 such near contacts is 'not strict' by the ideal test, moving 1.5 D linearly,
+    and strictly jammed by the sequential one)."""
     input:
         "results/ensembles/{ensemble}/slp/seed{seed}.nc",
     output:
@@ -42,7 +46,7 @@ rule verify_jamming_slp:
     log:
         "results/logs/verify_jamming_slp/{ensemble}_seed{seed}.log",
     shell:
-        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential > {log} 2>&1"
 
 
 rule jamming_summary:

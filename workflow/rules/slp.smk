@@ -168,7 +168,7 @@ rule slp_system:
 
 
 rule verify_slp_system:
-    """LP jamming tests of one SLP-only packing (strict jamming expected: deforming cell)."""
+    """LP jamming tests of one SLP-only packing, by sequential loading (see verify_jamming_slp)."""
     input:
         "results/slp/mrj/{system}/seed{seed}.nc",
     output:
@@ -180,7 +180,7 @@ rule verify_slp_system:
     log:
         "results/logs/verify_slp_system/{system}_seed{seed}.log",
     shell:
-        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential > {log} 2>&1"
 
 
 rule slp_system_summary:
@@ -243,7 +243,7 @@ rule slp_order_map_run:
 
 
 rule verify_slp_order_map:
-    """Strict-jamming verdict of one order-map packing."""
+    """Strict-jamming verdict of one order-map packing, by sequential loading (see verify_jamming_slp)."""
     input:
         "results/slp/order_map/s{k}_seed{seed}.nc",
     output:
@@ -255,7 +255,7 @@ rule verify_slp_order_map:
     log:
         "results/logs/verify_slp_order_map/s{k}_seed{seed}.log",
     shell:
-        "hardpack verify {input} --out {output} --seed {wildcards.seed} > {log} 2>&1"
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential > {log} 2>&1"
 
 
 SLP_ORDER_RUNS = ([(k, seed) for k in range(len(SLP_ORDER["settings"])) for seed in SLP_ORDER["seeds"]]
