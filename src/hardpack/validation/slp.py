@@ -105,7 +105,7 @@ def mrj_jamming_rows(summaries) -> list[Row]:
         strict = np.asarray(s["strict"].values) == 1
         out.append(Row("SLP MRJ-like packings (Table I)", f"{name}: fraction strictly jammed, d = {d}",
                        f"{SOURCE} L869-880", 1.0, float(strict.mean()), math.nan, 0.0,
-                       "deforming-cell SLP packings are strictly jammed (LP test)", bool(strict.all()), size))
+                       "deforming-cell SLP packings are strictly jammed (sequential LP test)", bool(strict.all()), size))
     return out
 
 
