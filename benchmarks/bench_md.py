@@ -3,13 +3,15 @@ time and peak memory. Prints tables; never part of the test suite.
 
     python benchmarks/bench_md.py            # full: d = 2..6, N = 1e3..1e5, 3 repeats
     python benchmarks/bench_md.py --quick    # d = 2..4, N = 1e3..1e4, 1 repeat
+    python benchmarks/bench_md.py --only poly --repeats 5   # one section
 
 Every configuration runs in its own subprocess (clean peak-memory figure, no cross-talk).
 Rates are medians over repeats of wall-clock collisions per second; the machine may be shared, so
 the CPU-time rate is printed too.
 
 1. Equilibrium fluid rate: NVE (Gamma = 0) at phi = 0.6 phi_J(d) (phi_J = 0.82, 0.64, 0.46,
-   0.31, 0.20 for d = 2..6), prepared by RSA plus a fast compression; windows of 5 N collisions.
+   0.31, 0.20 for d = 2..6), prepared by RSA plus a fast compression; timed windows of 5 N
+   collisions after a warm-up that lets the adaptive neighbour shell settle (:func:`warm_up`).
 2. Time to jam: N = 1e4 monodisperse spheres in 3D from RSA at phi = 0.1, Gamma = 0.02, until
    Z = 1e12 (numba compilation excluded: a small run compiles first), plus the collision rate in
    the dense part of the run (Z >= 1e3).
@@ -25,17 +27,32 @@ import argparse
 import json
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
 
+SECTIONS = ("compile", "fluid", "poly", "jam")
 PHI_J = {2: 0.82, 3: 0.64, 4: 0.46, 5: 0.31, 6: 0.20}
 RSA_START = {2: 0.33, 3: 0.23, 4: 0.15, 5: 0.10, 6: 0.066}
 
 
 def _peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def warm_up(sim, n: int, max_windows: int = 24) -> None:
+    """Compile, then run windows of 2 N collisions until the adaptive neighbour shell has stayed
+    unchanged for two windows, so the timed windows see the lists a long run settles on (the
+    shell moves by one factor SHELL_STEP per window, and lists follow it within a window)."""
+    steady = 0
+    for _ in range(max_windows):
+        shell = sim.shell
+        sim.run_window(2 * n)
+        steady = steady + 1 if sim.shell == shell else 0
+        if steady >= 2:
+            return
 
 
 def worker_rate(d: int, n: int, repeats: int, phi: float | None = None, omega: float = 1.0) -> dict:
@@ -54,8 +71,7 @@ def worker_rate(d: int, n: int, repeats: int, phi: float | None = None, omega: f
         packing = compress(packing, 0.1, 1, stop=StopCriteria(max_pressure=None, target_phi=phi)).packing
     prep = time.perf_counter() - t0
     sim = Simulation(packing, maxwell_boltzmann(n, d, 2), 0.0)
-    for _ in range(3):  # warm-up: compile, adapt the neighbour shell
-        sim.run_window(2 * n)
+    warm_up(sim, n)
     wall, cpu = [], []
     for _ in range(repeats):
         c0, w0, p0 = sim.collisions, time.perf_counter(), time.process_time()
@@ -122,6 +138,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small table, one repeat")
     parser.add_argument("--repeats", type=int, help="timed repeats per configuration")
+    parser.add_argument("--only", nargs="+", choices=SECTIONS, default=list(SECTIONS),
+                        help="run only these sections (default: all)")
     parser.add_argument("--worker", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
@@ -137,48 +155,60 @@ def main() -> None:
         print(json.dumps(result))
         return
 
+    sections = set(args.only)
     repeats = args.repeats or (1 if args.quick else 3)
     dims = (2, 3, 4) if args.quick else (2, 3, 4, 5, 6)
     sizes = (1000, 10000) if args.quick else (1000, 10000, 100000)
     print(f"hardpack.md benchmark ({'quick' if args.quick else 'full'}), {os.cpu_count()} CPUs, "
           f"load average {os.getloadavg()[0]:.1f}")
 
-    print("\n## Compile time (fresh numba cache)")
-    with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        for d in (3,) if args.quick else (2, 3, 4):
-            r = _run(["compile", d], env=env)
-            print(f"d = {d}: {r.get('compile_s', float('nan')):.1f} s {r.get('error', '')}")
+    if "compile" in sections:
+        print("\n## Compile time (fresh numba cache)")
+        with tempfile.TemporaryDirectory() as cache:
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+            for d in (3,) if args.quick else (2, 3, 4):
+                r = _run(["compile", d], env=env)
+                print(f"d = {d}: {r.get('compile_s', float('nan')):.1f} s {r.get('error', '')}")
 
-    print("\n## Equilibrium fluid at phi = 0.6 phi_J(d): collisions per second (median of "
-          f"{repeats}), peak memory")
-    print("| d | N | phi | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
-    print("|---|---|---|---|---|---|---|---|")
-    for d in dims:
-        for n in sizes:
-            r = _run(["rate", d, n, repeats])
-            if "error" in r:
-                print(f"| {d} | {n} | | | error: {r['error']} | | | |")
-                continue
-            print(f"| {d} | {n} | {r['phi']:.3f} | {r['Z']:.2f} | {r['rate']:.3g} | {r['cpu_rate']:.3g} "
-                  f"| {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
+    if "fluid" in sections:
+        print("\n## Equilibrium fluid at phi = 0.6 phi_J(d): collisions per second (median of "
+              f"{repeats}), peak memory")
+        print("| d | N | phi | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
+        print("|---|---|---|---|---|---|---|---|")
+        for d in dims:
+            for n in sizes:
+                r = _run(["rate", d, n, repeats])
+                if "error" in r:
+                    print(f"| {d} | {n} | | | error: {r['error']} | | | |")
+                    continue
+                print(f"| {d} | {n} | {r['phi']:.3f} | {r['Z']:.2f} | {r['rate']:.3g} | {r['cpu_rate']:.3g} "
+                      f"| {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
 
-    print(f"\n## Wide size distribution: 3D, N = 1e4, phi = 0.5, NVE collisions per second (median of "
-          f"{repeats}); uniform-in-volume radii over omega = 10 vs monodisperse")
-    print("| radii | grid levels | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
-    print("|---|---|---|---|---|---|---|")
-    poly = {}
-    for omega in (1.0, 10.0):
-        r = poly[omega] = _run(["poly", 10000, repeats, omega])
-        label = "monodisperse" if omega == 1.0 else f"UV omega = {omega:g}"
-        if "error" in r:
-            print(f"| {label} | error: {r['error']} | | | | | |")
-            continue
-        print(f"| {label} | {r['levels']} | {r['Z']:.2f} | {r['rate']:.3g} | {r['cpu_rate']:.3g} "
-              f"| {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
-    if all("error" not in r for r in poly.values()):
-        print(f"CPU-rate ratio monodisperse / UV omega = 10: {poly[1.0]['cpu_rate'] / poly[10.0]['cpu_rate']:.2f}")
+    if "poly" in sections:
+        print(f"\n## Wide size distribution: 3D, N = 1e4, phi = 0.5, NVE collisions per second; "
+              f"uniform-in-volume radii over omega = 10 against monodisperse, {repeats} interleaved pairs "
+              "(mono, UV, mono, UV, ...; 3 timed windows each) so machine drift cancels in each ratio")
+        print("| pair | radii | grid levels | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
+        print("|---|---|---|---|---|---|---|---|")
+        ratios = []
+        for k in range(repeats):
+            pair = {}
+            for omega in (1.0, 10.0):
+                r = pair[omega] = _run(["poly", 10000, 3, omega])
+                label = "monodisperse" if omega == 1.0 else f"UV omega = {omega:g}"
+                if "error" in r:
+                    print(f"| {k + 1} | {label} | error: {r['error']} | | | | | |")
+                    continue
+                print(f"| {k + 1} | {label} | {r['levels']} | {r['Z']:.2f} | {r['rate']:.3g} "
+                      f"| {r['cpu_rate']:.3g} | {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
+            if all("error" not in r for r in pair.values()):
+                ratios.append(pair[1.0]["cpu_rate"] / pair[10.0]["cpu_rate"])
+        if ratios:
+            print(f"CPU-rate ratio monodisperse / UV omega = 10: median {statistics.median(ratios):.2f} "
+                  f"(pairs: {', '.join(f'{x:.2f}' for x in ratios)})")
 
+    if "jam" not in sections:
+        return
     print(f"\n## Time to jam: N = 1e4, d = 3, Gamma = 0.02, RSA phi0 = 0.1 -> Z = 1e12 (median of "
           f"{repeats}, compile excluded)")
     runs = [_run(["jam", 10000, 0.02]) for _ in range(repeats)]

@@ -38,7 +38,7 @@ GRID_HEADROOM = 1.05
 #: smallest bounding skin (relative to the largest radius) before the box is declared too small
 MIN_SHELL = 1e-3
 #: rebuild the lists when the radius cap squeezes the requested skin by more than this factor
-SKIN_SLACK = 1.1
+SKIN_SLACK = 1.05
 
 
 @dataclass
