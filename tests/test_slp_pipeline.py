@@ -32,12 +32,15 @@ def _store(tmp_path, name, packing, seed):
 
 @pytest.fixture(scope="module")
 def order_map(tmp_path_factory):
-    """FCC (N = 32) and a disordered SLP packing of 27 spheres (seed 0 stops at phi ~ 0.62)."""
+    """FCC (N = 32) and a disordered SLP packing of 64 spheres (seed 1 stops at phi ~ 0.62).
+    Cells of 64 end disordered in most runs (34 of 36 in the order-map study); cells of 27 often
+    crystallise, and which seeds do depends on the LP solver's path (scipy 1.17's HiGHS takes the
+    27-sphere seed 0 start to FCC)."""
     tmp = tmp_path_factory.mktemp("order_map")
     fcc = _store(tmp, "fcc", lattice_packing("fcc", 2), 0)
-    slp = run_slp(random_packing(27, 3, monodisperse(), 0.3, seed=0), 3.5,
+    slp = run_slp(random_packing(64, 3, monodisperse(), 0.3, seed=1), 3.5,
                   Bounds(0.01, 0.01, 0.05)).packing
-    glass = _store(tmp, "slp", slp, 0)
+    glass = _store(tmp, "slp", slp, 1)
     return [fcc, glass]
 
 
@@ -50,7 +53,7 @@ def test_order_map_puts_fcc_at_t_one_and_the_glass_below(order_map):
     assert summary["phi"].values[1] < 0.70 and summary["T"].values[1] < 0.8
     assert summary["strict"].values.tolist() == [1, 1]
     assert summary["alpha"].values.tolist() == [3.5, 3.5]
-    assert summary["N"].values.tolist() == [32, 27]
+    assert summary["N"].values.tolist() == [32, 64]
     rows = order_map_rows(summary)
     assert rows[0].passed and rows[3].passed  # the densest is FCC; all strictly jammed
     assert rows[1].reproduced == pytest.approx(summary["phi"].values[1])  # the least dense one
