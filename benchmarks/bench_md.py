@@ -33,7 +33,6 @@ import sys
 import tempfile
 import time
 
-SECTIONS = ("compile", "fluid", "poly", "jam")
 PHI_J = {2: 0.82, 3: 0.64, 4: 0.46, 5: 0.31, 6: 0.20}
 RSA_START = {2: 0.33, 3: 0.23, 4: 0.15, 5: 0.10, 6: 0.066}
 
@@ -134,6 +133,76 @@ def _run(args: list[str], env=None, timeout: float = 1800.0) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def section_compile(quick: bool, repeats: int) -> None:
+    print("\n## Compile time (fresh numba cache)")
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        for d in (3,) if quick else (2, 3, 4):
+            r = _run(["compile", d], env=env)
+            print(f"d = {d}: {r.get('compile_s', float('nan')):.1f} s {r.get('error', '')}")
+
+
+def section_fluid(quick: bool, repeats: int) -> None:
+    dims = (2, 3, 4) if quick else (2, 3, 4, 5, 6)
+    sizes = (1000, 10000) if quick else (1000, 10000, 100000)
+    print("\n## Equilibrium fluid at phi = 0.6 phi_J(d): collisions per second (median of "
+          f"{repeats}), peak memory")
+    print("| d | N | phi | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
+    print("|---|---|---|---|---|---|---|---|")
+    for d in dims:
+        for n in sizes:
+            r = _run(["rate", d, n, repeats])
+            if "error" in r:
+                print(f"| {d} | {n} | | | error: {r['error']} | | | |")
+                continue
+            print(f"| {d} | {n} | {r['phi']:.3f} | {r['Z']:.2f} | {r['rate']:.3g} | {r['cpu_rate']:.3g} "
+                  f"| {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
+
+
+def section_poly(quick: bool, repeats: int) -> None:
+    print(f"\n## Wide size distribution: 3D, N = 1e4, phi = 0.5, NVE collisions per second; "
+          f"uniform-in-volume radii over omega = 10 against monodisperse, {repeats} interleaved pairs "
+          "(mono, UV, mono, UV, ...; 3 timed windows each) so machine drift cancels in each ratio")
+    print("| pair | radii | grid levels | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
+    print("|---|---|---|---|---|---|---|---|")
+    ratios = []
+    for k in range(repeats):
+        pair = {}
+        for omega in (1.0, 10.0):
+            r = pair[omega] = _run(["poly", 10000, 3, omega])
+            label = "monodisperse" if omega == 1.0 else f"UV omega = {omega:g}"
+            if "error" in r:
+                print(f"| {k + 1} | {label} | error: {r['error']} | | | | | |")
+                continue
+            print(f"| {k + 1} | {label} | {r['levels']} | {r['Z']:.2f} | {r['rate']:.3g} "
+                  f"| {r['cpu_rate']:.3g} | {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
+        if all("error" not in r for r in pair.values()):
+            ratios.append(pair[1.0]["cpu_rate"] / pair[10.0]["cpu_rate"])
+    if ratios:
+        print(f"CPU-rate ratio monodisperse / UV omega = 10: median {statistics.median(ratios):.2f} "
+              f"(pairs: {', '.join(f'{x:.2f}' for x in ratios)})")
+
+
+def section_jam(quick: bool, repeats: int) -> None:
+    print(f"\n## Time to jam: N = 1e4, d = 3, Gamma = 0.02, RSA phi0 = 0.1 -> Z = 1e12 (median of "
+          f"{repeats}, compile excluded)")
+    runs = [_run(["jam", 10000, 0.02]) for _ in range(repeats)]
+    runs = [r for r in runs if "error" not in r] or runs
+    if "error" in runs[0]:
+        print("error:", runs[0]["error"])
+        return
+    runs.sort(key=lambda r: r["wall_s"])
+    r = runs[len(runs) // 2]
+    walls = ", ".join(f"{x['wall_s']:.1f}" for x in runs)
+    print(f"wall {r['wall_s']:.1f} s (all: {walls}), "
+          f"CPU {r['cpu_s']:.1f} s, phi_J = {r['phi']:.4f}, Z = {r['Z']:.3g}, "
+          f"{r['collisions']:.3g} collisions, {r['rate']:.3g} coll/s overall, "
+          f"{r['dense_rate']:.3g} coll/s for Z >= 1e3, peak {r['peak_mb']:.0f} MB")
+
+
+SECTIONS = {"compile": section_compile, "fluid": section_fluid, "poly": section_poly, "jam": section_jam}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small table, one repeat")
@@ -155,74 +224,12 @@ def main() -> None:
         print(json.dumps(result))
         return
 
-    sections = set(args.only)
     repeats = args.repeats or (1 if args.quick else 3)
-    dims = (2, 3, 4) if args.quick else (2, 3, 4, 5, 6)
-    sizes = (1000, 10000) if args.quick else (1000, 10000, 100000)
     print(f"hardpack.md benchmark ({'quick' if args.quick else 'full'}), {os.cpu_count()} CPUs, "
           f"load average {os.getloadavg()[0]:.1f}")
-
-    if "compile" in sections:
-        print("\n## Compile time (fresh numba cache)")
-        with tempfile.TemporaryDirectory() as cache:
-            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-            for d in (3,) if args.quick else (2, 3, 4):
-                r = _run(["compile", d], env=env)
-                print(f"d = {d}: {r.get('compile_s', float('nan')):.1f} s {r.get('error', '')}")
-
-    if "fluid" in sections:
-        print("\n## Equilibrium fluid at phi = 0.6 phi_J(d): collisions per second (median of "
-              f"{repeats}), peak memory")
-        print("| d | N | phi | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
-        print("|---|---|---|---|---|---|---|---|")
-        for d in dims:
-            for n in sizes:
-                r = _run(["rate", d, n, repeats])
-                if "error" in r:
-                    print(f"| {d} | {n} | | | error: {r['error']} | | | |")
-                    continue
-                print(f"| {d} | {n} | {r['phi']:.3f} | {r['Z']:.2f} | {r['rate']:.3g} | {r['cpu_rate']:.3g} "
-                      f"| {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
-
-    if "poly" in sections:
-        print(f"\n## Wide size distribution: 3D, N = 1e4, phi = 0.5, NVE collisions per second; "
-              f"uniform-in-volume radii over omega = 10 against monodisperse, {repeats} interleaved pairs "
-              "(mono, UV, mono, UV, ...; 3 timed windows each) so machine drift cancels in each ratio")
-        print("| pair | radii | grid levels | Z | coll/s (wall) | coll/s (CPU) | neighbours | peak MB |")
-        print("|---|---|---|---|---|---|---|---|")
-        ratios = []
-        for k in range(repeats):
-            pair = {}
-            for omega in (1.0, 10.0):
-                r = pair[omega] = _run(["poly", 10000, 3, omega])
-                label = "monodisperse" if omega == 1.0 else f"UV omega = {omega:g}"
-                if "error" in r:
-                    print(f"| {k + 1} | {label} | error: {r['error']} | | | | | |")
-                    continue
-                print(f"| {k + 1} | {label} | {r['levels']} | {r['Z']:.2f} | {r['rate']:.3g} "
-                      f"| {r['cpu_rate']:.3g} | {r['neighbours']:.1f} | {r['peak_mb']:.0f} |", flush=True)
-            if all("error" not in r for r in pair.values()):
-                ratios.append(pair[1.0]["cpu_rate"] / pair[10.0]["cpu_rate"])
-        if ratios:
-            print(f"CPU-rate ratio monodisperse / UV omega = 10: median {statistics.median(ratios):.2f} "
-                  f"(pairs: {', '.join(f'{x:.2f}' for x in ratios)})")
-
-    if "jam" not in sections:
-        return
-    print(f"\n## Time to jam: N = 1e4, d = 3, Gamma = 0.02, RSA phi0 = 0.1 -> Z = 1e12 (median of "
-          f"{repeats}, compile excluded)")
-    runs = [_run(["jam", 10000, 0.02]) for _ in range(repeats)]
-    runs = [r for r in runs if "error" not in r] or runs
-    if "error" in runs[0]:
-        print("error:", runs[0]["error"])
-        return
-    runs.sort(key=lambda r: r["wall_s"])
-    r = runs[len(runs) // 2]
-    walls = ", ".join(f"{x['wall_s']:.1f}" for x in runs)
-    print(f"wall {r['wall_s']:.1f} s (all: {walls}), "
-          f"CPU {r['cpu_s']:.1f} s, phi_J = {r['phi']:.4f}, Z = {r['Z']:.3g}, "
-          f"{r['collisions']:.3g} collisions, {r['rate']:.3g} coll/s overall, "
-          f"{r['dense_rate']:.3g} coll/s for Z >= 1e3, peak {r['peak_mb']:.0f} MB")
+    for name, section in SECTIONS.items():
+        if name in args.only:
+            section(args.quick, repeats)
 
 
 if __name__ == "__main__":
