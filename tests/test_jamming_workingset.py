@@ -1,0 +1,82 @@
+"""Pieces of the working-set LP solver (hardpack.jamming.workingset) against exact answers.
+
+The solver as a whole is checked against HiGHS in test_jamming_hypostatic.py; here its basis
+repair (which columns of a singular basis are dependent) and the row generation of its K-LP.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from scipy.optimize import linprog
+from scipy.sparse.csgraph import maximum_bipartite_matching
+
+from hardpack.jamming import workingset
+
+
+def _regular_sparse(n: int, seed: int) -> sp.csc_matrix:
+    """A sparse regular matrix with 3 entries per column, none on the diagonal (like a rigidity
+    matrix, whose rows and columns are unrelated)."""
+    rng = np.random.default_rng(seed)
+    rows = np.concatenate([(np.arange(n) + s) % n for s in (1, 2, 5)])
+    cols = np.tile(np.arange(n), 3)
+    a = sp.csc_matrix((rng.uniform(1, 2, 3 * n) * rng.choice([-1, 1], 3 * n), (rows, cols)), shape=(n, n))
+    assert abs(np.linalg.det(a.toarray())) > 1e-8
+    return a
+
+
+def test_regulariser_stays_in_the_pattern_and_fills_structural_holes():
+    a = _regular_sparse(60, 0).tolil()
+    a[:, 7] = 0.0  # an empty column: structurally singular
+    a = sp.csc_matrix(a)
+    a.eliminate_zeros()
+    reg = workingset._regulariser(a, 1e-13)
+    assert reg.nnz == a.shape[0]
+    full = sp.csc_matrix(a + reg)
+    assert np.all(maximum_bipartite_matching(full.tocsr(), perm_type="row") >= 0)
+    outside = (abs(reg) > 0).astype(int) - (abs(reg) > 0).multiply(abs(a) > 0).astype(int)
+    assert outside.nnz == 0 or outside.sum() == 1  # only the empty column's entry is new
+
+
+def test_factorise_finds_exactly_the_dependent_columns():
+    """Two columns made linear combinations of others: the repair reports two columns, and
+    replacing them by unit columns of the reported rows gives a regular matrix."""
+    a = _regular_sparse(80, 1).tolil()
+    a[:, 30] = a[:, 3] * 2.0 - a[:, 4]
+    a[:, 50] = a[:, 12] * 0.5
+    a = sp.csc_matrix(a)
+    lu, cols, rows = workingset._factorise(a)
+    assert lu is None
+    assert cols.size == 2
+    fixed = a.tolil()
+    for c, r in zip(cols, rows):
+        fixed[:, c] = 0.0
+        fixed[r, c] = 1.0
+    assert abs(np.linalg.det(fixed.toarray())) > 1e-8
+    lu, cols, _ = workingset._factorise(sp.csc_matrix(fixed))
+    assert lu is not None and cols is None
+
+
+@pytest.mark.parametrize("bounding_rows", [1, 5, 1000])
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("loads", ["mixed", "positive"])
+def test_k_lp_row_generation_matches_the_full_lp(monkeypatch, bounding_rows, seed, loads):
+    """The K-LP over generated rows has the optimum of the LP over all rows (HiGHS, 1e-9), for
+    few or many starting rows. With positive basis loads y the rows start from the bounding
+    rows alone: 1 per column makes the first restricted LP infeasible for some seeds (the
+    widening); the mixed loads take several rounds of row generation."""
+    monkeypatch.setattr(workingset, "BOUNDING_ROWS", bounding_rows)
+    rng = np.random.default_rng(seed)
+    n, k = 60, 12
+    y = rng.normal(size=n) + 0.5 if loads == "mixed" else rng.uniform(0.1, 1.0, n)
+    null = rng.normal(size=(n, k))
+    h_s, h_w = rng.uniform(0, 1, n), rng.uniform(-0.5, 1, k)
+    upper = rng.uniform(1, 2, n)
+    mu, alpha, t = workingset._k_lp(y, null, h_s, h_w, upper)
+    q = h_s @ null + h_w
+    full = linprog(y, A_ub=null.T, b_ub=q, bounds=np.column_stack([np.zeros(n), upper]), method="highs")
+    assert full.status == 0
+    assert mu is not None
+    assert y @ mu == pytest.approx(full.fun, abs=1e-9 * max(1.0, abs(full.fun)))
+    assert np.all(null.T @ mu <= q + 1e-9) and np.all(mu >= -1e-12) and np.all(mu <= upper + 1e-12)
