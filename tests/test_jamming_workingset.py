@@ -80,3 +80,39 @@ def test_k_lp_row_generation_matches_the_full_lp(monkeypatch, bounding_rows, see
     assert mu is not None
     assert y @ mu == pytest.approx(full.fun, abs=1e-9 * max(1.0, abs(full.fun)))
     assert np.all(null.T @ mu <= q + 1e-9) and np.all(mu >= -1e-12) and np.all(mu <= upper + 1e-12)
+
+
+def _with_dense_row(n: int, seed: int) -> sp.csc_matrix:
+    """A regular sparse matrix whose last row has an entry in every column, most of them tiny
+    (the strain row of a sheared cell): the path of workingset._column_order."""
+    rng = np.random.default_rng(seed)
+    a = _regular_sparse(n, seed).tolil()
+    row = rng.uniform(-1e-6, 1e-6, n)
+    row[::7] = rng.uniform(1, 2, row[::7].size)
+    a[n - 1, :] = row
+    return sp.csc_matrix(a)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_ordered_lu_solves_with_dense_rows(seed):
+    a = _with_dense_row(400, seed)
+    assert workingset._column_order(a) is not None
+    lu, cols, _ = workingset._factorise(a)
+    assert cols is None
+    rng = np.random.default_rng(seed)
+    b, m = rng.normal(size=400), rng.normal(size=(400, 3))
+    dense = a.toarray()
+    np.testing.assert_allclose(dense @ lu.solve(b), b, atol=1e-9)
+    np.testing.assert_allclose(dense.T @ lu.solve(b, trans="T"), b, atol=1e-9)
+    np.testing.assert_allclose(dense @ lu.solve(m), m, atol=1e-9)
+
+
+def test_factorise_with_dense_rows_finds_the_dependent_column():
+    a = _with_dense_row(400, 4).tolil()
+    a[:, 100] = a[:, 10] - a[:, 20]
+    lu, cols, rows = workingset._factorise(sp.csc_matrix(a))
+    assert lu is None and cols.size == 1
+    fixed = a.copy()
+    fixed[:, cols[0]] = 0.0
+    fixed[rows[0], cols[0]] = 1.0
+    assert workingset._factorise(sp.csc_matrix(fixed))[1] is None
