@@ -67,6 +67,8 @@ def test_k_lp_row_generation_matches_the_full_lp(monkeypatch, bounding_rows, see
     rows alone: 1 per column makes the first restricted LP infeasible for some seeds (the
     widening); the mixed loads take several rounds of row generation."""
     monkeypatch.setattr(workingset, "BOUNDING_ROWS", bounding_rows)
+    if loads == "positive":  # no low-load rows either: R starts from the bounding rows alone
+        monkeypatch.setattr(workingset, "LOW_LOAD_ROWS", 0.0)
     rng = np.random.default_rng(seed)
     n, k = 60, 12
     y = rng.normal(size=n) + 0.5 if loads == "mixed" else rng.uniform(0.1, 1.0, n)

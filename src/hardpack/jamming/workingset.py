@@ -62,6 +62,11 @@ K0 = 20
 BOUNDING_ROWS = 5
 #: row generation adds, with each row found short, this many of the rows closest to it
 NEAR_ROWS = 1
+#: fraction of the rows, those of the smallest basis loads y, that the K-LP starts with: the
+#: rows whose force reaches zero at the optimum are mostly among them (in a strict LP at
+#: N = 1e4 in 3D, 71 % were in the lowest 5 % of y and 91 % in the lowest 10 %); starting
+#: with them saves rounds of row generation (8 s instead of 12-15 s for that K-LP)
+LOW_LOAD_ROWS = 0.05
 
 
 @dataclass(frozen=True)
@@ -385,10 +390,11 @@ def _k_lp(y, null, h_s, h_w, upper, tol: float = 1e-9):
         min y^T mu  s.t.  N^T mu <= h_S^T N + h_W^T,  0 <= mu <= u,
 
     and only over the rows R of the basis columns that may lose their force (row generation:
-    mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with y < 0 and the
-    BOUNDING_ROWS most negative entries of N of each column with q < 0 (without them such a
-    column would make the restricted primal unbounded; if they are too few, R is widened to
-    every row with a negative entry of those columns). Each round adds the rows with
+    mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with y < 0, the
+    LOW_LOAD_ROWS fraction of rows of smallest y, and the BOUNDING_ROWS most negative entries
+    of N of each column with q < 0 (without them such a column would make the restricted
+    primal unbounded; if they are too few, R is widened to every row with a negative entry of
+    those columns). Each round adds the rows with
     y + N alpha < -tol and as many of the rows next closest to it. When none is short, alpha
     is feasible for the full primal and optimal for a relaxation of it, hence optimal.
     Restricting R matters at large N: with every row that has a negative entry (the columns of
@@ -400,6 +406,9 @@ def _k_lp(y, null, h_s, h_w, upper, tol: float = 1e-9):
     if np.any(np.all(null[:, q < 0] >= 0, axis=0)):  # a column that lowers the cost unboundedly
         return None, None, None
     rows = y < tol * scale
+    low = int(LOW_LOAD_ROWS * n)
+    if low:
+        rows[np.argpartition(y, low - 1)[:low]] = True
     lowering = null[:, q < 0]  # the rows that bound these columns: the most negative entries
     if lowering.size:          # of each (all rows with a negative entry if these are infeasible)
         take = min(BOUNDING_ROWS, n)
