@@ -393,9 +393,9 @@ def _k_lp(y, null, h_s, h_w, upper, tol: float = 1e-9):
     mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with y < 0, the
     LOW_LOAD_ROWS fraction of rows of smallest y, and the BOUNDING_ROWS most negative entries
     of N of each column with q < 0 (without them such a column would make the restricted
-    primal unbounded; if they are too few, R is widened to every row with a negative entry of
-    those columns). Each round adds the rows with
-    y + N alpha < -tol and as many of the rows next closest to it. When none is short, alpha
+    primal unbounded; while they are too few, 8 times as many are taken, up to every row with
+    a negative entry). Each round adds the rows with y + N alpha < -tol and as many of the
+    rows next closest to it. When none is short, alpha
     is feasible for the full primal and optimal for a relaxation of it, hence optimal.
     Restricting R matters at large N: with every row that has a negative entry (the columns of
     N are dense) the K-LP of a strict test at N = 1e4 in 3D took 20-45 s per HiGHS solve.
@@ -410,11 +410,14 @@ def _k_lp(y, null, h_s, h_w, upper, tol: float = 1e-9):
     if low:
         rows[np.argpartition(y, low - 1)[:low]] = True
     lowering = null[:, q < 0]  # the rows that bound these columns: the most negative entries
-    if lowering.size:          # of each (all rows with a negative entry if these are infeasible)
-        take = min(BOUNDING_ROWS, n)
-        best = np.argpartition(lowering, take - 1, axis=0)[:take]
+
+    def add_bounding_rows(count: int) -> None:
+        best = np.argpartition(lowering, min(count, n) - 1, axis=0)[:count]
         rows[best[np.take_along_axis(lowering, best, axis=0) < 0]] = True
-    widened = False
+
+    bounding = BOUNDING_ROWS
+    if lowering.size:
+        add_bounding_rows(bounding)
     for _ in range(20):
         idx = np.flatnonzero(rows)
         if idx.size == 0:  # y >= 0 and no working column can lower the cost: alpha = 0
@@ -423,11 +426,11 @@ def _k_lp(y, null, h_s, h_w, upper, tol: float = 1e-9):
             res = solve_lp(y[idx], A_ub=null[idx].T if k else None, b_ub=q if k else None,
                            bounds=np.column_stack([np.zeros(idx.size), upper[idx]]),
                            options={"presolve": False})  # presolve costs more than it saves here
-        except LPFailure:
-            if widened:
+        except LPFailure:  # restricted primal unbounded: more bounding rows (all at the end)
+            if not lowering.size or bounding >= n:
                 return None, None, None
-            rows |= np.any(lowering < 0, axis=1)
-            widened = True
+            bounding *= 8
+            add_bounding_rows(bounding)
             continue
         alpha = -res.ineqlin.marginals if k else np.zeros(0)
         f = y + null @ alpha
