@@ -118,3 +118,23 @@ def test_factorise_with_dense_rows_finds_the_dependent_column():
     fixed[:, cols[0]] = 0.0
     fixed[rows[0], cols[0]] = 1.0
     assert workingset._factorise(sp.csc_matrix(fixed))[1] is None
+
+
+def test_column_order_falls_back_when_the_copy_is_singular(monkeypatch):
+    """If SuperLU refuses the sparsified copy, the order is SuperLU's own and the LU still solves."""
+    a = _with_dense_row(400, 5)
+    real = workingset.spla.splu
+    calls = []
+
+    def refuse_first(m, **kwargs):
+        calls.append(m.shape)
+        if len(calls) == 1:
+            raise RuntimeError("Factor is exactly singular")
+        return real(m, **kwargs)
+
+    monkeypatch.setattr(workingset.spla, "splu", refuse_first)
+    assert workingset._column_order(a) is None
+    lu, cols, _ = workingset._factorise(a)
+    assert cols is None
+    b = np.random.default_rng(5).normal(size=400)
+    np.testing.assert_allclose(a.toarray() @ lu.solve(b), b, atol=1e-9)

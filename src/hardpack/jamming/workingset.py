@@ -207,7 +207,8 @@ def _column_order(a: sp.csc_matrix) -> np.ndarray | None:
     most components). Ordered without them, the LU of that basis had 75e6 entries (45 s);
     ordered on a copy that keeps their entries above 1e-3 of the row's largest, 24e6 (5 s),
     like the unsheared basis. The copy's order comes from SuperLU itself (a factorisation of
-    the copy, regularised on a matching so that it is never singular)."""
+    the copy, regularised on a matching so that it is structurally regular; None if it is
+    numerically singular all the same)."""
     n = a.shape[0]
     rows = sp.csr_matrix(a)
     counts = np.diff(rows.indptr)
@@ -221,7 +222,10 @@ def _column_order(a: sp.csc_matrix) -> np.ndarray | None:
     copy = sp.csr_matrix((rows.data[keep], rows.indices[keep], np.concatenate(
         [[0], np.cumsum(np.bincount(row_of[keep], minlength=n))])), shape=a.shape).tocsc()
     copy = copy + _regulariser(copy, 1e-13 * float(size.max()))
-    return np.argsort(spla.splu(sp.csc_matrix(copy), permc_spec="COLAMD").perm_c)
+    try:
+        return np.argsort(spla.splu(sp.csc_matrix(copy), permc_spec="COLAMD").perm_c)
+    except RuntimeError:  # numerically singular copy: SuperLU's own order then
+        return None
 
 
 def _factorise(a: sp.csc_matrix):
