@@ -17,9 +17,11 @@ starts every LP from scratch and spends thousands of simplex iterations rebuildi
 derivation, the revised-simplex decomposition with column generation):
 
 1. Basis S: the n columns with the smallest gaps (or the previous LP's optimal basis: warm
-   start), factorised by SuperLU. Numerically dependent columns (tiny pivots: floppy modes of the
-   true-contact network, translations) are replaced by the box column e_r of the row left
-   without a pivot (LP basis repair), so A_S is regular.
+   start), factorised by SuperLU (:func:`_factorise`; columns ordered by :func:`_column_order`
+   when strain rows are dense). Numerically dependent columns (tiny pivots: floppy modes of the
+   true-contact network, translations), found on a copy regularised on a matching of the
+   pattern (:func:`_regulariser`), are replaced by the box column e_r of the row left without
+   a pivot (LP basis repair), so A_S is regular.
 2. Working set W: K more columns (the columns the repair took out, the partners of box columns
    in S, the next 20 smallest gaps or the previous LP's working set, and later every violated
    column). With y = -A_S^{-1} c and N = -A_S^{-1} A_W, every dual solution on S + W is
