@@ -120,3 +120,34 @@ def test_working_set_matches_highs(strict):
         warm = mine.warm
         assert mine.objective == pytest.approx(exact.objective, rel=1e-7)
         np.testing.assert_allclose(mine.displacement, exact.displacement, atol=1e-8)
+
+
+def test_strain_continuation_stops_at_an_interior_strain(monkeypatch):
+    """The strain continuation ends at the first stage whose optimal strain is inside its
+    bound (lp._strain_continuation): that optimum must be the optimum HiGHS finds with the full
+    bound. With a box of 5 D the contacts bound the strain at ~0.035 of the box (measured), so
+    the stage with a tenth of the bound is interior and the last stage is skipped (counted, so
+    the test exercises the shortcut); tolerance as in test_working_set_matches_highs."""
+    import hardpack.jamming.lp as lp
+
+    q, _ = _opened(jammed_disks(), 1e-3)
+    net = contact_network(q, 0.1)
+    moving = np.ones(q.n_particles, bool)
+    length = cell_length(q.lattice)
+    common = {"box": 5.0, "cell_length": length}
+    calls = []
+    solve = lp.solve_working_set
+    monkeypatch.setattr(lp, "solve_working_set", lambda *a, **k: calls.append(1) or solve(*a, **k))
+    early = 0
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        load = random_load(rng, moving, 2)
+        eps = random_strain_load(rng, 2, length)
+        calls.clear()
+        mine = solve_motion(net, moving, load, strain_load=eps, **common)
+        early += len(calls) < 6  # the continuation has 6 stages by default
+        exact = solve_motion(net, moving, load, strain_load=eps, working_set=False, **common)
+        assert mine.solver == "working-set"
+        assert mine.objective == pytest.approx(exact.objective, rel=1e-7)
+        np.testing.assert_allclose(mine.displacement, exact.displacement, atol=1e-8)
+    assert early == 4

@@ -145,7 +145,13 @@ def _strain_continuation(g, h, c, upper, n_pos, keys, factor: float = 10.0, stag
     """A strict LP without a warm start: the working set is solved for strain bounds
     ``factor**-stages`` times the final one, then ``factor`` times larger each stage, each
     warm-started from the previous optimum. Small strains close few near contacts, so every
-    stage starts close to its optimum; the last one is the LP itself. None if a stage fails."""
+    stage starts close to its optimum; the last one is the LP itself. None if a stage fails.
+
+    A stage whose optimal strain lies strictly inside its bound ends the continuation: the
+    stages differ only in the strain bound, so that optimum satisfies the optimality (KKT)
+    conditions of every larger bound with the same multipliers (an inactive bound has none).
+    At N = 1e4 in 3D the optimal strain is ~0.07 of the final bound, which saves the last
+    stage (15 s: a factorisation of the same basis)."""
     sol = None
     for stage in range(stages, -1, -1):
         bound = upper.copy()
@@ -154,6 +160,8 @@ def _strain_continuation(g, h, c, upper, n_pos, keys, factor: float = 10.0, stag
         sol = solve_working_set(g, h, c, bound, start=start, boxed=np.arange(n_pos, upper.size))
         if sol is None:
             return None
+        if np.all(np.abs(sol.x[n_pos:]) < (1.0 - 1e-6) * bound[n_pos:]):
+            break
     return sol
 
 
