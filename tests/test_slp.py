@@ -186,3 +186,42 @@ def test_table_i_3d_mrj_protocol_gives_a_strictly_jammed_isostatic_packing():
     verdict = verify(result.packing, seed=1)
     assert verdict.strict
     assert verdict.statics.isostaticity_gap_strict == 0
+
+
+def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path, monkeypatch):
+    """A run interrupted after 20 LPs (checkpoint after every step) and started again with the
+    same arguments continues from its checkpoint (20 LPs fewer) and ends with the packing and
+    history of the uninterrupted run, bit for bit (every step is a deterministic function of
+    the checkpointed state); the checkpoint is removed at the end, and one of another run is
+    refused."""
+    import hardpack.slp.driver as driver
+
+    start = random_packing(30, 3, monodisperse(), 0.3, seed=4)
+    args = (start, 1.5, Bounds(0.1, 0.1, 0.5))
+    whole = run_slp(*args)
+    ckpt = tmp_path / "slp.ckpt"
+    solve = driver.solve_step
+    calls = []
+
+    def dying(*a, **k):
+        calls.append(1)
+        if len(calls) > 20:
+            raise KeyboardInterrupt  # the job is killed
+        return solve(*a, **k)
+
+    monkeypatch.setattr(driver, "solve_step", dying)
+    with pytest.raises(KeyboardInterrupt):
+        run_slp(*args, checkpoint=ckpt, checkpoint_interval=0.0)
+    assert ckpt.exists()
+    with pytest.raises(InvalidInputError, match="different run"):
+        run_slp(start, 2.5, Bounds(0.1, 0.1, 0.5), checkpoint=ckpt)
+    counted = []
+    monkeypatch.setattr(driver, "solve_step", lambda *a, **k: counted.append(1) or solve(*a, **k))
+    resumed = run_slp(*args, checkpoint=ckpt, checkpoint_interval=0.0)
+    assert not ckpt.exists()
+    assert whole.n_steps > 20 and resumed.n_steps == whole.n_steps
+    assert len(counted) == whole.n_steps - 20  # it did not start again from scratch
+    np.testing.assert_array_equal(resumed.packing.positions, whole.packing.positions)
+    np.testing.assert_array_equal(resumed.packing.lattice, whole.packing.lattice)
+    for name in ("phi", "predicted_gain", "accepted", "trust_scale"):
+        np.testing.assert_array_equal(resumed.history[name].values, whole.history[name].values)

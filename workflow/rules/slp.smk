@@ -107,6 +107,7 @@ rule slp_mrj:
         history="results/ensembles/{ensemble}/slp/history_seed{seed}.nc",
     params:
         flags=slp_flags(SLP_MRJ) if SLP_MRJ else "",
+        checkpoint="results/ensembles/{ensemble}/slp/checkpoint_seed{seed}.ckpt",  # a killed job resumes
     threads: 1
     resources:
         mem_mb=2000,
@@ -114,7 +115,8 @@ rule slp_mrj:
     log:
         "results/logs/slp_mrj/{ensemble}_seed{seed}.log",
     shell:
-        "hardpack slp --init {input} --out {output.packing} --history {output.history} {params.flags} 2> {log}"
+        "hardpack slp --init {input} --out {output.packing} --history {output.history} {params.flags}"
+        " --checkpoint {params.checkpoint} 2> {log}"
 
 
 rule slp_mrj_summary:
@@ -157,6 +159,7 @@ rule slp_system:
         history="results/slp/mrj/{system}/history_seed{seed}.nc",
     params:
         flags=slp_flags(SLP_MRJ) if SLP_MRJ else "",
+        checkpoint="results/slp/mrj/{system}/checkpoint_seed{seed}.ckpt",  # a killed job resumes
     threads: 1
     resources:
         mem_mb=2000,
@@ -164,7 +167,8 @@ rule slp_system:
     log:
         "results/logs/slp_system/{system}_seed{seed}.log",
     shell:
-        "hardpack slp --init {input} --out {output.packing} --history {output.history} {params.flags} 2> {log}"
+        "hardpack slp --init {input} --out {output.packing} --history {output.history} {params.flags}"
+        " --checkpoint {params.checkpoint} 2> {log}"
 
 
 rule verify_slp_system:

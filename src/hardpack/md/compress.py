@@ -62,7 +62,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
-from hardpack.md import checkpoint as ckpt
+from hardpack.io import checkpoint as ckpt
 from hardpack.md.simulation import (
     RECORD_FIELDS,
     Simulation,

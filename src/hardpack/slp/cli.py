@@ -18,7 +18,8 @@ def cmd_slp(args) -> int:
     start = load_packing(args.init)
     bounds = Bounds(args.strain_bound, args.shear_bound, args.displacement_bound)
     result = run_slp(start, args.alpha, bounds, deforming=not args.isotropic, tol=args.tol,
-                     max_steps=args.max_steps, method=args.lp_method)
+                     max_steps=args.max_steps, method=args.lp_method, checkpoint=args.checkpoint,
+                     checkpoint_interval=args.checkpoint_interval)
     params = {
         "generator": "slp", "alpha": args.alpha, "strain_bound": args.strain_bound,
         "shear_bound": args.shear_bound, "displacement_bound": args.displacement_bound,
@@ -60,5 +61,9 @@ def register(subparsers) -> None:
     p.add_argument("--tol", type=float, default=1e-10,
                    help="stop when the predicted density gain is below this (paper: 1e-8; see hardpack.slp.driver)")
     p.add_argument("--max-steps", type=int, default=2000, help="maximum number of LPs")
+    p.add_argument("--checkpoint", help="checkpoint file: written every --checkpoint-interval seconds, "
+                   "resumed if present (same start and options), removed at the end")
+    p.add_argument("--checkpoint-interval", type=float, default=300.0,
+                   help="seconds between checkpoints (default 300)")
     p.add_argument("--attr", action="append", type=lambda t: tuple(t.split("=", 1)), metavar="KEY=VALUE")
     p.set_defaults(func=cmd_slp)

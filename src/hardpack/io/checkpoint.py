@@ -1,8 +1,10 @@
-"""Atomic checkpoints of an MD run, written at synchronisation points.
+"""Atomic checkpoints of long runs (MD compressions, SLP densifications).
 
-A checkpoint is an ``.npz`` file with the complete :meth:`hardpack.md.simulation.Simulation.state`
-plus a fingerprint of the run's defining inputs (start packing, growth rate, seed, window size,
-overlap tolerance, final growth stage, contact-force windows).
+A checkpoint is an ``.npz`` file with the complete state of a run (for MD:
+:meth:`hardpack.md.simulation.Simulation.state`, written at synchronisation points; for SLP:
+:func:`hardpack.slp.driver.run_slp`'s packing, trust region and history) plus a fingerprint of
+the run's defining inputs (for MD: start packing, growth rate, seed, window size, overlap
+tolerance, final growth stage, contact-force windows).
 It is written to a temporary file in the destination folder, flushed, and moved over the old one
 with :func:`os.replace`, so a run killed at any moment (even with SIGKILL) leaves a complete
 checkpoint. Restarting with the same arguments loads it and continues. Checkpoints are taken only
@@ -55,7 +57,7 @@ def save(path, fp: str, state: dict) -> None:
 
 def load(path, fp: str) -> dict | None:
     """The saved state, or None if ``path`` does not exist. A checkpoint of a different run (other
-    start packing, rate, seed or window) is refused rather than silently continued."""
+    start packing or parameters) is refused rather than silently continued."""
     path = Path(path)
     if not path.exists():
         return None
@@ -67,8 +69,8 @@ def load(path, fp: str) -> dict | None:
                                 "delete it to start afresh") from None
     if int(state.pop("format", -1)) != FORMAT or str(state.pop("fingerprint", "")) != fp:
         raise InvalidInputError(
-            f"checkpoint {path} belongs to a different run (other start packing, growth rates, seed, "
-            "window size or contact-force option); delete it or choose another checkpoint path"
+            f"checkpoint {path} belongs to a different run (other start packing or run parameters, "
+            "e.g. growth rates, seed, window size, SLP bounds); delete it or choose another checkpoint path"
         )
     return {k: (v.item() if v.ndim == 0 else v) for k, v in state.items()}
 
