@@ -7,7 +7,7 @@ the run's defining inputs (for MD: start packing, growth rate, seed, window size
 tolerance, final growth stage, contact-force windows).
 It is written to a temporary file in the destination folder, flushed, and moved over the old one
 with :func:`os.replace`, so a run killed at any moment (even with SIGKILL) leaves a complete
-checkpoint. Restarting with the same arguments loads it and continues. Checkpoints are taken only
+checkpoint. Restarting with the same arguments loads it and continues. MD checkpoints are taken only
 at synchronisation points after which the uninterrupted run also rebuilds its schedule and its
 neighbour lists from scratch (:attr:`Simulation.checkpoint_ready`), so the continued run is
 bit-identical to an uninterrupted one.

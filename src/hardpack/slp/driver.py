@@ -25,7 +25,7 @@ history, elapsed time) is written atomically every ``checkpoint_interval`` secon
 (:mod:`hardpack.io.checkpoint`); a run started again with the same start packing and parameters
 resumes there. Every step is a deterministic function of that state (HiGHS is deterministic),
 so the resumed run ends exactly where the uninterrupted one does. A 3D N = 2000 run of the full
-study takes ~2000 LPs and hours on a shared machine, longer than a session that may stop it.
+study takes up to 2000 LPs and hours on a shared machine, longer than a session that may stop it.
 """
 
 from __future__ import annotations
