@@ -5,8 +5,8 @@ A checkpoint is an ``.npz`` file with the complete state of a run (for MD:
 :func:`hardpack.slp.driver.run_slp`'s packing, trust region and history) plus a fingerprint of
 the run's defining inputs (for MD: start packing, growth rate, seed, window size, overlap
 tolerance, final growth stage, contact-force windows).
-It is written to a temporary file in the destination folder, flushed, and moved over the old one
-with :func:`os.replace`, so a run killed at any moment (even with SIGKILL) leaves a complete
+It is written by :func:`hardpack.io.atomic.atomic_path` (a temporary file in the destination folder,
+flushed and renamed over the old one), so a run killed at any moment (even with SIGKILL) leaves a complete
 checkpoint. Restarting with the same arguments loads it and continues. MD checkpoints are taken only
 at synchronisation points after which the uninterrupted run also rebuilds its schedule and its
 neighbour lists from scratch (:attr:`Simulation.checkpoint_ready`), so the continued run is
@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from hardpack.errors import InvalidInputError
+from hardpack.io.atomic import atomic_path
 
 FORMAT = 2
 
@@ -40,19 +39,8 @@ def fingerprint(packing, **params) -> str:
 
 def save(path, fp: str, state: dict) -> None:
     """Atomically write ``state`` (arrays and scalars) with fingerprint ``fp`` to ``path``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, fingerprint=np.array(fp), format=np.array(FORMAT), **state)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        np.savez(fh, fingerprint=np.array(fp), format=np.array(FORMAT), **state)
 
 
 def load(path, fp: str) -> dict | None:
