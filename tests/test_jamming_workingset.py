@@ -75,13 +75,38 @@ def test_k_lp_row_generation_matches_the_full_lp(monkeypatch, bounding_rows, see
     null = rng.normal(size=(n, k))
     h_s, h_w = rng.uniform(0, 1, n), rng.uniform(-0.5, 1, k)
     upper = rng.uniform(1, 2, n)
-    mu, alpha, t = workingset._k_lp(y, null, h_s, h_w, upper)
+    mu, alpha, t = workingset._KLP(y, h_s, upper).solve(null, h_w)
     q = h_s @ null + h_w
     full = linprog(y, A_ub=null.T, b_ub=q, bounds=np.column_stack([np.zeros(n), upper]), method="highs")
     assert full.status == 0
     assert mu is not None
     assert y @ mu == pytest.approx(full.fun, abs=1e-9 * max(1.0, abs(full.fun)))
     assert np.all(null.T @ mu <= q + 1e-9) and np.all(mu >= -1e-12) and np.all(mu <= upper + 1e-12)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_k_lp_grown_column_by_column_matches_the_full_lp(seed):
+    """The K-LP object kept across rounds, as the working set grows (2, 5, 9, then 14 columns),
+    has after each round the optimum of the LP over all rows and the columns so far (HiGHS,
+    1e-9): the additions to its HiGHS model and the restarts from the previous basis change
+    nothing but the time."""
+    rng = np.random.default_rng(100 + seed)
+    n, k = 60, 14
+    y, null = rng.normal(size=n) + 0.5, rng.normal(size=(n, k))
+    h_s, h_w, upper = rng.uniform(0, 1, n), rng.uniform(-0.5, 1, k), rng.uniform(1, 2, n)
+    k_lp = workingset._KLP(y, h_s, upper)
+    for size in (2, 5, 9, 14):
+        mu, alpha, t = k_lp.solve(null[:, :size], h_w[:size])
+        q = h_s @ null[:, :size] + h_w[:size]
+        full = linprog(y, A_ub=null[:, :size].T, b_ub=q, bounds=np.column_stack([np.zeros(n), upper]),
+                       method="highs")
+        assert full.status == 0 and mu is not None
+        assert y @ mu == pytest.approx(full.fun, abs=1e-9 * max(1.0, abs(full.fun)))
+        assert np.all(null[:, :size].T @ mu <= q + 1e-9) and np.all((mu >= -1e-12) & (mu <= upper + 1e-12))
+        # the primal: f = y + N alpha + t >= 0 with alpha, t >= 0 and the same objective
+        assert np.all(alpha >= -1e-12) and np.all(t >= -1e-12)
+        assert np.all(y + null[:, :size] @ alpha + t >= -1e-9)
+        assert q @ alpha + upper @ t == pytest.approx(-full.fun, abs=1e-8 * max(1.0, abs(full.fun)))
 
 
 def _with_dense_row(n: int, seed: int) -> sp.csc_matrix:

@@ -48,12 +48,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import highspy
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import maximum_bipartite_matching
 
-from hardpack.jamming.highs import LPFailure, solve_lp
+from hardpack.jamming.highs import HIGHS_OPTIONS, LPFailure
 
 #: relative pivot size below which a basis column counts as dependent (repaired)
 PIVOT_TOL = 1e-10
@@ -354,6 +355,7 @@ def solve_working_set(
             h_s = cols.gap(basis)
             penalty = np.asarray(abs(cols.matrix(basis)).T @ cols.upper).ravel()  # tension as box loads
             null = np.zeros((n, 0))
+            k_lp = _KLP(y, h_s, h_s + penalty)
             factorise = False
         new = working[null.shape[1]:]
         in_set[new] = True
@@ -362,7 +364,7 @@ def solve_working_set(
         k = working.size
         h_w = cols.gap(working)
         # 3. the K-LP (module docstring), in its dual form
-        mu, alpha, t = _k_lp(y, null, h_s, h_w, h_s + penalty)
+        mu, alpha, t = k_lp.solve(null, h_w)
         if mu is None:
             return None
         x = lu.solve(mu - h_s, trans="T")
@@ -389,11 +391,14 @@ def solve_working_set(
     return None
 
 
-def _k_lp(y, null, h_s, h_w, upper, tol: float = 1e-9):
-    """The K-LP  min (h_S^T N + h_W^T) alpha + u^T t  s.t.  N alpha + t >= -y,  alpha, t >= 0,
+class _KLP:
+    """The K-LP of one basis S,
+
+        min (h_S^T N + h_W^T) alpha + u^T t  s.t.  N alpha + t >= -y,  alpha, t >= 0,
+
     solved as its dual with K rows,
 
-        min y^T mu  s.t.  N^T mu <= h_S^T N + h_W^T,  0 <= mu <= u,
+        min y^T mu  s.t.  N^T mu <= q = h_S^T N + h_W^T,  0 <= mu <= u,
 
     and only over the rows R of the basis columns that may lose their force (row generation:
     mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with y < 0, the
@@ -401,57 +406,105 @@ def _k_lp(y, null, h_s, h_w, upper, tol: float = 1e-9):
     of N of each column with q < 0 (without them such a column would make the restricted
     primal unbounded; while they are too few, 8 times as many are taken, up to every row with
     a negative entry). Each round adds the rows with y + N alpha < -tol and as many of the
-    rows next closest to it. When none is short, alpha
-    is feasible for the full primal and optimal for a relaxation of it, hence optimal.
-    Restricting R matters at large N: with every row that has a negative entry (the columns of
-    N are dense) the K-LP of a strict test at N = 1e4 in 3D took 20-45 s per HiGHS solve.
-    Returns (mu, alpha, t) for all n rows, or (None,) * 3 if HiGHS fails."""
-    n, k = null.shape
-    scale = max(float(np.abs(y).max(initial=0.0)), 1e-300)
-    q = h_s @ null + h_w  # reduced costs of the working columns
-    if np.any(np.all(null[:, q < 0] >= 0, axis=0)):  # a column that lowers the cost unboundedly
-        return None, None, None
-    rows = y < tol * scale
-    low = int(LOW_LOAD_ROWS * n)
-    if low:
-        rows[np.argpartition(y, low - 1)[:low]] = True
-    lowering = null[:, q < 0]  # the rows that bound these columns: the most negative entries
+    rows next closest to it. When none is short, alpha is feasible for the full primal and
+    optimal for a relaxation of it, hence optimal. Restricting R matters at large N: with every
+    row that has a negative entry (the columns of N are dense) the K-LP of a strict test at
+    N = 1e4 in 3D took 20-45 s per HiGHS solve.
 
-    def add_bounding_rows(count: int) -> None:
-        best = np.argpartition(lowering, min(count, n) - 1, axis=0)[:count]
-        rows[best[np.take_along_axis(lowering, best, axis=0) < 0]] = True
+    One HiGHS instance (highspy) holds the restricted LP for the whole life of the basis: y, h_S
+    and u are those of S, so each round (rows of S joining R: new variables; working columns
+    joining W: new constraints) only adds to the model, and HiGHS continues from its previous
+    optimal basis instead of starting over (scipy's linprog cannot warm-start)."""
 
-    bounding = BOUNDING_ROWS
-    if lowering.size:
-        add_bounding_rows(bounding)
-    for _ in range(20):
-        idx = np.flatnonzero(rows)
-        if idx.size == 0:  # y >= 0 and no working column can lower the cost: alpha = 0
-            return np.zeros(n), np.zeros(k), np.zeros(n)
-        try:
-            res = solve_lp(y[idx], A_ub=null[idx].T if k else None, b_ub=q if k else None,
-                           bounds=np.column_stack([np.zeros(idx.size), upper[idx]]),
-                           options={"presolve": False})  # presolve costs more than it saves here
-        except LPFailure:  # restricted primal unbounded: more bounding rows (all at the end)
-            if not lowering.size or bounding >= n:
+    def __init__(self, y: np.ndarray, h_s: np.ndarray, upper: np.ndarray, tol: float = 1e-9):
+        self.y, self.h_s, self.upper, self.n = y, h_s, upper, y.size
+        self.limit = tol * max(float(np.abs(y).max(initial=0.0)), 1e-300)
+        self.rows = y < self.limit
+        low = int(LOW_LOAD_ROWS * self.n)
+        if low:
+            self.rows[np.argpartition(y, low - 1)[:low]] = True
+        self.var_rows = np.zeros(0, dtype=np.int64)  # row of S of each variable of the model
+        self.k = 0  # working columns that are constraints of the model
+        self.bounding = BOUNDING_ROWS
+        self.highs = highspy.Highs()
+        for name, value in {"output_flag": False, "presolve": "off", **HIGHS_OPTIONS}.items():
+            self.highs.setOptionValue(name, value)
+
+    def solve(self, null: np.ndarray, h_w: np.ndarray):
+        """Optimum with the working columns ``null`` (n x K: those of earlier calls first, then
+        the new ones) of gaps ``h_w``. Returns (mu, alpha, t) for all n rows, or (None,) * 3 if
+        the restricted LP is unbounded or HiGHS fails."""
+        n, k = null.shape
+        q = self.h_s @ null + h_w  # reduced costs of the working columns
+        fresh = np.zeros(k, dtype=bool)
+        fresh[self.k:] = q[self.k:] < 0
+        if np.any(np.all(null[:, fresh] >= 0, axis=0)):  # a column lowering the cost unboundedly
+            return None, None, None
+        self._add_bounding_rows(null[:, fresh], self.bounding)
+        for _ in range(20):
+            if not self.rows.any():  # y >= 0 and no working column can lower the cost: alpha = 0
+                return np.zeros(n), np.zeros(k), np.zeros(n)
+            if not self._extend(null, q):  # HiGHS refuses entries beyond 1e15 (near-singular S)
                 return None, None, None
-            bounding *= 8
-            add_bounding_rows(bounding)
-            continue
-        alpha = -res.ineqlin.marginals if k else np.zeros(0)
-        f = y + null @ alpha
-        short = ~rows & (f < -tol * scale)
-        if not short.any():
-            mu, t = np.zeros(n), np.zeros(n)
-            mu[idx], t[idx] = res.x, -res.upper.marginals
-            return mu, alpha, t
-        # the rows next closest to losing their force tend to be short in the next round
-        rest = np.flatnonzero(~rows & ~short)
-        near = min(int(short.sum()) * NEAR_ROWS, rest.size)
-        rows |= short
-        if near:
-            rows[rest[np.argpartition(f[rest], near - 1)[:near]]] = True
-    return None, None, None
+            self.highs.run()
+            status = self.highs.getModelStatus()
+            if status == highspy.HighsModelStatus.kInfeasible:  # restricted primal unbounded:
+                lowering = null[:, q < 0]  # more bounding rows (all of them at the end)
+                if not lowering.size or self.bounding >= n:
+                    return None, None, None
+                self.bounding *= 8
+                self._add_bounding_rows(lowering, self.bounding)
+                continue
+            if status != highspy.HighsModelStatus.kOptimal:
+                return None, None, None
+            sol = self.highs.getSolution()
+            alpha = -np.asarray(sol.row_dual)
+            f = self.y + null @ alpha
+            short = ~self.rows & (f < -self.limit)
+            if not short.any():
+                mu, t = np.zeros(n), np.zeros(n)
+                mu[self.var_rows] = sol.col_value
+                t[self.var_rows] = np.maximum(-np.asarray(sol.col_dual), 0.0)  # duals of mu <= u
+                return mu, alpha, t
+            # the rows next closest to losing their force tend to be short in the next round
+            rest = np.flatnonzero(~self.rows & ~short)
+            near = min(int(short.sum()) * NEAR_ROWS, rest.size)
+            self.rows |= short
+            if near:
+                self.rows[rest[np.argpartition(f[rest], near - 1)[:near]]] = True
+        return None, None, None
+
+    def _add_bounding_rows(self, lowering: np.ndarray, count: int) -> None:
+        """The ``count`` most negative entries of each column of ``lowering`` join R."""
+        if lowering.size:
+            best = np.argpartition(lowering, min(count, self.n) - 1, axis=0)[:count]
+            self.rows[best[np.take_along_axis(lowering, best, axis=0) < 0]] = True
+
+    def _extend(self, null: np.ndarray, q: np.ndarray) -> bool:
+        """Add the rows of R that are not yet variables, then the new working columns; False if
+        HiGHS refuses them (it drops entries below 1e-9 with a warning, as linprog does)."""
+        error = highspy.HighsStatus.kError
+        new_rows = np.flatnonzero(self.rows)
+        new_rows = new_rows[~np.isin(new_rows, self.var_rows)]
+        if new_rows.size:
+            block = sp.csc_matrix(null[new_rows, : self.k].T)  # column r: entries over the K rows
+            if self.highs.addCols(new_rows.size, self.y[new_rows], np.zeros(new_rows.size),
+                                  self.upper[new_rows], *_compressed(block)) == error:
+                return False
+            self.var_rows = np.concatenate([self.var_rows, new_rows])
+        k = null.shape[1]
+        if k > self.k:
+            block = sp.csr_matrix(null[self.var_rows, self.k:].T)  # row j: entries over R
+            if self.highs.addRows(k - self.k, np.full(k - self.k, -highspy.kHighsInf), q[self.k:],
+                                  *_compressed(block)) == error:
+                return False
+            self.k = k
+        return True
+
+
+def _compressed(block: sp.csr_matrix | sp.csc_matrix) -> tuple:
+    """(nnz, starts, indices, values) of a compressed sparse matrix, as highspy takes them."""
+    return block.nnz, block.indptr.astype(np.int32), block.indices.astype(np.int32), block.data
 
 
 def _optimal_basis(basis, f_s, working, alpha, n) -> np.ndarray:
