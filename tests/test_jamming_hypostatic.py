@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from test_jamming_support import jammed_disks
 
 from hardpack.geometry.lattices import lattice_packing
@@ -151,3 +152,39 @@ def test_strain_continuation_stops_at_an_interior_strain(monkeypatch):
         assert mine.objective == pytest.approx(exact.objective, rel=1e-7)
         np.testing.assert_allclose(mine.displacement, exact.displacement, atol=1e-8)
     assert early == 4
+
+
+@pytest.mark.parametrize("strict", [False, True])
+def test_working_set_returns_a_regular_basis_of_active_columns(monkeypatch, strict):
+    """The basis a working-set LP hands to the next one (workingset._KLP.optimal_basis, read
+    off the simplex pivots of the K-LP) is a vertex basis of the optimum: its columns are
+    linearly independent (numerical rank = their number) and all of them are active at the
+    optimal motion (slack 0 to the LP tolerance, 1e-10 of the box). A choice by load alone
+    takes zero-load columns at a degenerate optimum, which need not be either."""
+    import hardpack.jamming.lp as lp
+    from hardpack.jamming import workingset
+
+    q, _ = _opened(jammed_disks(), 1e-3)
+    net = contact_network(q, 0.1)
+    moving = np.ones(q.n_particles, bool)
+    length = cell_length(q.lattice)
+    seen = []
+    solve = lp.solve_working_set
+
+    def spy(g, h, c, upper, **kw):
+        sol = solve(g, h, c, upper, **kw)
+        seen.append((workingset._Columns(sp.csc_matrix(g), np.asarray(h, float), np.asarray(upper, float)), sol))
+        return sol
+
+    monkeypatch.setattr(lp, "solve_working_set", spy)
+    warm = None
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        load = random_load(rng, moving, 2)
+        eps = random_strain_load(rng, 2, length) * 1e-3 if strict else None
+        warm = solve_motion(net, moving, load, strain_load=eps, box=0.05, cell_length=length, warm=warm).warm
+    assert len(seen) >= 3
+    for cols, sol in seen:
+        basis = cols.matrix(sol.basis).toarray()
+        assert np.linalg.matrix_rank(basis) == sol.basis.size
+        assert np.abs(cols.slacks(sol.x)[sol.basis]).max() <= 1e-10 * 0.05

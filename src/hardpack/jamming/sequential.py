@@ -25,9 +25,11 @@ delta D_min / 2 per LP, so a sequence can never displace anything by more than
 max_steps delta D_min / 2 and a small delta makes the test unable to fail (:func:`verify`
 refuses such settings; Donev uses delta = 0.1-1, L1729-L1738). The LPs of one test are solved
 by :mod:`hardpack.jamming.workingset`, each warm-started from the previous one's basis, except
-that each loading sequence of the strict test starts cold (:func:`solve_motion`'s strain
-continuation): the optimum of a strict LP shears the cell and closes hundreds of near contacts,
-and another load closes others.
+that each loading sequence of the strict test starts over with :func:`solve_motion`'s strain
+continuation (the optimum of a strict LP shears the cell and closes hundreds of near contacts,
+and another load closes others), whose first stage, a strain bound 1e-5 times the LP's, starts
+from that of the previous sequence: at such strains the LP is nearly the collective one, for
+which a basis of another load is a good start.
 
 The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated over one loading
 sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
@@ -158,6 +160,7 @@ def sequential_test(
     current = packing
     best = -1.0
     warm = None  # the LPs of one test share their variables: each warm-starts the next
+    small_strain = None  # strict: first continuation stage of the last cold LP (lp.solve_motion)
     # LP box = the step's trust region: no LP motion beyond delta r_min can be taken (list_step)
     box = min(box, delta * float(packing.radii.min()))
     for load_index in range(1, n_loads + 1):
@@ -175,8 +178,11 @@ def sequential_test(
                     net, moving, sign * base, fixed=rattlers, box=box,
                     cell_length=cell_length(current.lattice),
                     strain_load=None if base_eps is None else sign * base_eps, warm=warm,
+                    small_strain=small_strain,
                 )
                 warm = mot.warm
+                if mot.small_strain is not None:
+                    small_strain = mot.small_strain
                 out.n_lp_highs += mot.solver == "highs"
                 steps += 1
                 log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, load_index,

@@ -324,12 +324,7 @@ def solve_working_set(
     basis, extra = (np.zeros(0, dtype=np.int64),) * 2 if start is None else map(np.unique, start)
     keep = basis >= m
     keep[~keep] = norms[basis[~keep]] > 0
-    basis = basis[keep][:n]
-    fill = candidates[~np.isin(candidates, basis)]
-    basis = np.concatenate([basis, fill[: n - basis.size]]).astype(np.int64)
-    if basis.size < n:  # too few columns: pad with box columns, the repair fixes the rows
-        spare = np.setdiff1d(m + n + np.arange(n), basis)
-        basis = np.concatenate([basis, spare[: n - basis.size]])
+    basis = _completed(basis[keep][:n], candidates, n, m)
     # 2. working set: the start's, the next K0 smallest gaps, partners of box columns in S
     pending = np.concatenate([extra, candidates]).astype(np.int64)
     boxed = np.zeros(0, dtype=np.int64) if boxed is None else np.asarray(boxed, dtype=np.int64)
@@ -376,7 +371,7 @@ def solve_working_set(
             forces = np.zeros(m)
             forces[basis[basis < m]] = f_s[basis < m]
             forces[working[working < m]] = alpha[working < m]
-            optimal = _optimal_basis(basis, f_s, working, alpha, n)
+            optimal = k_lp.optimal_basis(basis, working)
             rest = np.setdiff1d(np.concatenate([basis, working]), optimal)
             return WorkingSetSolution(x, forces, float(c @ x), optimal, rest, rounds)
         worst = violated[np.argsort(slack[violated])[: max(50, k)]]
@@ -384,7 +379,7 @@ def solve_working_set(
             working = np.concatenate([working, worst])
             continue
         # rebase: the basis moves to the current optimum, the working set restarts
-        new_basis = _optimal_basis(basis, f_s, working, alpha, n)
+        new_basis = _completed(k_lp.optimal_basis(basis, working), candidates, n, m)
         old = np.setdiff1d(np.concatenate([basis, working]), new_basis)
         pending = np.concatenate([worst[: max_working // 4], old[np.argsort(slack[old])]])
         basis, factorise = new_basis, True
@@ -474,6 +469,26 @@ class _KLP:
                 self.rows[rest[np.argpartition(f[rest], near - 1)[:near]]] = True
         return None, None, None
 
+    def optimal_basis(self, basis: np.ndarray, working: np.ndarray) -> np.ndarray:
+        """The basis of the full LP at the last optimum, read off HiGHS's basis of the K-LP:
+        the columns of S whose mu is basic or at its upper bound (their force reached zero, or
+        turned into a tension that box columns carry) leave, the working columns whose
+        constraint is active (alpha basic) enter. These are the simplex pivots, so the basis is
+        regular, where the n columns of largest load can be dependent at a degenerate optimum
+        (ties at zero load): at N = 1e4 in 3D such a basis cost a repair cycle of three extra
+        factorisations. With tensions fewer columns enter than leave; the next LP's start
+        completes the basis (solve_working_set)."""
+        if self.var_rows.size == 0:  # no K-LP solved: alpha = 0, the basis stays
+            return basis
+        status = self.highs.getBasis()
+        moved = (highspy.HighsBasisStatus.kBasic, highspy.HighsBasisStatus.kUpper)
+        leave = np.fromiter((st in moved for st in status.col_status), dtype=bool, count=self.var_rows.size)
+        enter = np.fromiter((st != highspy.HighsBasisStatus.kBasic for st in status.row_status),
+                            dtype=bool, count=self.k)
+        keep = np.ones(basis.size, dtype=bool)
+        keep[self.var_rows[leave]] = False
+        return np.concatenate([basis[keep], working[: self.k][enter]])
+
     def _add_bounding_rows(self, lowering: np.ndarray, count: int) -> None:
         """The ``count`` most negative entries of each column of ``lowering`` join R."""
         if lowering.size:
@@ -502,16 +517,20 @@ class _KLP:
         return True
 
 
+def _completed(basis: np.ndarray, candidates: np.ndarray, n: int, m: int) -> np.ndarray:
+    """``basis`` completed to n columns with the ``candidates`` (smallest gaps first) it lacks,
+    then box columns (the repair of the factorisation fixes any dependent ones)."""
+    fill = candidates[~np.isin(candidates, basis)]
+    basis = np.concatenate([basis, fill[: n - basis.size]]).astype(np.int64)
+    if basis.size < n:
+        spare = np.setdiff1d(m + n + np.arange(n), basis)
+        basis = np.concatenate([basis, spare[: n - basis.size]])
+    return basis
+
+
 def _compressed(block: sp.csr_matrix | sp.csc_matrix) -> tuple:
     """(nnz, starts, indices, values) of a compressed sparse matrix, as highspy takes them."""
     return block.nnz, block.indptr.astype(np.int32), block.indices.astype(np.int32), block.data
-
-
-def _optimal_basis(basis, f_s, working, alpha, n) -> np.ndarray:
-    """The n columns carrying the largest loads: S columns by f_S, W columns by alpha."""
-    idx = np.concatenate([basis, working])
-    load = np.concatenate([f_s, alpha])
-    return idx[np.argsort(-load, kind="stable")[:n]]
 
 
 __all__ = ["WarmStart", "WorkingSetSolution", "solve_working_set"]
