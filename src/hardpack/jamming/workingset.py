@@ -25,8 +25,9 @@ derivation, the revised-simplex decomposition with column generation):
 2. Working set W: K more columns (the columns the repair took out, the partners of box columns
    in S, the next 20 smallest gaps or the previous LP's working set, and later every violated
    column). With y = -A_S^{-1} c and N = -A_S^{-1} A_W, every dual solution on S + W is
-   f_S = y + N alpha, f_W = alpha: an LP in K variables (the K-LP), solved by HiGHS in its
-   dual form (K rows) over only the rows of S whose force can reach zero (row generation). The
+   f_S = y + N alpha, f_W = alpha: an LP in K variables (the K-LP, :class:`_KLP`), solved by
+   HiGHS in its dual form (K rows) over only the rows of S whose force can reach zero (row
+   generation), in one highspy model per basis that each round extends and re-solves. The
    columns of S may also carry tension t >= 0 at the price p_s = sum_k |a_sk| u_k: that is the
    cost of the same load carried by box columns, so it keeps the restricted LP feasible without
    changing the optimum of the full LP.
@@ -36,7 +37,9 @@ derivation, the revised-simplex decomposition with column generation):
    W would grow beyond ``max_working``, S moves to the current optimum and is factorised
    anew); when none is violated, x is feasible for the full LP and f (with the tensions
    expanded into box columns) is a dual solution of equal value: x is optimal to the
-   tolerances of HiGHS (1e-10) and of the pricing (1e-10 of the box).
+   tolerances of HiGHS (1e-10) and of the pricing (1e-10 of the box). The optimal basis, for
+   the next LP's warm start, applies the simplex pivots of the K-LP to S
+   (:meth:`_KLP.optimal_basis`).
 
 Returns None (the caller then uses HiGHS on the full LP) when the basis cannot be repaired or
 the LP does not converge within ``max_rounds`` rounds -- in practice LPs far from the contact
