@@ -158,7 +158,7 @@ def _strain_continuation(g, h, c, upper, n_pos, start=None, factor: float = 10.0
     previous loading sequence of a strict test. The smallest gaps start it otherwise, a poor
     basis once a strict step has sheared the cell: the motion of the previous load left the
     contacts that resisted it closest, and they carry negative loads under the next one (51 %
-    of the basis at N = 1e4 in 3D; that LP took > 6 min cold, 82 s from such a start).
+    of the basis at N = 1e4 in 3D; that LP took > 6 min cold, 170 s from such a start).
 
     A stage whose optimal strain lies strictly inside its bound ends the continuation: the
     stages differ only in the strain bound, so that optimum satisfies the optimality (KKT)
