@@ -143,8 +143,8 @@ def solve_motion(
         eps -= np.trace(eps) / d * np.eye(d)  # make it exact so that det(I + t eps) <= 1 for small t
     forces = np.zeros(net.n_contacts)
     forces[use] = f[: int(use.sum())]
-    first = None if first is None else WarmStart.of(first, keys)
-    return Motion(disp, eps, forces, objective, time.perf_counter() - t0, warm, solver, first)
+    return Motion(disp, eps, forces, objective, time.perf_counter() - t0, warm, solver,
+                  None if first is None else WarmStart.of(first, keys))
 
 
 def _strain_continuation(g, h, c, upper, n_pos, start=None, factor: float = 10.0, stages: int = 5):
