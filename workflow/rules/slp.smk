@@ -163,7 +163,7 @@ rule slp_system:
     threads: 1
     resources:
         mem_mb=2000,
-        runtime=180,  # minutes; 3D N = 2000 had taken 45 CPU-min and not yet converged
+        runtime=180,  # minutes; 3D N = 2000 (not in the default study) had taken 3 h and not converged
     log:
         "results/logs/slp_system/{system}_seed{seed}.log",
     shell:
