@@ -163,7 +163,7 @@ rule slp_system:
     threads: 1
     resources:
         mem_mb=2000,
-        runtime=180,  # minutes; 3D N = 2000 (not in the default study) had taken 3 h and not converged
+        runtime=180,  # minutes; 3D N = 2000 (not in the default study): 1.3 CPU-h for 520 LPs, not converged
     log:
         "results/logs/slp_system/{system}_seed{seed}.log",
     shell:
