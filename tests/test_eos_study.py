@@ -197,6 +197,53 @@ def test_cli_jam_and_summary(tmp_path):
         args.func(args)
 
 
+def test_cli_jam_resumes_a_killed_compression(tmp_path, monkeypatch, caplog):
+    """eos-jam --checkpoint: a run killed after its checkpoint was written (an exception from the
+    progress callback, as in the engine's own resume test) resumes there when started again and ends
+    identical to an uninterrupted run; the checkpoint is removed at the end. It holds one system."""
+    import hardpack.md as md
+
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers())
+    ckpt = tmp_path / "tri.ckpt"
+
+    def run(out, *extra):
+        args = parser.parse_args(["eos-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}',
+                                  "--systems", "tri", "--seed", "3", "--n", "60", "--final-growth-rate", "0.02",
+                                  "--out", str(tmp_path / out), *extra])
+        return args.func(args)
+
+    run("reference.nc")
+    windows = int(load_dataset(tmp_path / "reference.nc", kind="packing").attrs["windows"])
+    assert windows > 2 * 16  # checkpoints are written every 16 windows (hardpack.md.simulation.SORT_EVERY)
+    real = md.compress
+
+    def killed(*args, **kwargs):
+        seen = []
+
+        def kill(record):
+            if len(seen) >= windows - 5:
+                raise KeyboardInterrupt
+            seen.append(record)
+        return real(*args, **{**kwargs, "checkpoint_interval": 0.0, "progress": kill})
+
+    monkeypatch.setattr(md, "compress", killed)
+    with pytest.raises(KeyboardInterrupt):
+        run("resumed.nc", "--checkpoint", str(ckpt))
+    assert ckpt.exists()
+    monkeypatch.setattr(md, "compress", real)
+    with caplog.at_level("INFO", logger="hardpack.md"):
+        assert run("resumed.nc", "--checkpoint", str(ckpt)) == 0
+    assert "resumed from" in caplog.text
+    assert not ckpt.exists()
+    reference, resumed = (load_dataset(tmp_path / f, kind="packing") for f in ("reference.nc", "resumed.nc"))
+    np.testing.assert_array_equal(resumed["position"].values, reference["position"].values)
+    with pytest.raises(InvalidInputError, match="one system"):
+        args = parser.parse_args(["eos-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}', "--seed",
+                                  "1", "--systems", "poly", "tri", "--out", "a.nc", "b.nc", "--checkpoint", str(ckpt)])
+        args.func(args)
+
+
 def test_uniform_size_equivalent_is_gauss_legendre():
     """Sanity link to the closed forms (note sec. 2.4): TUS radii <a>(1 +- omega0 sqrt(3/5)), 5:8:5."""
     tri = study.system_distribution({"kind": "uniform_size", "omega": 3}, "tri")

@@ -1,6 +1,7 @@
 # Study 3 (issue 6): EOS and jamming density of polydisperse spheres vs their moment-matched bi- and
-# tridisperse equivalents (Ogarko ch. 3). One job per (family, width, seed) jams the polydisperse
-# system and both equivalents with the same protocol and N; one job per (family, width) measures the
+# tridisperse equivalents (Ogarko ch. 3). One job per (family, width, seed, system) jams the
+# polydisperse system or one of its equivalents, all with the same protocol and N (a checkpoint lets a
+# killed job resume: the slow runs take up to ~20 CPU min each); one job per (family, width) measures the
 # fluid Z(phi) of the three against BMCSL. The same jobs with a slow final stage ("crystallisation")
 # look for the large-species crystallisation of the bidisperse equivalents (Ogarko L4851-4865).
 # Summaries, figures and validation rows follow.
@@ -38,12 +39,12 @@ def poly_jam_mem_mb(wildcards):
 
 
 def poly_jam_runtime(wildcards):
-    """Minutes for the three systems. Measured: 3-11 CPU s per system at N = 500 (US omega = 2 and 10,
-    final Gamma = 0.002), 6-7 CPU min at final Gamma = 2e-5 and 13-18 at 1e-5; the collisions grow as
-    N / Gamma, and the budget is ~20x the measured time at Gamma = 0.002, for loaded machines and wide
-    UV distributions."""
+    """Minutes for one system. Measured: 3-11 CPU s at N = 500 (US omega = 2 and 10, final Gamma =
+    0.002), 6-7 CPU min at final Gamma = 2e-5 and 13-18 at 1e-5; the collisions grow as N / Gamma, and
+    the budget is ~20x the measured time at Gamma = 0.002, for loaded machines and wide UV
+    distributions."""
     runs = POLY_PROTOCOLS[wildcards.protocol]
-    return 10 + int(3 * runs["N"] // 100 * max(1.0, 0.002 / runs["final_growth_rate"]))
+    return 10 + int(runs["N"] // 100 * max(1.0, 0.002 / runs["final_growth_rate"]))
 
 
 def poly_fluid_runtime(wildcards):
@@ -53,11 +54,11 @@ def poly_fluid_runtime(wildcards):
 
 
 rule poly_jam:
-    """Two-stage LS compression of the polydisperse system and its bi- and tridisperse equivalents."""
+    """Two-stage LS compression of the polydisperse system or one of its bi- and tridisperse equivalents."""
     output:
-        expand("results/polydisperse/{{protocol}}/{{family}}/w{{width}}/seed{{seed}}_{system}.nc",
-               system=POLY_SYSTEMS),
+        "results/polydisperse/{protocol}/{family}/w{width}/seed{seed}_{system}.nc",
     params:
+        checkpoint="results/polydisperse/{protocol}/{family}/w{width}/seed{seed}_{system}.ckpt",
         spec=lambda w: _poly_spec(w.family, w.width),
         n=lambda w: POLY_PROTOCOLS[w.protocol]["N"],
         init_phi=lambda w: POLY_PROTOCOLS[w.protocol]["init_phi"],
@@ -69,17 +70,18 @@ rule poly_jam:
         protocol="|".join(POLY_PROTOCOLS),
         family=POLY_FAMILY,
         width=POLY_WIDTH,
+        system="|".join(POLY_SYSTEMS),
     threads: 1
     resources:
         mem_mb=poly_jam_mem_mb,
         runtime=poly_jam_runtime,
     log:
-        "results/logs/poly_jam/{protocol}/{family}_w{width}_seed{seed}.log",
+        "results/logs/poly_jam/{protocol}/{family}_w{width}_seed{seed}_{system}.log",
     shell:
-        "hardpack eos-jam --distribution '{params.spec}' --systems poly bi tri --seed {wildcards.seed}"
+        "hardpack eos-jam --distribution '{params.spec}' --systems {wildcards.system} --seed {wildcards.seed}"
         " --n {params.n} --init-phi {params.init_phi} --growth-rate {params.growth_rate}"
         " --switch-pressure {params.switch_pressure} --final-growth-rate {params.final_growth_rate}"
-        " --max-pressure {params.max_pressure} --out {output} 2> {log}"
+        " --max-pressure {params.max_pressure} --out {output} --checkpoint {params.checkpoint} 2> {log}"
 
 
 #: summary file prefix -> (protocol folder of the runs, `hardpack eos-summary --kind`)

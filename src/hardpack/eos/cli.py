@@ -94,9 +94,12 @@ def _json_spec(text: str) -> dict:
     return spec
 
 
-def _check_outputs(systems, outputs):
+def _check_outputs(systems, outputs, checkpoint=None):
     if len(systems) != len(outputs):
         raise InvalidInputError(f"give one --out per --systems entry ({len(systems)} systems, {len(outputs)} outputs)")
+    if checkpoint is not None and len(systems) != 1:
+        raise InvalidInputError(f"--checkpoint holds one compression: give one system, not {len(systems)} "
+                                "(run the others as separate commands, each with its own checkpoint)")
 
 
 def cmd_jam(args) -> int:
@@ -104,12 +107,12 @@ def cmd_jam(args) -> int:
     from hardpack.eos.study import JamProtocol, jam
 
     spec = _json_spec(args.distribution)
-    _check_outputs(args.systems, args.out)
+    _check_outputs(args.systems, args.out, args.checkpoint)
     protocol = JamProtocol(n=args.n, init_phi=args.init_phi, growth_rate=args.growth_rate,
                            switch_pressure=args.switch_pressure, final_growth_rate=args.final_growth_rate,
                            max_pressure=args.max_pressure)
     for system, out in zip(args.systems, args.out):
-        result = jam(spec, system, args.seed, protocol)
+        result = jam(spec, system, args.seed, protocol, checkpoint=args.checkpoint)
         result.save(out, config={"distribution": spec, "system": system, "seed": args.seed,
                                  **{k: getattr(protocol, k) for k in protocol.__dataclass_fields__}})
         s = result.stats
@@ -164,6 +167,8 @@ def register(subparsers) -> None:
     p.add_argument("--final-growth-rate", type=float, default=0.002, help="Gamma of the final stage (default 0.002)")
     p.add_argument("--max-pressure", type=float, default=1e12, help="final Z (default 1e12)")
     p.add_argument("--out", nargs="+", required=True, help="one packing netCDF per system")
+    p.add_argument("--checkpoint", help="checkpoint file of the compression (one system only): written "
+                   "every 5 min, resumed if present, removed at the end")
     p.set_defaults(func=cmd_jam)
 
     p = subparsers.add_parser("eos-fluid", help=cmd_fluid.__doc__)
