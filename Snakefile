@@ -30,6 +30,13 @@ report: "workflow/report/workflow.rst"
 FIGURES = []
 VALIDATION_INPUTS = {}
 
+
+def checkpoint_beside(wildcards, output):
+    """params function: the checkpoint of a resumable job, beside its first output (.nc -> .ckpt);
+    a killed job started again resumes from it, and the job removes it when it succeeds."""
+    return output[0].removesuffix(".nc") + ".ckpt"
+
+
 wildcard_constraints:
     ensemble="[A-Za-z][A-Za-z0-9_]*",
     seed=r"\d+",

@@ -69,3 +69,49 @@ def test_all_rattlers_is_not_jammed():
 
 def out_loads(r) -> int:
     return r.params["n_loads"]
+
+
+def test_killed_verification_resumes_from_its_checkpoint(tmp_path, monkeypatch, caplog):
+    """A verification killed after the collective test and two strict loading sequences (an
+    exception raised once the 8th checkpoint is written) resumes from the checkpoint: it solves
+    only the LPs of the remaining strict sequences and ends with the outcome of an uninterrupted
+    run, sequence by sequence (the random loads and the moved packing are restored); the
+    checkpoint is removed at the end. The ideal method refuses a checkpoint."""
+    from hardpack.errors import InvalidInputError
+    from hardpack.io import checkpoint as ckpt
+    from hardpack.jamming import sequential
+
+    p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-4)
+    kwargs = {"delta": 0.2, "method": "sequential", "seed": 2, "threshold": 1e-2, "contact_delta": 1e-3}
+    reference = verify(p, **kwargs)
+    assert len(reference.collective_test.steps) == len(reference.strict_test.steps) == 6
+    path = tmp_path / "verify.ckpt"
+    real_save, saves = ckpt.save, []
+
+    def killed(*args):
+        real_save(*args)
+        saves.append(1)
+        if len(saves) == 8:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(ckpt, "save", killed)
+    with pytest.raises(KeyboardInterrupt):
+        verify(p, checkpoint=path, **kwargs)
+    assert path.exists()
+    monkeypatch.setattr(ckpt, "save", real_save)
+    real_solve, lps = sequential.solve_motion, []
+    monkeypatch.setattr(sequential, "solve_motion", lambda *a, **k: lps.append(1) or real_solve(*a, **k))
+    with caplog.at_level("INFO", logger="hardpack.jamming"):
+        resumed = verify(p, checkpoint=path, **kwargs)
+    assert "resuming the sequential tests" in caplog.text
+    assert not path.exists()
+    assert len(lps) == sum(reference.strict_test.steps[2:])
+    for test in ("collective_test", "strict_test"):
+        ref, res = getattr(reference, test), getattr(resumed, test)
+        assert res.mean_displacement == ref.mean_displacement and res.steps == ref.steps
+        assert res.n_lp == ref.n_lp and res.jammed == ref.jammed
+        np.testing.assert_array_equal(res.displacement, ref.displacement)
+        np.testing.assert_array_equal(res.final.positions, ref.final.positions)
+    np.testing.assert_array_equal(resumed.strict_test.strain, reference.strict_test.strain)
+    with pytest.raises(InvalidInputError, match="sequential method"):
+        verify(p, delta=1e-6, checkpoint=path)

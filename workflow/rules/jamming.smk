@@ -23,10 +23,13 @@ rule verify_jamming:
     resources:
         mem_mb=lp_mem_mb,
         runtime=lp_runtime,
+    params:
+        checkpoint=checkpoint_beside,
     log:
         "results/logs/verify_jamming/{ensemble}_seed{seed}.log",
     shell:
-        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential > {log} 2>&1"
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential"
+        " --checkpoint {params.checkpoint} > {log} 2>&1"
 
 
 rule verify_jamming_slp:
@@ -43,10 +46,13 @@ rule verify_jamming_slp:
     resources:
         mem_mb=lp_mem_mb,
         runtime=lp_runtime,
+    params:
+        checkpoint=checkpoint_beside,
     log:
         "results/logs/verify_jamming_slp/{ensemble}_seed{seed}.log",
     shell:
-        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential > {log} 2>&1"
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential"
+        " --checkpoint {params.checkpoint} > {log} 2>&1"
 
 
 rule jamming_summary:

@@ -58,7 +58,7 @@ rule poly_jam:
     output:
         "results/polydisperse/{protocol}/{family}/w{width}/seed{seed}_{system}.nc",
     params:
-        checkpoint=lambda w, output: output[0].removesuffix(".nc") + ".ckpt",  # beside the packing
+        checkpoint=checkpoint_beside,
         spec=lambda w: _poly_spec(w.family, w.width),
         n=lambda w: POLY_PROTOCOLS[w.protocol]["N"],
         init_phi=lambda w: POLY_PROTOCOLS[w.protocol]["init_phi"],

@@ -42,6 +42,10 @@ def register(subparsers) -> None:
                    help="displacement counted as unjamming (default delta x mean diameter)")
     p.add_argument("--threshold", type=float, default=1e-3,
                    help="sequential method: mean displacement / D above which 'not jammed'")
+    p.add_argument("--checkpoint", default=None,
+                   help="sequential method: checkpoint file written after every loading sequence; "
+                        "a killed run started again with the same arguments resumes from it "
+                        "(removed at the end)")
     p.set_defaults(func=run)
 
 
@@ -57,7 +61,7 @@ def run(args) -> int:
         result = verify(
             packing, delta=args.delta, tests=tuple(args.tests), seed=args.seed,
             method=args.method, dr_large=args.dr_large, threshold=args.threshold,
-            md_pressure=pressure,
+            md_pressure=pressure, checkpoint=args.checkpoint,
         )
     except InvalidInputError as exc:
         print(f"hardpack verify: error: {exc}", file=sys.stderr)

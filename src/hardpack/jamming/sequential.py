@@ -46,8 +46,10 @@ current distance and D_ij, which never lets overlaps grow beyond the packing tol
 
 from __future__ import annotations
 
+import json
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -57,6 +59,7 @@ from hardpack.geometry.packing import Packing
 from hardpack.jamming.contacts import ContactNetwork, contact_network
 from hardpack.jamming.ideal import cell_length
 from hardpack.jamming.lp import random_load, random_strain_load, solve_motion
+from hardpack.jamming.workingset import WarmStart
 
 log = logging.getLogger(__name__)
 
@@ -149,8 +152,16 @@ def sequential_test(
     beta: float = 0.01,
     n_loads: int = 3,
     max_steps: int = 3,
+    resume: dict | None = None,
+    save: Callable[[dict], None] | None = None,
 ) -> SequentialOutcome:
-    """Algorithm 14 from ``packing`` (see the module docstring)."""
+    """Algorithm 14 from ``packing`` (see the module docstring).
+
+    Resumable: after each loading sequence, ``save`` (if given) receives the test's state, a
+    dict of arrays and scalars; passing such a dict back as ``resume`` (same packing, rng seed and
+    parameters) continues after that sequence -- with the packing, the random generator and the
+    LP warm starts as they were, so the outcome is that of an uninterrupted test.
+    """
     t0 = time.perf_counter()
     n, d = packing.n_particles, packing.dim
     diameter = 2.0 * packing.radii.mean()
@@ -161,72 +172,115 @@ def sequential_test(
     best = -1.0
     warm = None  # the LPs of one test share their variables: each warm-starts the next
     small_strain = None  # strict: first continuation stage of the last cold LP (lp.solve_motion)
+    base = base_eps = None
+    first, earlier = 0, 0.0  # the first loading sequence to run, seconds spent before a resume
+    if resume is not None:
+        current, base, base_eps, warm, small_strain, best, first, earlier = _restore(resume, out, packing, rng)
     # LP box = the step's trust region: no LP motion beyond delta r_min can be taken (list_step)
     box = min(box, delta * float(packing.radii.min()))
-    for load_index in range(1, n_loads + 1):
-        base = random_load(rng, moving, d)
-        base_eps = random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None
-        for sign in (1.0, -1.0):
-            if strict:  # a new load shears the cell the other way: the previous optimum closed
-                warm = None  # near contacts the new one does not (N = 1e4: > 7 min warm, 100 s cold)
-            total = np.zeros((n, d))
-            strain_total = np.zeros((d, d))
-            steps = 0
-            for _step in range(max_steps):
-                net = contact_network(current, delta)
-                mot = solve_motion(
-                    net, moving, sign * base, fixed=rattlers, box=box,
-                    cell_length=cell_length(current.lattice),
-                    strain_load=None if base_eps is None else sign * base_eps, warm=warm,
-                    small_strain=small_strain,
-                )
-                warm = mot.warm
-                if mot.small_strain is not None:
-                    small_strain = mot.small_strain
-                out.n_lp_highs += mot.solver == "highs"
-                steps += 1
-                log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, load_index,
-                         "+" if sign > 0 else "-", steps, mot.solver, mot.seconds)
-                tau = min(
-                    collision_step(net, mot.displacement, mot.strain),
-                    list_step(net, current.radii, mot.displacement, mot.strain),
-                    volume_step(mot.strain),
-                )
-                if not np.isfinite(tau) or tau <= 0:
-                    break
-                current, tau = _advance(current, net, mot.displacement, mot.strain, tau)
-                step = tau * mot.displacement
-                total += step
-                if strict:
-                    strain_total += tau * mot.strain
-                if _mean_size(total, moving, diameter) >= threshold:
-                    break  # step 10: unjammed beyond the threshold, the verdict is settled
-                if np.linalg.norm(step[moving], axis=1).max(initial=0.0) <= beta * diameter:
-                    break
-            out.n_lp += steps
-            rel = total - np.median(total[moving], axis=0) if moving.any() else total
-            size = np.linalg.norm(rel, axis=1) / diameter
-            size[rattlers] = 0.0
-            mean = float(size[moving].mean()) if moving.any() else 0.0
-            out.mean_displacement.append(mean)
-            out.max_displacement.append(float(size.max(initial=0.0)))
-            out.steps.append(steps)
-            out.strain_norm.append(float(np.linalg.norm(strain_total, 2)))
-            out.displacement = np.maximum(out.displacement, size)
-            log.info("%s test: loading sequence %d moved the particles by %.3g D on average "
-                     "(threshold %.3g D)", out.test, len(out.steps), mean, threshold)
-            if mean > best:
-                best, out.motion = mean, rel
-                out.strain = strain_total if strict else None
-            if mean >= threshold:
-                break
+    for sequence in range(first, 2 * n_loads):
         if best >= threshold:
-            break
+            break  # step 10: the verdict is settled
+        load_index, sign = sequence // 2 + 1, 1.0 if sequence % 2 == 0 else -1.0
+        if sign > 0:
+            base = random_load(rng, moving, d)
+            base_eps = random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None
+        if strict:  # a new load shears the cell the other way: the previous optimum closed
+            warm = None  # near contacts the new one does not (N = 1e4: > 7 min warm, 100 s cold)
+        total = np.zeros((n, d))
+        strain_total = np.zeros((d, d))
+        steps = 0
+        for _step in range(max_steps):
+            net = contact_network(current, delta)
+            mot = solve_motion(
+                net, moving, sign * base, fixed=rattlers, box=box,
+                cell_length=cell_length(current.lattice),
+                strain_load=None if base_eps is None else sign * base_eps, warm=warm,
+                small_strain=small_strain,
+            )
+            warm = mot.warm
+            if mot.small_strain is not None:
+                small_strain = mot.small_strain
+            out.n_lp_highs += mot.solver == "highs"
+            steps += 1
+            log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, load_index,
+                     "+" if sign > 0 else "-", steps, mot.solver, mot.seconds)
+            tau = min(
+                collision_step(net, mot.displacement, mot.strain),
+                list_step(net, current.radii, mot.displacement, mot.strain),
+                volume_step(mot.strain),
+            )
+            if not np.isfinite(tau) or tau <= 0:
+                break
+            current, tau = _advance(current, net, mot.displacement, mot.strain, tau)
+            step = tau * mot.displacement
+            total += step
+            if strict:
+                strain_total += tau * mot.strain
+            if _mean_size(total, moving, diameter) >= threshold:
+                break  # step 10: unjammed beyond the threshold, the verdict is settled
+            if np.linalg.norm(step[moving], axis=1).max(initial=0.0) <= beta * diameter:
+                break
+        out.n_lp += steps
+        rel = total - np.median(total[moving], axis=0) if moving.any() else total
+        size = np.linalg.norm(rel, axis=1) / diameter
+        size[rattlers] = 0.0
+        mean = float(size[moving].mean()) if moving.any() else 0.0
+        out.mean_displacement.append(mean)
+        out.max_displacement.append(float(size.max(initial=0.0)))
+        out.steps.append(steps)
+        out.strain_norm.append(float(np.linalg.norm(strain_total, 2)))
+        out.displacement = np.maximum(out.displacement, size)
+        log.info("%s test: loading sequence %d moved the particles by %.3g D on average "
+                 "(threshold %.3g D)", out.test, len(out.steps), mean, threshold)
+        if mean > best:
+            best, out.motion = mean, rel
+            out.strain = strain_total if strict else None
+        if save is not None:
+            save(_state(out, current, base, base_eps, warm, small_strain, best, sequence + 1, rng,
+                        earlier + time.perf_counter() - t0))
     # no particle left to load: every one is a rattler, nothing is jammed (Alg. 13 step 3)
     out.jammed = bool(moving.any() and max(out.mean_displacement, default=0.0) < threshold)
     out.final = current
-    out.seconds = time.perf_counter() - t0
+    out.seconds = earlier + time.perf_counter() - t0
     return out
+
+
+def _state(out: SequentialOutcome, current: Packing, base, base_eps, warm, small_strain, best: float,
+           next_sequence: int, rng: np.random.Generator, seconds: float) -> dict:
+    """The state of a test after a loading sequence, as arrays and scalars (see sequential_test)."""
+    state = {
+        "next_sequence": next_sequence, "best": best, "seconds": seconds,
+        "rng": json.dumps(rng.bit_generator.state),
+        "positions": current.positions, "lattice": current.lattice, "load": base,
+        "mean_displacement": np.asarray(out.mean_displacement), "strain_norm": np.asarray(out.strain_norm),
+        "max_displacement": np.asarray(out.max_displacement), "steps": np.asarray(out.steps),
+        "displacement": out.displacement, "motion": out.motion,
+        "n_lp": out.n_lp, "n_lp_highs": out.n_lp_highs,
+    }
+    if base_eps is not None:
+        state["strain_load"] = base_eps
+    if out.strain is not None:
+        state["strain"] = out.strain
+    for name, start in (("warm", warm), ("small_strain", small_strain)):
+        if start is not None:
+            state.update({f"{name}_{k}": v for k, v in start.arrays().items()})
+    return state
+
+
+def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.random.Generator):
+    """Load a :func:`_state` into ``out`` and ``rng``; returns the loop variables."""
+    rng.bit_generator.state = json.loads(state["rng"])
+    out.mean_displacement = [float(v) for v in state["mean_displacement"]]
+    out.strain_norm = [float(v) for v in state["strain_norm"]]
+    out.max_displacement = [float(v) for v in state["max_displacement"]]
+    out.steps = [int(v) for v in state["steps"]]
+    out.displacement, out.motion, out.strain = state["displacement"], state["motion"], state.get("strain")
+    out.n_lp, out.n_lp_highs = int(state["n_lp"]), int(state["n_lp_highs"])
+    current = packing.replace(positions=state["positions"], lattice=state["lattice"])
+    warm, small_strain = (WarmStart.from_arrays(state, f"{name}_") for name in ("warm", "small_strain"))
+    return (current, state["load"], state.get("strain_load"), warm, small_strain, float(state["best"]),
+            int(state["next_sequence"]), float(state["seconds"]))
 
 
 def _mean_size(total: np.ndarray, moving: np.ndarray, diameter: float) -> float:

@@ -26,6 +26,7 @@ from dataclasses import replace
 import numpy as np
 
 from hardpack.errors import InvalidInputError
+from hardpack.io import checkpoint as ckpt
 from hardpack.geometry.packing import Packing
 from hardpack.jamming.contacts import check_delta, contact_network
 from hardpack.jamming.forces import jamming_point_forces, self_stress, statics
@@ -68,6 +69,32 @@ def _check_tests(tests) -> tuple[str, ...]:
     return tests
 
 
+class _Saved:
+    """The checkpoint of the sequential tests: one file with the state of each test after its
+    last loading sequence, keys prefixed by the test's name. A finished test's state stays in it,
+    so that a resumed verification takes that test's outcome and random generator from it."""
+
+    def __init__(self, path, fingerprint: str):
+        self.path, self.fingerprint = path, fingerprint
+        self.state = {} if path is None else ckpt.load(path, fingerprint) or {}
+        if self.state:
+            log.info("resuming the sequential tests from %s", path)
+
+    def hooks(self, test: str) -> dict:
+        """``resume`` and ``save`` arguments of :func:`sequential_test` for ``test``."""
+        if self.path is None:
+            return {}
+        prefix = f"{test}__"
+        mine = {k.removeprefix(prefix): v for k, v in self.state.items() if k.startswith(prefix)}
+
+        def save(state: dict) -> None:
+            self.state = {k: v for k, v in self.state.items() if not k.startswith(prefix)}
+            self.state.update({prefix + k: v for k, v in state.items()})
+            ckpt.save(self.path, self.fingerprint, self.state)
+
+        return {"resume": mine or None, "save": save}
+
+
 def verify(
     packing: Packing,
     delta: float | None = None,
@@ -84,6 +111,7 @@ def verify(
     md_pressure: float | None = None,
     contact_delta: float | None = None,
     force_delta: float | None = None,
+    checkpoint=None,
 ) -> JammingResult:
     """Classify ``packing`` as locally / collectively / strictly jammed (see the module docstring).
 
@@ -113,6 +141,10 @@ def verify(
         the contacts within this tolerance (default SEQUENTIAL_DELTA, the first shell; see
         :func:`hardpack.jamming.forces.jamming_point_forces`). The result's network then also
         holds the near contacts that carry force; Z and the isostaticity counts leave them out.
+    checkpoint : sequential method only: path of a checkpoint written after every loading
+        sequence (:mod:`hardpack.io.checkpoint`); a killed verification started again with the
+        same arguments resumes from it and gives the result of an uninterrupted one. It is
+        removed when the verification ends.
     """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
@@ -148,6 +180,9 @@ def verify(
             f"neighbour-list tolerance delta >= {threshold * diameter / (max_steps * packing.radii.min()):.3g} "
             f"(Donev: 0.1-1, the default is {SEQUENTIAL_DELTA:g})"
         )
+    if checkpoint is not None and not sequential:
+        raise InvalidInputError("a checkpoint is for the sequential method, whose loading sequences "
+                                "it saves; the ideal method runs without one")
     if dr_large >= box:
         raise InvalidInputError(
             f"dr_large = {dr_large:g} must be smaller than the LP box {box:g}, otherwise no "
@@ -188,11 +223,15 @@ def verify(
     else:
         kwargs = {"rattlers": ~local_active, "threshold": threshold, "beta": beta,
                   "n_loads": n_loads, "max_steps": max_steps, **common}
+        saved = _Saved(checkpoint, ckpt.fingerprint(
+            packing, run="verify", delta=delta, seed=int(seed), tests=list(tests), dr_large=dr_large,
+            box=box, threshold=threshold, n_loads=n_loads, max_steps=max_steps, beta=beta,
+            contact_delta=contact_delta))
         if "collective" in tests:
-            collective = sequential_test(packing, delta, strict=False, **kwargs)
+            collective = sequential_test(packing, delta, strict=False, **kwargs, **saved.hooks("collective"))
             seconds["collective"] = collective.seconds
         if "strict" in tests:
-            strict = sequential_test(packing, delta, strict=True, **kwargs)
+            strict = sequential_test(packing, delta, strict=True, **kwargs, **saved.hooks("strict"))
             seconds["strict"] = strict.seconds
         backbone = local_active
 
@@ -216,6 +255,8 @@ def verify(
     stat = statics(net, backbone, forces, packing.volume, counted)
     seconds["forces"] = time.perf_counter() - t0
 
+    if checkpoint is not None:
+        ckpt.remove(checkpoint)
     params = {
         "method": method, "delta": delta, "dr_large": dr_large, "box": box, "seed": int(seed),
         "tests": list(tests), "mean_diameter": diameter,
