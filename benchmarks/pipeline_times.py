@@ -4,8 +4,9 @@ Snakemake keeps, for every output file, the start and end time of the job that w
 (`.snakemake/metadata/`, one JSON file per output, named by the output path in URL-safe
 base64). This sums them per rule over the outputs that still exist, counting a job with
 several outputs once. The sum of job times divided by the cores is the wall time an ideally
-packed run on those cores would take; a run resumed in segments (`--rerun-incomplete` after an
-interruption) spends more, since an interrupted job restarts from its last checkpoint.
+packed run on those cores would take. A job that was interrupted and started again (a run resumed
+in segments with `--rerun-incomplete`) counts with its last attempt only: the work of the earlier
+attempts up to their last checkpoint is not in the sum, and the work after it was lost.
 
     python benchmarks/pipeline_times.py [--root DIR] [--cores 2]
 
@@ -24,7 +25,8 @@ from pathlib import Path
 def job_times(root: Path) -> dict[str, list[float]]:
     """{rule: [seconds of each job]} for the jobs whose outputs exist under ``root``."""
     jobs: dict[tuple[str, float], float] = {}
-    for record in (root / ".snakemake" / "metadata").iterdir():
+    folder = root / ".snakemake" / "metadata"
+    for record in folder.iterdir() if folder.is_dir() else ():
         name = record.name
         output = base64.urlsafe_b64decode(name + "=" * (-len(name) % 4)).decode()
         if not (root / output).exists():
@@ -47,6 +49,8 @@ def main() -> None:
     parser.add_argument("--cores", type=int, default=2)
     args = parser.parse_args()
     per_rule = job_times(args.root)
+    if not per_rule:
+        raise SystemExit(f"no finished jobs recorded under {args.root / '.snakemake' / 'metadata'}")
     total = sum(sum(v) for v in per_rule.values())
     print(f"{'rule':28s} {'jobs':>5s} {'sum (h)':>8s} {'longest (min)':>14s}")
     for rule, times in sorted(per_rule.items(), key=lambda kv: -sum(kv[1])):
