@@ -35,7 +35,7 @@ def job_times(root: Path) -> dict[str, list[float]]:
         start, end = meta.get("starttime"), meta.get("endtime")
         if start is None or end is None or meta.get("incomplete"):
             continue
-        key = (meta["rule"], round(start, 3))  # the outputs of one job share its start
+        key = (meta["rule"], end)  # the outputs of one job share its end time (their starts differ by ms)
         jobs[key] = max(jobs.get(key, 0.0), end - start)
     per_rule: dict[str, list[float]] = defaultdict(list)
     for (rule, _), seconds in jobs.items():
