@@ -1,8 +1,10 @@
-"""Atomic checkpoints of long runs (MD compressions, SLP densifications).
+"""Atomic checkpoints of long runs (MD compressions, SLP densifications, sequential jamming tests).
 
 A checkpoint is an ``.npz`` file with the complete state of a run (for MD:
 :meth:`hardpack.md.simulation.Simulation.state`, written at synchronisation points; for SLP:
-:func:`hardpack.slp.driver.run_slp`'s packing, trust region and history) plus a fingerprint of
+:func:`hardpack.slp.driver.run_slp`'s packing, trust region and history; for the sequential
+jamming tests: the moved packing, random generator, LP warm starts and statistics after each
+loading sequence, :func:`hardpack.jamming.verify.verify`) plus a fingerprint of
 the run's defining inputs (for MD: start packing, growth rate, seed, window size, overlap
 tolerance, final growth stage, contact-force windows).
 It is written by :func:`hardpack.io.atomic.atomic_path` (a temporary file in the destination folder,

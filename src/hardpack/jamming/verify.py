@@ -26,8 +26,8 @@ from dataclasses import replace
 import numpy as np
 
 from hardpack.errors import InvalidInputError
-from hardpack.io import checkpoint as ckpt
 from hardpack.geometry.packing import Packing
+from hardpack.io import checkpoint as ckpt
 from hardpack.jamming.contacts import check_delta, contact_network
 from hardpack.jamming.forces import jamming_point_forces, self_stress, statics
 from hardpack.jamming.ideal import ideal_test
