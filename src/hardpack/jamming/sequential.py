@@ -179,7 +179,8 @@ def sequential_test(
     base = base_eps = None
     first, earlier = 0, 0.0  # the first loading sequence to run, seconds spent before a resume
     if resume is not None:
-        current, base, base_eps, warm, small_strain, best, first, earlier = _restore(resume, out, packing, rng)
+        current, base, base_eps, warm, small_strain, first, earlier = _restore(resume, out, packing, rng)
+        best = max(out.mean_displacement, default=best)
     # LP box = the step's trust region: no LP motion beyond delta r_min can be taken (list_step)
     box = min(box, delta * float(packing.radii.min()))
     for sequence in range(first, 2 * n_loads):
@@ -241,7 +242,7 @@ def sequential_test(
             best, out.motion = mean, rel
             out.strain = strain_total if strict else None
         if save is not None:
-            save(_state(out, current, base, base_eps, warm, small_strain, best, sequence + 1, rng,
+            save(_state(out, current, base, base_eps, warm, small_strain, sequence + 1, rng,
                         earlier + time.perf_counter() - t0))
     # no particle left to load: every one is a rattler, nothing is jammed (Alg. 13 step 3)
     out.jammed = bool(moving.any() and max(out.mean_displacement, default=0.0) < threshold)
@@ -250,11 +251,11 @@ def sequential_test(
     return out
 
 
-def _state(out: SequentialOutcome, current: Packing, base, base_eps, warm, small_strain, best: float,
+def _state(out: SequentialOutcome, current: Packing, base, base_eps, warm, small_strain,
            next_sequence: int, rng: np.random.Generator, seconds: float) -> dict:
     """The state of a test after a loading sequence, as arrays and scalars (see sequential_test)."""
     state = {
-        "next_sequence": next_sequence, "best": best, "seconds": seconds,
+        "next_sequence": next_sequence, "seconds": seconds,
         "rng": json.dumps(rng.bit_generator.state),
         "positions": current.positions, "lattice": current.lattice, "load": base,
         "mean_displacement": np.asarray(out.mean_displacement), "strain_norm": np.asarray(out.strain_norm),
@@ -283,7 +284,7 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     out.n_lp, out.n_lp_highs = int(state["n_lp"]), int(state["n_lp_highs"])
     current = packing.replace(positions=state["positions"], lattice=state["lattice"])
     warm, small_strain = (WarmStart.from_arrays(state, f"{name}_") for name in ("warm", "small_strain"))
-    return (current, state["load"], state.get("strain_load"), warm, small_strain, float(state["best"]),
+    return (current, state["load"], state.get("strain_load"), warm, small_strain,
             int(state["next_sequence"]), float(state["seconds"]))
 
 
