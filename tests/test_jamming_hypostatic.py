@@ -188,3 +188,28 @@ def test_working_set_returns_a_regular_basis_of_active_columns(monkeypatch, stri
         basis = cols.matrix(sol.basis).toarray()
         assert np.linalg.matrix_rank(basis) == sol.basis.size
         assert np.abs(cols.slacks(sol.x)[sol.basis]).max() <= 1e-10 * 0.05
+
+
+def test_long_working_set_lps_log_their_rounds(monkeypatch, caplog):
+    """A working-set LP logs each round once it has run PROGRESS_AFTER seconds (progress of
+    the > 1 h LPs at N = 1e4); set to -1 s here so that every round is long, and to 1 h so
+    that none is."""
+    import logging
+
+    from hardpack.jamming import workingset
+
+    q, _ = _opened(jammed_disks(), 1e-3)
+    net = contact_network(q, 0.1)
+    moving = np.ones(q.n_particles, bool)
+    load = random_load(np.random.default_rng(5), moving, 2)
+    common = {"box": 0.05, "cell_length": cell_length(q.lattice)}
+    for after, logged in ((3600.0, False), (-1.0, True)):
+        monkeypatch.setattr(workingset, "PROGRESS_AFTER", after)
+        caplog.clear()
+        with caplog.at_level(logging.INFO, logger="hardpack.jamming.workingset"):
+            mine = solve_motion(net, moving, load, **common)
+        assert mine.solver == "working-set"
+        rounds = [r.getMessage() for r in caplog.records if "working set, round" in r.getMessage()]
+        assert bool(rounds) == logged
+        if logged:
+            assert rounds[0].startswith("working set, round 1:") and "columns violated" in rounds[0]

@@ -49,6 +49,8 @@ hundreds of near contacts under a shear.
 
 from __future__ import annotations
 
+import logging
+import time
 from dataclasses import dataclass
 
 import highspy
@@ -73,6 +75,11 @@ NEAR_ROWS = 1
 #: N = 1e4 in 3D, 71 % were in the lowest 5 % of y and 91 % in the lowest 10 %); starting
 #: with them saves rounds of row generation (8 s instead of 12-15 s for that K-LP)
 LOW_LOAD_ROWS = 0.05
+#: seconds after which each further round of an LP is logged (progress of long LPs: at N = 1e4
+#: in 3D a strict LP far from its start can take > 1 h in rounds of 1-8 min)
+PROGRESS_AFTER = 60.0
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -322,6 +329,7 @@ def solve_working_set(
     basis moves to the current optimum instead (new LU) and the working set restarts from the
     columns closest to entering plus the violated ones.
     """
+    t0 = time.perf_counter()
     g = sp.csc_matrix(g)
     n, m = g.shape
     cols = _Columns(g, np.asarray(h, float), np.asarray(upper, float))
@@ -381,6 +389,10 @@ def solve_working_set(
         # 4. pricing
         slack = cols.slacks(x)
         violated = np.flatnonzero((slack < -tol) & ~in_set)
+        if time.perf_counter() - t0 > PROGRESS_AFTER:
+            log.info("working set, round %d: %d working columns, %d of %d basis loads in the K-LP, "
+                     "%d columns violated, %.0f s", rounds, k, int(k_lp.rows.sum()), n, violated.size,
+                     time.perf_counter() - t0)
         if violated.size == 0:
             forces = np.zeros(m)
             forces[basis[basis < m]] = f_s[basis < m]
