@@ -60,7 +60,6 @@ class Motion:
     seconds: float
     warm: WarmStart | None = None  # basis of this LP, to warm-start the next one (working set)
     solver: str = "highs"  # "working-set" or "highs"
-    small_strain: WarmStart | None = None  # continuation only: basis of its first stage
 
 
 def solve_motion(
@@ -74,7 +73,6 @@ def solve_motion(
     cell_length: float,
     working_set: bool = True,
     warm: WarmStart | None = None,
-    small_strain: WarmStart | None = None,
 ) -> Motion:
     """Solve the LP in the module docstring.
 
@@ -85,8 +83,7 @@ def solve_motion(
     components; giving it turns on the strain variables and the trace constraint (strict
     test). ``box`` bounds each displacement component and ``box / cell_length`` each strain
     component. ``warm``: the basis of a similar LP (``Motion.warm``) to start from; a strict LP
-    without one goes through the strain continuation, whose first stage starts from
-    ``small_strain`` (``Motion.small_strain`` of a similar LP) if given.
+    without one goes through the strain continuation, from the smallest gaps.
     """
     t0 = time.perf_counter()
     n, d = net.n_particles, net.dim
@@ -123,13 +120,12 @@ def solve_motion(
     keys = np.column_stack([net.i[use], net.j[use], net.shift[use]])
     if strict:
         keys = np.vstack([keys, np.full((1, keys.shape[1]), -1)])  # the trace column
-    sol = first = None
+    sol = None
     if working_set and (warm is not None or not strict):
         sol = solve_working_set(g, h, c, upper, start=None if warm is None else warm.locate(keys, nvar),
                                 boxed=np.arange(n_pos, nvar))
     elif working_set:
-        start = None if small_strain is None else small_strain.locate(keys, nvar)
-        sol, first = _strain_continuation(g, h, c, upper, n_pos, start)
+        sol = _strain_continuation(g, h, c, upper, n_pos)
     solver = "working-set" if sol is not None else "highs"
     if sol is not None:
         x, f, objective, warm = sol.x, sol.forces, sol.objective, WarmStart.of(sol, keys)
@@ -143,29 +139,30 @@ def solve_motion(
         eps -= np.trace(eps) / d * np.eye(d)  # make it exact so that det(I + t eps) <= 1 for small t
     forces = np.zeros(net.n_contacts)
     forces[use] = f[: int(use.sum())]
-    return Motion(disp, eps, forces, objective, time.perf_counter() - t0, warm, solver,
-                  None if first is None else WarmStart.of(first, keys))
+    return Motion(disp, eps, forces, objective, time.perf_counter() - t0, warm, solver)
 
 
-def _strain_continuation(g, h, c, upper, n_pos, start=None, factor: float = 10.0, stages: int = 5):
+def _strain_continuation(g, h, c, upper, n_pos, factor: float = 10.0, stages: int = 5):
     """A strict LP without a warm start: the working set is solved for strain bounds
     ``factor**-stages`` times the final one, then ``factor`` times larger each stage, each
     warm-started from the previous optimum. Small strains close few near contacts, so every
-    stage starts close to its optimum; the last one is the LP itself. Returns (the solution,
-    the first stage's solution), None for the solution if a stage fails.
+    stage starts close to its optimum; the last one is the LP itself. Returns the solution, or
+    None if a stage fails.
 
-    ``start`` (basis, working set) starts the first stage, e.g. from the first stage of the
-    previous loading sequence of a strict test. The smallest gaps start it otherwise, a poor
-    basis once a strict step has sheared the cell: the motion of the previous load left the
-    contacts that resisted it closest, and they carry negative loads under the next one (51 %
-    of the basis at N = 1e4 in 3D; that LP took > 6 min cold, 170 s from such a start).
+    The first stage starts from the smallest gaps. A start from the first stage of another
+    LP (e.g. of the previous loading sequence of a strict test) is a gamble: at N = 1e4 in 3D
+    it once took 170 s where the smallest gaps took > 6 min, but the first LPs of the fourth
+    and fifth sequences of the full study's test took 39 min and > 2 h from it, and 9 min
+    cold for the fifth (the packing moved 4-6e-4 D per sequence, so another sequence's basis
+    carries tens of thousands of negative loads; measured 2026-11-25).
 
     A stage whose optimal strain lies strictly inside its bound ends the continuation: the
     stages differ only in the strain bound, so that optimum satisfies the optimality (KKT)
     conditions of every larger bound with the same multipliers (an inactive bound has none).
     At N = 1e4 in 3D the optimal strain is ~0.07 of the final bound, which saves the last
     stage (15 s: a factorisation of the same basis)."""
-    sol = first = None
+    sol = None
+    start = None
     for stage in range(stages, -1, -1):
         bound = upper.copy()
         bound[n_pos:] /= factor**stage
@@ -175,11 +172,10 @@ def _strain_continuation(g, h, c, upper, n_pos, start=None, factor: float = 10.0
             start = (sol.basis, np.zeros(0, dtype=np.int64))
         sol = solve_working_set(g, h, c, bound, start=start, boxed=np.arange(n_pos, upper.size))
         if sol is None:
-            return None, first
-        first = sol if first is None else first
+            return None
         if np.all(np.abs(sol.x[n_pos:]) < (1.0 - 1e-6) * bound[n_pos:]):
             break
-    return sol, first
+    return sol
 
 
 def _highs_motion(g: sp.csc_matrix, h: np.ndarray, c: np.ndarray, upper: np.ndarray):

@@ -27,9 +27,8 @@ refuses such settings; Donev uses delta = 0.1-1, L1729-L1738). The LPs of one te
 by :mod:`hardpack.jamming.workingset`, each warm-started from the previous one's basis, except
 that each loading sequence of the strict test starts over with :func:`solve_motion`'s strain
 continuation (the optimum of a strict LP shears the cell and closes hundreds of near contacts,
-and another load closes others), whose first stage, a strain bound 1e-5 times the LP's, starts
-from that of the previous sequence: at such strains the LP is nearly the collective one, for
-which a basis of another load is a good start.
+and another load closes others), from the smallest gaps (a start from another sequence's LP
+took hours at N = 1e4 in 3D: :func:`hardpack.jamming.lp._strain_continuation`).
 
 The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated over one loading
 sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
@@ -175,11 +174,10 @@ def sequential_test(
     current = packing
     best = -1.0
     warm = None  # the LPs of one test share their variables: each warm-starts the next
-    small_strain = None  # strict: first continuation stage of the last cold LP (lp.solve_motion)
     base = base_eps = None
     first, earlier = 0, 0.0  # the first loading sequence to run, seconds spent before a resume
     if resume is not None:
-        current, base, base_eps, warm, small_strain, first, earlier = _restore(resume, out, packing, rng)
+        current, base, base_eps, warm, first, earlier = _restore(resume, out, packing, rng)
         best = max(out.mean_displacement, default=best)
     # LP box = the step's trust region: no LP motion beyond delta r_min can be taken (list_step)
     box = min(box, delta * float(packing.radii.min()))
@@ -201,11 +199,8 @@ def sequential_test(
                 net, moving, sign * base, fixed=rattlers, box=box,
                 cell_length=cell_length(current.lattice),
                 strain_load=None if base_eps is None else sign * base_eps, warm=warm,
-                small_strain=small_strain,
             )
             warm = mot.warm
-            if mot.small_strain is not None:
-                small_strain = mot.small_strain
             out.n_lp_highs += mot.solver == "highs"
             steps += 1
             log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, load_index,
@@ -242,7 +237,7 @@ def sequential_test(
             best, out.motion = mean, rel
             out.strain = strain_total if strict else None
         if save is not None:
-            save(_state(out, current, base, base_eps, warm, small_strain, sequence + 1, rng,
+            save(_state(out, current, base, base_eps, warm, sequence + 1, rng,
                         earlier + time.perf_counter() - t0))
     # no particle left to load: every one is a rattler, nothing is jammed (Alg. 13 step 3)
     out.jammed = bool(moving.any() and max(out.mean_displacement, default=0.0) < threshold)
@@ -251,8 +246,8 @@ def sequential_test(
     return out
 
 
-def _state(out: SequentialOutcome, current: Packing, base, base_eps, warm, small_strain,
-           next_sequence: int, rng: np.random.Generator, seconds: float) -> dict:
+def _state(out: SequentialOutcome, current: Packing, base, base_eps, warm, next_sequence: int,
+           rng: np.random.Generator, seconds: float) -> dict:
     """The state of a test after a loading sequence, as arrays and scalars (see sequential_test)."""
     state = {
         "next_sequence": next_sequence, "seconds": seconds,
@@ -267,9 +262,8 @@ def _state(out: SequentialOutcome, current: Packing, base, base_eps, warm, small
         state["strain_load"] = base_eps
     if out.strain is not None:
         state["strain"] = out.strain
-    for name, start in (("warm", warm), ("small_strain", small_strain)):
-        if start is not None:
-            state.update({f"{name}_{k}": v for k, v in start.arrays().items()})
+    if warm is not None:
+        state.update({f"warm_{k}": v for k, v in warm.arrays().items()})
     return state
 
 
@@ -283,8 +277,8 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     out.displacement, out.motion, out.strain = state["displacement"], state["motion"], state.get("strain")
     out.n_lp, out.n_lp_highs = int(state["n_lp"]), int(state["n_lp_highs"])
     current = packing.replace(positions=state["positions"], lattice=state["lattice"])
-    warm, small_strain = (WarmStart.from_arrays(state, f"{name}_") for name in ("warm", "small_strain"))
-    return (current, state["load"], state.get("strain_load"), warm, small_strain,
+    warm = WarmStart.from_arrays(state, "warm_")
+    return (current, state["load"], state.get("strain_load"), warm,
             int(state["next_sequence"]), float(state["seconds"]))
 
 
