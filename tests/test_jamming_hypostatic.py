@@ -9,6 +9,8 @@ opened by 1e-7 D the self-stress of the nearest jamming point must be exactly th
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -16,7 +18,7 @@ from test_jamming_support import jammed_disks
 
 from hardpack.geometry.lattices import lattice_packing
 from hardpack.geometry.packing import Packing
-from hardpack.jamming import contact_network, remove_rattlers, rigidity_matrix, verify
+from hardpack.jamming import contact_network, remove_rattlers, rigidity_matrix, verify, workingset
 from hardpack.jamming.ideal import cell_length
 from hardpack.jamming.lp import random_load, random_strain_load, solve_motion
 
@@ -162,7 +164,6 @@ def test_working_set_returns_a_regular_basis_of_active_columns(monkeypatch, stri
     optimal motion (slack 0 to the LP tolerance, 1e-10 of the box). A choice by load alone
     takes zero-load columns at a degenerate optimum, which need not be either."""
     import hardpack.jamming.lp as lp
-    from hardpack.jamming import workingset
 
     q, _ = _opened(jammed_disks(), 1e-3)
     net = contact_network(q, 0.1)
@@ -194,10 +195,6 @@ def test_long_working_set_lps_log_their_rounds(monkeypatch, caplog):
     """A working-set LP logs each round once it has run PROGRESS_AFTER seconds (progress of
     the > 1 h LPs at N = 1e4); set to -1 s here so that every round is long, and to 1 h so
     that none is."""
-    import logging
-
-    from hardpack.jamming import workingset
-
     q, _ = _opened(jammed_disks(), 1e-3)
     net = contact_network(q, 0.1)
     moving = np.ones(q.n_particles, bool)

@@ -162,14 +162,12 @@ def _strain_continuation(g, h, c, upper, n_pos, factor: float = 10.0, stages: in
     At N = 1e4 in 3D the optimal strain is ~0.07 of the final bound, which saves the last
     stage (15 s: a factorisation of the same basis)."""
     sol = None
-    start = None
     for stage in range(stages, -1, -1):
         bound = upper.copy()
         bound[n_pos:] /= factor**stage
-        if sol is not None:  # the same LP with a larger bound: the previous basis, but not its
-            # working set, whose columns (N = 1e4 in 3D: ~800, 25 ms of LU solves each) the
-            # larger bound rarely needs
-            start = (sol.basis, np.zeros(0, dtype=np.int64))
+        # after the first stage: the previous basis, but not its working set, whose columns
+        # (N = 1e4 in 3D: ~800, 25 ms of LU solves each) the larger bound rarely needs
+        start = None if sol is None else (sol.basis, np.zeros(0, dtype=np.int64))
         sol = solve_working_set(g, h, c, bound, start=start, boxed=np.arange(n_pos, upper.size))
         if sol is None:
             return None

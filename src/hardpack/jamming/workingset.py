@@ -389,10 +389,10 @@ def solve_working_set(
         # 4. pricing
         slack = cols.slacks(x)
         violated = np.flatnonzero((slack < -tol) & ~in_set)
-        if time.perf_counter() - t0 > PROGRESS_AFTER:
+        elapsed = time.perf_counter() - t0
+        if elapsed > PROGRESS_AFTER:
             log.info("working set, round %d: %d working columns, %d of %d basis loads in the K-LP, "
-                     "%d columns violated, %.0f s", rounds, k, int(k_lp.rows.sum()), n, violated.size,
-                     time.perf_counter() - t0)
+                     "%d columns violated, %.0f s", rounds, k, int(k_lp.rows.sum()), n, violated.size, elapsed)
         if violated.size == 0:
             forces = np.zeros(m)
             forces[basis[basis < m]] = f_s[basis < m]
