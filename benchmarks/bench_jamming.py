@@ -9,7 +9,7 @@ Gamma = 1e-2 to a reduced pressure of 1e3, then ``--gamma`` to 1e12) and cached 
 
     python benchmarks/bench_jamming.py --n 1000 --gamma 1e-4 --repeat 3
     python benchmarks/bench_jamming.py --packing a.nc b.nc --delta 1e-6
-    python benchmarks/bench_jamming.py --packing n10000.nc --repeat 1             # N = 1e4
+    python benchmarks/bench_jamming.py --packing n10000.nc --repeat 1 --method sequential --workers 2
     python benchmarks/bench_jamming.py --packing n1250.nc --tile 2 --method sequential  # scaling
 
 A tiled packing is for scaling only: its tile^3 copies may move against each other, so a tiled
@@ -55,7 +55,7 @@ def make_packing(n: int, gamma: float, seed: int, cache: Path) -> Path:
 
 
 def bench(path: Path, delta: float | None, repeat: int, seed: int, tile: int = 1,
-          method: str = "ideal") -> dict:
+          method: str = "ideal", workers: int = 1) -> dict:
     ds = load_dataset(path, kind="packing")
     packing = dataset_to_packing(ds, source=str(path)).tiled(tile)
     pressure = ds.attrs.get("Z")
@@ -63,7 +63,7 @@ def bench(path: Path, delta: float | None, repeat: int, seed: int, tile: int = 1
     cpu = []
     for _ in range(repeat):
         t0, c0 = time.perf_counter(), time.process_time()
-        r = verify(packing, delta=delta, seed=seed, md_pressure=pressure, method=method)
+        r = verify(packing, delta=delta, seed=seed, md_pressure=pressure, method=method, workers=workers)
         total = time.perf_counter() - t0
         cpu.append(time.process_time() - c0)
         runs.append((total, r))
@@ -90,10 +90,12 @@ def main(argv=None) -> int:
                     help="Algorithm 13 (ideal) or 14 (sequential random loading, for LS packings)")
     ap.add_argument("--tile", type=int, default=1,
                     help="verify the packing repeated tile^3 times (scaling only: not jammed, see above)")
+    ap.add_argument("--workers", type=int, default=1,
+                    help="sequential method: loading sequences run at once (one process each)")
     args = ap.parse_args(argv)
     paths = list(args.packing) + [make_packing(n, args.gamma, args.seed, args.cache) for n in args.n]
     for path in paths:
-        b = bench(path, args.delta, args.repeat, args.seed, args.tile, args.method)
+        b = bench(path, args.delta, args.repeat, args.seed, args.tile, args.method, args.workers)
         r, s = b["result"], b["seconds"]
         print(f"\n{path}: N={b['n']} phi={b['phi']:.4f}")
         print(r.summary())

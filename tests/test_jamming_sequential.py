@@ -115,3 +115,32 @@ def test_killed_verification_resumes_from_its_checkpoint(tmp_path, monkeypatch, 
     np.testing.assert_array_equal(resumed.strict_test.strain, reference.strict_test.strain)
     with pytest.raises(InvalidInputError, match="sequential method"):
         verify(p, delta=1e-6, checkpoint=path)
+
+
+def test_every_loading_sequence_starts_from_the_given_packing():
+    """The square lattice of the previous tests, with a threshold the sliding rows do not reach
+    in one sequence: the load B and then -B each carry the free row over three LPs. Both start
+    from the given (centrosymmetric) packing, so -B is the mirror image of B and moves it
+    exactly as far (Algorithm 14 as run here, see hardpack.jamming.sequential: the text's
+    sequence -B starts where B ended, and moved it 9 % less in this case)."""
+    p = _shrunk(lattice_packing("square", (2, 1)), 1e-3)
+    r = verify(p, delta=0.2, method="sequential", tests=("collective",), seed=1, threshold=0.25,
+               contact_delta=2e-3, n_loads=1)
+    forward, reverse = r.collective_test.mean_displacement
+    assert r.collective_test.steps == [3, 3]
+    assert forward > 0.1  # the rows slid: 3 LPs of up to delta r_min = 0.1 D
+    assert reverse == pytest.approx(forward, rel=1e-9)
+
+
+def test_sequences_run_side_by_side_with_the_same_outcome():
+    """workers = 2 runs the loading sequences in two worker processes; recorded in order, they
+    give exactly the outcome of one process (same loads, same LPs), the strict test included."""
+    p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-4)
+    kwargs = {"delta": 0.2, "method": "sequential", "seed": 2, "threshold": 1e-2, "contact_delta": 1e-3}
+    serial, parallel = verify(p, **kwargs), verify(p, workers=2, **kwargs)
+    for test in ("collective_test", "strict_test"):
+        one, two = getattr(serial, test), getattr(parallel, test)
+        assert two.mean_displacement == one.mean_displacement and two.steps == one.steps
+        np.testing.assert_array_equal(two.displacement, one.displacement)
+        np.testing.assert_array_equal(two.final.positions, one.final.positions)
+    np.testing.assert_array_equal(parallel.strict_test.strain, serial.strict_test.strain)

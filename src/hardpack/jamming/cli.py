@@ -46,6 +46,9 @@ def register(subparsers) -> None:
                    help="sequential method: checkpoint file written after every loading sequence; "
                         "a killed run started again with the same arguments resumes from it "
                         "(removed at the end)")
+    p.add_argument("--workers", type=int, default=1,
+                   help="sequential method: loading sequences run at once, one process each "
+                        "(default 1; the result does not depend on it)")
     p.set_defaults(func=run)
 
 
@@ -61,7 +64,7 @@ def run(args) -> int:
         result = verify(
             packing, delta=args.delta, tests=tuple(args.tests), seed=args.seed,
             method=args.method, dr_large=args.dr_large, threshold=args.threshold,
-            md_pressure=pressure, checkpoint=args.checkpoint,
+            md_pressure=pressure, checkpoint=args.checkpoint, workers=args.workers,
         )
     except InvalidInputError as exc:
         print(f"hardpack verify: error: {exc}", file=sys.stderr)

@@ -20,15 +20,23 @@ Donev dissertation sec. 4.6.2, seeds/000_chapters/ch04-05.txt L1678-L1814:
    accumulated in a sequence exceeds the threshold (a valid packing that far from the start
    certifies the verdict; the remaining loads could only add statistics).
 
+Every loading sequence starts from the given packing. The text goes on from wherever the
+previous sequence ended (steps 9-10); we do not, for three reasons. (a) The test is about the
+given packing: each sequence then probes its own jamming polytope J_dR in one load direction,
+as B and -B do in Algorithm 13, instead of the neighbourhood of a packing the test itself
+sheared (a strict sequence at N = 1e4 in 3D moves the particles by ~5e-4 D, the gaps of the
+contacts it opened; the reversed load then mostly undoes it). (b) Speed: at the moved packing
+the smallest gaps no longer mark the contact core, and the first LP of the next strict sequence
+took 600 s there, against 45-90 s at the given packing (N = 1e4 in 3D, measured 2026-11-25:
+3 of the 4 sequences after the first took 600 s). (c) The sequences are independent, so they
+can run side by side (``workers``).
 The contact list must reach beyond the gaps that matter: step 6 moves no particle by more than
 delta D_min / 2 per LP, so a sequence can never displace anything by more than
 max_steps delta D_min / 2 and a small delta makes the test unable to fail (:func:`verify`
-refuses such settings; Donev uses delta = 0.1-1, L1729-L1738). The LPs of one test are solved
-by :mod:`hardpack.jamming.workingset`, each warm-started from the previous one's basis, except
-that each loading sequence of the strict test starts over with :func:`solve_motion`'s strain
-continuation (the optimum of a strict LP shears the cell and closes hundreds of near contacts,
-and another load closes others), from the smallest gaps (a start from another sequence's LP
-took hours at N = 1e4 in 3D: :func:`hardpack.jamming.lp._strain_continuation`).
+refuses such settings; Donev uses delta = 0.1-1, L1729-L1738). The LPs are solved by
+:mod:`hardpack.jamming.workingset`; within a sequence each warm-starts from the previous one's
+basis, and the first starts from the smallest gaps (a strict one through :func:`solve_motion`'s
+strain continuation: its optimum shears the cell and closes hundreds of near contacts).
 
 The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated over one loading
 sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
@@ -44,16 +52,21 @@ current distance and D_ij, which never lets overlaps grow beyond the packing tol
 
 A test is resumable after any loading sequence (``save`` / ``resume`` of
 :func:`sequential_test`; :func:`hardpack.jamming.verify.verify` keeps them in a checkpoint file):
-at N = 1e4 in 3D a strict loading sequence takes 2-8 min.
+at N = 1e4 in 3D a strict loading sequence takes 2-5 min.
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import os
 import time
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from functools import partial
+from multiprocessing import get_context
 
 import numpy as np
 
@@ -62,12 +75,15 @@ from hardpack.geometry.packing import Packing
 from hardpack.jamming.contacts import ContactNetwork, contact_network
 from hardpack.jamming.ideal import cell_length
 from hardpack.jamming.lp import random_load, random_strain_load, solve_motion
-from hardpack.jamming.workingset import WarmStart
 
 log = logging.getLogger(__name__)
 
 #: relative approach allowed for pairs in contact (see the module docstring)
 APPROACH_SLACK = 1e-11
+#: environment of the worker processes: one BLAS thread each. Two workers with OpenBLAS's own
+#: thread pools (a second thread each, or as many as Snakemake gives the job) took 2.6 times as
+#: long per LP on 2 cores; with one thread each, as long as one process alone (N = 1e4 in 3D)
+ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
 @dataclass
@@ -82,7 +98,7 @@ class SequentialOutcome:
     displacement: np.ndarray | None = None  # (N,) largest |dr_i| / D over sequences
     motion: np.ndarray | None = None  # (N, d) sequence with the largest mean displacement
     strain: np.ndarray | None = None  # (d, d) total strain of that sequence
-    final: Packing | None = None  # the packing after all loads
+    final: Packing | None = None  # the packing at the end of the last loading sequence
     n_lp: int = 0
     n_lp_highs: int = 0  # LPs HiGHS solved (the others: hardpack.jamming.workingset)
     seconds: float = 0.0
@@ -157,118 +173,194 @@ def sequential_test(
     max_steps: int = 3,
     resume: dict | None = None,
     save: Callable[[dict], None] | None = None,
+    workers: int = 1,
 ) -> SequentialOutcome:
     """Algorithm 14 from ``packing`` (see the module docstring).
 
+    The ``n_loads`` random loads are drawn from ``rng`` first; the loading sequences (B, -B for
+    each load) are independent, since each starts from ``packing``: ``workers`` > 1 runs that
+    many at once in worker processes. The outcome does not depend on ``workers``: sequences are
+    recorded in order, and those after the one that settles the verdict are discarded.
+
     Resumable: after each loading sequence, ``save`` (if given) receives the test's state, a
     dict of arrays and scalars; passing such a dict back as ``resume`` (same packing, rng seed and
-    parameters) continues after that sequence -- with the packing, the random generator and the
-    LP warm starts as they were, so the outcome is that of an uninterrupted test.
+    parameters) continues after that sequence, with the same loads, so the outcome is that of
+    an uninterrupted test.
     """
     t0 = time.perf_counter()
     n, d = packing.n_particles, packing.dim
-    diameter = 2.0 * packing.radii.mean()
     moving = ~rattlers
     out = SequentialOutcome(test="strict" if strict else "collective", jammed=True, threshold=threshold)
     out.displacement = np.zeros(n)
-    current = packing
-    best = -1.0
-    warm = None  # the LPs of one test share their variables: each warm-starts the next
-    base = base_eps = None
+    out.final = packing
+    start_rng = json.dumps(rng.bit_generator.state)
     first, earlier = 0, 0.0  # the first loading sequence to run, seconds spent before a resume
     if resume is not None:
-        current, base, base_eps, warm, first, earlier = _restore(resume, out, packing, rng)
-        best = max(out.mean_displacement, default=best)
+        start_rng, first, earlier = _restore(resume, out, packing, rng)
+    loads = [(random_load(rng, moving, d),
+              random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None)
+             for _ in range(n_loads)]
+    todo = []  # (sequence, load, strain load): B and -B for each load
+    if max(out.mean_displacement, default=0.0) < threshold:  # else settled before a resume
+        for sequence in range(first, 2 * n_loads):
+            load, strain_load = loads[sequence // 2]
+            sign = 1.0 if sequence % 2 == 0 else -1.0
+            todo.append((sequence, sign * load, None if strain_load is None else sign * strain_load))
     # LP box = the step's trust region: no LP motion beyond delta r_min can be taken (list_step)
     box = min(box, delta * float(packing.radii.min()))
-    for sequence in range(first, 2 * n_loads):
-        if best >= threshold:
-            break  # step 10: the verdict is settled
-        load_index, sign = sequence // 2 + 1, 1.0 if sequence % 2 == 0 else -1.0
-        if sign > 0:
-            base = random_load(rng, moving, d)
-            base_eps = random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None
-        if strict:  # a new load shears the cell the other way: the previous optimum closed
-            warm = None  # near contacts the new one does not (N = 1e4: > 7 min warm, 100 s cold)
-        total = np.zeros((n, d))
-        strain_total = np.zeros((d, d))
-        steps = 0
-        for _step in range(max_steps):
-            net = contact_network(current, delta)
-            mot = solve_motion(
-                net, moving, sign * base, fixed=rattlers, box=box,
-                cell_length=cell_length(current.lattice),
-                strain_load=None if base_eps is None else sign * base_eps, warm=warm,
-            )
-            warm = mot.warm
-            out.n_lp_highs += mot.solver == "highs"
-            steps += 1
-            log.info("%s test, load %d%s, LP %d: %s, %.1f s", out.test, load_index,
-                     "+" if sign > 0 else "-", steps, mot.solver, mot.seconds)
-            tau = min(
-                collision_step(net, mot.displacement, mot.strain),
-                list_step(net, current.radii, mot.displacement, mot.strain),
-                volume_step(mot.strain),
-            )
-            if not np.isfinite(tau) or tau <= 0:
-                break
-            current, tau = _advance(current, net, mot.displacement, mot.strain, tau)
-            step = tau * mot.displacement
-            total += step
-            if strict:
-                strain_total += tau * mot.strain
-            if _mean_size(total, moving, diameter) >= threshold:
-                break  # step 10: unjammed beyond the threshold, the verdict is settled
-            if np.linalg.norm(step[moving], axis=1).max(initial=0.0) <= beta * diameter:
-                break
-        out.n_lp += steps
-        rel = total - np.median(total[moving], axis=0) if moving.any() else total
-        size = np.linalg.norm(rel, axis=1) / diameter
-        size[rattlers] = 0.0
-        mean = float(size[moving].mean()) if moving.any() else 0.0
-        out.mean_displacement.append(mean)
-        out.max_displacement.append(float(size.max(initial=0.0)))
-        out.steps.append(steps)
-        out.strain_norm.append(float(np.linalg.norm(strain_total, 2)))
-        out.displacement = np.maximum(out.displacement, size)
-        log.info("%s test: loading sequence %d moved the particles by %.3g D on average "
-                 "(threshold %.3g D)", out.test, len(out.steps), mean, threshold)
-        if mean > best:
-            best, out.motion = mean, rel
-            out.strain = strain_total if strict else None
+    run = partial(_loading_sequence, packing, delta, rattlers, box=box, threshold=threshold,
+                  beta=beta, max_steps=max_steps)
+    for sequence, result in _in_order(run, todo, workers):
+        _record(out, result, moving, 2.0 * packing.radii.mean())
         if save is not None:
-            save(_state(out, current, base, base_eps, warm, sequence + 1, rng,
-                        earlier + time.perf_counter() - t0))
+            save(_state(out, start_rng, sequence + 1, earlier + time.perf_counter() - t0))
+        if out.mean_displacement[-1] >= threshold:
+            break  # step 10: the verdict is settled
     # no particle left to load: every one is a rattler, nothing is jammed (Alg. 13 step 3)
     out.jammed = bool(moving.any() and max(out.mean_displacement, default=0.0) < threshold)
-    out.final = current
     out.seconds = earlier + time.perf_counter() - t0
     return out
 
 
-def _state(out: SequentialOutcome, current: Packing, base, base_eps, warm, next_sequence: int,
-           rng: np.random.Generator, seconds: float) -> dict:
-    """The state of a test after a loading sequence, as arrays and scalars (see sequential_test)."""
+@dataclass(frozen=True)
+class _Sequence:
+    """What one loading sequence (steps 5-7) did."""
+
+    total: np.ndarray  # (N, d) displacement accumulated over its LPs
+    strain: np.ndarray | None  # (d, d) strain accumulated (strict test)
+    steps: int  # LPs solved
+    n_lp_highs: int  # of which HiGHS solved
+    final: Packing  # the packing at its end
+
+
+def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequence: int,
+                      load: np.ndarray, strain_load: np.ndarray | None, *, box: float,
+                      threshold: float, beta: float, max_steps: int) -> _Sequence:
+    """Steps 5-7 of Algorithm 14 from ``packing`` under ``load`` (and ``strain_load``: strict
+    test). Each LP warm-starts from the previous one's basis; the first starts cold, and a
+    strict one goes through the strain continuation of :func:`solve_motion`."""
+    d = packing.dim
+    moving = ~rattlers
+    diameter = 2.0 * packing.radii.mean()
+    test = "collective" if strain_load is None else "strict"
+    name = f"{sequence // 2 + 1}{'+' if sequence % 2 == 0 else '-'}"
+    current, warm = packing, None
+    total = np.zeros((packing.n_particles, d))
+    strain_total = None if strain_load is None else np.zeros((d, d))
+    steps = highs = 0
+    for _step in range(max_steps):
+        net = contact_network(current, delta)
+        mot = solve_motion(net, moving, load, fixed=rattlers, box=box, cell_length=cell_length(current.lattice),
+                           strain_load=strain_load, warm=warm)
+        warm = mot.warm
+        highs += mot.solver == "highs"
+        steps += 1
+        tau = min(
+            collision_step(net, mot.displacement, mot.strain),
+            list_step(net, current.radii, mot.displacement, mot.strain),
+            volume_step(mot.strain),
+        )
+        if np.isfinite(tau) and tau > 0:
+            current, tau = _advance(current, net, mot.displacement, mot.strain, tau)
+        else:
+            tau = 0.0
+        step = tau * mot.displacement
+        largest = np.linalg.norm(step[moving], axis=1).max(initial=0.0)
+        log.info("%s test, load %s, LP %d: %s, %.1f s; step %.3g: mean %.3g D, largest %.3g D", test, name,
+                 steps, mot.solver, mot.seconds, tau, _mean_size(step, moving, diameter), largest / diameter)
+        if tau == 0.0:
+            break
+        total += step
+        if strain_total is not None:
+            strain_total += tau * mot.strain
+        if _mean_size(total, moving, diameter) >= threshold:
+            break  # step 10: unjammed beyond the threshold, the verdict is settled
+        if largest <= beta * diameter:
+            break
+    return _Sequence(total, strain_total, steps, highs, current)
+
+
+def _in_order(run: Callable, todo: list, workers: int):
+    """(sequence, run(sequence, load, strain_load)) for the ``todo`` items, in their order;
+    with ``workers`` > 1 computed that many at a time in worker processes, the next ones
+    already running while the caller handles a result (a caller that stops early cancels them)."""
+    if workers <= 1 or len(todo) <= 1:
+        for item in todo:
+            yield item[0], run(*item)
+        return
+    level = logging.getLogger("hardpack").getEffectiveLevel()
+    with _environment(ONE_THREAD), ProcessPoolExecutor(
+            min(workers, len(todo)), mp_context=get_context("spawn"), initializer=_worker_logging,
+            initargs=(level,)) as pool:
+        futures = [pool.submit(run, *item) for item in todo]  # the workers start here
+        try:
+            for item, future in zip(todo, futures):
+                yield item[0], future.result()
+        finally:
+            for future in futures:
+                future.cancel()
+
+
+@contextmanager
+def _environment(values: dict[str, str]):
+    """os.environ updated with ``values`` inside the block (for the processes started there)."""
+    saved = {key: os.environ.get(key) for key in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+def _worker_logging(level: int) -> None:
+    """Progress lines of a worker process go to its standard error, as the parent's do."""
+    logging.basicConfig(level=level, format="%(asctime)s %(name)s: %(message)s", datefmt="%H:%M:%S")
+
+
+def _record(out: SequentialOutcome, result: _Sequence, moving: np.ndarray, diameter: float) -> None:
+    """Add one loading sequence's statistics to ``out`` (module docstring)."""
+    total = result.total
+    rel = total - np.median(total[moving], axis=0) if moving.any() else total
+    size = np.linalg.norm(rel, axis=1) / diameter
+    size[~moving] = 0.0
+    mean = float(size[moving].mean()) if moving.any() else 0.0
+    if mean > max(out.mean_displacement, default=-1.0):
+        out.motion, out.strain = rel, result.strain
+    out.mean_displacement.append(mean)
+    out.max_displacement.append(float(size.max(initial=0.0)))
+    out.steps.append(result.steps)
+    out.strain_norm.append(0.0 if result.strain is None else float(np.linalg.norm(result.strain, 2)))
+    out.displacement = np.maximum(out.displacement, size)
+    out.n_lp += result.steps
+    out.n_lp_highs += result.n_lp_highs
+    out.final = result.final
+    log.info("%s test: loading sequence %d moved the particles by %.3g D on average "
+             "(threshold %.3g D)", out.test, len(out.steps), mean, out.threshold)
+
+
+def _state(out: SequentialOutcome, start_rng: str, next_sequence: int, seconds: float) -> dict:
+    """The state of a test after a loading sequence, as arrays and scalars (see sequential_test):
+    the random generator as the test found it (the loads are drawn from it again)."""
     state = {
-        "next_sequence": next_sequence, "seconds": seconds,
-        "rng": json.dumps(rng.bit_generator.state),
-        "positions": current.positions, "lattice": current.lattice, "load": base,
+        "next_sequence": next_sequence, "seconds": seconds, "rng": start_rng,
+        "positions": out.final.positions, "lattice": out.final.lattice,
         "mean_displacement": np.asarray(out.mean_displacement), "strain_norm": np.asarray(out.strain_norm),
         "max_displacement": np.asarray(out.max_displacement), "steps": np.asarray(out.steps),
         "displacement": out.displacement, "motion": out.motion,
         "n_lp": out.n_lp, "n_lp_highs": out.n_lp_highs,
     }
-    if base_eps is not None:
-        state["strain_load"] = base_eps
     if out.strain is not None:
         state["strain"] = out.strain
-    if warm is not None:
-        state.update({f"warm_{k}": v for k, v in warm.arrays().items()})
     return state
 
 
 def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.random.Generator):
-    """Load a :func:`_state` into ``out`` and ``rng``; returns the loop variables."""
+    """Load a :func:`_state` into ``out`` and ``rng``; returns (the generator's state at the
+    test's start, the next sequence, the seconds spent)."""
     rng.bit_generator.state = json.loads(state["rng"])
     out.mean_displacement = [float(v) for v in state["mean_displacement"]]
     out.strain_norm = [float(v) for v in state["strain_norm"]]
@@ -276,10 +368,8 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     out.steps = [int(v) for v in state["steps"]]
     out.displacement, out.motion, out.strain = state["displacement"], state["motion"], state.get("strain")
     out.n_lp, out.n_lp_highs = int(state["n_lp"]), int(state["n_lp_highs"])
-    current = packing.replace(positions=state["positions"], lattice=state["lattice"])
-    warm = WarmStart.from_arrays(state, "warm_")
-    return (current, state["load"], state.get("strain_load"), warm,
-            int(state["next_sequence"]), float(state["seconds"]))
+    out.final = packing.replace(positions=state["positions"], lattice=state["lattice"])
+    return state["rng"], int(state["next_sequence"]), float(state["seconds"])
 
 
 def _mean_size(total: np.ndarray, moving: np.ndarray, diameter: float) -> float:

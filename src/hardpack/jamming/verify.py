@@ -112,6 +112,7 @@ def verify(
     contact_delta: float | None = None,
     force_delta: float | None = None,
     checkpoint=None,
+    workers: int = 1,
 ) -> JammingResult:
     """Classify ``packing`` as locally / collectively / strictly jammed (see the module docstring).
 
@@ -145,6 +146,8 @@ def verify(
         sequence (:mod:`hardpack.io.checkpoint`); a killed verification started again with the
         same arguments resumes from it and gives the result of an uninterrupted one. It is
         removed when the verification ends.
+    workers : sequential method only: loading sequences run at once, each in its own process
+        (they are independent; the result does not depend on this number).
     """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
@@ -166,7 +169,7 @@ def verify(
     box = diameter if box is None else _positive("box", box)
     threshold = _positive("threshold", threshold)
     beta = _positive("beta", beta)
-    for name, value in (("n_loads", n_loads), ("max_steps", max_steps)):
+    for name, value in (("n_loads", n_loads), ("max_steps", max_steps), ("workers", workers)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise InvalidInputError(f"{name} must be a positive integer, got {value!r}")
     if md_pressure is not None:
@@ -222,7 +225,7 @@ def verify(
         backbone = collective.backbone if collective is not None and collective.jammed else local_active
     else:
         kwargs = {"rattlers": ~local_active, "threshold": threshold, "beta": beta,
-                  "n_loads": n_loads, "max_steps": max_steps, **common}
+                  "n_loads": n_loads, "max_steps": max_steps, "workers": workers, **common}
         saved = _Saved(checkpoint, ckpt.fingerprint(
             packing, run="verify", delta=delta, seed=int(seed), tests=list(tests), dr_large=dr_large,
             box=box, threshold=threshold, n_loads=n_loads, max_steps=max_steps, beta=beta,
