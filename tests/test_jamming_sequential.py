@@ -144,3 +144,16 @@ def test_sequences_run_side_by_side_with_the_same_outcome():
         np.testing.assert_array_equal(two.displacement, one.displacement)
         np.testing.assert_array_equal(two.final.positions, one.final.positions)
     np.testing.assert_array_equal(parallel.strict_test.strain, serial.strict_test.strain)
+
+
+def test_a_checkpoint_of_the_older_layout_is_refused():
+    """A state saved before every sequence started from the given packing (no layout version)
+    would resume with other loads: refused with a message that says what to do."""
+    from hardpack.errors import InvalidInputError
+    from hardpack.jamming.sequential import sequential_test
+
+    p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-4)
+    old = {"next_sequence": 1, "rng": "{}", "seconds": 1.0}
+    with pytest.raises(InvalidInputError, match="older hardpack.*delete it"):
+        sequential_test(p, 0.2, strict=False, rattlers=np.zeros(p.n_particles, bool),
+                        rng=np.random.default_rng(0), box=1.0, resume=old)

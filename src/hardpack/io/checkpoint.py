@@ -3,7 +3,7 @@
 A checkpoint is an ``.npz`` file with the complete state of a run (for MD:
 :meth:`hardpack.md.simulation.Simulation.state`, written at synchronisation points; for SLP:
 :func:`hardpack.slp.driver.run_slp`'s packing, trust region and history; for the sequential
-jamming tests: the moved packing, random generator, LP warm starts and statistics after each
+jamming tests: the random generator as the test found it and the statistics after each
 loading sequence, :func:`hardpack.jamming.verify.verify`) plus a fingerprint of
 the run's defining inputs (for MD: start packing, growth rate, seed, window size, overlap
 tolerance, final growth stage, contact-force windows).

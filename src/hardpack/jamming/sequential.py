@@ -84,6 +84,8 @@ APPROACH_SLACK = 1e-11
 #: thread pools (a second thread each, or as many as Snakemake gives the job) took 2.6 times as
 #: long per LP on 2 cores; with one thread each, as long as one process alone (N = 1e4 in 3D)
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+#: layout of a saved test state (1: sequences went on from the moved packing, with LP warm starts)
+STATE_VERSION = 2
 
 
 @dataclass
@@ -346,7 +348,7 @@ def _state(out: SequentialOutcome, start_rng: str, next_sequence: int, seconds: 
     """The state of a test after a loading sequence, as arrays and scalars (see sequential_test):
     the random generator as the test found it (the loads are drawn from it again)."""
     state = {
-        "next_sequence": next_sequence, "seconds": seconds, "rng": start_rng,
+        "version": STATE_VERSION, "next_sequence": next_sequence, "seconds": seconds, "rng": start_rng,
         "positions": out.final.positions, "lattice": out.final.lattice,
         "mean_displacement": np.asarray(out.mean_displacement), "strain_norm": np.asarray(out.strain_norm),
         "max_displacement": np.asarray(out.max_displacement), "steps": np.asarray(out.steps),
@@ -361,6 +363,10 @@ def _state(out: SequentialOutcome, start_rng: str, next_sequence: int, seconds: 
 def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.random.Generator):
     """Load a :func:`_state` into ``out`` and ``rng``; returns (the generator's state at the
     test's start, the next sequence, the seconds spent)."""
+    if state.get("version") != STATE_VERSION:
+        raise InvalidInputError("the checkpoint holds a sequential test saved by an older hardpack, "
+                                "whose loading sequences went on from the moved packing; delete it "
+                                "to start the verification afresh")
     rng.bit_generator.state = json.loads(state["rng"])
     out.mean_displacement = [float(v) for v in state["mean_displacement"]]
     out.strain_norm = [float(v) for v in state["strain_norm"]]
