@@ -26,10 +26,9 @@ given packing: each sequence then probes its own jamming polytope J_dR in one lo
 as B and -B do in Algorithm 13, instead of the neighbourhood of a packing the test itself
 sheared (a strict sequence at N = 1e4 in 3D moves the particles by ~5e-4 D, the gaps of the
 contacts it opened; the reversed load then mostly undoes it). (b) Speed: at the moved packing
-the smallest gaps no longer mark the contact core, and the first LP of the next strict sequence
-took 600 s there, against 45-90 s at the given packing (N = 1e4 in 3D, measured 2026-11-25:
-3 of the 4 sequences after the first took 600 s). (c) The sequences are independent, so they
-can run side by side (``workers``).
+the smallest gaps no longer mark the contact core: at N = 1e4 in 3D the first LPs of strict
+sequences 2-6 took 530-850 s there, against 45-52 s at the given packing (measured
+2026-11-25). (c) The sequences are independent, so they can run side by side (``workers``).
 The contact list must reach beyond the gaps that matter: step 6 moves no particle by more than
 delta D_min / 2 per LP, so a sequence can never displace anything by more than
 max_steps delta D_min / 2 and a small delta makes the test unable to fail (:func:`verify`
@@ -293,7 +292,7 @@ def _in_order(run: Callable, todo: list, workers: int):
     level = logging.getLogger("hardpack").getEffectiveLevel()
     with _environment(ONE_THREAD), ProcessPoolExecutor(
             min(workers, len(todo)), mp_context=get_context("spawn"), initializer=_worker_logging,
-            initargs=(level,)) as pool:
+            initargs=(level,), max_tasks_per_child=1) as pool:  # a fresh process per sequence
         futures = [pool.submit(run, *item) for item in todo]  # the workers start here
         try:
             for item, future in zip(todo, futures):
