@@ -292,7 +292,7 @@ def _in_order(run: Callable, todo: list, workers: int):
     level = logging.getLogger("hardpack").getEffectiveLevel()
     with _environment(ONE_THREAD), ProcessPoolExecutor(
             min(workers, len(todo)), mp_context=get_context("spawn"), initializer=_worker_logging,
-            initargs=(level,), max_tasks_per_child=1) as pool:  # a fresh process per sequence
+            initargs=(level,)) as pool:
         futures = [pool.submit(run, *item) for item in todo]  # the workers start here
         try:
             for item, future in zip(todo, futures):
