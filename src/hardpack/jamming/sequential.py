@@ -284,7 +284,8 @@ def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequ
 def _in_order(run: Callable, todo: list, workers: int):
     """(sequence, run(sequence, load, strain_load)) for the ``todo`` items, in their order;
     with ``workers`` > 1 computed that many at a time in worker processes, the next ones
-    already running while the caller handles a result (a caller that stops early cancels them)."""
+    already running while the caller handles a result. A caller that stops early cancels those
+    not yet started; the running ones end first (their results are discarded)."""
     if workers <= 1 or len(todo) <= 1:
         for item in todo:
             yield item[0], run(*item)
