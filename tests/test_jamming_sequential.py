@@ -157,3 +157,14 @@ def test_a_checkpoint_of_the_older_layout_is_refused():
     with pytest.raises(InvalidInputError, match="older hardpack.*delete it"):
         sequential_test(p, 0.2, strict=False, rattlers=np.zeros(p.n_particles, bool),
                         rng=np.random.default_rng(0), box=1.0, resume=old)
+
+
+def test_side_by_side_sequences_after_the_verdict_are_discarded():
+    """The sliding rows of the square lattice settle 'not jammed' in the first sequence; with two
+    workers the second sequence runs meanwhile, but the outcome keeps only the first, as one
+    process does (Alg. 14 step 10)."""
+    p = _shrunk(lattice_packing("square", (2, 1)), 1e-3)
+    r = verify(p, delta=0.2, method="sequential", tests=("collective",), seed=1, threshold=1e-2,
+               contact_delta=2e-3, workers=2)
+    assert not r.collective
+    assert r.collective_test.n_lp == 1 and len(r.collective_test.mean_displacement) == 1
