@@ -29,6 +29,7 @@ contacts it opened; the reversed load then mostly undoes it). (b) Speed: at the 
 the smallest gaps no longer mark the contact core: at N = 1e4 in 3D the first LPs of strict
 sequences 2-6 took 530-850 s there, against 45-52 s at the given packing (measured
 2026-11-25). (c) The sequences are independent, so they can run side by side (``workers``).
+
 The contact list must reach beyond the gaps that matter: step 6 moves no particle by more than
 delta D_min / 2 per LP, so a sequence can never displace anything by more than
 max_steps delta D_min / 2 and a small delta makes the test unable to fail (:func:`verify`

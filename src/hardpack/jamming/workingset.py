@@ -117,17 +117,6 @@ class WarmStart:
 
         return cls(keys[b[b < m]], box(b), keys[w[w < m]], box(w))
 
-    def arrays(self) -> dict[str, np.ndarray]:
-        """The four arrays by field name (for a checkpoint; :meth:`from_arrays` reads them back)."""
-        return {name: getattr(self, name) for name in self.__dataclass_fields__}
-
-    @classmethod
-    def from_arrays(cls, arrays: dict, prefix: str = "") -> WarmStart | None:
-        """The warm start stored under ``prefix`` + field name in ``arrays``; None if absent."""
-        if prefix + "basis_keys" not in arrays:
-            return None
-        return cls(**{name: np.asarray(arrays[prefix + name]) for name in cls.__dataclass_fields__})
-
     def locate(self, keys: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         """(basis, working) as unified indices into the columns with these ``keys`` and n
         variables (box columns of variables beyond n are dropped)."""
