@@ -68,6 +68,12 @@ K0 = 20
 #: rows of the K-LP that start bounding each working column of negative reduced cost (the
 #: rows with its most negative entries of N; row generation adds the others that are needed)
 BOUNDING_ROWS = 5
+#: rows joining the K-LP for an improving ray of its unbounded restricted primal bound it this
+#: many times over (their tension cost against the ray's gain), so that the next solve rarely
+#: finds a ray of the same columns again
+RAY_MARGIN = 2.0
+#: HiGHS solves of one K-LP (row generation and ray rows) before the working set gives up
+MAX_RESOLVES = 50
 #: row generation adds, with each row found short, this many of the rows closest to it
 NEAR_ROWS = 1
 #: fraction of the rows, those of the smallest basis loads y, that the K-LP starts with: the
@@ -414,9 +420,12 @@ class _KLP:
     mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with y < 0, the
     LOW_LOAD_ROWS fraction of rows of smallest y, and the BOUNDING_ROWS most negative entries
     of N of each column with q < 0 (without them such a column would make the restricted
-    primal unbounded; while they are too few, 8 times as many are taken, up to every row with
-    a negative entry). Each round adds the rows with y + N alpha < -tol and as many of the
-    rows next closest to it. When none is short, alpha is feasible for the full primal and
+    primal unbounded). While the restricted primal is unbounded all the same, HiGHS's Farkas
+    certificate of its dual form gives an improving ray d >= 0 of alpha; the rows off R that
+    the ray drives negative (N d < 0) join R, those of largest tension cost u_r |(N d)_r|
+    first, until their cost outweighs the ray's gain RAY_MARGIN times (:meth:`_add_ray_rows`).
+    Each round adds the rows with y + N alpha < -tol and as many of the rows next closest to
+    it. When none is short, alpha is feasible for the full primal and
     optimal for a relaxation of it, hence optimal. Restricting R matters at large N: with every
     row that has a negative entry (the columns of N are dense) the K-LP of a strict test at
     N = 1e4 in 3D took 20-45 s per HiGHS solve.
@@ -435,7 +444,6 @@ class _KLP:
             self.rows[np.argpartition(y, low - 1)[:low]] = True
         self.var_rows = np.zeros(0, dtype=np.int64)  # row of S of each variable of the model
         self.k = 0  # working columns that are constraints of the model
-        self.bounding = BOUNDING_ROWS
         self.highs = highspy.Highs()
         for name, value in {"output_flag": False, "presolve": "off", **HIGHS_OPTIONS}.items():
             self.highs.setOptionValue(name, value)
@@ -450,20 +458,17 @@ class _KLP:
         fresh[self.k:] = q[self.k:] < 0
         if np.any(np.all(null[:, fresh] >= 0, axis=0)):  # a column lowering the cost unboundedly
             return None, None, None
-        self._add_bounding_rows(null[:, fresh], self.bounding)
-        for _ in range(20):
+        self._add_bounding_rows(null[:, fresh], BOUNDING_ROWS)
+        for _ in range(MAX_RESOLVES):
             if not self.rows.any():  # y >= 0 and no working column can lower the cost: alpha = 0
                 return np.zeros(n), np.zeros(k), np.zeros(n)
             if not self._extend(null, q):  # HiGHS refuses entries beyond 1e15 (near-singular S)
                 return None, None, None
             self.highs.run()
             status = self.highs.getModelStatus()
-            if status == highspy.HighsModelStatus.kInfeasible:  # restricted primal unbounded:
-                lowering = null[:, q < 0]  # more bounding rows (all of them at the end)
-                if not lowering.size or self.bounding >= n:
+            if status == highspy.HighsModelStatus.kInfeasible:  # restricted primal unbounded
+                if not self._add_ray_rows(null, q):
                     return None, None, None
-                self.bounding *= 8
-                self._add_bounding_rows(lowering, self.bounding)
                 continue
             if status != highspy.HighsModelStatus.kOptimal:
                 return None, None, None
@@ -503,6 +508,30 @@ class _KLP:
         keep = np.ones(basis.size, dtype=bool)
         keep[self.var_rows[leave]] = False
         return np.concatenate([basis[keep], working[: self.k][enter]])
+
+    def _add_ray_rows(self, null: np.ndarray, q: np.ndarray) -> bool:
+        """Rows that bound the improving ray of the unbounded restricted primal (class
+        docstring) join R; False if HiGHS gives no ray or no row off R can bound it (the full
+        primal is unbounded: the caller gives up).
+
+        HiGHS's dual ray of the dual form (rows N^T mu <= q) is a Farkas certificate -d <= 0:
+        every mu in [0, u] has (N d)^T mu >= sum_r u_r min(0, (N d)_r) > q^T d over R. Along
+        alpha = s d the primal cost changes by s (q^T d + sum_R u_r max(0, -(N d)_r)) < 0;
+        a row r off R with (N d)_r < 0 adds u_r |(N d)_r| to that slope."""
+        _, has_ray, ray = self.highs.getDualRay()
+        if not has_ray:
+            return False
+        d = np.maximum(-np.asarray(ray), 0.0)
+        push = null @ d
+        cost = self.upper * np.maximum(-push, 0.0)
+        gain = -(q @ d) - cost[self.rows].sum()
+        candidates = np.flatnonzero(~self.rows & (push < 0))
+        if candidates.size == 0:
+            return False
+        order = candidates[np.argsort(-cost[candidates])]
+        enough = int(np.searchsorted(np.cumsum(cost[order]), RAY_MARGIN * max(gain, 0.0))) + 1
+        self.rows[order[: max(enough, BOUNDING_ROWS)]] = True
+        return True
 
     def _add_bounding_rows(self, lowering: np.ndarray, count: int) -> None:
         """The ``count`` most negative entries of each column of ``lowering`` join R."""
