@@ -163,3 +163,21 @@ def test_column_order_falls_back_when_the_copy_is_singular(monkeypatch):
     assert cols is None
     b = np.random.default_rng(5).normal(size=400)
     np.testing.assert_allclose(a.toarray() @ lu.solve(b), b, atol=1e-9)
+
+
+@pytest.mark.parametrize("dense_rows", [False, True])
+def test_block_solves_match_a_dense_solve(dense_rows):
+    """The blocked triangular solves (hardpack.jamming.triangular) give A^{-1} B for a block
+    wider than two passes (70 = 2 x 32 + 6 columns), with SuperLU's own column order and with
+    a given one (dense rows, as in a strict LP). Tolerance 1e-10: the condition number of
+    these matrices is ~1e2-1e3, so round-off stays near 1e-13."""
+    a = _regular_sparse(120, 3).tolil()
+    if dense_rows:
+        a[0, :] = np.linspace(0.5, 1.5, 120)  # a dense row: _column_order gives an order
+    a = sp.csc_matrix(a)
+    order = workingset._column_order(a)
+    assert (order is not None) == dense_rows
+    lu = workingset._OrderedLU(a, order)
+    b = np.random.default_rng(4).standard_normal((120, 70))
+    exact = np.linalg.solve(a.toarray(), b)
+    assert np.abs(lu.solve_block(b) - exact).max() <= 1e-10 * np.abs(exact).max()
