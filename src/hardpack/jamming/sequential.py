@@ -252,6 +252,8 @@ def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequ
     steps = highs = 0
     for _step in range(max_steps):
         net = contact_network(current, delta)
+        if warm is not None:  # particles that left the cell come back through the other side
+            warm = warm.rewrapped(_wraps(current, net))
         mot = solve_motion(net, moving, load, fixed=rattlers, box=box, cell_length=cell_length(current.lattice),
                            strain_load=strain_load, warm=warm)
         warm = mot.warm
@@ -280,6 +282,13 @@ def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequ
         if largest <= beta * diameter:
             break
     return _Sequence(total, strain_total, steps, highs, current)
+
+
+def _wraps(packing: Packing, net: ContactNetwork) -> np.ndarray:
+    """(N, d) integer lattice vectors w_i with x_i = net.x_i + lattice @ w_i: how the contact
+    network wrapped the packing's positions into the cell (the image shifts of its contacts
+    change accordingly, :meth:`hardpack.jamming.workingset.WarmStart.rewrapped`)."""
+    return np.rint(np.linalg.solve(net.lattice, (packing.positions - net.positions).T).T).astype(np.int64)
 
 
 def _in_order(run: Callable, todo: list, workers: int):

@@ -124,6 +124,21 @@ class WarmStart:
 
         return cls(keys[b[b < m]], box(b), keys[w[w < m]], box(w))
 
+    def rewrapped(self, wraps: np.ndarray) -> WarmStart:
+        """The same columns after the particles were wrapped back into the cell by the integer
+        lattice vectors ``wraps`` (N, d): x_i -> x_i - lattice @ w_i. A contact key (i, j, n)
+        (``keys`` of :func:`hardpack.jamming.lp.solve_motion`: separation x_j + lattice @ n - x_i)
+        becomes (i, j, n + w_j - w_i); keys with i < 0 (the trace column) stay."""
+
+        def moved(keys):
+            keys = keys.copy()
+            real = keys[:, 0] >= 0
+            i, j = keys[real, 0], keys[real, 1]
+            keys[real, 2:] += wraps[j] - wraps[i]
+            return keys
+
+        return WarmStart(moved(self.basis_keys), self.basis_box, moved(self.working_keys), self.working_box)
+
     def locate(self, keys: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         """(basis, working) as unified indices into the columns with these ``keys`` and n
         variables (box columns of variables beyond n are dropped)."""
