@@ -61,12 +61,16 @@ def test_factorise_finds_exactly_the_dependent_columns():
 @pytest.mark.parametrize("bounding_rows", [1, 5, 1000])
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("loads", ["mixed", "positive"])
-def test_k_lp_row_generation_matches_the_full_lp(monkeypatch, bounding_rows, seed, loads):
+@pytest.mark.parametrize("max_new_rows", [1, 500])
+def test_k_lp_row_generation_matches_the_full_lp(monkeypatch, bounding_rows, seed, loads, max_new_rows):
     """The K-LP over generated rows has the optimum of the LP over all rows (HiGHS, 1e-9), for
     few or many starting rows. With positive basis loads y the rows start from the bounding
-    rows alone: 1 per column makes the first restricted LP infeasible for some seeds (the
-    widening); the mixed loads take several rounds of row generation."""
+    rows alone: 1 per column leaves the first restricted primal unbounded for some seeds
+    (HiGHS's ray then brings the rows that bound it); the mixed loads (y < 0 on ~30 % of the
+    rows, of which the K-LP starts with the lowest 5 %) take several rounds of row generation,
+    one row per round with max_new_rows = 1."""
     monkeypatch.setattr(workingset, "BOUNDING_ROWS", bounding_rows)
+    monkeypatch.setattr(workingset, "MAX_NEW_ROWS", max_new_rows)
     if loads == "positive":  # no low-load rows either: R starts from the bounding rows alone
         monkeypatch.setattr(workingset, "LOW_LOAD_ROWS", 0.0)
     rng = np.random.default_rng(seed)

@@ -73,14 +73,25 @@ BOUNDING_ROWS = 5
 #: many times over (their tension cost against the ray's gain), so that the next solve rarely
 #: finds a ray of the same columns again
 RAY_MARGIN = 2.0
-#: HiGHS solves of one K-LP (row generation and ray rows) before the working set gives up
-MAX_RESOLVES = 50
+#: HiGHS solves of one K-LP (row generation and ray rows) before the working set gives up (each
+#: adds rows and continues from the previous optimum; MAX_NEW_ROWS per round needs many)
+MAX_RESOLVES = 200
 #: row generation adds, with each row found short, this many of the rows closest to it
 NEAR_ROWS = 1
+#: rows one round of row generation adds at most (the most negative of those found short;
+#: without near rows then): a warm start at N = 1e4 in 3D found 4718 rows short after its first
+#: K-LP, and adding them all (with as many near rows) grew the K-LP to 11000 dense rows, 28 s
+#: per HiGHS solve; 500 at a time it stayed below 3000 rows and took 8 s in all (250: the same,
+#: 1000 and 2000: 10-14 s)
+MAX_NEW_ROWS = 500
 #: fraction of the rows, those of the smallest basis loads y, that the K-LP starts with: the
 #: rows whose force reaches zero at the optimum are mostly among them (in a strict LP at
 #: N = 1e4 in 3D, 71 % were in the lowest 5 % of y and 91 % in the lowest 10 %); starting
-#: with them saves rounds of row generation (8 s instead of 12-15 s for that K-LP)
+#: with them saves rounds of row generation (8 s instead of 12-15 s for that K-LP). The rows
+#: with y < 0 beyond them are left to row generation: a warm start from the previous LP of a
+#: strict loading sequence (N = 1e4 in 3D) once had y < 0 on 68 % of its rows, all through the
+#: trace column's negative load (a pressure turned into a tension); one working column that
+#: relieves it lifts most of them, and a K-LP over all of them took 118 s instead of 25 s
 LOW_LOAD_ROWS = 0.05
 #: seconds after which each further round of an LP is logged (progress of long LPs: at N = 1e4
 #: in 3D a strict LP far from its start can take > 1 h in rounds of 1-8 min)
@@ -446,15 +457,16 @@ class _KLP:
         min y^T mu  s.t.  N^T mu <= q = h_S^T N + h_W^T,  0 <= mu <= u,
 
     and only over the rows R of the basis columns that may lose their force (row generation:
-    mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with y < 0, the
-    LOW_LOAD_ROWS fraction of rows of smallest y, and the BOUNDING_ROWS most negative entries
+    mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with the
+    LOW_LOAD_ROWS fraction of rows of smallest y (with y < 0 when there are fewer than
+    LOW_LOAD_ROWS n rows at all), and the BOUNDING_ROWS most negative entries
     of N of each column with q < 0 (without them such a column would make the restricted
     primal unbounded). While the restricted primal is unbounded all the same, HiGHS's Farkas
     certificate of its dual form gives an improving ray d >= 0 of alpha; the rows off R that
     the ray drives negative (N d < 0) join R, those of largest tension cost u_r |(N d)_r|
     first, until their cost outweighs the ray's gain RAY_MARGIN times (:meth:`_add_ray_rows`).
-    Each round adds the rows with y + N alpha < -tol and as many of the rows next closest to
-    it. When none is short, alpha is feasible for the full primal and
+    Each round adds the rows with y + N alpha < -tol (at most MAX_NEW_ROWS, the most negative)
+    and, if these were all, as many of the rows next closest to it. When none is short, alpha is feasible for the full primal and
     optimal for a relaxation of it, hence optimal. Restricting R matters at large N: with every
     row that has a negative entry (the columns of N are dense) the K-LP of a strict test at
     N = 1e4 in 3D took 20-45 s per HiGHS solve.
@@ -467,10 +479,12 @@ class _KLP:
     def __init__(self, y: np.ndarray, h_s: np.ndarray, upper: np.ndarray, tol: float = 1e-9):
         self.y, self.h_s, self.upper, self.n = y, h_s, upper, y.size
         self.limit = tol * max(float(np.abs(y).max(initial=0.0)), 1e-300)
-        self.rows = y < self.limit
         low = int(LOW_LOAD_ROWS * self.n)
         if low:
+            self.rows = np.zeros(self.n, dtype=bool)
             self.rows[np.argpartition(y, low - 1)[:low]] = True
+        else:
+            self.rows = y < self.limit
         self.var_rows = np.zeros(0, dtype=np.int64)  # row of S of each variable of the model
         self.k = 0  # working columns that are constraints of the model
         self.highs = highspy.Highs()
@@ -510,10 +524,14 @@ class _KLP:
                 mu[self.var_rows] = sol.col_value
                 t[self.var_rows] = np.maximum(-np.asarray(sol.col_dual), 0.0)  # duals of mu <= u
                 return mu, alpha, t
+            short = np.flatnonzero(short)
+            if short.size > MAX_NEW_ROWS:
+                self.rows[short[np.argpartition(f[short], MAX_NEW_ROWS - 1)[:MAX_NEW_ROWS]]] = True
+                continue
             # the rows next closest to losing their force tend to be short in the next round
-            rest = np.flatnonzero(~self.rows & ~short)
-            near = min(int(short.sum()) * NEAR_ROWS, rest.size)
-            self.rows |= short
+            self.rows[short] = True
+            rest = np.flatnonzero(~self.rows)
+            near = min(short.size * NEAR_ROWS, rest.size)
             if near:
                 self.rows[rest[np.argpartition(f[rest], near - 1)[:near]]] = True
         return None, None, None
