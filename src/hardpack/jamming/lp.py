@@ -166,7 +166,7 @@ def _strain_continuation(g, h, c, upper, n_pos, factor: float = 10.0, stages: in
         bound = upper.copy()
         bound[n_pos:] /= factor**stage
         # after the first stage: the previous basis, but not its working set, whose columns
-        # (N = 1e4 in 3D: ~800, 25 ms of LU solves each) the larger bound rarely needs
+        # (N = 1e4 in 3D: ~800, 5 ms of LU solves each) the larger bound rarely needs
         start = None if sol is None else (sol.basis, np.zeros(0, dtype=np.int64))
         sol = solve_working_set(g, h, c, bound, start=start, boxed=np.arange(n_pos, upper.size))
         if sol is None:
