@@ -8,7 +8,7 @@ def lp_mem_mb(wildcards):
 
 def lp_threads(wildcards):
     """Loading sequences run side by side (hardpack verify --workers) for large packings, whose
-    strict sequences take minutes each (N = 1e4 in 3D: 2-5 min)."""
+    strict sequences take a minute or more each (N = 1e4 in 3D: 1-1.5 min, 2-3 LPs)."""
     return 2 if ENSEMBLES[wildcards.ensemble]["N"] >= 5000 else 1
 
 
