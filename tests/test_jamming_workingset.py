@@ -115,7 +115,7 @@ def test_k_lp_grown_column_by_column_matches_the_full_lp(seed):
 
 def _with_dense_row(n: int, seed: int) -> sp.csc_matrix:
     """A regular sparse matrix whose last row has an entry in every column, most of them tiny
-    (the strain row of a sheared cell): the path of workingset._column_order."""
+    (the strain row of a sheared cell): the path of workingset._row_scale."""
     rng = np.random.default_rng(seed)
     a = _regular_sparse(n, seed).tolil()
     row = rng.uniform(-1e-6, 1e-6, n)
@@ -125,9 +125,13 @@ def _with_dense_row(n: int, seed: int) -> sp.csc_matrix:
 
 
 @pytest.mark.parametrize("seed", range(3))
-def test_ordered_lu_solves_with_dense_rows(seed):
+def test_scaled_lu_solves_with_dense_rows(seed):
+    """The dense row is scaled down for the LU (its largest entry 1e-3 of the others'); the
+    solves are those of the matrix itself (1e-9: these matrices have condition ~1e3)."""
     a = _with_dense_row(400, seed)
-    assert workingset._column_order(a) is not None
+    scale = workingset._row_scale(a)
+    assert np.all(scale[:-1] == 1.0)
+    assert np.abs(a[-1].toarray()).max() * scale[-1] == pytest.approx(1e-3 * np.abs(a[:-1].toarray()).max())
     lu, cols, _ = workingset._factorise(a)
     assert cols is None
     rng = np.random.default_rng(seed)
@@ -149,39 +153,18 @@ def test_factorise_with_dense_rows_finds_the_dependent_column():
     assert workingset._factorise(sp.csc_matrix(fixed))[1] is None
 
 
-def test_column_order_falls_back_when_the_copy_is_singular(monkeypatch):
-    """If SuperLU refuses the sparsified copy, the order is SuperLU's own and the LU still solves."""
-    a = _with_dense_row(400, 5)
-    real = workingset.spla.splu
-    calls = []
-
-    def refuse_first(m, **kwargs):
-        calls.append(m.shape)
-        if len(calls) == 1:
-            raise RuntimeError("Factor is exactly singular")
-        return real(m, **kwargs)
-
-    monkeypatch.setattr(workingset.spla, "splu", refuse_first)
-    assert workingset._column_order(a) is None
-    lu, cols, _ = workingset._factorise(a)
-    assert cols is None
-    b = np.random.default_rng(5).normal(size=400)
-    np.testing.assert_allclose(a.toarray() @ lu.solve(b), b, atol=1e-9)
-
-
 @pytest.mark.parametrize("dense_rows", [False, True])
 def test_block_solves_match_a_dense_solve(dense_rows):
     """The blocked triangular solves (hardpack.jamming.triangular) give A^{-1} B for a block
-    wider than two passes (70 = 2 x 32 + 6 columns), with SuperLU's own column order and with
-    a given one (dense rows, as in a strict LP). Tolerance 1e-10: the condition number of
-    these matrices is ~1e2-1e3, so round-off stays near 1e-13."""
+    wider than two passes (70 = 2 x 32 + 6 columns), with and without a scaled dense row (as in
+    a strict LP). Tolerance 1e-10: the condition number of these matrices is ~1e2-1e3, so
+    round-off stays near 1e-13."""
     a = _regular_sparse(120, 3).tolil()
     if dense_rows:
-        a[0, :] = np.linspace(0.5, 1.5, 120)  # a dense row: _column_order gives an order
+        a[0, :] = np.linspace(0.5, 1.5, 120)  # a dense row: scaled for the LU
     a = sp.csc_matrix(a)
-    order = workingset._column_order(a)
-    assert (order is not None) == dense_rows
-    lu = workingset._OrderedLU(a, order)
+    assert np.any(workingset._row_scale(a) != 1.0) == dense_rows
+    lu = workingset._ScaledLU(a)
     b = np.random.default_rng(4).standard_normal((120, 70))
     exact = np.linalg.solve(a.toarray(), b)
     assert np.abs(lu.solve_block(b) - exact).max() <= 1e-10 * np.abs(exact).max()
