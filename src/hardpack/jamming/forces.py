@@ -211,7 +211,8 @@ def polish(a: sp.csr_matrix, f: np.ndarray, iterations: int = 4) -> np.ndarray:
     """Project f onto {A f = 0} changing only the loaded contacts (f > 1e-9 max f).
 
     Solves (A_S A_S^T + lam I) y = A_S f_S and sets f_S -= A_S^T y, repeated (iterative
-    refinement); lam = 1e-12 times the mean diagonal only regularises floppy directions.
+    refinement); lam = 1e-12 times the mean diagonal only regularises floppy directions (and
+    makes the matrix positive definite, so it is factorised without pivoting).
     """
     f = f.copy()
     start = f.copy()
@@ -225,7 +226,12 @@ def polish(a: sp.csr_matrix, f: np.ndarray, iterations: int = 4) -> np.ndarray:
         if solve is None:
             normal = (a_s @ a_s.T).tocsc()
             lam = 1e-12 * normal.diagonal().mean()
-            solve = spla.splu(normal + lam * sp.identity(normal.shape[0], format="csc")).solve
+            # symmetric positive definite: diagonal pivots and a symmetric order (SuperLU's
+            # symmetric mode); at N = 1e4 in 3D 13 s and 4.6e7 LU entries, against 55 s and 1.1e8
+            # with the default partial pivoting and COLAMD
+            solve = spla.splu(normal + lam * sp.identity(normal.shape[0], format="csc"),
+                              permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                              options={"SymmetricMode": True}).solve
         f[support] -= a_s.T @ solve(r)
     if np.abs(a @ f).max() > np.abs(a @ start).max() or f.min() < 0:
         return start  # a floppy support: the projection did not help
