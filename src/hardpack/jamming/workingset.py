@@ -445,18 +445,18 @@ class _KLP:
 
     and only over the rows R of the basis columns that may lose their force (row generation:
     mu = 0 off R, i.e. the rows off R are dropped from the primal). R starts with the
-    LOW_LOAD_ROWS fraction of rows of smallest y (with y < 0 when there are fewer than
-    LOW_LOAD_ROWS n rows at all), and the BOUNDING_ROWS most negative entries
+    LOW_LOAD_ROWS fraction of rows of smallest y (the rows with y < tol in a basis too small
+    for that fraction to hold a row), and the BOUNDING_ROWS most negative entries
     of N of each column with q < 0 (without them such a column would make the restricted
     primal unbounded). While the restricted primal is unbounded all the same, HiGHS's Farkas
     certificate of its dual form gives an improving ray d >= 0 of alpha; the rows off R that
     the ray drives negative (N d < 0) join R, those of largest tension cost u_r |(N d)_r|
     first, until their cost outweighs the ray's gain RAY_MARGIN times (:meth:`_add_ray_rows`).
     Each round adds the rows with y + N alpha < -tol (at most MAX_NEW_ROWS, the most negative)
-    and, if these were all, as many of the rows next closest to it. When none is short, alpha is feasible for the full primal and
-    optimal for a relaxation of it, hence optimal. Restricting R matters at large N: with every
-    row that has a negative entry (the columns of N are dense) the K-LP of a strict test at
-    N = 1e4 in 3D took 20-45 s per HiGHS solve.
+    and, if these were all, as many of the rows next closest to it. When none is short, alpha
+    is feasible for the full primal and optimal for a relaxation of it, hence optimal.
+    Restricting R matters at large N: with every row that has a negative entry (the columns of
+    N are dense) the K-LP of a strict test at N = 1e4 in 3D took 20-45 s per HiGHS solve.
 
     One HiGHS instance (highspy) holds the restricted LP for the whole life of the basis: y, h_S
     and u are those of S, so each round (rows of S joining R: new variables; working columns
@@ -548,8 +548,8 @@ class _KLP:
         docstring) join R; False if HiGHS gives no ray or no row off R can bound it (the full
         primal is unbounded: the caller gives up).
 
-        HiGHS's dual ray of the dual form (rows N^T mu <= q) is a Farkas certificate -d <= 0:
-        every mu in [0, u] has (N d)^T mu >= sum_r u_r min(0, (N d)_r) > q^T d over R. Along
+        HiGHS's dual ray of the dual form (rows N^T mu <= q) is a Farkas certificate -d, d >= 0:
+        every mu in [0, u] over R has (N d)^T mu >= sum_r u_r min(0, (N d)_r) > q^T d. Along
         alpha = s d the primal cost changes by s (q^T d + sum_R u_r max(0, -(N d)_r)) < 0;
         a row r off R with (N d)_r < 0 adds u_r |(N d)_r| to that slope."""
         _, has_ray, ray = self.highs.getDualRay()
