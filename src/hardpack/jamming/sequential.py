@@ -335,8 +335,7 @@ def _worker_logging(level: int) -> None:
 
 def _record(out: SequentialOutcome, result: _Sequence, moving: np.ndarray, diameter: float) -> None:
     """Add one loading sequence's statistics to ``out`` (module docstring)."""
-    total = result.total
-    rel = total - np.median(total[moving], axis=0) if moving.any() else total
+    rel = _relative(result.total, moving)
     size = np.linalg.norm(rel, axis=1) / diameter
     size[~moving] = 0.0
     mean = float(size[moving].mean()) if moving.any() else 0.0
@@ -388,12 +387,17 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     return state["rng"], int(state["next_sequence"]), float(state["seconds"])
 
 
+def _relative(total: np.ndarray, moving: np.ndarray) -> np.ndarray:
+    """Displacements relative to the bulk: the componentwise median over the moving particles
+    subtracted (module docstring)."""
+    return total - np.median(total[moving], axis=0) if moving.any() else total
+
+
 def _mean_size(total: np.ndarray, moving: np.ndarray, diameter: float) -> float:
-    """Mean |dr_i| / D over the moving particles, relative to their componentwise median."""
+    """Mean |dr_i| / D over the moving particles, relative to the bulk (:func:`_relative`)."""
     if not moving.any():
         return 0.0
-    rel = total[moving] - np.median(total[moving], axis=0)
-    return float(np.linalg.norm(rel, axis=1).mean() / diameter)
+    return float(np.linalg.norm(_relative(total, moving)[moving], axis=1).mean() / diameter)
 
 
 def _advance(packing: Packing, net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None,

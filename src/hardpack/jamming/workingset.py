@@ -488,7 +488,7 @@ class _KLP:
         fresh[self.k:] = q[self.k:] < 0
         if np.any(np.all(null[:, fresh] >= 0, axis=0)):  # a column lowering the cost unboundedly
             return None, None, None
-        self._add_bounding_rows(null[:, fresh], BOUNDING_ROWS)
+        self._add_bounding_rows(null[:, fresh])
         for _ in range(MAX_RESOLVES):
             if not self.rows.any():  # y >= 0 and no working column can lower the cost: alpha = 0
                 return np.zeros(n), np.zeros(k), np.zeros(n)
@@ -567,10 +567,11 @@ class _KLP:
         self.rows[order[: max(enough, BOUNDING_ROWS)]] = True
         return True
 
-    def _add_bounding_rows(self, lowering: np.ndarray, count: int) -> None:
-        """The ``count`` most negative entries of each column of ``lowering`` join R."""
+    def _add_bounding_rows(self, lowering: np.ndarray) -> None:
+        """The BOUNDING_ROWS most negative entries of each column of ``lowering`` join R."""
         if lowering.size:
-            best = np.argpartition(lowering, min(count, self.n) - 1, axis=0)[:count]
+            count = min(BOUNDING_ROWS, self.n)
+            best = np.argpartition(lowering, count - 1, axis=0)[:count]
             self.rows[best[np.take_along_axis(lowering, best, axis=0) < 0]] = True
 
     def _extend(self, null: np.ndarray, q: np.ndarray) -> bool:
