@@ -60,4 +60,4 @@ rule all:
         expand("results/ensembles/{ensemble}/slp_jamming_summary.nc",
                ensemble=config.get("slp", {}).get("mrj", {}).get("ensembles", [])),
         FIGURES,
-        "results/validation/report.md",
+        "results/validation/gate.txt",

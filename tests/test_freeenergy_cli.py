@@ -83,5 +83,8 @@ def test_bcmd_ladder_cli(tmp_path):
     args = parse(["bcmd-ladder", "--out", str(out)])
     assert args.func(args) == 0
     ds = load_dataset(out)
-    # every cheap check within its tolerance (the rungs are tested in detail elsewhere)
-    assert np.all(np.abs(ds["value"] - ds["exact"]) <= ds["tolerance"])
+    # every cheap check's deviation from its exact value within two of its standard errors (the
+    # rungs are tested in detail elsewhere; the simplex formula is an identity: round-off only)
+    checked = ds.sel(check=[c for c in ds.check.values if c != "bcmd-simplex-formula"])
+    assert np.all(np.abs(checked["value"]) <= 2 * checked["error"])
+    assert float(ds["value"].sel(check="bcmd-simplex-formula")) < 1e-9

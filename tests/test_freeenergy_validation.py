@@ -5,52 +5,75 @@ import pytest
 import xarray as xr
 
 from hardpack.freeenergy.crystal import free_volume_z
-from hardpack.validation.freeenergy import density_rows, ladder_rows, simplex_rows
+from hardpack.validation.freeenergy import density_rows, eos_integral_error, ladder_rows, simplex_rows
 
 
-def simplex_summary(rel, iso=1):
-    n = np.array([126, 126])
-    exact = np.array([4.977, 4.977 + 3 * np.log(126) / 126])
+def simplex_summary(rel, exact=(4.946, 4.950), iso=1, n_b=978):
+    """Two isostatic backbones of Table 6.1's size per frozen mode (centre-of-mass values shifted by
+    d ln N / N), with BCMD values off by ``rel``."""
+    shift = 3 * np.log(n_b) / n_b
+    exact = np.array([*exact, *(np.array(exact) + shift)])
+    rel = np.asarray(rel, float)
     return xr.Dataset(
-        {"exact": ("sample", exact), "bcmd": ("sample", exact * (1 + np.asarray(rel))),
-         "rel_diff": ("sample", np.asarray(rel, float)), "isostatic": ("sample", [iso, iso]),
-         "isostaticity_gap": ("sample", [0, 0] if iso else [5, 5]), "n_backbone": ("sample", n),
-         "dim": ("sample", [3, 3]), "n_events": ("sample", [10, 10]),
-         "seconds_bcmd": ("sample", [1.0, 1.0])},
-        coords={"seed": ("sample", [1, 1]), "frozen": ("sample", ["particle", "cm"])},
+        {"exact": ("sample", exact), "bcmd": ("sample", exact * (1 + rel)), "rel_diff": ("sample", rel),
+         "isostatic": ("sample", [iso] * 4), "isostaticity_gap": ("sample", [0] * 4 if iso else [5] * 4),
+         "n_backbone": ("sample", [n_b] * 4), "dim": ("sample", [3] * 4), "n_events": ("sample", [10] * 4),
+         "seconds_bcmd": ("sample", [1.0] * 4)},
+        coords={"seed": ("sample", [1, 2, 1, 2]), "frozen": ("sample", ["particle", "particle", "cm", "cm"])},
     )
 
 
-def test_simplex_rows():
-    rows = simplex_rows(simplex_summary([0.002, -0.008]))
-    assert [r.passed for r in rows] == [True, True]
-    assert rows[1].published == pytest.approx(4.977 + 3 * np.log(126) / 126)
-    assert [r.passed for r in simplex_rows(simplex_summary([0.002, -0.02]))] == [True, False]
-    rows = simplex_rows(simplex_summary([np.nan, np.nan], iso=0))
-    assert not any(r.passed for r in rows) and "no isostatic" in rows[0].detail
+def test_simplex_rows_against_table_6_1():
+    rows = {r.target: r for r in simplex_rows(simplex_summary([0.0005, -0.001, 0.0002, 0.0012]))}
+    assert rows["donev-t6.1-bcmd-vs-exact-particle"].passed  # Table 6.1: within 0.13 %
+    assert rows["donev-t6.1-bcmd-vs-exact-cm"].passed
+    assert rows["donev-t6.1-exact-particle"].passed  # 4.948 +- our spread vs the published 4.9479
+    assert rows["donev-t6.1-exact-cm"].reproduced == pytest.approx(4.948 + 3 * np.log(978) / 978)
+    bad = {r.target: r for r in simplex_rows(simplex_summary([0.002, 0.0, 0.0, 0.0]))}
+    assert bad["donev-t6.1-bcmd-vs-exact-particle"].status == "fail"  # one packing off by 0.2 %
+    assert bad["donev-t6.1-bcmd-vs-exact-particle"].reproduced == pytest.approx(0.002)
+    far = {r.target: r for r in simplex_rows(simplex_summary([0, 0, 0, 0], exact=(5.10, 5.11)))}
+    assert far["donev-t6.1-exact-particle"].status == "fail"
+    small = {r.target: r for r in simplex_rows(simplex_summary([0, 0, 0, 0], n_b=126))}
+    assert {r.status for r in small.values()} == {"n/a"}
+    none = simplex_rows(simplex_summary([np.nan] * 4, iso=0))
+    assert all(r.status == "fail" and "no isostatic" in r.detail for r in none)
+
+
+def _eos(phi):
+    return xr.Dataset({"Z": ("sample", free_volume_z(phi)), "Z_err": ("sample", 1e-3 * free_volume_z(phi)),
+                       "N": ("sample", [108] * phi.size), "wall_time": ("sample", [1.0] * phi.size)},
+                      coords={"phi": ("sample", phi)})
 
 
 def test_density_row_compares_bcmd_with_the_eos_integral():
-    # BCMD excesses that follow the free-volume pressure exactly pass; a 0.02 offset fails
+    # BCMD excesses that follow the free-volume pressure exactly pass; a 0.05 offset fails
     phi = np.array([0.545, 0.6, 0.65, 0.7, 0.73])
     x = (phi / (np.pi / np.sqrt(18))) ** (1 / 3)
     exact = 6.0 - 3 * np.log((1 - x) / (1 - x[0]))
-    eos = xr.Dataset({"Z": ("sample", free_volume_z(phi)), "N": ("sample", [108] * 5),
-                      "wall_time": ("sample", [1.0] * 5)}, coords={"phi": ("sample", phi)})
 
-    def bcmd(excess):
-        return xr.Dataset({"excess": ("sample", excess), "n_particles": ("sample", [108] * 5),
-                           "n_events": ("sample", [1] * 5), "seconds": ("sample", [1.0] * 5)},
-                          coords={"phi": ("sample", phi), "seed": ("sample", [1] * 5)})
+    def bcmd(excess, noise=1e-3):
+        two = np.concatenate([excess - noise, excess + noise])  # two seeds per density
+        return xr.Dataset({"excess": ("sample", two), "n_particles": ("sample", [108] * two.size),
+                           "n_events": ("sample", [1] * two.size), "seconds": ("sample", [1.0] * two.size)},
+                          coords={"phi": ("sample", np.tile(phi, 2)), "seed": ("sample", np.repeat([1, 2], 5))})
 
-    row = density_rows(bcmd(exact), eos)[0]
-    assert row.passed and row.reproduced == pytest.approx(row.published, abs=1e-9)
-    assert not density_rows(bcmd(exact + np.r_[0, 0, 0, 0, 0.02]), eos)[0].passed
+    row = density_rows(bcmd(exact), _eos(phi))[0]
+    assert row.passed and row.reproduced == pytest.approx(0.0, abs=1e-9)
+    assert density_rows(bcmd(exact + np.r_[0, 0, 0, 0, 0.05]), _eos(phi))[0].status == "fail"
+
+
+def test_eos_integral_error_is_the_linear_propagation_of_the_point_errors():
+    phi = np.array([0.545, 0.6, 0.65, 0.7, 0.73])
+    z = free_volume_z(phi)
+    assert eos_integral_error(phi, z, np.zeros_like(z)) == 0.0
+    one = eos_integral_error(phi, z, 0.01 * z)
+    assert eos_integral_error(phi, z, 0.02 * z) == pytest.approx(2 * one, rel=1e-9)  # linear
 
 
 def test_ladder_rows():
-    ds = xr.Dataset({"value": ("check", [1.004, 0.5]), "exact": ("check", [1.0, 1.0]),
-                     "tolerance": ("check", [0.01, 0.01]), "why": ("check", ["x", "y"]),
-                     "seconds": ("check", [1.0, 1.0])},
-                    coords={"check": ["a", "b"]})
-    assert [r.passed for r in ladder_rows(ds)] == [True, False]
+    ds = xr.Dataset({"value": ("check", [0.004, 0.05, 3e-15]), "error": ("check", [0.003, 0.01, np.nan]),
+                     "n_samples": ("check", [10, 10, 1]), "seconds": ("check", [1.0, 1.0, 0.1])},
+                    coords={"check": ["bcmd-billiard-simplex", "bcmd-disjoint-cells-free-energy",
+                                      "bcmd-simplex-formula"]})
+    assert [r.status for r in ladder_rows(ds)] == ["pass", "fail", "pass"]

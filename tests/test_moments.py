@@ -1,4 +1,4 @@
-"""Moments and equivalent mixtures vs Ogarko's Tables 3.1, 3.3, 3.4 and closed forms (seed 002, note 002)."""
+"""Moments and equivalent mixtures vs Ogarko's Tables 3.1, 3.3, 3.4 (the validation targets) and closed forms."""
 
 import math
 
@@ -7,40 +7,75 @@ import pytest
 
 from hardpack.distributions import Discrete, LogNormal, bidisperse, monodisperse, uniform_size, uniform_volume
 from hardpack.eos import moments as mo
-from hardpack.eos.published import ONE_UNIT, TABLE_31_US, TABLE_31_UV, TABLE_33, TABLE_34, matches_printed, rows
+from hardpack.validation.analytic import moment_table_rows
+from hardpack.validation.targets import load_targets
 from hardpack.errors import InvalidInputError
 
 
-def assert_printed(value, printed, units=0.5):
-    """value rounds to the printed string (|value - printed| <= units * ulp, plus round-off)."""
-    assert matches_printed(value, printed, units), (value, printed)
+OMEGAS_31 = (1.2, 1.4, 2, 4, 5, 7, 8, 10, 20, 50, 100)
+#: the printed cells our values do not round to (Table 3.3 omega = 4 n2 and delta1; Table 3.4
+#: sigma = 0.15 n1, 0.5 delta2, 1.0 n2): each lies 0.51-0.77 units of the last digit below ours
+KNOWN_MISPRINTS = {"ogarko-t3.3-uv-omega4-n2", "ogarko-t3.3-uv-omega4-delta1", "ogarko-t3.4-ln-sigma0.15-n1",
+                   "ogarko-t3.4-ln-sigma0.5-delta2", "ogarko-t3.4-ln-sigma1.0-n2"}
 
 
-@pytest.mark.parametrize("row", rows(TABLE_31_US), ids=lambda r: f"US{r[0]}")
-def test_table_31_uniform_size(row):
-    dist = uniform_size(float(row[0]))
-    O1, O2 = mo.dimensionless_moments(dist)
-    eq = mo.equivalent_bidisperse(dist)
-    for value, printed in zip((O1, O2, eq.R, mo.polydispersity(dist)), row[1:]):
-        assert_printed(value, printed)
-    assert eq.n1 == pytest.approx(0.5, abs=1e-9)  # printed "1/2" for every omega (L5426-5430)
+def test_every_printed_cell_of_tables_31_33_34_rounds_to_ours_but_the_known_misprints():
+    rows = moment_table_rows()
+    assert len(rows) == 9 * 4 + 9 * 5 + 7 * 4 + 20 * 4  # one row per printed cell
+    assert {r.target for r in rows if r.status != "pass"} == KNOWN_MISPRINTS
+    for r in rows:
+        if r.target in KNOWN_MISPRINTS:
+            units = (r.reproduced - r.published) / (2 * r.tolerance)
+            assert 0.5 < units < 0.8 and r.status == "known deviation", (r.target, units)
+    # the table rounds: many of its cells lie below our values, so truncation does not explain the five
+    tri = [r for r in rows if r.target.startswith(("ogarko-t3.3", "ogarko-t3.4"))]
+    assert sum(r.reproduced < r.published for r in tri) == 42
 
 
-@pytest.mark.parametrize("row", rows(TABLE_31_UV), ids=lambda r: f"UV{r[0]}")
-def test_table_31_uniform_volume(row):
-    # Every entry, including omega = 1.2: O1 = 2 w ln w/(w^2 - 1) = 0.99448 rounds to the printed 0.994.
-    # (Note 002 calls this a rounding quirk by confusing it with US omega = 1.2, O1 = 0.99454 -> 0.995.)
-    dist = uniform_volume(float(row[0]))
-    O1, O2 = mo.dimensionless_moments(dist)
-    eq = mo.equivalent_bidisperse(dist)
-    for value, printed in zip((O1, O2, eq.R, eq.n1, mo.polydispersity(dist)), row[1:]):
-        assert_printed(value, printed)
+def test_uniform_size_bidisperse_equivalent_is_equimolar():
+    for omega in OMEGAS_31:
+        assert mo.equivalent_bidisperse(uniform_size(omega)).n1 == pytest.approx(0.5, abs=1e-9)
 
 
-@pytest.mark.parametrize("row", rows(TABLE_31_US) + rows(TABLE_31_UV), ids=lambda r: f"w{r[0]}")
-def test_closed_form_equivalent_matches_quadrature(row):
+def test_independent_high_precision_tridisperse_solve_agrees():
+    """The five misprinted cells, recomputed with 50-digit Gauss quadrature from the exact moments
+    (an independent route to the 3-node equivalent), agree with ours to 1e-10."""
+    mpmath = pytest.importorskip("mpmath")
+    mpmath.mp.dps = 50
+    for family, x, name in (("UV", 4, "n2"), ("UV", 4, "delta1"), ("LN", 0.15, "n1"), ("LN", 0.5, "delta2"),
+                            ("LN", 1.0, "n2")):
+        dist = uniform_volume(x) if family == "UV" else LogNormal(x)
+        ours = getattr(mo.equivalent_tridisperse(dist), name)
+        ref = _gauss_equivalent(mpmath, family, x)[name]
+        assert float(ref) == pytest.approx(ours, rel=1e-10), (family, x, name)
+
+
+def _gauss_equivalent(mp, family, x):
+    """The 3-node Gauss rule of the radius distribution, computed in 50 digits from its exact raw
+    moments M_0..M_5 (monic orthogonal polynomial from the Hankel system, nodes by polyroots,
+    weights by a Vandermonde solve), in Ogarko's conventions: number fractions n_i of the radii
+    a_1 > a_2 > a_3 and delta_i = n_i a_i / <a>."""
+    if family == "UV":
+        w = mp.mpf(x)
+        norm = (1 - w**-2) / 2  # f(a) ~ a^-3 on [1, w]
+        moments = [((w ** (k - 2) - 1) / (k - 2) if k != 2 else mp.log(w)) / norm for k in range(6)]
+    else:
+        s = mp.mpf(x)
+        moments = [mp.e ** (k * k * s * s / 2) for k in range(6)]
+    a = mp.matrix([[moments[i + j] for j in range(3)] for i in range(3)])
+    c = mp.lu_solve(a, mp.matrix([-moments[i + 3] for i in range(3)]))
+    nodes = sorted((mp.re(r) for r in mp.polyroots([1, c[2], c[1], c[0]], maxsteps=200, extraprec=200)),
+                   reverse=True)
+    v = mp.matrix([[node**k for node in nodes] for k in range(3)])
+    weights = mp.lu_solve(v, mp.matrix(moments[:3]))
+    mean = moments[1]
+    return {"n1": weights[0], "n2": weights[1], "delta1": weights[0] * nodes[0] / mean,
+            "delta2": weights[1] * nodes[1] / mean}
+
+
+@pytest.mark.parametrize("omega", OMEGAS_31)
+def test_closed_form_equivalent_matches_quadrature(omega):
     """Eqs. 3.20-3.21 (closed form from O1, O2) = 2-node Gauss quadrature, and back-substitution."""
-    omega = float(row[0])
     for dist in (uniform_size(omega), uniform_volume(omega)):
         eq = mo.equivalent_bidisperse(dist)
         n1, R = mo.bidisperse_from_O(*mo.dimensionless_moments(dist))
@@ -66,20 +101,12 @@ def test_table_31_limits():
     assert O1 < 1e-6 and O2 < 1e-11  # 2 ln(w)/w and 2 ln(w)^3/w^2
 
 
-def _tridisperse_check(kind, x, eq, printed):
-    for name, value, p in zip(("n1", "n2", "delta1", "delta2"), (eq.n1, eq.n2, eq.delta1, eq.delta2), printed):
-        assert_printed(value, p, 1.0 if (kind, x, name) in ONE_UNIT else 0.5)
-
-
-@pytest.mark.parametrize("row", rows(TABLE_33), ids=lambda r: f"UV{r[0]}")
-def test_table_33_uniform_volume_tridisperse(row):
-    omega = float(row[0])
-    dist = uniform_volume(omega)
-    eq = mo.equivalent_tridisperse(dist)
-    _tridisperse_check("UV", int(omega), eq, row[1:])
+@pytest.mark.parametrize("omega", (2, 3, 4, 5, 6, 8, 10))
+def test_uniform_volume_tridisperse_matches_five_moments(omega):
+    eq = mo.equivalent_tridisperse(uniform_volume(omega))
     a = eq.radii
-    assert a[0] > a[1] > a[2] > 0  # Ogarko's ordering a1 >= a2 >= a3 (L6336-6338)
-    assert mo.raw_moments(eq.mixture, 5) == pytest.approx(mo.raw_moments(dist, 5), rel=1e-10)
+    assert a[0] > a[1] > a[2] > 0  # Ogarko's ordering a1 >= a2 >= a3
+    assert mo.raw_moments(eq.mixture, 5) == pytest.approx(mo.raw_moments(uniform_volume(omega), 5), rel=1e-10)
 
 
 def test_table_33_radii_example():
@@ -87,14 +114,11 @@ def test_table_33_radii_example():
     assert mo.equivalent_tridisperse(uniform_volume(10)).radii == pytest.approx([4.454, 1.911, 0.726], abs=6e-4)
 
 
-@pytest.mark.parametrize("row", rows(TABLE_34), ids=lambda r: f"LN{r[0]}")
-def test_table_34_lognormal_tridisperse(row):
-    sigma = float(row[0])
-    dist = LogNormal(sigma)
-    eq = mo.equivalent_tridisperse(dist)
-    _tridisperse_check("LN", sigma, eq, row[1:])
+@pytest.mark.parametrize("sigma", (0.05, 0.5, 1.0))
+def test_lognormal_tridisperse_matches_five_moments(sigma):
     # sigma = 1: M_5 = e^10, n1 ~ 1e-5; the moments are still matched to 1e-10
-    assert mo.raw_moments(eq.mixture, 5) == pytest.approx(mo.raw_moments(dist, 5), rel=1e-10)
+    eq = mo.equivalent_tridisperse(LogNormal(sigma))
+    assert mo.raw_moments(eq.mixture, 5) == pytest.approx(mo.raw_moments(LogNormal(sigma), 5), rel=1e-10)
 
 
 @pytest.mark.parametrize("sigma", [0.1, 0.5, 1.0])

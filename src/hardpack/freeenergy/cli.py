@@ -107,8 +107,10 @@ def run_ladder(args) -> int:
 
     ds = ladder_dataset()
     write_dataset(ds, args.out)
-    for check, row in zip(ds.check.values, ds[["value", "exact", "seconds"]].to_dataframe().values):
-        print(f"{check}: {row[0]:.6g} (exact {row[1]:.6g}), {row[2]:.1f} s")
+    for check in ds.check.values:
+        row = ds.sel(check=check)
+        print(f"{check}: deviation from exact {float(row.value):.3g} +- {float(row.error):.2g} "
+              f"({int(row.n_samples)} samples, {float(row.seconds):.1f} s)")
     return 0
 
 

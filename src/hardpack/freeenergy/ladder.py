@@ -1,9 +1,9 @@
-"""The cheap rungs of the BCMD validation ladder (note ``bcmd_free_energy.md`` sec. 5.2 items
-1-3), each a number beside its exact value, for the tests and the validation report.
+"""The cheap rungs of the BCMD validation ladder, each a number beside its exact value, for the
+tests and the validation report (Donev 2006, ch. 6; Donev et al. 2007, Sec. 4).
 
 1. Disjoint cells: spheres whose cells never touch are independent billiards in shrinking balls,
    so Delta f = (d/2) ln(K/K_0) = d ln(dmu_max / dmu_min) exactly (Eq. 6.10 / 6.16), and the
-   cell pressure is p_c = mu / Delta mu (note sec. 1.5).
+   cell pressure is p_c = mu / Delta mu.
 2. A point billiard in a random simplex intersected with a shrinking ball recovers the simplex
    volume (Eq. 6.13; :mod:`hardpack.freeenergy.billiard`).
 3. The simplex-volume formula (Eq. 6.5) against qhull's volume of the vertex hull.
@@ -76,32 +76,44 @@ def simplex_formula_error(dims=(2, 3, 4, 5, 6), per_dim=3, seed=0) -> float:
     return worst
 
 
-def ladder_dataset() -> xr.Dataset:
-    """The rungs as one Dataset over ``check`` (value, exact, tolerance, why, seconds)."""
-    rows = []
+def _mean_error(values) -> tuple[float, float]:
+    values = np.asarray(values, float)
+    return float(values.mean()), float(values.std(ddof=1) / np.sqrt(values.size))
+
+
+def ladder_dataset(seeds=tuple(range(3, 13))) -> xr.Dataset:
+    """The rungs as one Dataset over ``check`` (the validation target ids ``bcmd-*``): each
+    check's deviation from its exact value, our standard error of it, the number of samples it
+    comes from, and the seconds it took.
+
+    - disjoint cells: BCMD's Delta f minus d ln 10, over ``seeds``;
+    - disjoint cells: p_c / (mu / dmu) - 1, over every segment of those runs;
+    - point billiard: volume / exact - 1 of a random 3-simplex, over ``seeds``;
+    - simplex formula: the worst |Eq. 6.5 / qhull - 1| (an identity: no error, one sample).
+    """
     t = time.perf_counter()
-    res, exact = disjoint_cells()
-    rows.append(("disjoint cells: (d/2) ln(K/K0) = d ln(dmu_max/dmu_min), FCC N = 32",
-                 res.delta_f, exact, 2e-3, "adiabatic error at wall speed ~1e-3 v",
-                 time.perf_counter() - t))
-    ds = res.dataset
-    ratio = float((ds.p_c / ((1 + ds.dmu_mid) / ds.dmu_mid)).mean())
-    rows.append(("disjoint cells: mean p_c / (mu / dmu)", ratio, 1.0, 0.01,
-                 "per-segment wall-impulse noise", 0.0))
+    runs = [disjoint_cells(seed=s) for s in seeds]
+    exact = runs[0][1]
+    df, df_err = _mean_error([res.delta_f - exact for res, _ in runs])
+    ratios = np.concatenate([(res.dataset.p_c / ((1 + res.dataset.dmu_mid) / res.dataset.dmu_mid)).values
+                             for res, _ in runs]) - 1.0
+    pc, pc_err = _mean_error(ratios)
+    t_cells = time.perf_counter() - t
     t = time.perf_counter()
-    ratios = [est / vol for est, vol, _ in (billiard_simplex(seed=s) for s in (5, 6, 7))]
-    rows.append(("point billiard: volume of a random 3-simplex / exact (mean of 3 runs)",
-                 float(np.mean(ratios)), 1.0, 0.01,
-                 "the issue's 1 % (seed scatter ~0.4 % per run)", time.perf_counter() - t))
+    billiard, billiard_err = _mean_error([est / vol - 1.0 for est, vol, _ in
+                                          (billiard_simplex(seed=s) for s in seeds)])
+    t_billiard = time.perf_counter() - t
     t = time.perf_counter()
-    err = simplex_formula_error()
-    rows.append(("simplex formula Eq. 6.5 vs qhull, max relative error (n = 2..6)", err, 0.0,
-                 1e-9, "round-off of a sparse LU and of qhull", time.perf_counter() - t))
-    names, value, exact, tol, why, seconds = zip(*rows)
+    formula = simplex_formula_error()
+    t_formula = time.perf_counter() - t
+    rows = [("bcmd-disjoint-cells-free-energy", df, df_err, len(seeds), t_cells),
+            ("bcmd-disjoint-cells-pressure", pc, pc_err, ratios.size, 0.0),
+            ("bcmd-billiard-simplex", billiard, billiard_err, len(seeds), t_billiard),
+            ("bcmd-simplex-formula", formula, np.nan, 1, t_formula)]
+    names, value, error, samples, seconds = zip(*rows)
     return xr.Dataset(
-        {"value": ("check", np.array(value)), "exact": ("check", np.array(exact)),
-         "tolerance": ("check", np.array(tol)), "why": ("check", np.array(why, dtype=str)),
-         "seconds": ("check", np.array(seconds))},
+        {"value": ("check", np.array(value)), "error": ("check", np.array(error)),
+         "n_samples": ("check", np.array(samples)), "seconds": ("check", np.array(seconds))},
         coords={"check": np.array(names, dtype=str)},
         attrs={"hardpack_kind": "bcmd_ladder"},
     )

@@ -16,6 +16,7 @@ from hardpack.freeenergy.crystal import (
 )
 from hardpack.plots.style import figure
 from hardpack.validation.freeenergy import TARGETS, finite_size_extrapolation
+from hardpack.validation.targets import load_targets
 
 
 def plot_fcc_finite_size(summaries: dict):
@@ -23,7 +24,9 @@ def plot_fcc_finite_size(summaries: dict):
     a + b ln N / N and the published values."""
     fig, axes = figure(1, len(summaries), figsize=(4.2 * len(summaries), 3.4), squeeze=False)
     for ax, (state, ds) in zip(axes.flat, summaries.items()):
-        value, lines, var, label = TARGETS[state]
+        tid, var = TARGETS[state]
+        target = load_targets()[tid]
+        value, label = target.published, target.quantity
         n = ds["n_particles"].values.astype(float)
         x = np.log(n) / n
         y = ds[var].values
@@ -34,7 +37,7 @@ def plot_fcc_finite_size(summaries: dict):
             xs = np.linspace(0, x.max(), 50)
             ax.plot(xs, a + b * xs, "-", color="C0", lw=0.8,
                     label=f"fit a + b ln N/N: a = {a:.4f} +- {err:.4f}")
-        ax.axhline(value, color="C3", ls="--", label=f"published {value} (ch. 6 {lines})")
+        ax.axhline(value, color="C3", ls="--", label=f"published {value} ({target.citation.split(' (')[0]})")
         ax.set_xlim(left=0)
         ax.set_xlabel(r"$\ln N / N$")
         ax.set_ylabel(label.replace("FCC ", "") + r" [$k_BT$ per particle]")

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from hardpack.plots.style import figure
-from hardpack.validation.packings import LS_TARGETS
-from hardpack.validation.rows import mean_sem
+from hardpack.validation.rows import seed_statistics
+from hardpack.validation.targets import load_targets
 
 
 def plot_jamming_vs_d(jammed: list, verdicts: list):
@@ -16,10 +16,11 @@ def plot_jamming_vs_d(jammed: list, verdicts: list):
     fig, (left, right) = figure(1, 2, figsize=(7.0, 3.0))
     for s in jammed:
         d = int(s["d"].values.ravel()[0])
-        mean, sem = mean_sem(s["phi"].values)
+        mean, sem, _, _ = seed_statistics(s["phi"].values)
         left.errorbar([d], [mean], [sem], fmt="o", color="C0",
                       label=f"LS, N = {int(s['N'].values.ravel()[0])}" if s is jammed[0] else None)
-    pub = sorted((d, v[0]) for (kind, d), v in LS_TARGETS.items() if kind == "monodisperse")
+    targets = load_targets()
+    pub = [(d, targets[f"donev-t11.1-phij-d{d}"].published) for d in range(3, 7)]
     left.plot(*zip(*pub), "k_", ms=14, mew=1.5, label="published (Skoge et al., Donev Table 11.1)")
     left.set_xlabel("dimension d")
     left.set_ylabel(r"jamming density $\phi_J$")
@@ -29,7 +30,7 @@ def plot_jamming_vs_d(jammed: list, verdicts: list):
     for s in verdicts:
         d = int(s["d"].values.ravel()[0])
         dims.append(d)
-        mean, sem = mean_sem(s["z_mean"].values)
+        mean, sem, _, _ = seed_statistics(s["z_mean"].values)
         right.errorbar([d], [mean], [sem], fmt="o", color="C1",
                        label="LS, rattlers removed" if s is verdicts[0] else None)
     if dims:

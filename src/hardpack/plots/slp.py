@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from hardpack.plots.style import figure
-from hardpack.slp.published import TABLE_I, TABLE_II
+from hardpack.slp.published import TABLE_II
+from hardpack.validation.targets import load_targets
 
 
 def plot_densest(summary):
@@ -53,12 +54,13 @@ def plot_slp_vs_ls(pairs: dict):
     labelled = False
     for k, n in enumerate(names):
         d = int(pairs[n][0]["d"].values[0]) if "d" in pairs[n][0] else None
-        if d in TABLE_I:
-            _, ls_pub, _, slp_pub, _ = TABLE_I[d]
-            ax.errorbar(k - 0.25, slp_pub[0], yerr=slp_pub[1], fmt="s", mfc="none", color="C0", capsize=3,
-                        label="Torquato & Jiao SLP (Table I)" if not labelled else None)
-            ax.errorbar(k + 0.25, ls_pub[0], yerr=ls_pub[1], fmt="^", mfc="none", color="C1", capsize=3,
-                        label="Torquato & Jiao LS (Table I)" if not labelled else None)
+        targets = load_targets()
+        if f"tj-t1-slp-phi-d{d}" in targets:
+            slp_pub, ls_pub = targets[f"tj-t1-slp-phi-d{d}"], targets[f"tj-t1-ls-phi-d{d}"]
+            ax.errorbar(k - 0.25, slp_pub.published, yerr=slp_pub.tolerance, fmt="s", mfc="none", color="C0",
+                        capsize=3, label="Torquato & Jiao SLP (Table I)" if not labelled else None)
+            ax.errorbar(k + 0.25, ls_pub.published, yerr=ls_pub.tolerance, fmt="^", mfc="none", color="C1",
+                        capsize=3, label="Torquato & Jiao LS (Table I)" if not labelled else None)
             labelled = True
     ax.set_xticks(x)
     ax.set_xticklabels([f"{n}\nd={int(pairs[n][0]['d'].values[0])}, N={int(pairs[n][0]['N'].values[0])}"

@@ -1,5 +1,11 @@
-"""The validation report: published numbers beside reproduced ones (issue 9)."""
+"""The validation report: every reproduced number beside its published target, and the gate.
 
-from hardpack.validation.rows import Row, to_dataset, to_markdown
+Targets are data (``targets.yaml``, :mod:`hardpack.validation.targets`); rows judge a reproduced
+value against a target (:mod:`hardpack.validation.rows`); one module per study builds its rows
+from the pipeline's summaries.
+"""
 
-__all__ = ["Row", "to_dataset", "to_markdown"]
+from hardpack.validation.rows import Row, evaluate, gate, to_dataset, to_markdown
+from hardpack.validation.targets import Target, load_targets
+
+__all__ = ["Row", "Target", "evaluate", "gate", "load_targets", "to_dataset", "to_markdown"]

@@ -1,82 +1,69 @@
-"""Validation rows computed from theory alone: Ogarko's moment tables and the HGrid cost model."""
+"""Validation rows computed from theory alone: Ogarko's moment tables and the HGrid cost model.
+
+Every printed cell of Ogarko's Tables 3.1, 3.3, 3.4 and the minima of Fig. 2.15 is a target of
+``targets.yaml``; each row puts our closed form beside it (it must round to the printed digits).
+"""
 
 from __future__ import annotations
 
-import math
-
 from hardpack.distributions import LogNormal, uniform_size, uniform_volume
 from hardpack.eos import moments as mo
-from hardpack.eos.published import (
-    FIG_2_15,
-    ONE_UNIT,
-    TABLE_31_US,
-    TABLE_31_UV,
-    TABLE_33,
-    TABLE_34,
-    matches_printed,
-    rows,
-    ulp,
-)
-from hardpack.validation.rows import Row
-
-OGARKO = "Ogarko dissertation (seed 002)"
-ROUNDING = "reproduced value must round to the printed digits"
+from hardpack.validation.rows import Row, evaluate
+from hardpack.validation.targets import load_targets
 
 
-def _table_row(study, label, source, printed, values, names, exceptions=frozenset()):
-    units = [1.0 if name in exceptions else 0.5 for name in names]
-    ok = all(matches_printed(v, p, u) for v, p, u in zip(values, printed, units))
-    worst = max(abs(v - float(p)) / ulp(p) for v, p in zip(values, printed))
-    detail = ", ".join(f"{n} {p} vs {v:.6g}" for n, p, v in zip(names, printed, values))
-    why = ROUNDING + (f"; one unit for {sorted(exceptions)} (printed digits truncated, see tests)" if exceptions else "")
-    return Row(study, label, source, float(printed[0]), float(values[0]), math.nan,
-               units[0] * ulp(printed[0]), why, ok, detail + f"; worst {worst:.2f} units of the last digit")
+def _cells(prefix: str) -> dict[str, dict[str, object]]:
+    """Targets of one printed table: {row label: {column: Target}} (e.g. "omega1.2": {"o1": ...})."""
+    out: dict[str, dict[str, object]] = {}
+    for tid, t in load_targets().items():
+        if tid.startswith(prefix + "-"):
+            label, _, column = tid[len(prefix) + 1:].rpartition("-")
+            out.setdefault(label, {})[column] = t
+    return out
+
+
+def _parameter(label: str, name: str) -> float:
+    return float(label.removeprefix(name))
+
+
+def moment_values(family: str, width: float) -> dict[str, float]:
+    """Our closed forms of every column of Tables 3.1 (US, UV), 3.3 (UV) and 3.4 (LN) at one width,
+    keyed like the table columns (lower case)."""
+    if family == "us":
+        dist = uniform_size(width)
+    elif family == "uv":
+        dist = uniform_volume(width)
+    else:
+        dist = LogNormal(width)
+    o1, o2 = mo.dimensionless_moments(dist)
+    bi = mo.equivalent_bidisperse(dist)
+    tri = mo.equivalent_tridisperse(dist)
+    return {"o1": o1, "o2": o2, "r_bi": bi.R, "n1_bi": bi.n1, "delta": mo.polydispersity(dist),
+            "n1": tri.n1, "n2": tri.n2, "delta1": tri.delta1, "delta2": tri.delta2}
 
 
 def moment_table_rows() -> list[Row]:
-    """Tables 3.1 (US, UV), 3.3 (UV tridisperse) and 3.4 (log-normal tridisperse): one row per printed line."""
+    """One row per printed cell of Tables 3.1 (US, UV), 3.3 (UV tridisperse) and 3.4 (log-normal)."""
     out = []
-    study = "EOS vs moments: equivalent mixtures (analytic)"
-    for line in rows(TABLE_31_US):
-        dist = uniform_size(float(line[0]))
-        o1, o2 = mo.dimensionless_moments(dist)
-        values = (o1, o2, mo.equivalent_bidisperse(dist).R, mo.polydispersity(dist))
-        out.append(_table_row(study, f"Table 3.1 US omega={line[0]}: O1, O2, R_bi, delta",
-                              f"{OGARKO} L5470-5516", line[1:], values, ("O1", "O2", "R_bi", "delta")))
-    for line in rows(TABLE_31_UV):
-        dist = uniform_volume(float(line[0]))
-        o1, o2 = mo.dimensionless_moments(dist)
-        bi = mo.equivalent_bidisperse(dist)
-        values = (o1, o2, bi.R, bi.n1, mo.polydispersity(dist))
-        out.append(_table_row(study, f"Table 3.1 UV omega={line[0]}: O1, O2, R_bi, n1_bi, delta",
-                              f"{OGARKO} L5470-5516", line[1:], values, ("O1", "O2", "R_bi", "n1_bi", "delta")))
-    for table, key, make, lines_ref in ((TABLE_33, "UV", uniform_volume, "L6466-6486"),
-                                        (TABLE_34, "LN", LogNormal, "L6606-6652")):
-        for line in rows(table):
-            par = float(line[0])
-            tri = mo.equivalent_tridisperse(make(par))
-            values = (tri.n1, tri.n2, tri.delta1, tri.delta2)
-            names = ("n1", "n2", "delta1", "delta2")
-            exceptions = frozenset(n for n in names if (key, par, n) in ONE_UNIT)
-            label = "omega" if key == "UV" else "sigma"
-            tab = "3.3" if key == "UV" else "3.4"
-            out.append(_table_row(study, f"Table {tab} {key} {label}={line[0]}: tridisperse n1, n2, delta1, delta2",
-                                  f"{OGARKO} {lines_ref}", line[1:], values, names, exceptions))
+    for prefix, family, name in (("ogarko-t3.1-us", "us", "omega"), ("ogarko-t3.1-uv", "uv", "omega"),
+                                 ("ogarko-t3.3-uv", "uv", "omega"), ("ogarko-t3.4-ln", "ln", "sigma")):
+        for label, columns in _cells(prefix).items():
+            values = moment_values(family, _parameter(label, name))
+            for column, t in columns.items():
+                out.append(evaluate(t, values[column]))
     return out
 
 
 def hgrid_rows() -> list[Row]:
-    """Fig. 2.15 minima of the analytic HGrid cost (alpha = -3, omega = 100, nu = 0.7, d = 3, K = 0.2)."""
+    """Fig. 2.15: minima of the analytic HGrid cost and their level counts (alpha = -3,
+    omega = 100, nu = 0.7, d = 3, K = 0.2), one row per printed number."""
     from hardpack.hgrid.cost_model import PowerLawSystem, best_levels
 
     system = PowerLawSystem(alpha=-3.0, omega=100.0, nu=0.7, d=3)
     out = []
-    for rule, (printed, levels) in FIG_2_15.items():
-        l_max = 50 if rule != "optimal" else 12
-        L, cost, _ = best_levels(system, rule, L_max=l_max)
-        detail = f"minimum at L = {L}" + (f" (printed L = {levels})" if levels else "")
-        ok = abs(cost - printed) <= 0.01 and (levels is None or L == levels)
-        out.append(Row("Hierarchical grid cost model (analytic)", f"Fig. 2.15 minimum T/N, {rule} cell sizes",
-                       f"{OGARKO} L3090-3112", printed, float(cost), math.nan, 0.01,
-                       "printed to 2 decimals; the level count must match too", ok, detail))
+    for rule, columns in _cells("ogarko-fig2.15-min").items():
+        levels, cost, _ = best_levels(system, rule, L_max=12 if rule == "optimal" else 50)
+        values = {"cost": float(cost), "levels": float(levels)}
+        for column, t in columns.items():
+            out.append(evaluate(t, values[column], detail=f"minimum at L = {levels}"))
     return out

@@ -1,32 +1,38 @@
-"""``hardpack validate``: write the validation table (netCDF) and report (Markdown).
+"""``hardpack validate``: the validation table (netCDF), the report (Markdown) and the gate.
 
 Each input is ``NAME=PATH``: NAME picks the row builder of :data:`ROW_BUILDERS` (one per study),
 PATH is a summary Dataset the pipeline wrote. A builder receives every dataset given under its
 name, in order. The analytic rows (moment tables, hierarchical-grid cost model) need no input.
+
+The gate (:func:`hardpack.validation.rows.gate`): the command exits with status 1 when an
+applicable row fails, when a documented deviation now passes, or when fewer than
+``--min-applicable`` reproduction and analytic rows are applicable. ``--check TABLE.nc`` applies
+the gate to a table written before (the pipeline writes the report first, so that a failing gate
+keeps it).
 """
 
 from __future__ import annotations
 
 import logging
+import sys
 
 from hardpack.errors import InvalidInputError
 from hardpack.io import load_dataset, write_dataset
 from hardpack.io.atomic import write_text
 from hardpack.validation.analytic import hgrid_rows, moment_table_rows
-from hardpack.validation.freeenergy import (
-    bcmd_rows,
-    density_rows,
-    ladder_rows,
-    simplex_rows,
-)
+from hardpack.validation.freeenergy import bcmd_rows, density_rows, ladder_rows, simplex_rows
 from hardpack.validation.jamming import jamming_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
 from hardpack.validation.polydisperse import polydisperse_rows
-from hardpack.validation.rows import to_dataset, to_markdown
+from hardpack.validation.rows import from_dataset, gate, headline, to_dataset, to_markdown
 from hardpack.validation.slp import densest_rows, mrj_jamming_rows, order_map_rows
 from hardpack.validation.structure import structure_rows
+from hardpack.validation.targets import load_targets
 
 log = logging.getLogger(__name__)
+
+#: the smallest number of applicable reproduction and analytic rows the gate accepts
+MIN_APPLICABLE = 30
 
 #: input name -> function(list of summary Datasets) -> list of Rows
 ROW_BUILDERS = {
@@ -58,22 +64,54 @@ def parse_inputs(items: list[str]) -> dict[str, list[str]]:
     return grouped
 
 
-def cmd_validate(args) -> int:
-    """Validation table and report from the pipeline's summaries (NAME=PATH inputs)."""
+def build_rows(inputs: dict[str, list[str]]) -> list:
+    """Every validation row: the analytic ones and those of each named summary."""
     rows = moment_table_rows() + hgrid_rows()
-    for name, paths in parse_inputs(args.inputs).items():
+    for name, paths in inputs.items():
         rows += ROW_BUILDERS[name]([load_dataset(p) for p in paths])
-    write_dataset(to_dataset(rows), args.out_nc)
-    write_text(args.out_md, to_markdown(rows))
-    n_pass = sum(r.passed for r in rows)
-    log.info("validation: %d of %d rows pass; wrote %s and %s", n_pass, len(rows), args.out_nc, args.out_md)
+    return rows
+
+
+def _report_gate(rows, min_applicable: int) -> int:
+    problems = gate(rows, min_applicable)
+    for line in headline(rows):
+        log.info("validation %s", line.removeprefix("- ").replace("**", ""))
+    if problems:
+        print(f"hardpack validate: the gate failed ({len(problems)} problem(s)):", file=sys.stderr)
+        for p in problems:
+            print(f"  {p}", file=sys.stderr)
+        return 1
+    log.info("validation gate passed")
     return 0
+
+
+def cmd_validate(args) -> int:
+    """Validation table, report and gate from the pipeline's summaries (NAME=PATH inputs)."""
+    if args.check:
+        if args.inputs or args.out_nc or args.out_md:
+            raise InvalidInputError("--check TABLE.nc takes no inputs and no --out-nc / --out-md")
+        return _report_gate(from_dataset(load_dataset(args.check, kind="validation")), args.min_applicable)
+    if not (args.out_nc and args.out_md):
+        raise InvalidInputError("give --out-nc and --out-md (or --check TABLE.nc to gate a written table)")
+    rows = build_rows(parse_inputs(args.inputs))
+    measured = {r.target for r in rows}
+    unmeasured = [t for tid, t in load_targets().items() if tid not in measured]
+    write_dataset(to_dataset(rows), args.out_nc)
+    write_text(args.out_md, to_markdown(rows, gate(rows, args.min_applicable), unmeasured))
+    log.info("wrote %s and %s", args.out_nc, args.out_md)
+    return 0 if args.no_gate else _report_gate(rows, args.min_applicable)
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("validate", help=cmd_validate.__doc__)
     p.add_argument("inputs", nargs="*", metavar="NAME=PATH",
                    help=f"summary datasets by row builder ({', '.join(ROW_BUILDERS)}); repeatable")
-    p.add_argument("--out-nc", required=True, help="validation table (netCDF)")
-    p.add_argument("--out-md", required=True, help="readable report (Markdown)")
+    p.add_argument("--out-nc", help="validation table (netCDF)")
+    p.add_argument("--out-md", help="readable report (Markdown)")
+    p.add_argument("--check", metavar="TABLE.nc", help="apply the gate to a validation table written before")
+    p.add_argument("--min-applicable", type=int, default=MIN_APPLICABLE,
+                   help=f"fewest applicable reproduction and analytic rows the gate accepts (default {MIN_APPLICABLE})")
+    p.add_argument("--no-gate", action="store_true",
+                   help="write the table and report and exit 0 whatever the rows say (the pipeline "
+                        "gates in a separate step, so that a failing gate keeps the report)")
     p.set_defaults(func=cmd_validate)

@@ -1,4 +1,4 @@
-"""Validation rows of the BCMD study (issue 7): FCC at melting and in the jamming limit (finite-N
+"""Validation rows of the BCMD study: FCC at melting and in the jamming limit (finite-N
 extrapolation), FCC vs density (BCMD against the engine's EOS), LS packings against their exact
 jamming simplex, and the cheap ladder checks. Each row's detail gives the cost of its point."""
 
@@ -8,20 +8,15 @@ import math
 
 import numpy as np
 
-from hardpack.freeenergy.crystal import (
-    MELTING_EXCESS,
-    MELTING_PHI,
-    cell_offset,
-    eos_excess,
-)
-from hardpack.validation.rows import Row, within
+from hardpack.freeenergy.crystal import MELTING_PHI, cell_offset, eos_excess
+from hardpack.validation.jamming import largest_magnitude
+from hardpack.validation.rows import Row, evaluate, seed_statistics
+from hardpack.validation.targets import load_targets
 
-SOURCE = "Donev dissertation ch. 6 (seed 000, ch06.txt)"
-STUDY = "BCMD free energies"
-# (published value, lines, quantity attribute in the BCMD dataset)
+#: state -> (target id, variable of the BCMD summary)
 TARGETS = {
-    "melting": (5.91916, "L1008-1010", "excess", "FCC excess free energy at phi = 0.545"),
-    "jamming": (2.160, "L1012-1018", "delta_f", "FCC jamming-limit constant f_J - f_c^J"),
+    "melting": ("donev-ch6-fcc-melting", "excess"),
+    "jamming": ("donev-ch6-fcc-jamming", "delta_f"),
 }
 
 
@@ -35,10 +30,11 @@ def _cost(ds) -> str:
 
 
 def finite_size_extrapolation(n, values) -> tuple[float, float, str]:
-    """Infinite-N value from values(N) = a + b ln(N)/N (the leading correction, note sec. 5.4).
+    """Infinite-N value from values(N) = a + b ln(N)/N (the leading finite-size correction of a
+    free energy per particle, Donev 2006, Sec. 6.4.1), with the fit's standard error of a.
 
-    With fewer than three sizes, the largest-N mean is returned with the size of the correction
-    3 ln N / N as its uncertainty, and the caller must not count it as a reproduction.
+    With fewer than three sizes there is nothing to fit: the largest-N mean is returned with a
+    NaN error (the caller reports the row n/a).
     """
     n = np.asarray(n, float)
     values = np.asarray(values, float)
@@ -52,103 +48,100 @@ def finite_size_extrapolation(n, values) -> tuple[float, float, str]:
         cov = sigma2 * np.linalg.inv(design.T @ design)
         return float(coef[0]), math.sqrt(max(cov[0, 0], 0.0)), f"fit a + b ln N / N over N = {sizes.astype(int).tolist()}"
     big = sizes.max()
-    return float(values[n == big].mean()), 3 * math.log(big) / big, f"largest N = {int(big)} only (no extrapolation)"
+    return float(values[n == big].mean()), math.nan, f"largest N = {int(big)} only (no extrapolation)"
 
 
 def bcmd_rows(summaries: dict) -> list[Row]:
     """One row per state in ``summaries`` (state name -> combined BCMD Dataset)."""
+    targets = load_targets()
     out = []
     for state, ds in summaries.items():
-        value, lines, var, label = TARGETS[state]
-        est, err, how = finite_size_extrapolation(ds["n_particles"].values, ds[var].values)
-        extrapolated = np.unique(ds["n_particles"].values).size >= 3
-        out.append(Row(
-            "BCMD free energies (FCC)", label, f"{SOURCE} {lines}", value, est, err, 0.005,
-            "the issue's acceptance band after the finite-N correction; the +- is the fit error",
-            extrapolated and within(est, value, 0.005, err),
-            (how if extrapolated else how + ": inconclusive, counted as not reproduced")
-            + f"; {_cost(ds)}",
-        ))
+        tid, var = TARGETS[state]
+        n = ds["n_particles"].values
+        est, err, how = finite_size_extrapolation(n, ds[var].values)
+        out.append(evaluate(targets[tid], est, err, n=int(n.max()), sizes=np.unique(n).size,
+                            detail=f"{how}; {_cost(ds)}"))
     return out
 
 
+def eos_integral_error(phi, z, z_err) -> float:
+    """Standard error of the EOS integral from phi.min() to phi.max(): the spline integral is
+    linear in the measured Z, so each point's error enters through its exact sensitivity."""
+    phi, z, z_err = (np.asarray(a, float) for a in (phi, z, z_err))
+    top = np.argmax(phi)
+    base = eos_excess(phi, z, excess0=0.0)[top]
+    total = 0.0
+    for i in range(z.size):
+        if not (np.isfinite(z_err[i]) and z_err[i] > 0):
+            continue
+        dz = z.copy()
+        dz[i] += z_err[i]
+        total += (eos_excess(phi, dz, excess0=0.0)[top] - base) ** 2
+    return math.sqrt(total)
+
+
 def density_rows(density, eos) -> list[Row]:
-    """BCMD's change of the FCC excess free energy from melting to the densest point against the
+    """BCMD's change of the FCC excess free energy from melting to the densest point minus the
     integral of the engine's crystal EOS over the same range (both at the same N; the finite-N
     offsets of the two BCMD points cancel to O(ln N / N) of their difference).
-    density: the BCMD summary over (phi, seed); eos: the MD summary over phi."""
-    bcmd = density
-    phi_b = bcmd["phi"].values
-    excess = bcmd["excess"].values
+
+    density: the BCMD summary over (phi, seed); eos: the MD summary over phi (Z, Z_err)."""
+    phi_b, excess = density["phi"].values, density["excess"].values
     lo, hi = np.isclose(phi_b, MELTING_PHI, atol=1e-6), np.isclose(phi_b, phi_b.max())
-    reproduced = float(excess[hi].mean() - excess[lo].mean())
-    spread = [np.std(excess[m], ddof=1) / np.sqrt(m.sum()) for m in (lo, hi) if m.sum() > 1]
-    err = float(np.hypot(*spread)) if len(spread) == 2 else math.nan
+    low, low_err, n_low, _ = seed_statistics(excess[lo])
+    high, high_err, n_high, _ = seed_statistics(excess[hi])
     phi_e, z = eos["phi"].values, eos["Z"].values
-    integral = eos_excess(phi_e, z, excess0=0.0)[np.argmax(phi_e)]
-    df_eos = float(cell_offset(phi_e.max()) - MELTING_EXCESS - integral)
-    n = int(np.asarray(bcmd["n_particles"].values).ravel()[0])
-    return [Row(
-        STUDY, f"FCC excess(phi = {phi_b.max():.4g}) - excess(0.545): BCMD vs int (Z - 1) dphi/phi",
-        "thermodynamic integration of the engine's crystal EOS (this pipeline)", float(integral),
-        reproduced, err, 0.01,
-        "two BCMD points with seed scatter ~0.004 each; EOS spline error < 1e-3",
-        within(reproduced, float(integral), 0.01, err),
-        f"N = {n}; Delta f(phi_max): BCMD {float(cell_offset(phi_b.max()) - excess[hi].mean()):.4f}"
-        f", published 5.91916 + EOS integral {df_eos:.4f} (jamming limit 2.160); BCMD "
-        f"{_cost(bcmd)}; EOS {eos.sizes['sample']} runs, "
-        f"{float(eos['wall_time'].sum()):.3g} s",
+    z_err = eos["Z_err"].values if "Z_err" in eos else np.full_like(z, np.nan)
+    integral = float(eos_excess(phi_e, z, excess0=0.0)[np.argmax(phi_e)])
+    integral_err = eos_integral_error(phi_e, z, z_err)
+    difference = (high - low) - integral
+    err = math.sqrt(sum(e**2 for e in (low_err, high_err, integral_err) if math.isfinite(e)))
+    n = int(np.asarray(density["n_particles"].values).ravel()[0])
+    return [evaluate(
+        load_targets()["bcmd-density-vs-eos"], difference, err, n=n, seeds=min(n_low, n_high),
+        label=f"phi = {phi_b.max():.4g}",
+        detail=f"N = {n}; BCMD {high - low:.4f} against the EOS integral {integral:.4f} +- "
+               f"{integral_err:.2g}; Delta f(phi_max) by BCMD {float(cell_offset(phi_b.max())) - high:.4f}; "
+               f"BCMD {_cost(density)}; EOS {eos.sizes['sample']} runs, {float(eos['wall_time'].sum()):.3g} s",
     )]
 
 
 def simplex_rows(ds) -> list[Row]:
-    """BCMD of rattler-free LS packings vs their exact jamming simplex, one row per frozen mode
-    (means over packings; the tolerance is the issue's 1 %)."""
+    """BCMD of rattler-free LS packings against their exact jamming simplex (Donev 2006, Table
+    6.1), per frozen mode: the exact value against the published one of Table 6.1's packing, and
+    the largest relative difference of BCMD from the exact value. Only isostatic backbones have a
+    simplex; a mode without one fails with the isostaticity gaps in its detail."""
+    targets = load_targets()
     out = []
-    for frozen in ("particle", "cm"):
+    for frozen, suffix in (("particle", "particle"), ("cm", "cm")):
         sel = ds.isel(sample=np.flatnonzero(ds["frozen"].values == frozen))
         iso = sel["isostatic"].values.astype(bool)
-        n = sel["n_backbone"].values
-        label = ("frozen particle" if frozen == "particle"
-                 else "frozen centre of mass (exact + d ln N / N)")
+        n_b = sel["n_backbone"].values.astype(int)
+        n = int(n_b.max()) if n_b.size else 0
         if not iso.any():
-            gaps = sel["isostaticity_gap"].values.tolist()
-            out.append(Row(
-                STUDY, f"f_J - f_c^J of LS backbones, BCMD vs exact simplex, {label}",
-                f"{SOURCE} Table 6.1 L1082-1139 (method)", math.nan, math.nan, math.nan, 0.01,
-                "the issue's 1 %", False,
-                f"no isostatic backbone (M - N_f - 1 = {gaps}): the simplex formula does not apply",
-            ))
+            detail = (f"no isostatic backbone (M - N_f - 1 = {sel['isostaticity_gap'].values.tolist()}): "
+                      "the simplex formula does not apply")
+            for tid in (f"donev-t6.1-exact-{suffix}", f"donev-t6.1-bcmd-vs-exact-{suffix}"):
+                out.append(evaluate(targets[tid], math.nan, n=n, seeds=sel.sizes["sample"], detail=detail))
             continue
-        exact = sel["exact"].values[iso]
-        bcmd = sel["bcmd"].values[iso]
         rel = sel["rel_diff"].values[iso]
-        diff = bcmd - exact  # the packings differ; their differences are the sample
-        err = float(np.std(diff, ddof=1) / np.sqrt(diff.size)) if diff.size > 1 else math.nan
-        shift = sel["dim"].values[iso] * np.log(n[iso]) / n[iso] if frozen == "cm" else None
-        detail = (f"{iso.sum()} isostatic backbone(s), N_b = {n[iso].tolist()}, relative "
-                  f"differences {np.round(rel, 4).tolist()}; {_cost(sel)}")
-        if shift is not None:
-            detail += f"; CM shift d ln N / N = {np.round(shift, 4).tolist()}"
-        out.append(Row(
-            STUDY, f"f_J - f_c^J of LS backbones, BCMD vs exact simplex, {label}",
-            f"{SOURCE} Table 6.1 L1082-1139 (method; exact value from Eq. 6.5)",
-            float(exact.mean()), float(bcmd.mean()), err, 0.01 * float(exact.mean()),
-            "the issue's 1 % (the paper: ~0.05 % at N = 978)",
-            bool(np.all(np.abs(rel) <= 0.01)), detail,
-        ))
+        detail = (f"{iso.sum()} isostatic backbone(s), N_b = {n_b[iso].tolist()}, BCMD / exact - 1 = "
+                  f"{np.round(rel, 5).tolist()}; {_cost(sel)}")
+        n_iso = int(n_b[iso].max())
+        out.append(evaluate(targets[f"donev-t6.1-exact-{suffix}"], samples=sel["exact"].values[iso], n=n_iso,
+                            detail=detail + ("; centre-of-mass value = exact + d ln N_b / N_b" if frozen == "cm" else "")))
+        out.append(evaluate(targets[f"donev-t6.1-bcmd-vs-exact-{suffix}"], largest_magnitude(rel), n=n_iso,
+                            seeds=int(iso.sum()), detail=detail))
     return out
 
 
 def ladder_rows(ds) -> list[Row]:
-    """The cheap checks (hardpack.freeenergy.ladder): |value - exact| <= tolerance."""
+    """The cheap checks (:func:`hardpack.freeenergy.ladder.ladder_dataset`): each check's
+    deviation from its exact value against 0 with our standard error."""
+    targets = load_targets()
     out = []
     for check in ds["check"].values:
         r = ds.sel(check=check)
-        value, exact, tol = float(r["value"]), float(r["exact"]), float(r["tolerance"])
-        out.append(Row(
-            STUDY, str(check), "note bcmd_free_energy.md sec. 5.2 items 1-3 (exact values)",
-            exact, value, math.nan, tol, str(r["why"].values),
-            within(value, exact, tol), f"cost {float(r['seconds']):.2g} s",
-        ))
+        out.append(evaluate(targets[str(check)], float(r["value"]), float(r["error"]),
+                            seeds=int(r["n_samples"]), detail=f"cost {float(r['seconds']):.2g} s"))
     return out

@@ -1,13 +1,8 @@
-"""Validation rows of the jamming verdicts of the LS packings (Donev ch. 4 and ch. 9).
+"""Validation rows of the jamming verdicts of the LS packings (Donev 2006, ch. 4 and ch. 9).
 
 Input: ensemble jamming summaries (``jamming_summary`` rule: per seed z_mean, rattler_fraction,
-collective, ...), matched to a published system by :func:`hardpack.validation.packings.system_key`.
-
-- mean contact number after rattler removal: isostatic 2d (3D spheres 6, L1659-1661 of ch. 9;
-  2D binary disks 4), tolerance 0.05 (the issue's band: an isostatic backbone of N_b particles has
-  Z = 2d (1 - 1/N_b) + 2/N_b, within 0.01 of 2d for N_b >= 200);
-- rattler fraction, 3D monodisperse: about 2.2 % (ch. 9 L1659-1661), tolerance 0.008 (<= 3 %);
-- fraction of packings collectively jammed: 1 (LS packings at Z = 1e12 are, ch. 4 sec. 4.5).
+isostaticity_gap, collective, ...), matched to a published system by
+:func:`hardpack.validation.packings.system_key`.
 """
 
 from __future__ import annotations
@@ -16,37 +11,69 @@ import math
 
 import numpy as np
 
-from hardpack.validation.packings import system_key
-from hardpack.validation.rows import Row, mean_sem, within
+from hardpack.validation.packings import n_particles, system_key
+from hardpack.validation.rows import Row, evaluate
+from hardpack.validation.targets import load_targets
 
-CH9 = "Donev dissertation ch. 9 (seed 000, ch07-09)"
-CH4 = "Donev dissertation ch. 4 (seed 000, ch04-05)"
+def _system(key) -> str | None:
+    """Target suffix of a recognised system: d<d> for monodisperse spheres, binary2d."""
+    if key is None:
+        return None
+    if key[0] == "monodisperse":
+        return f"d{key[1]}"
+    return "binary2d" if key == ("binary_1.4_equimolar", 2) else None
 
+
+def fraction_statistics(values, n_particles: int) -> tuple[float, float]:
+    """Mean of per-seed particle fractions and its uncertainty: the larger of the standard error
+    over seeds and the binomial error of the pooled count (one packing of N particles still has
+    sqrt(f (1 - f) / N)). NaN values make the mean NaN (the row then fails)."""
+    values = np.asarray(values, float)
+    mean = float(values.mean())
+    if not math.isfinite(mean):
+        return math.nan, math.nan
+    binomial = math.sqrt(max(mean * (1 - mean), 0.0) / (n_particles * values.size))
+    sem = values.std(ddof=1) / math.sqrt(values.size) if values.size > 1 else 0.0
+    return mean, max(binomial, sem)
+
+
+def verdict_fraction(values) -> float:
+    """Fraction of seeds with a positive verdict (NaN when any verdict is missing)."""
+    values = np.asarray(values, float)
+    return float(np.mean(values == 1)) if np.all(np.isfinite(values)) else math.nan
+
+
+def largest_magnitude(values) -> float:
+    """The value of largest magnitude (NaN if any is missing): a per-packing claim must hold for
+    every seed."""
+    values = np.asarray(values, float)
+    return float(values[np.argmax(np.abs(values))]) if np.all(np.isfinite(values)) else math.nan
 
 
 def jamming_rows(summaries) -> list[Row]:
-    """Contact number, rattler fraction and collective-jamming rate of recognised LS ensembles."""
+    """Isostaticity, rattler fraction and collective-jamming rate of recognised LS ensembles."""
+    targets = load_targets()
     out = []
     for s in summaries:
-        key = system_key(s)
-        if key not in (("monodisperse", 3), ("binary_1.4_equimolar", 2)):
+        system = _system(system_key(s))
+        if system is None:
             continue
-        name, d = s.attrs.get("ensemble", "?"), key[1]
-        size = f"N = {int(s['N'].values[0])}, {s.sizes['sample']} seeds"
-        z, z_sem = mean_sem(s["z_mean"].values)
-        out.append(Row("jamming (LP verdicts)", f"{name}: contact number after rattlers, {key[0]} d = {d}",
-                       f"{CH9} L1659-1661 (isostatic Z = 2d)", 2.0 * d, z, z_sem, 0.05,
-                       "issue band; a finite isostatic backbone has 2d(1 - 1/N_b) + 2/N_b",
-                       within(z, 2.0 * d, 0.05, z_sem),
-                       f"{size}; isostaticity gaps {', '.join(str(int(g)) for g in s['isostaticity_gap'].values)}"))
-        if key == ("monodisperse", 3):
-            r, r_sem = mean_sem(s["rattler_fraction"].values)
-            out.append(Row("jamming (LP verdicts)", f"{name}: rattler fraction, monodisperse d = 3",
-                           f"{CH9} L1659-1661", 0.022, r, r_sem, 0.008, "issue: at most 3 %",
-                           within(r, 0.022, 0.008, r_sem), size))
-        collective = np.asarray(s["collective"].values) == 1
-        out.append(Row("jamming (LP verdicts)", f"{name}: fraction collectively jammed",
-                       f"{CH4} sec. 4.5", 1.0, float(collective.mean()), math.nan, 0.0,
-                       "every LS packing at Z = 1e12 should pass the collective test",
-                       bool(collective.all()), size))
+        n, seeds, label = n_particles(s), s.sizes["sample"], s.attrs.get("ensemble", "")
+        size = f"N = {n}, {seeds} seeds"
+        gaps = np.asarray(s["isostaticity_gap"].values, float)
+        if f"donev-ch9-isostatic-{system}" in targets:
+            out.append(evaluate(
+                targets[f"donev-ch9-isostatic-{system}"], largest_magnitude(gaps), n=n, seeds=seeds, label=label,
+                detail=f"{size}; the claim holds per packing, so the row takes the gap of largest magnitude; "
+                       f"gaps per seed {', '.join(f'{g:g}' for g in gaps)}; backbone Z "
+                       f"{', '.join(f'{z:.4f}' for z in s['z_mean'].values)}"))
+        f, unc = fraction_statistics(s["rattler_fraction"].values, n)
+        for tid in (f"donev-ch9-rattlers-{system}", f"tj-t1-ls-rattlers-{system}"):
+            if tid in targets:
+                out.append(evaluate(targets[tid], f, unc, n=n, seeds=seeds, label=label,
+                                    detail=f"{size}; uncertainty: binomial or over seeds, the larger"))
+        if f"donev-4.7.2-collective-{system}" in targets:
+            out.append(evaluate(targets[f"donev-4.7.2-collective-{system}"],
+                                verdict_fraction(s["collective"].values), n=n, seeds=seeds, label=label,
+                                detail=size))
     return out

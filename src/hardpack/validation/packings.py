@@ -1,31 +1,27 @@
-"""Validation rows for jamming densities of generated ensembles (LS engine and SLP MRJ runs).
+"""Validation rows for the jamming densities of generated ensembles (LS engine and SLP MRJ runs).
 
 An ensemble summary (``hardpack combine`` output with attributes ``ensemble`` and
-``distribution``) is matched to a published system by its dimension and size distribution.
+``distribution``) is matched to a published system by its dimension and size distribution
+(:func:`system_key`); the targets are those of ``targets.yaml``.
 """
 
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 
-from hardpack.slp.published import MRJ_2D_POLYDISPERSE, TABLE_I, TABLE_I_LINES
-from hardpack.validation.rows import Row, mean_sem, within
+from hardpack.validation.rows import Row, evaluate
+from hardpack.validation.targets import Target, load_targets
 
-DONEV = "Donev dissertation (seed 000)"
-# published LS jamming densities: (value, printed error, source)
+#: (system, d) -> the LS jamming-density targets of that system
 LS_TARGETS = {
-    ("monodisperse", 3): (0.645, 0.005, f"{DONEV} Table 11.1, ch10-14 L618-648"),
-    ("monodisperse", 4): (0.46, 0.005, f"{DONEV} Table 11.1, ch10-14 L618-648"),
-    ("monodisperse", 5): (0.31, 0.005, f"{DONEV} Table 11.1, ch10-14 L618-648"),
-    ("monodisperse", 6): (0.20, 0.01, f"{DONEV} Table 11.1, ch10-14 L618-648"),
-    ("binary_1.4_equimolar", 2): (0.84, 0.0, f"{DONEV} ch01-03 L540-541 (amorphous binary disks)"),
+    ("monodisperse", 3): ("donev-t11.1-phij-d3", "donev-t4.3-phi", "tj-t1-ls-phi-d3"),
+    ("monodisperse", 4): ("donev-t11.1-phij-d4", "tj-t1-ls-phi-d4"),
+    ("monodisperse", 5): ("donev-t11.1-phij-d5", "tj-t1-ls-phi-d5"),
+    ("monodisperse", 6): ("donev-t11.1-phij-d6", "tj-t1-ls-phi-d6"),
+    ("binary_1.4_equimolar", 2): ("donev-t4.2-phi",),
 }
-# phi_J depends on the growth rate and on N (Donev ch. 1: 0.635-0.655 over a wide range of
-# rates, L378-380): the tolerance is the issue's acceptance band, wider than the printed error.
-LS_TOLERANCE = {3: 0.015, 4: 0.015, 5: 0.015, 6: 0.015, 2: 0.01}
 
 
 def system_key(summary) -> tuple | None:
@@ -42,50 +38,59 @@ def system_key(summary) -> tuple | None:
     return None
 
 
+def n_particles(summary) -> int:
+    """The number of particles of an ensemble summary (all its samples have the same N)."""
+    values = np.unique(np.asarray(summary["N"].values).ravel())
+    return int(values.max())
+
+
+def at_n(prefix: str, n: int) -> Target:
+    """The row of a printed table keyed by N (targets ``<prefix>-n<N>``) at ``n``, or its nearest
+    row: that one then reports n/a, since each printed row holds at its own N only."""
+    rows = {int(tid.rsplit("-n", 1)[1]): t for tid, t in load_targets().items() if tid.startswith(prefix + "-n")}
+    return rows[min(rows, key=lambda m: (abs(m - n), m))]
+
+
+def _target(tid: str, n: int) -> Target:
+    return at_n(tid, n) if tid in ("donev-t4.3-phi", "donev-t4.2-phi") else load_targets()[tid]
+
+
+def _detail(s) -> str:
+    parts = [f"N = {n_particles(s)}", f"{s.sizes['sample']} seeds"]
+    if "growth_rate" in s:
+        parts.append(f"Gamma = {float(np.asarray(s['growth_rate'].values).ravel()[0]):g}")
+    if "Z" in s:
+        parts.append(f"min reduced pressure {float(s['Z'].min()):.3g}")
+    return ", ".join(parts)
+
 
 def ls_rows(summaries) -> list[Row]:
-    """Mean final phi (reduced pressure >= max_pressure) of each recognised LS ensemble."""
+    """Mean final phi of each recognised LS ensemble against Donev's Tables 11.1, 4.2 and 4.3."""
     out = []
     for s in summaries:
         key = system_key(s)
-        if key not in LS_TARGETS:
-            continue
-        value, _, source = LS_TARGETS[key]
-        mean, sem = mean_sem(s["phi"].values)
-        tol = LS_TOLERANCE[key[1]]
-        rate = float(np.asarray(s["growth_rate"].values).ravel()[0]) if "growth_rate" in s else math.nan
-        out.append(Row(
-            "LS jamming densities (event-driven MD)",
-            f"{s.attrs.get('ensemble', '?')}: phi_J, {key[0]} d = {key[1]}",
-            source, value, mean, sem, tol,
-            "phi_J depends on the growth rate and N; acceptance band of the engine issue",
-            within(mean, value, tol, sem),
-            f"N = {int(s['N'].values[0])}, Gamma = {rate:g}, {s.sizes['sample']} seeds, min Z {float(s['Z'].min()):.3g}"
-            if "Z" in s else f"{s.sizes['sample']} seeds",
-        ))
+        n = n_particles(s)
+        for tid in LS_TARGETS.get(key, ()):
+            out.append(evaluate(_target(tid, n), samples=s["phi"].values, n=n, detail=_detail(s),
+                                label=s.attrs.get("ensemble", "")))
     return out
 
 
 def slp_mrj_rows(summaries) -> list[Row]:
-    """Mean SLP density of each recognised ensemble against Table I (or the 2-D text value)."""
+    """Mean SLP density of each recognised ensemble against Torquato & Jiao's Table I (or the 2D
+    polydisperse value of their Sec. V.A)."""
     out = []
     for s in summaries:
         key = system_key(s)
         if key is None:
             continue
-        if key[0] == "monodisperse" and key[1] in TABLE_I:
-            n_pub, _, _, (value, _), _ = TABLE_I[key[1]]
-            source = f"Torquato & Jiao 2010 (seed 003) Table I, {TABLE_I_LINES}"
+        if key[0] == "monodisperse" and 3 <= key[1] <= 6:
+            tid = f"tj-t1-slp-phi-d{key[1]}"
         elif key == ("us_omega2", 2):
-            value, n_pub = MRJ_2D_POLYDISPERSE["phi"], 500
-            source = f"Torquato & Jiao 2010 (seed 003) {MRJ_2D_POLYDISPERSE['lines']}"
+            tid = "tj-sec5-poly2d-phi"
         else:
             continue
-        mean, sem = mean_sem(s["phi"].values)
-        out.append(Row(
-            "SLP MRJ-like packings (Table I)", f"{s.attrs.get('ensemble', '?')}: SLP phi, {key[0]} d = {key[1]}",
-            source, value, mean, sem, 0.01,
-            f"the paper used N = {n_pub}; finite N and protocol details shift phi by ~0.01",
-            within(mean, value, 0.01, sem), f"N = {int(s['N'].values[0])}, {s.sizes['sample']} seeds",
-        ))
+        n = n_particles(s)
+        out.append(evaluate(load_targets()[tid], samples=s["phi"].values, n=n,
+                            detail=f"N = {n}, {s.sizes['sample']} seeds", label=s.attrs.get("ensemble", "")))
     return out

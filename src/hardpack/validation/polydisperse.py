@@ -1,6 +1,8 @@
-"""Validation rows of the EOS-vs-moments study (issue 6; Ogarko ch. 3): fluid Z against BMCSL, jamming
-densities of the bi-/tridisperse equivalents against the polydisperse ones, and the jamming densities
-against the published fits."""
+"""Validation rows of the EOS-vs-moments study (Ogarko, dissertation, ch. 3): fluid Z against
+BMCSL, jamming densities of the bi-/tridisperse equivalents against the polydisperse ones, the
+jamming densities against the published fits, and crystallisation of the slow runs. Each claim
+covers the families and widths of its target's ``domain``; other (family, width) pairs get no row.
+"""
 
 from __future__ import annotations
 
@@ -12,24 +14,29 @@ import numpy as np
 from hardpack.eos import theory
 from hardpack.eos.study import seed_statistics
 from hardpack.errors import InvalidInputError
-from hardpack.validation.rows import Row, within
+from hardpack.validation.rows import Row, evaluate
+from hardpack.validation.targets import load_targets
 
-OGARKO = "Ogarko dissertation (seed 002)"
-FLUID_STUDY = "EOS vs moments: fluid Z against BMCSL"
-JAM_STUDY = "EOS vs moments: jamming density of equivalent mixtures"
-#: published fits (function, source lines, fit accuracy, rate of the fit)
-FITS = {
-    "uniform_size": (theory.phij_fit_uniform_size, "Eq. 3.15, L4886-4902", 0.005, "Gamma_O = 8e-6"),
-    "uniform_volume": (theory.phij_fit_uniform_volume, "Eq. 3.16, L4906-4925", 0.01, "Gamma_O = 16e-6"),
-    "lognormal": (theory.phij_fit_lognormal, "Eq. 3.52, L6656-6705", 0.007, "Gamma_O = 16e-3"),
-}
-RATE_EFFECT = 0.01  # nu_max rises by up to 1 % as Gamma decreases (L4961-4970)
-#: large-particle crystallinity counted as partial crystallisation (crystallisation_rows)
+#: system -> the target of its equivalence with the polydisperse phi_J
+EQUIVALENCE = {"tri": "ogarko-tri-equivalence", "bi": "ogarko-bi-equivalence"}
+#: family -> the target of its published phi_J fit
+FITS = {"uniform_size": "ogarko-eq3.15-fit", "uniform_volume": "ogarko-eq3.16-fit",
+        "lognormal": "ogarko-eq3.52-fit"}
+#: large-particle q6 crystallinity counted as partial crystallisation (crystallisation_rows):
+#: random jammed packings give 0.000-0.004 in every fast run of the study, and the published
+#: breakdown is a partial crystallisation of the large species, not a full crystal
 CRYSTALLISED = 0.05
+
+
+def _published_fit(target, width: float) -> float:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return float(getattr(theory, target.published_from)(width))
 
 
 def fluid_rows(summary) -> list[Row]:
     """One row per (distribution, system): the largest |Z/Z_BMCSL - 1| over phi < 0.5."""
+    t = load_targets()["ogarko-fluid-bmcsl"]
     out = []
     for case in summary["case"].values:
         c = summary.sel(case=case)
@@ -39,102 +46,85 @@ def fluid_rows(summary) -> list[Row]:
             if s.sizes["phi"] == 0:
                 continue
             worst = int(np.argmax(np.abs(s["rel_dev"].values)))
-            dev = float(s["rel_dev"].values[worst])
             err = float(s["Z_err"].values[worst] / s["Z_bmcsl"].values[worst])
             phis = ", ".join(f"{p:.2f}: {100 * d:+.2f} %" for p, d in zip(s["phi"].values, s["rel_dev"].values))
-            out.append(Row(
-                FLUID_STUDY, f"{case} {system}: worst Z/Z_BMCSL - 1 for phi < 0.5", f"{OGARKO} L4494-4502, L5707-5710",
-                0.0, dev, err, 0.01, "simulations within 1 % of BMCSL (Eq. 3.9) for phi < 0.54 in ch. 3.1-3.2",
-                within(dev, 0.0, 0.01, err), f"N = {int(c['N'])}; by phi: {phis}"))
+            out.append(evaluate(t, float(s["rel_dev"].values[worst]), err, n=int(c["N"]), seeds=1,
+                                label=f"{case} {system}", detail=f"N = {int(c['N'])}; by phi: {phis}"))
     return out
 
 
-def _dev_row(stats, family, width, system, tolerance, source, why):
-    s = stats.sel(width=width, system=system)
-    dev, err = float(s["dev"]), float(s["dev_sem"])
-    return Row(JAM_STUDY, f"{family} {stats.attrs['width_name']}={width:g}: phi_J({system})/phi_J(poly) - 1",
-               f"{OGARKO} {source}", 0.0, dev, err, tolerance, why, within(dev, 0.0, tolerance, err),
-               f"phi_J poly {float(stats['phi_J_mean'].sel(width=width, system='poly')):.4f}, {system} "
-               f"{float(s['phi_J_mean']):.4f}; N = {stats.attrs['N']}, {int(s['n_seeds'])} seeds; "
-               f"large-particle crystallinity {float(s['crystallinity_large']):.3f}")
-
-
 def jam_rows(summary, fits: bool = True) -> list[Row]:
-    """Equivalence rows (tri: all widths up to omega = 10; bi: omega <= 4) and, if ``fits``, the
+    """Equivalence rows of the systems and widths the claims cover, and, if ``fits``, the
     published fits of phi_J(omega) / phi_J(sigma) at this summary's protocol."""
+    targets = load_targets()
     stats = seed_statistics(summary)
-    family = summary.attrs["family"]
-    systems = list(stats["system"].values)
+    family, n = summary.attrs["family"], int(stats.attrs["N"])
     out = []
     for width in stats["width"].values:
-        if "tri" in systems and (family == "lognormal" or width <= 10):
-            out.append(_dev_row(stats, family, width, "tri", 0.01, "L5753-5757, Fig. 3.12",
-                                "tridisperse maximal equivalents within 1 % of the polydisperse phi_J up to "
-                                "omega = 100 (perfect for omega <= 3); same protocol and N"))
-        if "bi" in systems and (family == "lognormal" or width <= 4):
-            out.append(_dev_row(stats, family, width, "bi", 0.01, "L4747-4752, L4851-4856",
-                                "bidisperse equivalents within 1 % for 1.2 <= omega <= 4 (slightly below)"))
+        for system, tid in EQUIVALENCE.items():
+            t = targets[tid]
+            if system not in stats["system"].values or not t.covers(family, float(width)):
+                continue
+            s = stats.sel(width=width, system=system)
+            out.append(evaluate(
+                t, float(s["dev"]), float(s["dev_sem"]), n=n, seeds=int(s["n_seeds"]),
+                label=f"{family} {stats.attrs['width_name']} = {width:g}",
+                detail=f"phi_J poly {float(stats['phi_J_mean'].sel(width=width, system='poly')):.4f}, {system} "
+                       f"{float(s['phi_J_mean']):.4f}; N = {n}, {int(s['n_seeds'])} seeds; large-particle "
+                       f"crystallinity {float(s['crystallinity_large']):.3f}"))
     return out + (_fit_rows(stats, family, summary.attrs.get("study_protocol", "")) if fits else [])
 
 
 def _fit_rows(stats, family, protocol) -> list[Row]:
-    """phi_J of the polydisperse system against the published fit, one row per width."""
-    fit, source, accuracy, rate = FITS[family]
+    """phi_J of the polydisperse system against the published fit, one row per covered width."""
+    t = load_targets()[FITS[family]]
     poly = stats.sel(system="poly")
+    n = int(stats.attrs["N"])
     out = []
     for width in stats["width"].values:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            published = float(fit(width))
-        value, err = float(poly["phi_J_mean"].sel(width=width)), float(poly["phi_J_sem"].sel(width=width))
-        tol = (accuracy + RATE_EFFECT) * published
-        out.append(Row(
-            JAM_STUDY, f"{family} {stats.attrs['width_name']}={width:g}: phi_J (polydisperse) vs published fit",
-            f"{OGARKO} {source}", published, value, err, tol,
-            f"fit accuracy {100 * accuracy:g} % at {rate} plus up to 1 % rate effect (L4961-4970); a faster "
-            "protocol puts phi_J at or below the fit",
-            within(value, published, tol, err), f"N = {stats.attrs['N']}; protocol {protocol}"))
+        if not t.covers(family, float(width)):
+            continue
+        out.append(evaluate(
+            t, float(poly["phi_J_mean"].sel(width=width)), float(poly["phi_J_sem"].sel(width=width)),
+            n=n, seeds=int(poly["n_seeds"].sel(width=width)), published=_published_fit(t, float(width)),
+            label=f"{family} {stats.attrs['width_name']} = {width:g}", detail=f"N = {n}; protocol {protocol}"))
     return out
 
 
 def crystallisation_rows(summary) -> list[Row]:
-    """Slow runs (Ogarko L4851-4865, L5074-5088, L5759-5763, L6831-6834): the large species of the
-    bidisperse equivalent of a uniform-size distribution partly crystallises for omega > 5 and not for
-    omega <= 4; the maximal tridisperse equivalent and the polydisperse system do not crystallise; and
-    phi_J against the published fit, which was measured at such slow rates.
+    """Slow runs: the large species of the bidisperse equivalent of a uniform-size distribution
+    partly crystallises for omega > 5 and not for omega <= 4; the maximal tridisperse equivalent and
+    the polydisperse system do not crystallise; and phi_J against the published fit, which was
+    measured at such slow rates.
 
-    The text puts the onset at "omega >= 5 (R_bi >= 2.25)" once (L4862) and at "omega > 5" twice
-    (L5763, L6834); its equimolar bidisperse regimes are amorphous up to R_bi = 2.06 and a crystal of
-    large particles from R_bi = 2.40 (L5074-5088). The US equivalents have R_bi = 2.06, 2.25, 2.40,
-    2.79 at omega = 4, 5, 6, 10 (equal numbers), so 4 < omega <= 5 is the crossover: no bidisperse
-    row there.
+    The text puts the onset at "omega >= 5 (R_bi >= 2.25)" once and at "omega > 5" twice; its
+    equimolar bidisperse regimes are amorphous up to R_bi = 2.06 and a crystal of large particles
+    from R_bi = 2.40 (Ogarko, Sec. 3.1.4). The US equivalents have R_bi = 2.06, 2.25, 2.40, 2.79 at
+    omega = 4, 5, 6, 10, so 4 < omega <= 5 is the crossover: no target covers it.
 
     Crystallised = large-particle q6 crystallinity (:func:`hardpack.eos.study.large_species_crystallinity`)
-    of at least CRYSTALLISED, averaged over seeds. Random jammed packings give 0.000-0.004 in every
-    fast run of the study; the published breakdown is "partial" crystallisation, not a full crystal."""
+    of at least :data:`CRYSTALLISED`, averaged over seeds."""
+    targets = load_targets()
     stats = seed_statistics(summary)
-    family = summary.attrs["family"]
+    family, n = summary.attrs["family"], int(stats.attrs["N"])
     protocol = summary.attrs.get("study_protocol", "")
+    ids = {"bi": ("ogarko-crystallisation-bi-above5", "ogarko-crystallisation-bi-upto4"),
+           "tri": ("ogarko-crystallisation-tri",), "poly": ("ogarko-crystallisation-poly",)}
     out = []
     for width in stats["width"].values:
         for system in stats["system"].values:
             s = stats.sel(width=width, system=system)
             value = float(s["crystallinity_large"])
-            expected = system == "bi" and family == "uniform_size" and width > 5
-            if system == "bi":
-                if family == "uniform_size" and 4 < width <= 5:
-                    continue  # the crossover (docstring)
-                why = ("bidisperse equivalents of US distributions: partial crystallisation of the large species "
-                       "for omega > 5 (R_bi >= 2.40), none for 1.22 <= omega <= 4 (R_bi <= 2.06)")
-            else:
-                why = f"no crystallisation of the {system}disperse system for omega >= 1.4"
-            out.append(Row(
-                JAM_STUDY, f"{family} {stats.attrs['width_name']}={width:g}: {system} large-species crystallised "
-                f"(1) or not (0), slow compression", f"{OGARKO} L4851-4865, L5759-5763", float(expected),
-                float(value >= CRYSTALLISED), math.nan, 0.0, why, (value >= CRYSTALLISED) == expected,
-                f"large-particle crystallinity {value:.3f} (threshold {CRYSTALLISED}); phi_J "
-                f"{float(s['phi_J_mean']):.4f}, {100 * float(s['dev']):+.2f} % from poly; N = {stats.attrs['N']}, "
-                f"{int(s['n_seeds'])} seeds; protocol {protocol}"))
+            for tid in ids[str(system)]:
+                t = targets[tid]
+                if not t.covers(family, float(width)):
+                    continue
+                out.append(evaluate(
+                    t, float(value >= CRYSTALLISED) if math.isfinite(value) else math.nan, n=n,
+                    seeds=int(s["n_seeds"]), label=f"{family} {stats.attrs['width_name']} = {width:g} {system}",
+                    detail=f"large-particle crystallinity {value:.3f} (threshold {CRYSTALLISED}); phi_J "
+                           f"{float(s['phi_J_mean']):.4f}, {100 * float(s['dev']):+.2f} % from poly; N = {n}, "
+                           f"{int(s['n_seeds'])} seeds; protocol {protocol}"))
     return out + _fit_rows(stats, family, protocol)
 
 
