@@ -63,15 +63,17 @@ def test_fluid_pressure_within_one_percent_of_bmcsl(spec, system):
 @pytest.mark.slow
 def test_tridisperse_jams_like_polydisperse():
     """US omega = 3, N = 500, 2 seeds each (two-stage protocol, final Gamma = 0.005): phi_J(tri) within 1 %
-    of phi_J(poly) (L5753-5757, 'perfect agreement' for omega <= 3). Both lie below the fit Eq. 3.15
-    (0.6744), which was measured ~100x more slowly: phi_J rises as Gamma decreases (L4961-4970; here
-    ~2.5 % lower), but not by more than 4 %."""
+    of phi_J(poly) ('perfect agreement' for omega <= 3, Ogarko Sec. 3.2). phi_J(poly) lies below the
+    fit Eq. 3.15 plus its 0.5 % accuracy (the fit was measured at far slower rates, and phi_J rises
+    as the rate drops, Sec. 3.1.3) and above the monodisperse random close packing of a fast
+    compression, 0.637 (Ogarko ch. 4, Fig. 4.4): polydispersity raises phi_J (Eq. 3.15 grows with
+    omega from phi_RCP)."""
     spec = {"kind": "uniform_size", "omega": 3}
     protocol = study.JamProtocol(n=500, final_growth_rate=0.005)
     phi = {s: np.mean([study.jam(spec, s, seed, protocol).stats["phi"] for seed in (1, 2)]) for s in ("poly", "tri")}
     assert phi["tri"] == pytest.approx(phi["poly"], rel=0.01)
     fit = float(phij_fit_uniform_size(3.0))
-    assert 0.96 * fit < phi["poly"] < 1.005 * fit
+    assert 0.637 < phi["poly"] < 1.005 * fit
 
 
 @pytest.mark.parametrize("spec", [{"kind": "uniform_volume", "omega": 10}, {"kind": "lognormal", "sigma": 0.5}])

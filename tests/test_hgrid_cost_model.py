@@ -88,9 +88,9 @@ def test_figure_2_15_minima():
     constant-m 11.60 at L* = 12 (our 12.398 and 11.595), optimal 11.58; L = 8 and 19 cost 10 % more than
     the constant-m optimum; exponential L* = 4 with L = 6 24 % worse.
 
-    The text also prints 11.57 for the exponential minimum. That cannot be right (it is below the printed
-    optimum 11.58); the model gives 12.13 at L* = 4, and the text's own "L = 3 is 43 % worse" is 47 % here.
-    We test the model's exponential values and treat the printed 11.57 as a misattribution (note sec. 4.1)."""
+    The printed exponential numbers that our model does not reproduce (the minimum 11.57, below the
+    printed optimum 11.58, and "L = 3 is 43 % worse") are tested in
+    test_figure_2_15_printed_exponential_minimum, an expected failure."""
     L_lin, t_lin, _ = cm.best_levels(FIG_215, "linear", L_max=60)
     assert (L_lin, round(t_lin, 2)) == (43, 12.40)
     levels = np.arange(1, 31)
@@ -99,19 +99,32 @@ def test_figure_2_15_minima():
     assert const_m[7] / const_m[11] == pytest.approx(1.10, abs=0.005)
     assert const_m[18] / const_m[11] == pytest.approx(1.10, abs=0.005)
     expo = cm.cost_vs_levels(FIG_215, "exponential", levels)
-    assert levels[np.argmin(expo)] == 4 and expo.min() == pytest.approx(12.13, abs=0.005)
-    assert expo[5] / expo[3] == pytest.approx(1.24, abs=0.005)
-    assert expo[2] / expo[3] == pytest.approx(1.474, abs=0.005)
+    assert levels[np.argmin(expo)] == 4
+    assert expo[5] / expo[3] == pytest.approx(1.24, abs=0.005)  # printed: L = 6 is 24 % worse
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "Ogarko Fig. 2.15 prints 11.57 for the exponential minimum, below the printed optimum 11.58: "
+    "impossible for one cost model (the optimum bounds every rule). With the stated parameters our "
+    "model gives 12.13 at L = 4, and 47 % (printed 43 %) for L = 3; the printed exponential curve "
+    "does not follow from the stated parameters."))
+def test_figure_2_15_printed_exponential_minimum():
+    levels = np.arange(1, 31)
+    expo = cm.cost_vs_levels(FIG_215, "exponential", levels)
+    assert round(expo.min(), 2) == 11.57
+    assert expo[2] / expo[3] == pytest.approx(1.43, abs=0.005)
 
 
 def test_figure_2_15_optimal():
-    """The optimised cell sizes reach 11.57-11.58 (printed 11.58) and never lose to constant-m at equal L."""
+    """The optimised cell sizes never lose to constant-m at equal L, and reach at least the printed
+    optimum 11.58 (a lower cost is a better optimum of the same model; ours is 11.574, a documented
+    deviation of the validation table)."""
     costs = []
     for L in (6, 8, 10):
         opt = FIG_215.cost(cm.optimal_cells(FIG_215, L))
         assert opt <= FIG_215.cost(cm.constant_m_cells(FIG_215, L)) + 1e-9
         costs.append(opt)
-    assert min(costs) == pytest.approx(11.58, abs=0.01)
+    assert min(costs) <= 11.58 + 0.005
 
 
 def test_constant_m_cells():

