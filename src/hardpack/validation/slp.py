@@ -80,3 +80,31 @@ def order_map_rows(summary) -> list[Row]:
         evaluate(targets["tj-fig6-strict"], verdict_fraction(summary["strict"].values), n=int(n.min()),
                  seeds=phi.size, detail=size),
     ]
+
+
+def diluted_rows(summary) -> list[Row]:
+    """Sec. VI of the paper: re-jammed diluted MRJ packings (rounds >= 1 of the ``slp_diluted``
+    summary over (seed, round)). The least dense of them against the paper's lower end 0.6, its
+    density without rattlers against 0.595, its backbone contact number against Z = 6.3 at
+    phi = 0.6, and the fraction of them that are strictly jammed."""
+    targets = load_targets()
+    diluted = summary.sel(round=[r for r in summary["round"].values if r >= 1])
+    phi = diluted["phi"].values.ravel()
+    if phi.size == 0:
+        return []
+    k = int(np.nanargmin(phi)) if np.any(np.isfinite(phi)) else 0
+    flat = {name: diluted[name].values.ravel() for name in ("phi_no_rattlers", "z_mean", "N", "strict")}
+    seeds, rounds = diluted.sizes["seed"], diluted.sizes["round"]
+    n = int(flat["N"][k])
+    where = (f"{phi.size} re-jammed packings ({seeds} seeds x {rounds} rounds), N = "
+             f"{int(flat['N'].min())}-{int(flat['N'].max())}; the least dense: seed "
+             f"{int(diluted['seed'].values[k // rounds])}, round {int(diluted['round'].values[k % rounds])}")
+    return [
+        evaluate(targets["tj-sec6-diluted-phi"], float(phi[k]), n=n, seeds=seeds, detail=where),
+        evaluate(targets["tj-sec6-diluted-phi-backbone"], float(flat["phi_no_rattlers"][k]), n=n, seeds=seeds,
+                 detail=where),
+        evaluate(targets["tj-sec6-diluted-z"], float(flat["z_mean"][k]), n=n, seeds=seeds,
+                 detail=f"{where}; its phi = {phi[k]:.4f}"),
+        evaluate(targets["tj-sec6-diluted-strict"], verdict_fraction(flat["strict"]), n=int(flat["N"].min()),
+                 seeds=seeds, detail=where),
+    ]
