@@ -16,6 +16,7 @@ from hardpack.cli import main
 from hardpack.distributions import monodisperse
 from hardpack.initial import random_packing
 from hardpack.io import load_dataset, load_packing, save_packing, write_dataset
+from hardpack.md import StopCriteria, compress
 
 
 @pytest.fixture(scope="module")
@@ -125,6 +126,30 @@ def test_every_long_command_checks_its_outputs(tmp_path, capsys, start):
         assert main(args) == 2, args
         assert _error(capsys) == (f"hardpack {args[0]}: error: --out {folder} is a folder; give a file "
                                   f"path such as {tmp_path / 'result.nc'}")
+
+
+def test_checkpoint_is_kept_until_the_output_is_written(tmp_path, capsys, start, monkeypatch):
+    import hardpack.io
+
+    reference = compress(load_packing(start), 0.05, 1, stop=StopCriteria(max_pressure=1e8)).packing
+    out, ckpt = tmp_path / "out.nc", tmp_path / "run.ckpt.npz"
+    args = ["compress", "--init", str(start), "--out", str(out), "--growth-rate", "0.05", "--seed", "1",
+            "--max-pressure", "1e8", "--checkpoint", str(ckpt), "--checkpoint-interval", "0"]
+    saved = hardpack.io.save_packing
+
+    def fails(*a, **k):
+        raise OSError(28, "No space left on device", str(out))
+
+    monkeypatch.setattr(hardpack.io, "save_packing", fails)
+    assert main(args) == 2
+    assert "No space left on device" in _error(capsys)
+    assert ckpt.exists() and not out.exists()
+    monkeypatch.setattr(hardpack.io, "save_packing", saved)
+    assert main(args) == 0
+    final = load_packing(out)
+    np.testing.assert_array_equal(final.positions, reference.positions)
+    np.testing.assert_array_equal(final.radii, reference.radii)
+    assert not ckpt.exists()
 
 
 # ---------------------------------------------------------------- file modes

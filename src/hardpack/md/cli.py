@@ -18,8 +18,6 @@ import sys
 import numpy as np
 import xarray as xr
 
-from hardpack.errors import InvalidInputError
-
 log = logging.getLogger(__name__)
 
 
@@ -34,6 +32,7 @@ def _optional_float(text: str):
 
 def cmd_compress(args) -> int:
     """LS compression of a start packing to jamming (event-driven MD with growing spheres)."""
+    from hardpack.io import checkpoint as ckpt
     from hardpack.io import load_packing
     from hardpack.md import StopCriteria, compress
 
@@ -43,7 +42,8 @@ def cmd_compress(args) -> int:
     result = compress(packing, args.growth_rate, args.seed, stop=stop, checkpoint=args.checkpoint,
                       window=args.window, checkpoint_interval=args.checkpoint_interval,
                       final_growth_rate=args.final_growth_rate, switch_pressure=args.switch_pressure,
-                      contact_forces=args.contact_forces, contact_windows=args.contact_windows)
+                      contact_forces=args.contact_forces, contact_windows=args.contact_windows,
+                      keep_checkpoint=True)
     config = {"init": str(args.init), "growth_rate": args.growth_rate, "seed": args.seed,
               "max_pressure": args.max_pressure, "target_phi": args.target_phi,
               "max_collisions": args.max_collisions, "window": args.window,
@@ -51,6 +51,8 @@ def cmd_compress(args) -> int:
               "switch_pressure": args.switch_pressure if args.final_growth_rate else None,
               "contact_windows": args.contact_windows if args.contact_forces else None}
     result.save(args.out, args.timeseries, config=config)
+    if args.checkpoint is not None:  # only now that the results are safely written
+        ckpt.remove(args.checkpoint)
     s = result.stats
     log.info("wrote %s: phi=%.8f Z=%.4g phi_J_est=%.8f (%s, %d collisions, %.1f s)", args.out,
              s["phi"], s["Z"], s["phi_J_est"], s["stop_reason"], s["collisions"], s["wall_time"])
@@ -127,11 +129,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s",
                         datefmt="%H:%M:%S")
-    try:
-        return args.func(args)
-    except InvalidInputError as exc:
-        print(f"hardpack {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    from hardpack.cli import run_command
+
+    return run_command(args)
 
 
 if __name__ == "__main__":
