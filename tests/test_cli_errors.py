@@ -249,3 +249,27 @@ def test_info_shows_overlaps_and_says_it_is_a_diagnosis(capsys, overlapping):
     out = capsys.readouterr().out
     assert "overlaps: " in out and "shown for diagnosis: every other command refuses" in out
 
+
+
+# ---------------------------------------------------------------- signals outside a polling run
+def test_a_signal_during_any_command_ends_in_one_line(tmp_path, capsys, start, monkeypatch):
+    """SIGTERM while a command without its own polling runs (here: the sequential jamming test,
+    which checkpoints after every loading sequence) ends in one line with status 143, says where
+    the checkpoint is, and leaves the caller's signal handlers as they were."""
+    import signal
+
+    import hardpack.jamming.cli
+
+    def killed(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)  # the handler raises before this ends
+        raise AssertionError("SIGTERM was not handled")
+
+    monkeypatch.setattr(hardpack.jamming.cli, "verify", killed)
+    before = signal.getsignal(signal.SIGTERM)
+    ckpt = tmp_path / "v.ckpt"
+    assert main(["verify", str(start), "--out", str(tmp_path / "v.nc"), "--method", "sequential",
+                 "--checkpoint", str(ckpt)]) == 143
+    assert _error(capsys) == (f"hardpack verify: interrupted: stopped by SIGTERM; a checkpoint written "
+                              f"before is kept in {ckpt}: start the same command again to resume from it")
+    assert signal.getsignal(signal.SIGTERM) is before

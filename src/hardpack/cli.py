@@ -187,11 +187,11 @@ def run_command(args) -> int:
     from hardpack.io import interrupt
 
     prefix = f"hardpack {args.command}"
-    interrupt.install()
     try:
         check_arguments(args)
-        status = args.func(args)
-        sys.stdout.flush()
+        with interrupt.installed():
+            status = args.func(args)
+            sys.stdout.flush()
         return status
     except InvalidInputError as exc:
         print(f"{prefix}: error: {exc}", file=sys.stderr)
@@ -204,7 +204,12 @@ def run_command(args) -> int:
         print(f"{prefix}: error: {exc.strerror or exc}{where}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
-        print(f"{prefix}: interrupted: {str(exc) or 'stopped by SIGINT'}", file=sys.stderr)
+        text = str(exc) or "stopped by SIGINT"
+        checkpoint = getattr(args, "checkpoint", None)
+        if checkpoint and "checkpoint" not in text:  # stopped at once, not by a polling run
+            text += (f"; a checkpoint written before is kept in {checkpoint}: start the same command "
+                     "again to resume from it")
+        print(f"{prefix}: interrupted: {text}", file=sys.stderr)
         return getattr(exc, "exit_code", 130)
 
 

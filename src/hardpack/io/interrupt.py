@@ -4,8 +4,8 @@ Inside :func:`deferred` the two signals only set a flag, :func:`requested`; the 
 it after each unit of work (an MD window, an SLP step), writes its checkpoint at the next point
 where the saved state continues exactly as the uninterrupted run would, and raises
 :class:`Interrupted` (a :class:`KeyboardInterrupt`) with a message that says how to resume.
-A second signal stops at once. Outside :func:`deferred`, after :func:`install` (the command line
-does it), both signals raise :class:`Interrupted` immediately, so atomic writes remove their
+A second signal stops at once. Outside :func:`deferred`, within :func:`installed` (the command
+line runs every command in it), both signals raise :class:`Interrupted` immediately, so atomic writes remove their
 temporary files and the command exits with status 128 + signal number (130 for SIGINT, 143 for
 SIGTERM). Handlers are installed only in the main thread of the process that installed them;
 worker processes keep the default behaviour.
@@ -60,13 +60,23 @@ def _handler(signum, frame) -> None:
     raise Interrupted(signum, f"stopped by {_name(signum)}")
 
 
-def install() -> None:
-    """Make SIGINT and SIGTERM raise :class:`Interrupted` in this process (main thread only)."""
+@contextlib.contextmanager
+def installed():
+    """Within, SIGINT and SIGTERM raise :class:`Interrupted` (main thread only; the previous
+    handlers are restored on exit)."""
     global _owner
+    previous = {}
     if threading.current_thread() is threading.main_thread():
+        previous = {sig: signal.getsignal(sig) for sig in SIGNALS}
         _owner = os.getpid()
         for sig in SIGNALS:
             signal.signal(sig, _handler)
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            if handler is not None:
+                signal.signal(sig, handler)
 
 
 def requested() -> int | None:
