@@ -86,3 +86,20 @@ def test_hard_rods_obey_tonks(tmp_path, phi):
     a = load_dataset(out).attrs
     assert a["phi"] == pytest.approx(phi, abs=1e-12)
     assert abs(a["Z"] - 1 / (1 - phi)) < 3 * a["Z_err"]
+
+
+def test_rods_jam_at_phi_one_where_slp_takes_them():
+    """The honest 1D end state: sequential LP (exact steps) packs polydisperse rods to phi = 1 up to
+    its stopping tolerance, and the jamming test finds every rod in the backbone, isostatic
+    (z = 2d = 2), strictly jammed; the LS end state of the test above is not jammed."""
+    from hardpack.distributions import uniform_size
+    from hardpack.jamming.verify import verify
+    from hardpack.slp import Bounds, run_slp
+
+    rods = run_slp(random_packing(30, 1, uniform_size(2), 0.3, seed=3), 1.5, Bounds(0.1, 0.1, 0.5)).packing
+    assert rods.phi > 1 - 1e-8
+    verdict = verify(rods)
+    assert verdict.summary().startswith("verdict: strictly jammed")
+    assert not verdict.rattler.any()
+    ls = compress(random_packing(100, 1, monodisperse(), 0.3, seed=1), 0.1, 1).packing
+    assert verify(ls).summary().startswith("verdict: not jammed")
