@@ -289,7 +289,8 @@ def _end_state_check(final: Packing, stats: dict) -> None:
 
 def _jammed_short(stop: StopCriteria, record: dict, growth_rate: float) -> None:
     """Refuse to go on when a run that must reach ``stop.target_phi`` jammed below it."""
-    if stop.target_phi is None or stop.max_pressure is not None or record["Z"] < JAMMED_PRESSURE:
+    if stop.target_phi is None or stop.max_pressure is not None or growth_rate <= 0 \
+            or record["Z"] < JAMMED_PRESSURE:
         return
     phi_j = record["phi_J_est"] if math.isfinite(record["phi_J_est"]) else record["phi"]
     if phi_j >= stop.target_phi:
