@@ -108,3 +108,92 @@ def test_damaged_checkpoint_is_refused(tmp_path, init_file):
     ckpt.write_bytes(b"not a checkpoint")
     with pytest.raises(InvalidInputError, match="cannot be read"):
         compress(load_packing(init_file), 0.05, 1, checkpoint=ckpt)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_signal_writes_a_checkpoint_and_resume_is_bit_identical(tmp_path, init_file, sig):
+    reference = compress(load_packing(init_file), 0.05, 1, stop=StopCriteria(max_pressure=1e10)).packing
+    out, ckpt = tmp_path / "out.nc", tmp_path / "run.ckpt.npz"
+    base = _cli("compress", "--init", str(init_file), "--out", str(out), *ARGS, "--checkpoint", str(ckpt))
+    # a first run killed hard leaves an early checkpoint
+    first = subprocess.Popen([*base, "--checkpoint-interval", "0"], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    while _windows(ckpt) < 1:
+        assert first.poll() is None and time.time() < deadline
+        time.sleep(0.01)
+    os.kill(first.pid, signal.SIGKILL)
+    first.wait()
+    early = _windows(ckpt)
+    # the second run writes no timed checkpoint: only the signal makes it write one
+    second = subprocess.Popen([*base, "--checkpoint-interval", "1e9"], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True)
+    for line in second.stderr:
+        if "resumed from" in line:
+            break
+    time.sleep(0.3)
+    assert second.poll() is None, "the run ended before the signal"
+    os.kill(second.pid, sig)
+    err = second.stderr.read()
+    assert second.wait(timeout=120) == 128 + sig
+    assert not out.exists() and _windows(ckpt) > early
+    last = err.strip().splitlines()[-1]
+    assert last.startswith(f"hardpack compress: interrupted: stopped by {signal.Signals(sig).name} at phi = ")
+    assert last.endswith(f"checkpoint written to {ckpt}: start the same run again (same arguments and "
+                         "checkpoint) to resume")
+
+    again = subprocess.run([*base, "--checkpoint-interval", "1e9"], capture_output=True, text=True,
+                           timeout=300, check=False)
+    assert again.returncode == 0, again.stderr
+    assert "resumed from" in again.stderr
+    final = load_packing(out)
+    np.testing.assert_array_equal(final.positions, reference.positions)
+    np.testing.assert_array_equal(final.radii, reference.radii)
+    assert not ckpt.exists()
+
+
+def _collisions(path):
+    try:
+        with np.load(path) as data:
+            return int(data["collisions"])
+    except (OSError, KeyError, ValueError):
+        return -1
+
+
+@pytest.mark.slow
+def test_eos_sigterm_and_resume_is_bit_identical(tmp_path, init_file):
+    args = ["eos", "--init", str(init_file), "--phi", "0.4", "--seed", "5", "--collisions", "1500000",
+            "--blocks", "10"]
+    reference = tmp_path / "reference.nc"
+    run = subprocess.run(_cli(*args, "--out", str(reference)), capture_output=True, text=True, check=False)
+    assert run.returncode == 0, run.stderr
+    out, ckpt = tmp_path / "eos.nc", tmp_path / "eos.ckpt"
+    base = _cli(*args, "--out", str(out), "--checkpoint", str(ckpt))
+    first = subprocess.Popen([*base, "--checkpoint-interval", "0"], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    while _collisions(ckpt) < 1:  # the equilibrium run has saved its state
+        assert first.poll() is None and time.time() < deadline
+        time.sleep(0.01)
+    os.kill(first.pid, signal.SIGKILL)
+    first.wait()
+    early = _collisions(ckpt)
+    second = subprocess.Popen([*base, "--checkpoint-interval", "1e9"], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True)
+    for line in second.stderr:
+        if "resumed from" in line and str(ckpt) + " " in line:
+            break
+    time.sleep(0.3)
+    assert second.poll() is None, "the run ended before the signal"
+    os.kill(second.pid, signal.SIGTERM)
+    err = second.stderr.read()
+    assert second.wait(timeout=120) == 128 + signal.SIGTERM
+    assert _collisions(ckpt) > early and not out.exists()
+    assert err.strip().splitlines()[-1].startswith("hardpack eos: interrupted: stopped by SIGTERM at ")
+
+    again = subprocess.run([*base, "--checkpoint-interval", "1e9"], capture_output=True, text=True,
+                           timeout=300, check=False)
+    assert again.returncode == 0, again.stderr
+    np.testing.assert_array_equal(load_dataset(out)["Z_block"].values,
+                                  load_dataset(reference)["Z_block"].values)
+    assert not ckpt.exists() and not (tmp_path / "eos.ckpt.prep").exists()

@@ -1,6 +1,8 @@
 """Sequential linear programming (Torquato & Jiao 2010): the LP algebra and published densities."""
 
 import math
+import os
+import signal
 
 import numpy as np
 import pytest
@@ -226,3 +228,37 @@ def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path,
     np.testing.assert_array_equal(resumed.packing.lattice, whole.packing.lattice)
     for name in ("phi", "predicted_gain", "accepted", "trust_scale"):
         np.testing.assert_array_equal(resumed.history[name].values, whole.history[name].values)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_writes_the_checkpoint_and_the_run_resumes_identically(tmp_path, monkeypatch, sig):
+    """SIGTERM or SIGINT during LP 20 (no timed checkpoint): the run writes its checkpoint before
+    LP 21 and raises Interrupted; started again it does only the remaining LPs and ends with the
+    uninterrupted run's packing, bit for bit."""
+    import hardpack.slp.driver as driver
+    from hardpack.io.interrupt import Interrupted
+
+    start = random_packing(30, 3, monodisperse(), 0.3, seed=4)
+    args = (start, 1.5, Bounds(0.1, 0.1, 0.5))
+    whole = run_slp(*args)
+    ckpt = tmp_path / "slp.ckpt"
+    solve = driver.solve_step
+    calls = []
+
+    def signalled(*a, **k):
+        calls.append(1)
+        if len(calls) == 20:
+            os.kill(os.getpid(), sig)
+        return solve(*a, **k)
+
+    monkeypatch.setattr(driver, "solve_step", signalled)
+    with pytest.raises(Interrupted, match=f"stopped by {signal.Signals(sig).name} at SLP step 20"):
+        run_slp(*args, checkpoint=ckpt, checkpoint_interval=1e9)
+    assert ckpt.exists() and len(calls) == 20
+    counted = []
+    monkeypatch.setattr(driver, "solve_step", lambda *a, **k: counted.append(1) or solve(*a, **k))
+    resumed = run_slp(*args, checkpoint=ckpt, checkpoint_interval=1e9)
+    assert not ckpt.exists()
+    assert len(counted) == whole.n_steps - 20
+    np.testing.assert_array_equal(resumed.packing.positions, whole.packing.positions)
+    np.testing.assert_array_equal(resumed.packing.lattice, whole.packing.lattice)

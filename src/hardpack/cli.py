@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import sys
 
 import numpy as np
@@ -56,7 +57,10 @@ def cmd_init(args) -> int:
 
 
 def cmd_info(args) -> int:
-    """Summary of a hardpack netCDF file: N, d, phi, radii and provenance."""
+    """Summary of a hardpack netCDF file: N, d, phi, radii and provenance.
+
+    A diagnostic: it also reads packings whose particles overlap, and reports the overlaps.
+    """
     from hardpack.io import load_dataset
 
     ds = load_dataset(args.file)
@@ -72,7 +76,9 @@ def cmd_info(args) -> int:
               f"ratio {r.max() / r.min():.4g}")
         print(f"  cell volume {p.volume:.6g}, orthorhombic: {p.is_orthorhombic}")
         report = p.overlap_report()
-        print(f"  overlaps: {report}")
+        note = (" (shown for diagnosis: every other command refuses an overlapping packing)"
+                if report.n_overlapping else "")
+        print(f"  overlaps: {report}{note}")
     else:
         print("  " + ", ".join(f"{k}: {v}" for k, v in ds.sizes.items()))
         for name, var in ds.data_vars.items():
@@ -131,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_lattice)
 
-    p = sub.add_parser("info", help=cmd_info.__doc__)
+    p = sub.add_parser("info", help=cmd_info.__doc__.splitlines()[0])
     p.add_argument("file", help="a netCDF file written by hardpack")
     p.set_defaults(func=cmd_info)
 
@@ -149,6 +155,64 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: argparse destinations that name files a command writes; checked before the command runs
+OUTPUT_OPTIONS = ("out", "timeseries", "history", "checkpoint", "out_nc", "out_md")
+#: seeds are stored as 64-bit signed netCDF attributes
+MAX_SEED = 2**63 - 1
+
+
+def check_arguments(args) -> None:
+    """Refuse, before any work, a seed out of range and output (or checkpoint) paths that cannot be
+    written (:func:`hardpack.io.atomic.check_writable`), so that a long run never fails at its end."""
+    from hardpack.io.atomic import check_writable
+
+    seed = getattr(args, "seed", None)
+    if seed is not None and not 0 <= seed <= MAX_SEED:
+        raise InvalidInputError(f"--seed must be an integer from 0 to 2**63 - 1, got {seed}")
+    for dest in OUTPUT_OPTIONS:
+        value = getattr(args, dest, None)
+        for path in ([] if value is None else value if isinstance(value, list) else [value]):
+            check_writable(path, "--" + dest.replace("_", "-"))
+
+
+def run_command(args) -> int:
+    """Run a parsed subcommand with the command line's error handling.
+
+    Refused input (:class:`InvalidInputError`) and files that cannot be written (``OSError``) end
+    in one line ``hardpack <command>: error: ...`` and exit status 2; SIGINT and SIGTERM end in
+    ``hardpack <command>: interrupted: ...`` (after long runs wrote their checkpoint,
+    :mod:`hardpack.io.interrupt`) and status 130 or 143; a closed standard output (``hardpack info
+    FILE | head -1``) ends quietly with status 141 (128 + SIGPIPE), like other Unix tools.
+    """
+    from hardpack.io import interrupt
+
+    prefix = f"hardpack {args.command}"
+    try:
+        check_arguments(args)
+        with interrupt.installed():
+            status = args.func(args)
+            sys.stdout.flush()
+        return status
+    except InvalidInputError as exc:
+        print(f"{prefix}: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+    except OSError as exc:
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"{prefix}: error: {exc.strerror or exc}{where}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        text = str(exc) or "stopped by SIGINT"
+        checkpoint = getattr(args, "checkpoint", None)
+        if checkpoint and "checkpoint" not in text:  # stopped at once, not by a polling run
+            text += (f"; a checkpoint written before is kept in {checkpoint}: start the same command "
+                     "again to resume from it")
+        print(f"{prefix}: interrupted: {text}", file=sys.stderr)
+        return getattr(exc, "exit_code", 130)
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -156,11 +220,7 @@ def main(argv=None) -> int:
         level=logging.WARNING if args.quiet else logging.INFO,
         format="%(asctime)s %(name)s: %(message)s", datefmt="%H:%M:%S",
     )
-    try:
-        return args.func(args)
-    except InvalidInputError as exc:
-        print(f"hardpack {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    return run_command(args)
 
 
 if __name__ == "__main__":

@@ -283,6 +283,16 @@ def from_spec(spec: dict) -> Distribution:
     missing = [k for k in keys if k not in spec]
     if missing:
         raise InvalidInputError(f"distribution {kind!r} needs key(s) {missing}")
+    for key in keys:
+        value = spec[key]
+        numbers = value if isinstance(value, (list, tuple)) else [value]
+        if not numbers or any(isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating))
+                              for v in numbers):
+            raise InvalidInputError(
+                f"distribution {kind!r}: {key} must be "
+                f"{'a list of numbers' if key in ('radii', 'fractions') else 'a number'}, got {value!r} "
+                "(write numbers without quotes in JSON)"
+            )
     if kind == "monodisperse":
         return monodisperse()
     args = [tuple(spec[k]) if isinstance(spec[k], list) else spec[k] for k in keys]

@@ -107,6 +107,8 @@ def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed:
         raise InvalidInputError(f"d must be an integer in 1..12, got {d!r}")
     if not (np.isfinite(phi) and 0 < phi < 1):
         raise InvalidInputError(f"phi must be in (0, 1), got {phi!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
     if not isinstance(distribution, Distribution):
         raise InvalidInputError(f"distribution must be a hardpack Distribution, got {type(distribution).__name__}")
     n, d = int(n), int(d)

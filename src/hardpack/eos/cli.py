@@ -105,6 +105,7 @@ def _check_outputs(systems, outputs, checkpoint=None):
 def cmd_jam(args) -> int:
     """Jam a distribution and/or its bi- and tridisperse equivalents (two-stage LS compression)."""
     from hardpack.eos.study import JamProtocol, jam
+    from hardpack.io import checkpoint as ckpt
 
     spec = _json_spec(args.distribution)
     _check_outputs(args.systems, args.out, args.checkpoint)
@@ -112,9 +113,11 @@ def cmd_jam(args) -> int:
                            switch_pressure=args.switch_pressure, final_growth_rate=args.final_growth_rate,
                            max_pressure=args.max_pressure)
     for system, out in zip(args.systems, args.out):
-        result = jam(spec, system, args.seed, protocol, checkpoint=args.checkpoint)
+        result = jam(spec, system, args.seed, protocol, checkpoint=args.checkpoint, keep_checkpoint=True)
         result.save(out, config={"distribution": spec, "system": system, "seed": args.seed,
                                  **{k: getattr(protocol, k) for k in protocol.__dataclass_fields__}})
+        if args.checkpoint is not None:  # only now that the packing is safely written
+            ckpt.remove(args.checkpoint)
         s = result.stats
         log.info("%s %s seed %d: phi_J = %.6f (Z = %.3g, %d collisions, %.1f s CPU, crystallinity %.3f)",
                  args.distribution, system, args.seed, s["phi"], s["Z"], s["collisions"], s["cpu_time"],

@@ -87,11 +87,13 @@ def large_species_crystallinity(packing, solid: np.ndarray) -> float:
     return float(solid[large].mean()) if large.any() else math.nan
 
 
-def jam(spec: dict, system: str, seed: int, protocol: JamProtocol = JamProtocol(), checkpoint=None):
+def jam(spec: dict, system: str, seed: int, protocol: JamProtocol = JamProtocol(), checkpoint=None,
+        keep_checkpoint: bool = False):
     """Jam one system: RSA start (seed), then the two-stage LS compression (velocities from seed).
 
     ``checkpoint``: path of the compression's checkpoint (:func:`hardpack.md.compress`): a killed run
-    started again resumes there (the RSA start is the same for the same seed) and ends identical.
+    started again resumes there (the RSA start is the same for the same seed) and ends identical;
+    removed at the end unless ``keep_checkpoint`` (the caller removes it once the result is written).
     Returns the :class:`hardpack.md.CompressResult` with ``stats`` extended by the study's attributes
     (family, width, system, O1, O2, cpu_time, crystallinity and that of the large particles;
     cpu_time counts this process only, ``wall_time`` the whole run, resumed parts included).
@@ -106,7 +108,7 @@ def jam(spec: dict, system: str, seed: int, protocol: JamProtocol = JamProtocol(
     packing = random_packing(protocol.n, 3, dist, protocol.init_phi, seed)
     result = compress(packing, protocol.growth_rate, seed, stop=StopCriteria(max_pressure=protocol.max_pressure),
                       final_growth_rate=protocol.final_growth_rate, switch_pressure=protocol.switch_pressure,
-                      checkpoint=checkpoint)
+                      checkpoint=checkpoint, keep_checkpoint=keep_checkpoint)
     cpu = time.process_time() - start
     solid = crystallinity(result.packing)["solid"].values
     o1, o2 = mo.dimensionless_moments(result.packing.radii)

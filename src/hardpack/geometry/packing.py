@@ -155,7 +155,9 @@ class Packing:
             if report.n_overlapping:
                 raise InvalidInputError(
                     f"particles overlap beyond the tolerance {self.overlap_tol:g}: {report}. "
-                    "Fix the configuration, or pass allow_overlap=True if overlaps are intended"
+                    "Hard particles must not overlap: regenerate the packing or shrink the radii "
+                    "(`hardpack info FILE` lists the overlaps); in Python, Packing(..., "
+                    "allow_overlap=True) accepts a deliberately overlapping configuration"
                 )
 
     # ------------------------------------------------------------------ basic properties

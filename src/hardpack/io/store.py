@@ -139,14 +139,53 @@ def load_packing(path, **packing_kwargs) -> Packing:
     return dataset_to_packing(ds, source=str(path), **packing_kwargs)
 
 
+def _check_members(dsets, names, index) -> None:
+    """Refuse an ensemble whose members do not belong together (the message names the files)."""
+    seen: dict = {}
+    for name in names:
+        key = Path(name).resolve() if not name.startswith("dataset ") else name
+        if key in seen:
+            raise InvalidInputError(f"{name} is given twice ({seen[key]} and {name}); give each file once")
+        seen[key] = name
+    kinds = {}
+    for ds, name in zip(dsets, names):
+        kinds.setdefault(ds.attrs.get("hardpack_kind"), []).append(name)
+    if None in kinds:
+        raise StoreError(f"{', '.join(kinds[None])}: not a hardpack result (no hardpack_kind attribute)")
+    if len(kinds) > 1:
+        listing = "; ".join(f"{kind}: {', '.join(files)}" for kind, files in kinds.items())
+        raise InvalidInputError(f"the files hold different kinds of results ({listing}); "
+                                "combine files of one kind only (e.g. only packings)")
+    dims = {}
+    for ds, name in zip(dsets, names):
+        dims.setdefault(ds.attrs.get("d"), []).append(name)
+    if len(dims) > 1 and "d" not in index:
+        listing = "; ".join(f"d = {d}: {', '.join(files)}" for d, files in dims.items())
+        raise InvalidInputError(f"the files are of different dimensions ({listing}); combine one "
+                                "dimension at a time, or add d to --index to tabulate them together")
+    rows: dict = {}
+    for ds, name in zip(dsets, names):
+        row = tuple(repr(np.asarray(ds.attrs[k]).tolist()) for k in index)
+        if row in rows:
+            values = ", ".join(f"{k} = {ds.attrs[k]}" for k in index)
+            raise InvalidInputError(f"{rows[row]} and {name} have the same index values ({values}); "
+                                    "each sample needs its own (a duplicate run, or index by more "
+                                    "attributes)")
+        rows[row] = name
+
+
 def combine_ensemble(sources, index=("seed",), variables=None) -> xr.Dataset:
-    """One Dataset over a ``sample`` dimension from packings (paths or Datasets).
+    """One Dataset over a ``sample`` dimension from results of one kind (paths or Datasets).
 
     Each ``index`` name (a protocol parameter such as ``seed``, ``N``, ``d``, ``distribution``,
     ``growth_rate``) becomes a coordinate along ``sample`` taken from the file attributes;
     scalar attributes ``N``, ``d``, ``phi`` and any numeric ones named in ``variables`` become
     data variables, with the radius range and mean. Per-particle arrays are stacked along
     ``sample`` only when every member has the same N and d.
+
+    Refused, with the files named: a file given twice, two files with the same index values,
+    files of different ``hardpack_kind`` (e.g. a jamming verdict among packings) or without one,
+    and files of different dimension d unless ``d`` is an index.
     """
     dsets, names = [], []
     for src in sources:
@@ -163,6 +202,7 @@ def combine_ensemble(sources, index=("seed",), variables=None) -> xr.Dataset:
                 raise StoreError(f"{name} has no attribute {key!r} to index the ensemble by")
             vals.append(ds.attrs[key])
         coords[key] = ("sample", np.asarray(vals))
+    _check_members(dsets, names, index)
     for key in ("N", "d", "phi", *(variables or ())):
         if key not in coords and all(key in ds.attrs for ds in dsets):
             scalars[key] = ("sample", np.asarray([ds.attrs[key] for ds in dsets]))

@@ -4,7 +4,8 @@ Both read a start packing written by ``hardpack init`` (or any packing netCDF). 
 writes the final packing (with run statistics as attributes) and the per-window time series;
 with ``--checkpoint`` a killed run started again with the same arguments resumes and ends with
 the same packing as an uninterrupted run. ``eos`` optionally compresses to ``--phi`` first and
-then measures the reduced pressure with block error bars at fixed phi.
+then measures the reduced pressure with block error bars at fixed phi (resumable likewise).
+Both write their checkpoint on Ctrl-C or SIGTERM and remove it once the outputs are written.
 
 Also runnable without the top-level CLI: ``python -m hardpack.md.cli compress ...``.
 """
@@ -17,8 +18,6 @@ import sys
 
 import numpy as np
 import xarray as xr
-
-from hardpack.errors import InvalidInputError
 
 log = logging.getLogger(__name__)
 
@@ -34,6 +33,7 @@ def _optional_float(text: str):
 
 def cmd_compress(args) -> int:
     """LS compression of a start packing to jamming (event-driven MD with growing spheres)."""
+    from hardpack.io import checkpoint as ckpt
     from hardpack.io import load_packing
     from hardpack.md import StopCriteria, compress
 
@@ -43,7 +43,8 @@ def cmd_compress(args) -> int:
     result = compress(packing, args.growth_rate, args.seed, stop=stop, checkpoint=args.checkpoint,
                       window=args.window, checkpoint_interval=args.checkpoint_interval,
                       final_growth_rate=args.final_growth_rate, switch_pressure=args.switch_pressure,
-                      contact_forces=args.contact_forces, contact_windows=args.contact_windows)
+                      contact_forces=args.contact_forces, contact_windows=args.contact_windows,
+                      keep_checkpoint=True)
     config = {"init": str(args.init), "growth_rate": args.growth_rate, "seed": args.seed,
               "max_pressure": args.max_pressure, "target_phi": args.target_phi,
               "max_collisions": args.max_collisions, "window": args.window,
@@ -51,6 +52,8 @@ def cmd_compress(args) -> int:
               "switch_pressure": args.switch_pressure if args.final_growth_rate else None,
               "contact_windows": args.contact_windows if args.contact_forces else None}
     result.save(args.out, args.timeseries, config=config)
+    if args.checkpoint is not None:  # only now that the results are safely written
+        ckpt.remove(args.checkpoint)
     s = result.stats
     log.info("wrote %s: phi=%.8f Z=%.4g phi_J_est=%.8f (%s, %d collisions, %.1f s)", args.out,
              s["phi"], s["Z"], s["phi_J_est"], s["stop_reason"], s["collisions"], s["wall_time"])
@@ -59,15 +62,19 @@ def cmd_compress(args) -> int:
 
 def cmd_eos(args) -> int:
     """Equilibrium reduced pressure Z = pV/(NkT) with a block error bar at fixed phi."""
+    from hardpack.io import checkpoint as ckpt
     from hardpack.io import load_packing, write_dataset
     from hardpack.md import StopCriteria, compress, equilibrate
 
     packing = load_packing(args.init)
+    checkpoints = [] if args.checkpoint is None else [args.checkpoint, args.checkpoint + ".prep"]
     if args.phi is not None and args.phi != packing.phi:
         rate = args.prep_rate if args.phi > packing.phi else -args.prep_rate
-        packing = compress(packing, rate, args.seed,
-                           stop=StopCriteria(max_pressure=None, target_phi=args.phi)).packing
-    res = equilibrate(packing, args.seed, args.collisions, n_blocks=args.blocks)
+        packing = compress(packing, rate, args.seed, stop=StopCriteria(max_pressure=None, target_phi=args.phi),
+                           checkpoint=checkpoints[1] if checkpoints else None, keep_checkpoint=True,
+                           checkpoint_interval=args.checkpoint_interval).packing
+    res = equilibrate(packing, args.seed, args.collisions, n_blocks=args.blocks, checkpoint=args.checkpoint,
+                      checkpoint_interval=args.checkpoint_interval, keep_checkpoint=True)
     ds = xr.Dataset({"Z_block": (("block",), res.Z_blocks)},
                     coords={"block": np.arange(len(res.Z_blocks))})
     ds.attrs.update(hardpack_kind="md_eos", Z=res.Z, Z_err=res.Z_err, phi=res.phi,
@@ -75,6 +82,8 @@ def cmd_eos(args) -> int:
                     md_time=res.md_time, wall_time=res.wall_time, seed=args.seed,
                     init=str(args.init))
     write_dataset(ds, args.out, seed=args.seed)
+    for path in checkpoints:  # only now that the result is safely written
+        ckpt.remove(path)
     log.info("wrote %s: phi=%.6f Z=%.5f +- %.5f", args.out, res.phi, res.Z, res.Z_err)
     return 0
 
@@ -92,7 +101,8 @@ def register(subparsers) -> None:
     p.add_argument("--target-phi", type=float, help="stop exactly at this volume fraction")
     p.add_argument("--max-collisions", type=int, help="stop after this many collisions")
     p.add_argument("--max-wall-time", type=float, help="stop after this many seconds")
-    p.add_argument("--checkpoint", help="checkpoint file: written at sync points, resumed if present")
+    p.add_argument("--checkpoint", help="checkpoint file: written at sync points every --checkpoint-interval "
+                   "seconds and on Ctrl-C or SIGTERM, resumed if present, removed once --out is written")
     p.add_argument("--checkpoint-interval", type=float, default=300.0,
                    help="seconds between checkpoints (default 300)")
     p.add_argument("--window", type=float,
@@ -118,6 +128,11 @@ def register(subparsers) -> None:
     p.add_argument("--seed", type=int, required=True, help="seed of the initial velocities")
     p.add_argument("--collisions", type=int, required=True, help="collisions to average over")
     p.add_argument("--blocks", type=int, default=20, help="number of blocks for the error bar")
+    p.add_argument("--checkpoint", help="checkpoint file (and CHECKPOINT.prep for the compression to "
+                   "--phi): written every --checkpoint-interval seconds and on Ctrl-C or SIGTERM, "
+                   "resumed if present, removed once --out is written")
+    p.add_argument("--checkpoint-interval", type=float, default=300.0,
+                   help="seconds between checkpoints (default 300)")
     p.set_defaults(func=cmd_eos)
 
 
@@ -127,11 +142,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s",
                         datefmt="%H:%M:%S")
-    try:
-        return args.func(args)
-    except InvalidInputError as exc:
-        print(f"hardpack {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    from hardpack.cli import run_command
+
+    return run_command(args)
 
 
 if __name__ == "__main__":

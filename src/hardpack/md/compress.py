@@ -44,6 +44,13 @@ Z_switch = 1e3, Z_max = 1e12, 3 seeds each, :func:`hardpack.jamming.verify`):
 Recommended: ``growth_rate=0.02, switch_pressure=1e3, final_growth_rate=2e-4`` (1e-4 where the
 verifier's default thresholds must pass).
 
+**Checks of the end state.** A run asked for a target phi without a pressure cap stops with
+an :class:`InvalidInputError` when its reduced pressure passes ``JAMMED_PRESSURE`` while the
+jamming-density estimate is still below the target: the packing jammed at this growth rate short
+of the target (the LS jamming density rises as the growth rate falls). A run stopped at
+``max_pressure`` claims a jammed packing; :func:`jamming_backbone` checks the claim (stats
+``backbone_volume_fraction`` and ``jamming_check``, and a warning when it fails).
+
 **Pressure.** Per window Z = pV/(NkT) = 1 + sum_coll r_ij . J_ij / (d N kT dt) with kT the
 window's time-averaged kinetic temperature (note sec. 2.5; Z = 1 + virial / (2 * integral of
 KE dt)); the running jamming-density estimate is phi_J_est = phi / (1 - d/Z), the free-volume form
@@ -63,6 +70,7 @@ import xarray as xr
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.io import checkpoint as ckpt
+from hardpack.io import interrupt
 from hardpack.md.simulation import (
     RECORD_FIELDS,
     Simulation,
@@ -75,6 +83,13 @@ log = logging.getLogger("hardpack.md")
 #: default heating per window: collisions per particle ~ HEATING * d / Gamma (see default_window)
 HEATING = 0.03
 MAX_WINDOW = 20.0
+#: reduced pressure at which a run that must reach a target phi without a pressure cap counts as
+#: jammed short of it (contact gaps ~ D / Z = 1e-9 D: the particles cannot rearrange any more)
+JAMMED_PRESSURE = 1e9
+#: end-state check of runs stopped at max_pressure (:func:`jamming_backbone`): relative contact
+#: gap and the smallest share of the particle volume that must sit in the d + 1 contact backbone
+BACKBONE_GAP = 1e-2
+MIN_BACKBONE_VOLUME = 0.5
 
 
 @dataclass(frozen=True)
@@ -220,12 +235,80 @@ def _check_final_stage(growth_rate: float, final_growth_rate, switch_pressure, s
         )
 
 
+def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
+    """Share of the particle volume in the packing's d + 1 contact backbone.
+
+    Contacts are pairs with relative gap ``|r_ij| / (a_i + a_j) - 1 <= gap``; particles with fewer
+    than d + 1 contacts (which cannot be locally jammed: d vectors do not positively span R^d,
+    Donev 2006, ch. 4, local jamming) are removed repeatedly together with their contacts, and the volume of
+    the particles left is returned as a fraction of the total. Near a jammed state at reduced
+    pressure Z the contact gaps are ~ D / Z (free-volume theory, Donev 2006, Eqs. 1.1-1.2), far
+    below ``gap = 1e-2`` once Z > 1e3, while only rattlers (a few percent of the particles, mostly
+    small ones) lack d + 1 contacts; weighting by volume keeps many small rattlers of a wide size
+    distribution from counting against a jammed backbone of large particles. A value far below 1
+    (every particle a rattler after a growth much faster than the thermal speed; a chain of hard
+    rods in d = 1, which jam only at phi = 1) means the end state is not jammed, whatever the
+    pressure measured in the last window.
+    """
+    from hardpack.geometry.balls import ball_volume
+    from hardpack.geometry.neighbours import pairs_within
+
+    pairs = pairs_within(packing, rel_gap=gap)
+    i, j = np.asarray(pairs.i), np.asarray(pairs.j)
+    n, d = packing.n_particles, packing.dim
+    alive = np.ones(n, dtype=bool)
+    while True:
+        keep = alive[i] & alive[j]
+        count = np.bincount(i[keep], minlength=n) + np.bincount(j[keep], minlength=n)
+        drop = alive & (count < d + 1)
+        if not drop.any():
+            break
+        alive &= ~drop
+    volume = ball_volume(packing.radii, d)
+    return float(volume[alive].sum() / volume.sum())
+
+
+def _end_state_check(final: Packing, stats: dict) -> None:
+    """Record (and warn about) a run stopped at max_pressure whose end state is not jammed."""
+    share = jamming_backbone(final)
+    passed = share >= MIN_BACKBONE_VOLUME
+    stats.update(backbone_volume_fraction=share, jamming_check="passed" if passed else "far_from_jammed")
+    if passed:
+        return
+    d = final.dim
+    why = ("hard rods (d = 1) jam only at phi = 1: compress to a --target-phi instead"
+           if d == 1 else
+           f"the growth rate {stats['growth_rate']:g} is probably too fast for the particles to "
+           "rearrange (the LS protocol needs growth well below the thermal speed, e.g. 0.02, with "
+           "a slow final stage)")
+    log.warning(
+        "the end state is far from jammed although the reduced pressure reached %.3g: only %.1f %% "
+        "of the particle volume has %d or more contacts within a relative gap of %g (a jammed "
+        "packing has nearly all of it); %s", stats["Z"], 100 * share, d + 1, BACKBONE_GAP, why)
+
+
+def _jammed_short(stop: StopCriteria, record: dict, growth_rate: float) -> None:
+    """Refuse to go on when a run that must reach ``stop.target_phi`` jammed below it."""
+    if stop.target_phi is None or stop.max_pressure is not None or growth_rate <= 0 \
+            or record["Z"] < JAMMED_PRESSURE:
+        return
+    phi_j = record["phi_J_est"] if math.isfinite(record["phi_J_est"]) else record["phi"]
+    if phi_j >= stop.target_phi:
+        return
+    raise InvalidInputError(
+        f"target phi {stop.target_phi:g} is above the jamming density reached: at growth rate "
+        f"{growth_rate:g} the packing jammed at phi = {phi_j:.6f} (reduced pressure {record['Z']:.3g}). "
+        "Choose a target phi below it, or compress more slowly (a smaller growth rate: "
+        "--growth-rate of compress, --prep-rate of eos), which jams denser"
+    )
+
+
 def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria | None = None,
              checkpoint=None, progress=None, *, window: float | None = None,
              checkpoint_interval: float = 300.0, progress_interval: float = 10.0,
              overlap_tol: float = DEFAULT_OVERLAP_TOL, final_growth_rate: float | None = None,
              switch_pressure: float = 1e3, contact_forces: bool = False,
-             contact_windows: int = 10) -> CompressResult:
+             contact_windows: int = 10, keep_checkpoint: bool = False) -> CompressResult:
     """LS compression of ``packing`` at growth rate ``growth_rate`` (Gamma, module docstring).
 
     seed: initial Maxwell-Boltzmann velocities from numpy default_rng(seed) (the only randomness).
@@ -233,7 +316,10 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     checkpoint: path of an atomic checkpoint written at synchronisation points every
     ``checkpoint_interval`` seconds; if it exists (same packing, rates, seed, window, contact
     options) the run resumes from it and ends bit-identical to an uninterrupted run. Removed on
-    success.
+    success unless ``keep_checkpoint`` (then the caller removes it once the result is safely
+    written). On SIGINT or SIGTERM the run writes its checkpoint at the next point where it can
+    resume exactly (at most ``SORT_EVERY`` windows later) and raises
+    :class:`hardpack.io.interrupt.Interrupted`.
     progress: callable receiving each window's record (dict); progress lines also go to the
     ``hardpack.md`` logger every ``progress_interval`` seconds.
     window: collisions per particle between synchronisations (default :func:`default_window` of
@@ -279,28 +365,35 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     started = time.perf_counter()
     last_ckpt = last_log = started
     last_coll = sim.collisions
-    while (reason := _stop_reason(stop, sim, started)) is None:
-        budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
-        if stop.max_collisions is not None:
-            budget = min(budget, int(stop.max_collisions) - sim.collisions)
-        record = sim.run_window(budget, stop.target_phi)
-        if final_growth_rate is not None and sim.growth_rate != final_growth_rate \
-                and record["Z"] >= switch_pressure:
-            sim.growth_rate = float(final_growth_rate)
-            log.info("Z=%.4g >= %.4g after %d collisions: growth rate now %g", record["Z"],
-                     switch_pressure, sim.collisions, final_growth_rate)
-        if progress is not None:
-            progress(record)
-        now = time.perf_counter()
-        if now - last_log >= progress_interval:
-            log.info("phi=%.6f Z=%.4g phi_J_est=%.6f collisions=%d (%.3g /s)", record["phi"],
-                     record["Z"], record["phi_J_est"], sim.collisions,
-                     (sim.collisions - last_coll) / (now - last_log))
-            last_log, last_coll = now, sim.collisions
-        if checkpoint is not None and now - last_ckpt >= checkpoint_interval \
-                and sim.checkpoint_ready and _stop_reason(stop, sim, started) is None:
-            ckpt.save(checkpoint, fp, sim.state())
-            last_ckpt = time.perf_counter()
+    with interrupt.deferred():
+        while (reason := _stop_reason(stop, sim, started)) is None:
+            budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
+            if stop.max_collisions is not None:
+                budget = min(budget, int(stop.max_collisions) - sim.collisions)
+            record = sim.run_window(budget, stop.target_phi)
+            _jammed_short(stop, record, sim.growth_rate)
+            if final_growth_rate is not None and sim.growth_rate != final_growth_rate \
+                    and record["Z"] >= switch_pressure:
+                sim.growth_rate = float(final_growth_rate)
+                log.info("Z=%.4g >= %.4g after %d collisions: growth rate now %g", record["Z"],
+                         switch_pressure, sim.collisions, final_growth_rate)
+            if progress is not None:
+                progress(record)
+            now = time.perf_counter()
+            if now - last_log >= progress_interval:
+                log.info("phi=%.6f Z=%.4g phi_J_est=%.6f collisions=%d (%.3g /s)", record["phi"],
+                         record["Z"], record["phi_J_est"], sim.collisions,
+                         (sim.collisions - last_coll) / (now - last_log))
+                last_log, last_coll = now, sim.collisions
+            if interrupt.requested() is not None and (checkpoint is None or sim.checkpoint_ready):
+                if checkpoint is not None:
+                    ckpt.save(checkpoint, fp, sim.state())
+                raise interrupt.stop(checkpoint, f"phi = {record['phi']:.6f}, Z = {record['Z']:.4g}, "
+                                                 f"{sim.collisions} collisions")
+            if checkpoint is not None and now - last_ckpt >= checkpoint_interval \
+                    and sim.checkpoint_ready and _stop_reason(stop, sim, started) is None:
+                ckpt.save(checkpoint, fp, sim.state())
+                last_ckpt = time.perf_counter()
 
     final = sim.packing()
     report = final.overlap_report(overlap_tol)
@@ -333,6 +426,8 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
             "switch_collisions": switch_coll,
             "final_stage_collisions": None if switch_coll is None else int(sim.collisions) - switch_coll,
         })
+    if reason == "max_pressure":
+        _end_state_check(final, stats)
     contacts = None
     if contact_forces:
         contacts = sim.contacts.result(final)
@@ -340,6 +435,6 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     ts_attrs = {k: stats[k] for k in ("growth_rate", "seed", "stop_reason", "final_growth_rate",
                                       "switch_pressure") if k in stats}
     ts = timeseries_dataset(sim, ts_attrs | {"N": sim.n, "d": sim.d})
-    if checkpoint is not None:
+    if checkpoint is not None and not keep_checkpoint:
         ckpt.remove(checkpoint)
     return CompressResult(final, sim.velocities(), ts, stats, contacts)

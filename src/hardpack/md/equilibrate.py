@@ -5,18 +5,29 @@ stays 1. After ``n_equilibration`` collisions the run is cut into ``n_blocks`` w
 numbers of collisions; each window gives Z = 1 + sum r_ij . J_ij / (2 * integral of KE dt)
 (note 000 sec. 2.5), and the error is the standard error of the block means, std/sqrt(n_blocks)
 (blocks of many collisions per particle are much longer than the pressure's correlation time).
+
+With ``checkpoint`` the run is resumable like :func:`hardpack.md.compress`: its state is saved at
+checkpoint-ready windows every ``checkpoint_interval`` seconds and on SIGINT or SIGTERM
+(:mod:`hardpack.io.interrupt`), and a run started again with the same arguments ends with the
+same block values, bit for bit.
 """
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
+from hardpack.io import checkpoint as ckpt
+from hardpack.io import interrupt
 from hardpack.md.simulation import Simulation, check_packing, maxwell_boltzmann
+
+log = logging.getLogger("hardpack.md")
 
 
 @dataclass
@@ -36,10 +47,13 @@ class EquilibriumResult:
 
 def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int = 20,
                 n_equilibration: int | None = None,
-                overlap_tol: float = DEFAULT_OVERLAP_TOL) -> EquilibriumResult:
+                overlap_tol: float = DEFAULT_OVERLAP_TOL, checkpoint=None,
+                checkpoint_interval: float = 300.0, keep_checkpoint: bool = False) -> EquilibriumResult:
     """Run NVE hard-sphere MD at fixed phi and measure Z over ``n_collisions`` collisions.
 
     n_equilibration: collisions discarded first (default n_collisions // 4).
+    checkpoint: resumable checkpoint (module docstring), removed at the end unless
+    ``keep_checkpoint`` (then the caller removes it once the result is written).
     """
     check_packing(packing)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -55,10 +69,35 @@ def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int
                      overlap_tol=overlap_tol)
     block = max(1, int(n_collisions) // int(n_blocks))
     per_window = max(1, round(20 * sim.n))  # keep windows short enough for frequent checks
-    while sim.collisions < n_eq:
-        sim.run_window(min(per_window, n_eq - sim.collisions))
-    start_time, start_coll = sim.time, sim.collisions
-    z = np.array([sim.run_window(block)["Z"] for _ in range(int(n_blocks))])
+    fp = ckpt.fingerprint(packing, run="equilibrate", seed=int(seed), n_collisions=int(n_collisions),
+                          n_blocks=int(n_blocks), n_equilibration=n_eq, overlap_tol=overlap_tol)
+    z: list[float] = []
+    start_time, start_coll = 0.0, n_eq
+    state = None if checkpoint is None else ckpt.load(checkpoint, fp)
+    if state is not None:
+        z = list(np.atleast_1d(state.pop("Z_blocks")))[:int(state.pop("n_blocks_done"))]
+        start_time = float(state.pop("start_time"))
+        sim.restore(state)
+        log.info("resumed from %s after %d collisions (%d blocks done)", checkpoint, sim.collisions, len(z))
+    last_save = time.perf_counter()
+    with interrupt.deferred():
+        while len(z) < int(n_blocks):
+            if sim.collisions < n_eq:
+                sim.run_window(min(per_window, n_eq - sim.collisions))
+                start_time, start_coll = sim.time, sim.collisions
+            else:
+                z.append(sim.run_window(block)["Z"])
+            if checkpoint is not None and sim.checkpoint_ready and len(z) < int(n_blocks) and (
+                    interrupt.requested() is not None or time.perf_counter() - last_save >= checkpoint_interval):
+                ckpt.save(checkpoint, fp, sim.state() | {"Z_blocks": np.asarray(z, dtype=float),
+                                                          "n_blocks_done": len(z), "start_time": start_time})
+                last_save = time.perf_counter()
+            if interrupt.requested() is not None and (checkpoint is None or sim.checkpoint_ready):
+                raise interrupt.stop(checkpoint, f"{sim.collisions} of {n_eq + block * int(n_blocks)} "
+                                                 "collisions")
+    z = np.asarray(z)
+    if checkpoint is not None and not keep_checkpoint:
+        ckpt.remove(checkpoint)
     return EquilibriumResult(
         Z=float(z.mean()), Z_err=float(z.std(ddof=1) / math.sqrt(len(z))), Z_blocks=z,
         phi=sim.phi(), collisions=sim.collisions - start_coll, md_time=sim.time - start_time,

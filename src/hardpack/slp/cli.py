@@ -6,6 +6,7 @@ import logging
 
 import scipy
 
+from hardpack.io import checkpoint as ckpt
 from hardpack.io import load_dataset, load_packing, save_packing, write_dataset
 from hardpack.slp.driver import run_slp
 from hardpack.slp.lp import METHODS, Bounds
@@ -19,7 +20,7 @@ def cmd_slp(args) -> int:
     bounds = Bounds(args.strain_bound, args.shear_bound, args.displacement_bound)
     result = run_slp(start, args.alpha, bounds, deforming=not args.isotropic, tol=args.tol,
                      max_steps=args.max_steps, method=args.lp_method, checkpoint=args.checkpoint,
-                     checkpoint_interval=args.checkpoint_interval)
+                     checkpoint_interval=args.checkpoint_interval, keep_checkpoint=True)
     params = {
         "generator": "slp", "alpha": args.alpha, "strain_bound": args.strain_bound,
         "shear_bound": args.shear_bound, "displacement_bound": args.displacement_bound,
@@ -37,6 +38,8 @@ def cmd_slp(args) -> int:
     save_packing(result.packing, args.out, attrs=attrs, config=params)
     if args.history:
         write_dataset(result.history, args.history, attrs=params)
+    if args.checkpoint is not None:  # only now that the results are safely written
+        ckpt.remove(args.checkpoint)
     log.info("SLP %s: phi = %.8f after %d LPs (%d rejected), %.1f s, converged=%s",
              args.out, result.packing.phi, result.n_steps, result.n_rejected, result.wall_seconds,
              result.converged)

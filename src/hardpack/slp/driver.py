@@ -40,6 +40,7 @@ import xarray as xr
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
+from hardpack.io import interrupt
 from hardpack.geometry.reduction import lll_reduce
 from hardpack.slp.lp import Bounds, solve_step
 
@@ -73,14 +74,17 @@ def _apply(packing: Packing, strain: np.ndarray, displacement: np.ndarray) -> Pa
 
 def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = True, tol: float = 1e-10,
             max_steps: int = 2000, reject_overlap: float = 1e-4, progress_every: int = 10,
-            method: str = "highs-ipm", checkpoint=None, checkpoint_interval: float = 300.0) -> SLPResult:
+            method: str = "highs-ipm", checkpoint=None, checkpoint_interval: float = 300.0,
+            keep_checkpoint: bool = False) -> SLPResult:
     """Densify ``packing`` by sequential LPs until the predicted density gain is below ``tol``.
 
     ``alpha``: influence-sphere radius over the pair's mean diameter (gamma_mn = alpha D_mn);
     ``bounds``: full trust-region widths; ``deforming``: symmetric strain (strictly jammed end
     states) or isotropic shrink only (collectively jammed end states); ``method``: the HiGHS
     solver of :func:`hardpack.slp.lp.solve_step`; ``checkpoint``: path of a resumable checkpoint
-    (module docstring), removed when the run ends.
+    (module docstring), removed when the run ends unless ``keep_checkpoint`` (then the caller
+    removes it once the result is written). On SIGINT or SIGTERM the run writes its checkpoint
+    before the next LP and raises :class:`hardpack.io.interrupt.Interrupted`.
     """
     if not (0 < tol < 1):
         raise InvalidInputError(f"tol must be in (0, 1), got {tol}")
@@ -107,42 +111,48 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
         wall_before, cpu_before = float(state["wall_seconds"]), float(state["cpu_seconds"])
         log.info("resumed from %s at SLP step %d (phi = %.8f)", checkpoint, first, current.phi)
     last_save = time.perf_counter()
-    for step in range(first, int(max_steps)):
-        if checkpoint is not None and time.perf_counter() - last_save >= checkpoint_interval:
-            _save(checkpoint, fp, current, scale, step, n_rejected, records,
-                  wall_before + time.perf_counter() - start, cpu_before + time.process_time() - cpu_start)
-            last_save = time.perf_counter()
-        sol = solve_step(current, alpha, bounds.scaled(scale), deforming, method=method)
-        gain = -sol.trace
-        if gain < tol:
-            if scale == 1.0:
-                converged = True
-                records.append((step, current.phi, gain, sol.n_constraints, sol.lp_seconds, scale, 0.0, 1))
-                break
-            scale = 1.0  # a tiny trust region predicts a tiny gain: retry at full width
-            continue
-        trial = _apply(current, sol.strain, sol.displacement)
-        worst = trial.overlap_report(tol=0.0).overlap
-        if worst > reject_overlap:
-            n_rejected += 1
-            records.append((step, current.phi, gain, sol.n_constraints, sol.lp_seconds, scale, worst, 0))
-            scale /= 2
-            if scale < MIN_TRUST_SCALE:
-                raise InvalidInputError(
-                    f"SLP step {step}: the trust region shrank below {MIN_TRUST_SCALE:g} of the bounds "
-                    f"without an acceptable step (worst overlap {worst:.2e}); lower the bounds"
-                )
-            continue
-        if worst > 0:
-            grow = (1.0 + 1e-12) / (1.0 - worst)
-            trial = Packing(trial.positions * grow, trial.radii, trial.lattice * grow,
-                            species=trial.species, allow_overlap=True)
-        current = _reduced(Packing(trial.positions, trial.radii, trial.lattice, species=trial.species))
-        records.append((step, current.phi, gain, sol.n_constraints, sol.lp_seconds, scale, max(worst, 0.0), 1))
-        scale = min(1.0, 2 * scale)
-        if progress_every and step % progress_every == 0:
-            log.info("SLP step %d: phi = %.8f, predicted gain %.2e, %d constraints, trust %.3g",
-                     step, current.phi, gain, sol.n_constraints, scale)
+    with interrupt.deferred():
+        for step in range(first, int(max_steps)):
+            if interrupt.requested() is not None:
+                if checkpoint is not None:
+                    _save(checkpoint, fp, current, scale, step, n_rejected, records,
+                          wall_before + time.perf_counter() - start, cpu_before + time.process_time() - cpu_start)
+                raise interrupt.stop(checkpoint, f"SLP step {step} (phi = {current.phi:.8f})")
+            if checkpoint is not None and time.perf_counter() - last_save >= checkpoint_interval:
+                _save(checkpoint, fp, current, scale, step, n_rejected, records,
+                      wall_before + time.perf_counter() - start, cpu_before + time.process_time() - cpu_start)
+                last_save = time.perf_counter()
+            sol = solve_step(current, alpha, bounds.scaled(scale), deforming, method=method)
+            gain = -sol.trace
+            if gain < tol:
+                if scale == 1.0:
+                    converged = True
+                    records.append((step, current.phi, gain, sol.n_constraints, sol.lp_seconds, scale, 0.0, 1))
+                    break
+                scale = 1.0  # a tiny trust region predicts a tiny gain: retry at full width
+                continue
+            trial = _apply(current, sol.strain, sol.displacement)
+            worst = trial.overlap_report(tol=0.0).overlap
+            if worst > reject_overlap:
+                n_rejected += 1
+                records.append((step, current.phi, gain, sol.n_constraints, sol.lp_seconds, scale, worst, 0))
+                scale /= 2
+                if scale < MIN_TRUST_SCALE:
+                    raise InvalidInputError(
+                        f"SLP step {step}: the trust region shrank below {MIN_TRUST_SCALE:g} of the bounds "
+                        f"without an acceptable step (worst overlap {worst:.2e}); lower the bounds"
+                    )
+                continue
+            if worst > 0:
+                grow = (1.0 + 1e-12) / (1.0 - worst)
+                trial = Packing(trial.positions * grow, trial.radii, trial.lattice * grow,
+                                species=trial.species, allow_overlap=True)
+            current = _reduced(Packing(trial.positions, trial.radii, trial.lattice, species=trial.species))
+            records.append((step, current.phi, gain, sol.n_constraints, sol.lp_seconds, scale, max(worst, 0.0), 1))
+            scale = min(1.0, 2 * scale)
+            if progress_every and step % progress_every == 0:
+                log.info("SLP step %d: phi = %.8f, predicted gain %.2e, %d constraints, trust %.3g",
+                         step, current.phi, gain, sol.n_constraints, scale)
     cols = list(zip(*records)) if records else [[] for _ in range(8)]
     history = xr.Dataset(
         {
@@ -157,7 +167,7 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
         coords={"step": ("lp", np.asarray(cols[0], np.int64))},
         attrs={"hardpack_kind": "slp_history"},
     )
-    if checkpoint is not None:
+    if checkpoint is not None and not keep_checkpoint:
         ckpt.remove(checkpoint)
     return SLPResult(
         packing=current, history=history, converged=converged, n_steps=len(records),

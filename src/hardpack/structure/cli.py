@@ -17,7 +17,7 @@ def cmd_structure(args) -> int:
     from hardpack.structure.analysis import analyse
 
     ds = load_dataset(args.packing, kind="packing")
-    packing = dataset_to_packing(ds, source=str(args.packing), allow_overlap=True)
+    packing = dataset_to_packing(ds, source=str(args.packing))
     rattlers = None
     if args.jamming:
         verdict = load_dataset(args.jamming, kind="jamming")
