@@ -186,3 +186,17 @@ def test_warm_start_survives_particles_wrapping_through_the_cell():
     assert changed > 0  # some keys did change: the test exercises the wrap
     basis, _ = warm.rewrapped(_wraps(moved, after)).locate(keys[1], 2)
     assert np.sort(basis).tolist() == list(range(after.n_contacts))
+
+
+@pytest.mark.parametrize("name, d", [("square", 2), ("sc", 3)])
+def test_one_particle_cell_shears_at_decreasing_volume(name, d):
+    """Square and SC with one particle per cell (gaps 1e-4 D): the particle is caged by its
+    own images (collectively jammed), but the shear eps_12 keeps every contact at first order
+    and lowers the volume at second order (Donev Table 4.1: not strictly jammed). The particle
+    is its own bulk, so only the strain shows the motion: it exceeds the threshold."""
+    p = _shrunk(lattice_packing(name, (1,) * d), 1e-4)
+    r = verify(p, delta=0.2, method="sequential", seed=2, threshold=1e-2, contact_delta=1e-3)
+    assert r.collective and not r.strict
+    assert max(r.strict_test.mean_displacement) == 0.0
+    assert max(r.strict_test.strain_norm) >= 1e-2
+    assert r.category == "collectively jammed"

@@ -42,9 +42,15 @@ The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated o
 sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
 subtracted), in units of the mean diameter, averaged over the non-rattlers (rattlers are fixed
 and excluded; Donev's tables include them, L2280-L2290). In the strict test dr_i includes the
-affine part of a cell deformation, as the LP variables of the text do; the accumulated strain
-is reported too. The verdict is "jammed" when no sequence reaches a mean of ``threshold`` (a
-judgement, as the text says, L1789-L1814).
+affine part of a cell deformation, as the LP variables of the text do. The strain accumulated
+over the sequence, |eps|_2 (the largest relative displacement the cell deformation gives two
+touching particles, in units of their distance D), counts as well: with one particle per cell,
+e.g. the square or simple cubic lattice sheared at decreasing volume (Donev Table 4.1: not
+strictly jammed), that particle is its own bulk and no displacement relative to the bulk can
+see the cell deform. The strain does not depend on the supercell (L1216-L1303), where the
+affine part of the mean displacement grows with the cell. The verdict is "jammed" when no
+sequence reaches ``threshold`` with its mean displacement or its strain (a judgement, as the
+text says, L1789-L1814).
 
 Round-off: a pair already in contact may approach by the LP feasibility tolerance (~1e-10);
 the collision time is therefore computed for a distance (1 - 1e-11) times the smaller of the
@@ -105,6 +111,16 @@ class SequentialOutcome:
     n_lp_highs: int = 0  # LPs HiGHS solved (the others: hardpack.jamming.workingset)
     seconds: float = 0.0
     method: str = "sequential"
+
+    def size(self, sequence: int) -> float:
+        """How far loading sequence ``sequence`` unjammed the packing, compared with the
+        threshold (module docstring): the larger of its mean displacement / D and its strain."""
+        return max(self.mean_displacement[sequence], self.strain_norm[sequence])
+
+    @property
+    def unjammed(self) -> bool:
+        """Some loading sequence reached the threshold."""
+        return any(self.size(k) >= self.threshold for k in range(len(self.steps)))
 
 
 def collision_step(net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None) -> float:
@@ -203,7 +219,7 @@ def sequential_test(
               random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None)
              for _ in range(n_loads)]
     todo = []  # (sequence, load, strain load): B and -B for each load
-    if max(out.mean_displacement, default=0.0) < threshold:  # else settled before a resume
+    if not out.unjammed:  # else settled before a resume
         for sequence in range(first, 2 * n_loads):
             load, strain_load = loads[sequence // 2]
             sign = 1.0 if sequence % 2 == 0 else -1.0
@@ -216,10 +232,10 @@ def sequential_test(
         _record(out, result, moving, 2.0 * packing.radii.mean())
         if save is not None:
             save(_state(out, start_rng, sequence + 1, earlier + time.perf_counter() - t0))
-        if out.mean_displacement[-1] >= threshold:
+        if out.size(-1) >= threshold:
             break  # step 10: the verdict is settled
     # no particle left to load: every one is a rattler, nothing is jammed (Alg. 13 step 3)
-    out.jammed = bool(moving.any() and max(out.mean_displacement, default=0.0) < threshold)
+    out.jammed = bool(moving.any() and not out.unjammed)
     out.seconds = earlier + time.perf_counter() - t0
     return out
 
@@ -277,7 +293,8 @@ def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequ
         total += step
         if strain_total is not None:
             strain_total += tau * mot.strain
-        if _mean_size(total, moving, diameter) >= threshold:
+        strain_size = 0.0 if strain_total is None else np.linalg.norm(strain_total, 2)
+        if max(_mean_size(total, moving, diameter), strain_size) >= threshold:
             break  # step 10: unjammed beyond the threshold, the verdict is settled
         if largest <= beta * diameter:
             break
@@ -339,18 +356,19 @@ def _record(out: SequentialOutcome, result: _Sequence, moving: np.ndarray, diame
     size = np.linalg.norm(rel, axis=1) / diameter
     size[~moving] = 0.0
     mean = float(size[moving].mean()) if moving.any() else 0.0
-    if mean > max(out.mean_displacement, default=-1.0):
+    strain = 0.0 if result.strain is None else float(np.linalg.norm(result.strain, 2))
+    if not out.steps or max(mean, strain) > max(out.size(k) for k in range(len(out.steps))):
         out.motion, out.strain = rel, result.strain
     out.mean_displacement.append(mean)
     out.max_displacement.append(float(size.max(initial=0.0)))
     out.steps.append(result.steps)
-    out.strain_norm.append(0.0 if result.strain is None else float(np.linalg.norm(result.strain, 2)))
+    out.strain_norm.append(strain)
     out.displacement = np.maximum(out.displacement, size)
     out.n_lp += result.steps
     out.n_lp_highs += result.n_lp_highs
     out.final = result.final
-    log.info("%s test: loading sequence %d moved the particles by %.3g D on average "
-             "(threshold %.3g D)", out.test, len(out.steps), mean, out.threshold)
+    log.info("%s test: loading sequence %d moved the particles by %.3g D on average and strained "
+             "the cell by %.3g (threshold %.3g)", out.test, len(out.steps), mean, strain, out.threshold)
 
 
 def _state(out: SequentialOutcome, start_rng: str, next_sequence: int, seconds: float) -> dict:
