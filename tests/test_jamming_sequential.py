@@ -200,3 +200,15 @@ def test_one_particle_cell_shears_at_decreasing_volume(name, d):
     assert max(r.strict_test.mean_displacement) == 0.0
     assert max(r.strict_test.strain_norm) >= 1e-2
     assert r.category == "collectively jammed"
+
+
+def test_a_checkpoint_of_layout_2_is_refused():
+    """Layout 2 had no undetermined reason and no fallback counts: refused, not misread."""
+    from hardpack.errors import InvalidInputError
+    from hardpack.jamming.sequential import sequential_test
+
+    p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-4)
+    old = {"version": 2, "next_sequence": 1, "rng": "{}", "seconds": 1.0}
+    with pytest.raises(InvalidInputError, match="older hardpack \\(state layout 2, this one reads 3"):
+        sequential_test(p, 0.2, strict=False, rattlers=np.zeros(p.n_particles, bool),
+                        rng=np.random.default_rng(0), box=1.0, resume=old)

@@ -441,9 +441,9 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     """Load a :func:`_state` into ``out`` and ``rng``; returns (the generator's state at the
     test's start, the next sequence, the seconds spent)."""
     if state.get("version") != STATE_VERSION:
-        raise InvalidInputError("the checkpoint holds a sequential test saved by an older hardpack, "
-                                "whose loading sequences went on from the moved packing; delete it "
-                                "to start the verification afresh")
+        raise InvalidInputError(f"the checkpoint holds a sequential test saved by an older hardpack "
+                                f"(state layout {state.get('version', 1)}, this one reads {STATE_VERSION}: "
+                                "see STATE_VERSION); delete it to start the verification afresh")
     rng.bit_generator.state = json.loads(state["rng"])
     out.mean_displacement = [float(v) for v in state["mean_displacement"]]
     out.strain_norm = [float(v) for v in state["strain_norm"]]
