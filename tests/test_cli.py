@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from hardpack.cli import main
 from hardpack.io import load_dataset, load_packing
@@ -46,3 +47,17 @@ def test_lattice_command_writes_a_crystal(tmp_path):
     p = load_packing(out)
     assert p.n_particles == 108 and abs(p.phi - np.pi / np.sqrt(18)) < 1e-12
     assert main(["lattice", "--name", "fcx", "--out", str(out)]) == 2
+
+
+def test_lattice_command_refuses_bad_repetitions(tmp_path, capsys):
+    """A wrong number of repetitions crashed with numpy's broadcast error; non-integers stop in
+    argparse; zero is refused. Nothing is written."""
+    out = tmp_path / "fcc.nc"
+    assert main(["lattice", "--name", "fcc", "--reps", "2", "2", "--out", str(out)]) == 2
+    assert "reps must be one repetition count or 3 of them" in capsys.readouterr().err
+    assert main(["lattice", "--name", "fcc", "--reps", "0", "--out", str(out)]) == 2
+    assert "positive whole numbers" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["lattice", "--name", "fcc", "--reps", "1.5", "--out", str(out)])
+    assert "invalid int value: '1.5'" in capsys.readouterr().err
+    assert not out.exists()

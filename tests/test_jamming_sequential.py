@@ -186,3 +186,29 @@ def test_warm_start_survives_particles_wrapping_through_the_cell():
     assert changed > 0  # some keys did change: the test exercises the wrap
     basis, _ = warm.rewrapped(_wraps(moved, after)).locate(keys[1], 2)
     assert np.sort(basis).tolist() == list(range(after.n_contacts))
+
+
+@pytest.mark.parametrize("name, d", [("square", 2), ("sc", 3)])
+def test_one_particle_cell_shears_at_decreasing_volume(name, d):
+    """Square and SC with one particle per cell (gaps 1e-4 D): the particle is caged by its
+    own images (collectively jammed), but the shear eps_12 keeps every contact at first order
+    and lowers the volume at second order (Donev Table 4.1: not strictly jammed). The particle
+    is its own bulk, so only the strain shows the motion: it exceeds the threshold."""
+    p = _shrunk(lattice_packing(name, (1,) * d), 1e-4)
+    r = verify(p, delta=0.2, method="sequential", seed=2, threshold=1e-2, contact_delta=1e-3)
+    assert r.collective and not r.strict
+    assert max(r.strict_test.mean_displacement) == 0.0
+    assert max(r.strict_test.strain_norm) >= 1e-2
+    assert r.category == "collectively jammed"
+
+
+def test_a_checkpoint_of_layout_2_is_refused():
+    """Layout 2 had no undetermined reason and no fallback counts: refused, not misread."""
+    from hardpack.errors import InvalidInputError
+    from hardpack.jamming.sequential import sequential_test
+
+    p = _shrunk(lattice_packing("triangular", (4, 4)), 1e-4)
+    old = {"version": 2, "next_sequence": 1, "rng": "{}", "seconds": 1.0}
+    with pytest.raises(InvalidInputError, match="older hardpack \\(state layout 2, this one reads 3"):
+        sequential_test(p, 0.2, strict=False, rattlers=np.zeros(p.n_particles, bool),
+                        rng=np.random.default_rng(0), box=1.0, resume=old)

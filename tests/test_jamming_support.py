@@ -13,14 +13,18 @@ without the MD engine. Recipe (O'Hern et al. 2003 style, then made exact):
    exact (gap ~1e-15) and every other pair open. Rattlers keep their place and shrink if needed.
 
 The tests at the bottom check that the maker does what it says (exact contacts, isostatic).
+The jamming tests read its 64 disks from tests/data (:func:`jammed_disks`); a slow test checks
+that the maker still makes them.
 """
 
 from __future__ import annotations
 
 import functools
 import itertools
+from pathlib import Path
 
 import numpy as np
+import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.optimize import minimize
@@ -30,6 +34,7 @@ from hardpack.distributions import bidisperse
 from hardpack.geometry.neighbours import pairs_within
 from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
+from hardpack.io import load_packing
 
 S3 = np.sqrt(3.0)
 
@@ -196,20 +201,46 @@ def _exact_contacts(x, radii, lattice):
     return Packing(x, radii, lattice)
 
 
-@functools.cache
-def jammed_disks() -> Packing:
-    """64 binary disks (size ratio 1.4, equimolar), exactly jammed; built once per process."""
+#: jammed_disks() as stored: making them takes 25 CPU s (the bisection of soft-sphere
+#: minimisations), which every test run paid; test_maker_still_makes_the_stored_disks (slow)
+#: checks that the maker gives them
+JAMMED_DISKS = Path(__file__).parent / "data" / "jammed_disks_n64.nc"
+
+
+def make_jammed_disks() -> Packing:
+    """64 binary disks (size ratio 1.4, equimolar), exactly jammed."""
     return soft_jammed(64, 2, bidisperse(1.4, 0.5), seed=3, phi_high=0.87)
 
 
+@functools.cache
+def jammed_disks() -> Packing:
+    """:func:`make_jammed_disks`'s packing, read from ``tests/data`` (JAMMED_DISKS)."""
+    return load_packing(JAMMED_DISKS)
+
+
 # ---------------------------------------------------------------------------- self-tests
-def test_maker_gives_exact_isostatic_contacts():
-    """The backbone contacts are exact to round-off and the next pair is open by more than
-    1e-5, so any contact tolerance between 1e-12 and 1e-5 sees the same network (what the
-    jamming tests rely on)."""
-    p = jammed_disks()
+def _check_exact_isostatic_contacts(p: Packing) -> None:
     gaps = np.sort(pairs_within(p, rel_gap=0.05).gap)
     tight = gaps[gaps < 1e-12]
     assert tight.size == 2 * (p.n_particles - 2 - 1) + 1  # isostatic: 2 rattlers for seed 3
     assert gaps[tight.size] > 1e-5
     assert np.abs(tight).max() < 1e-12
+
+
+def test_maker_gives_exact_isostatic_contacts():
+    """The backbone contacts are exact to round-off and the next pair is open by more than
+    1e-5, so any contact tolerance between 1e-12 and 1e-5 sees the same network (what the
+    jamming tests rely on)."""
+    _check_exact_isostatic_contacts(jammed_disks())
+
+
+@pytest.mark.slow
+def test_maker_still_makes_the_stored_disks():
+    """The maker's packing is the stored one (bit for bit on the machine that stored it; to
+    1e-9 elsewhere) and exactly isostatic itself."""
+    made = make_jammed_disks()
+    _check_exact_isostatic_contacts(made)
+    stored = jammed_disks()
+    np.testing.assert_allclose(made.lattice, stored.lattice, rtol=1e-12)
+    np.testing.assert_allclose(made.radii, stored.radii, rtol=1e-12)
+    np.testing.assert_allclose(made.positions, stored.positions, atol=1e-9 * made.lattice[0, 0])

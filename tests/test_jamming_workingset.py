@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from scipy.optimize import linprog
-from scipy.sparse.csgraph import maximum_bipartite_matching
+from scipy.sparse.csgraph import maximum_bipartite_matching, structural_rank
 
-from hardpack.jamming import workingset
+from hardpack.geometry.lattices import lattice_packing
+from hardpack.jamming import contact_network, workingset
+from hardpack.jamming.rigidity import anchored_transpose
 
 
 def _regular_sparse(n: int, seed: int) -> sp.csc_matrix:
@@ -168,3 +170,63 @@ def test_block_solves_match_a_dense_solve(dense_rows):
     b = np.random.default_rng(4).standard_normal((120, 70))
     exact = np.linalg.solve(a.toarray(), b)
     assert np.abs(lu.solve_block(b) - exact).max() <= 1e-10 * np.abs(exact).max()
+
+
+def test_factorise_a_crystal_basis_with_equal_entries():
+    """A basis of the BCC 3 x 2 x 1 cell's collective LP: its first 33 contact columns (all of
+    gap 0, as a cold start takes them), rank 27 and structural rank 29. SuperLU refused the
+    regularised copy with equal regularising entries ('Factor is exactly singular', the crash
+    of verify(lattice_packing('bcc', (3, 2, 1)))); now the 6 dependent columns are found, and
+    the repair cycles of _repaired_lu (dependent columns replaced by the unit columns of their
+    rows) end with a regular basis."""
+    p = lattice_packing("bcc", (3, 2, 1))
+    net = contact_network(p, 1e-6)
+    backbone = np.ones(p.n_particles, bool)
+    _, at = anchored_transpose(net, backbone, net.among(backbone))
+    basis = at.T.tocsc()[:, :33].tocsc()
+    assert np.linalg.matrix_rank(basis.toarray()) == 27 and structural_rank(basis) == 29
+    lu, cols, _ = workingset._factorise(basis)
+    assert lu is None and cols.size == 6
+    columns = workingset._Columns(basis, np.zeros(33), np.ones(33))
+    lu, repaired, replaced = workingset._repaired_lu(columns, np.arange(33))
+    assert lu is not None and replaced.size >= 6
+    regular = columns.matrix(repaired).toarray()
+    assert np.linalg.matrix_rank(regular) == 33
+    x = np.arange(33.0)
+    np.testing.assert_allclose(regular @ lu.solve(x), x, atol=1e-9)
+
+
+def test_structurally_singular_basis_never_reaches_superlu(monkeypatch):
+    """SuperLU on a structurally singular matrix calls BLAS with negative sizes (OpenBLAS:
+    'On entry to DGEMV parameter number 2 had an illegal value'): _factorise probes such a
+    matrix on its regularised copy only."""
+    seen = []
+    real = workingset._ScaledLU
+
+    class Spy(real):
+        def __init__(self, a):
+            seen.append(workingset.structurally_regular(a))
+            super().__init__(a)
+
+    monkeypatch.setattr(workingset, "_ScaledLU", Spy)
+    a = sp_random_structurally_singular()
+    lu, cols, _ = workingset._factorise(a)
+    assert lu is None and cols.size >= 1
+    assert seen and all(seen)
+
+
+def sp_random_structurally_singular():
+    """40 x 40, two columns supported on the same single row: structural rank 39."""
+    rng = np.random.default_rng(3)
+    n = 40
+    rows = np.concatenate([(np.arange(n) + s) % n for s in (1, 2, 5)])
+    cols = np.tile(np.arange(n), 3)
+    a = sp.csc_matrix((rng.uniform(1, 2, 3 * n), (rows, cols)), shape=(n, n)).tolil()
+    a[:, 10] = 0.0
+    a[:, 11] = 0.0
+    a[4, 10] = 1.0
+    a[4, 11] = 2.0
+    a = sp.csc_matrix(a)
+    a.eliminate_zeros()
+    assert not workingset.structurally_regular(a)
+    return a

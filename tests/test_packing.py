@@ -152,3 +152,16 @@ def test_tiled_packing_keeps_phi_and_contact_number():
     assert len(pairs_within(big, rel_gap=1e-9).i) == 6 * len(pairs_within(p, rel_gap=1e-9).i)
     with pytest.raises(InvalidInputError, match="positive integers"):
         p.tiled(0)
+
+
+@pytest.mark.parametrize("reps", [1.5, (2.9, 1, 1), 0, -1, (1, 1, 0), True, "2", float("nan"), (2, 2), (1, 1, 1, 1), [[1, 2, 3]]])
+def test_lattice_repetitions_must_be_positive_whole_numbers_one_per_vector(reps):
+    """Non-integer repetitions were truncated (1.5 -> 1, 2.9 -> 2), a wrong count crashed."""
+    with pytest.raises(InvalidInputError, match="reps must be"):
+        lattice_packing("fcc", reps)
+
+
+def test_lattice_repetitions_accept_whole_floats_and_numpy_integers():
+    assert lattice_packing("fcc", 2.0).n_particles == 32
+    assert lattice_packing("fcc", np.array([3, 2, 1])).n_particles == 24
+    assert lattice_packing("triangular", (np.int64(3), 2)).n_particles == 6

@@ -57,7 +57,10 @@ def test_analyse_two_dimensional_packing_has_psi6():
     assert abs(float(ds.psi6_global) - 1) < 1e-12 and "Q6" not in ds
 
 
-def test_cli_analyses_all_particles_when_the_verdict_leaves_no_backbone(tmp_path):
+def test_cli_reports_a_verdict_without_backbone(tmp_path):
+    """Every particle a rattler: no backbone. The output says so (verdict, count) and has no
+    backbone quantities, instead of passing off an analysis of all particles as one without
+    rattlers (the near-contact exponent alpha is the backbone's when a mask is given)."""
     src = tmp_path / "sc.nc"
     save_packing(lattice_packing("sc", 3), src)
     verdict = write_dataset(xr.Dataset({"rattler": ("particle", np.ones(27, np.int8))},
@@ -66,4 +69,8 @@ def test_cli_analyses_all_particles_when_the_verdict_leaves_no_backbone(tmp_path
     out = tmp_path / "o.nc"
     assert run(["structure", str(src), "--out", str(out), "--jamming", str(verdict), "--kmax", "7"]) == 0
     with xr.open_dataset(out) as ds:
-        assert ds.attrs["rattler_mask"] == "none" and float(ds.z_contacts) == 6.0
+        assert ds.attrs["rattler_mask"] == str(verdict)
+        assert ds.attrs["backbone"].startswith("none") and ds.attrs["n_rattlers"] == 27
+        assert ds.attrs["jamming_verdict"] == "not jammed"
+        assert "Z_backbone" not in ds and np.isnan(float(ds.alpha))
+        assert float(ds.z_contacts) == 6.0  # all-particle quantities stay

@@ -10,6 +10,7 @@ D_d (D_4 = 0.6169, D_5 = 0.4653; Conway & Sloane) in any d.
 from __future__ import annotations
 
 import itertools
+import numbers
 
 import numpy as np
 
@@ -71,17 +72,35 @@ LATTICES = ("square", "triangular", "honeycomb", "kagome", "sc", "bcc", "fcc", "
 def lattice_packing(name: str, reps=1) -> Packing:
     """A crystal of ``name`` with its unit cell repeated ``reps`` times along each lattice vector.
 
-    ``reps`` is an int or a sequence of d ints. Spheres have radius 1/2 and touch their nearest
-    neighbours exactly.
+    ``reps`` is a positive integer or a sequence of d of them (whole-valued floats such as 2.0
+    are taken as integers; 2.5, 0, -1, True or a sequence of the wrong length are refused).
+    Spheres have radius 1/2 and touch their nearest neighbours exactly.
     """
     lat, basis, radius = _cell(name)
     d = lat.shape[0]
-    reps = np.broadcast_to(np.asarray(reps, dtype=int), (d,))
-    if (reps < 1).any():
-        raise InvalidInputError(f"reps must be >= 1 along every lattice vector, got {reps.tolist()}")
+    reps = _repetitions(reps, d, name)
     cells = np.array(list(itertools.product(*[range(r) for r in reps])), dtype=float)
     frac = (cells[:, None, :] + basis[None, :, :]).reshape(-1, d) / reps
     big = lat * reps  # scale each column (lattice vector)
     positions = frac @ big.T
     radii = np.full(len(positions), radius)
     return Packing(positions, radii, big)
+
+
+def _repetitions(reps, d: int, name: str) -> np.ndarray:
+    """``reps`` of :func:`lattice_packing` as d positive ints, or InvalidInputError."""
+    values = np.atleast_1d(np.asarray(reps, dtype=object))
+    if values.ndim != 1 or values.size not in (1, d):
+        raise InvalidInputError(
+            f"reps must be one repetition count or {d} of them (one per lattice vector of the "
+            f"{d}D lattice {name!r}), got {reps!r}")
+    counts = []
+    for value in values:
+        whole = (isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+                 and np.isfinite(float(value)) and float(value).is_integer())
+        if not whole or value < 1:
+            raise InvalidInputError(
+                f"reps must be positive whole numbers of unit cells along the lattice vectors "
+                f"(e.g. 2 or (3, 2, 1)), got {reps!r}: {value!r} is not")
+        counts.append(int(value))
+    return np.broadcast_to(np.array(counts, dtype=int), (d,))

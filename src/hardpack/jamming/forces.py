@@ -46,7 +46,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from hardpack.jamming.contacts import ContactNetwork
-from hardpack.jamming.highs import LPFailure, solve_lp
+from hardpack.jamming.highs import LPFailure, note_fallback, solve_lp
 from hardpack.jamming.isostatic import RigidBackbone
 from hardpack.jamming.rigidity import anchored_transpose, rigidity_transpose
 from hardpack.jamming.workingset import solve_working_set
@@ -118,6 +118,7 @@ def self_stress(net: ContactNetwork, backbone: np.ndarray) -> Forces:
         f = res2.x[:m] + res2.x[-1]
         t = res2.x[-1] * m / f.sum()  # relative to the mean force
     except LPFailure:  # keep the jamming-gap solution
+        note_fallback("uniform_forces_lp_failed")
         f, t = res.x, 0.0
     f = polish(a, np.maximum(f, 0.0))
     f *= m / f.sum()
@@ -202,6 +203,7 @@ def _reduced_lps(null: np.ndarray, h: np.ndarray, dist: np.ndarray, uniform: np.
                         bounds=[(None, None)] * (k + 1))
         f = null @ res2.x[:k]
     except LPFailure:
+        note_fallback("uniform_forces_lp_failed")
         f = null @ res.x
     f = np.where(f < 0, 0.0, f)  # round-off negatives (f = N alpha >= t >= 0 up to tolerance)
     return f, float(f.min() / f.mean()), mu

@@ -33,7 +33,7 @@ import numpy as np
 
 from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.isostatic import RigidBackbone
-from hardpack.jamming.lp import random_strain_load, solve_motion
+from hardpack.jamming.lp import VolumeIncrease, random_strain_load, solve_motion
 from hardpack.jamming.rattlers import neighbours_of, remove_rattlers
 
 log = logging.getLogger(__name__)
@@ -41,7 +41,9 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class TestOutcome:
-    """Result of one jamming test (collective or strict)."""
+    """Result of one jamming test (collective or strict). ``jammed`` is False also when
+    ``undetermined`` holds a reason (an LP whose strain violates the volume constraint beyond
+    the LP's accuracy, :class:`hardpack.jamming.lp.VolumeIncrease`: neither a motion nor a proof)."""
 
     test: str
     jammed: bool
@@ -53,6 +55,7 @@ class TestOutcome:
     seconds: float = 0.0
     method: str = "ideal"
     loads: list = field(default_factory=list)  # per LP: dict(max, mean, removed, strain)
+    undetermined: str = ""  # why the test could not decide ("" when it did)
 
     @property
     def max_displacement(self) -> float:
@@ -111,7 +114,13 @@ def ideal_test(
                 break
             load = sign * _centred(base, active)
             strain_load = None if base_eps is None else sign * base_eps
-            disp, eps = _solve(net, active, load, strain_load, box, length, cache)
+            try:
+                disp, eps = _solve(net, active, load, strain_load, box, length, cache)
+            except VolumeIncrease as exc:
+                out.undetermined = f"LP {out.n_lp + 1}: {exc}"
+                log.warning("%s test undetermined: %s", out.test, out.undetermined)
+                out.seconds = time.perf_counter() - t0
+                return out
             out.n_lp += 1
             rel = relative_displacement(net, active, disp, eps)
             size = np.linalg.norm(rel, axis=1)

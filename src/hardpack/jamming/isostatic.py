@@ -42,6 +42,7 @@ from hardpack.jamming.rigidity import (
     strain_pairs,
     strain_tensor,
 )
+from hardpack.jamming.workingset import structurally_regular
 
 #: backbones with more than this many self-stresses are left to HiGHS
 MAX_SELF_STRESSES = 12
@@ -78,8 +79,12 @@ class RigidBackbone:
             others = np.setdiff1d(np.arange(m), removed)
             removed = np.sort(np.r_[removed, rng.choice(others, k - removed.size, replace=False)])
             rest = np.setdiff1d(np.arange(m), removed)
+            lu = None
+            square = a[:, rest].tocsc()
+            if not structurally_regular(square):  # SuperLU must not see it (_factorise)
+                continue
             try:
-                lu = spla.splu(a[:, rest].tocsc(), permc_spec="COLAMD")
+                lu = spla.splu(square, permc_spec="COLAMD")
                 break
             except RuntimeError:  # exactly singular
                 lu = None

@@ -9,11 +9,14 @@ import xarray as xr
 
 from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.forces import Forces, Statics
+from hardpack.jamming.highs import FALLBACKS
 from hardpack.jamming.ideal import TestOutcome
 from hardpack.jamming.sequential import SequentialOutcome
 
 CATEGORIES = ("local", "collective", "strict")
 ADVERBS = {"local": "locally", "collective": "collectively", "strict": "strictly"}
+#: codes of a test's verdict in the dataset's attributes
+VERDICT_CODES = {True: 1, False: 0, None: -1, "undetermined": -2}
 
 
 @dataclass
@@ -25,6 +28,8 @@ class JammingResult:
     - ``rattler``: particles outside the backbone (local rattlers, plus rattling clusters the
       collective test removed when it found a jammed backbone).
     - ``network``: all contacts within delta; ``forces.forces`` is the backbone self-stress.
+    - ``undetermined``: the tests that could not decide, with the reason (their verdict is None).
+    - ``fallbacks``: how many times each numerical fallback of :data:`FALLBACKS` happened.
     """
 
     params: dict
@@ -40,21 +45,34 @@ class JammingResult:
     volume: float
     md_pressure: float | None = None
     seconds: dict = field(default_factory=dict)
+    fallbacks: dict = field(default_factory=lambda: dict.fromkeys(FALLBACKS, 0))
 
     # ------------------------------------------------------------------ verdicts
     @property
     def collective(self) -> bool | None:
-        return None if self.collective_test is None else bool(self.collective_test.jammed)
+        """None when the test was not run or could not decide (:attr:`undetermined`)."""
+        return _verdict(self.collective_test)
 
     @property
     def strict(self) -> bool | None:
-        return None if self.strict_test is None else bool(self.strict_test.jammed)
+        """None when the test was not run or could not decide (:attr:`undetermined`)."""
+        return _verdict(self.strict_test)
+
+    @property
+    def undetermined(self) -> dict:
+        """{test: reason} of the tests that ran but could not decide."""
+        return {name: out.undetermined for name, out in
+                (("collective", self.collective_test), ("strict", self.strict_test))
+                if out is not None and out.undetermined}
 
     @property
     def category(self) -> str:
-        """The strongest category that holds among the tests run ('not jammed' if none)."""
+        """The strongest category that holds among the tests run ('not jammed' if none), and the
+        first test that could not decide, if any."""
         best = "not jammed"
         for name in CATEGORIES:
+            if name in self.undetermined:
+                return f"{best}; {name} jamming undetermined"
             value = getattr(self, name)
             if value is None:
                 continue
@@ -111,12 +129,19 @@ class JammingResult:
             (f"verdict: {self.category}  (local={_yn(self.local)}, collective={_yn(self.collective)}, "
              f"strict={_yn(self.strict)}; method={p['method']}, delta={p['delta']:g}, "
              f"dr_large={p['dr_large']:.3g}, seed={p['seed']})"),
+            *(f"{name} test undetermined: {reason}" for name, reason in self.undetermined.items()),
             (f"N={self.network.n_particles}, contacts={self.network.n_contacts}, "
              f"rattlers={int(self.rattler.sum())} ({100 * self.rattler_fraction:.2f}%), "
              f"backbone N_b={s.n_backbone}, M_b={s.n_contacts}, Z={s.z_mean:.4f}"),
             (f"isostaticity: M_b - d(N_b-1) - 1 = {s.isostaticity_gap} (collective), "
              f"M_b - [d(N_b-1) + d(d+1)/2] = {s.isostaticity_gap_strict} (strict)"),
         ]
+        if not self.local:
+            lines.append(f"no backbone: all {self.network.n_particles} particles are rattlers, so "
+                         "nothing is jammed (no collective or strict LP was needed)")
+        for name, count in self.fallbacks.items():
+            if count:
+                lines.append(f"numerical fallback {name}: {count} ({FALLBACKS[name]})")
         for test in ("collective", "strict"):
             u = self.unjamming(test)
             if u:
@@ -144,7 +169,11 @@ class JammingResult:
 
     # ------------------------------------------------------------------ dataset
     def to_dataset(self) -> xr.Dataset:
-        """Per-particle, per-contact and scalar results (dims 'particle', 'contact', 'dim')."""
+        """Per-particle, per-contact and scalar results (dims 'particle', 'contact', 'dim').
+
+        Verdict attributes ``local``, ``collective``, ``strict``: 1 jammed, 0 not jammed, -1 not
+        run, -2 undetermined (the reason in ``<test>_undetermined``); ``fallback_<name>``: the
+        count of each numerical fallback (:data:`FALLBACKS`), 0 when it did not happen."""
         net, d = self.network, self.network.dim
         data = {
             "contact_i": (("contact",), net.i),
@@ -170,7 +199,9 @@ class JammingResult:
         s = self.statics
         attrs = dict(
             hardpack_kind="jamming", verdict=self.category,
-            **{k: -1 if v is None else int(v) for k, v in self.verdicts.items()},
+            **{k: VERDICT_CODES["undetermined" if k in self.undetermined else v] for k, v in self.verdicts.items()},
+            **{f"{k}_undetermined": reason for k, reason in self.undetermined.items()},
+            **{f"fallback_{k}": int(v) for k, v in self.fallbacks.items()},
             **{k: v for k, v in self.params.items() if v is not None},
             N=net.n_particles, d=d, n_contacts=net.n_contacts, n_rattlers=int(self.rattler.sum()),
             rattler_fraction=self.rattler_fraction, n_backbone=s.n_backbone,
@@ -188,6 +219,10 @@ class JammingResult:
         for key, value in self.seconds.items():
             attrs[f"seconds_{key}"] = value
         return xr.Dataset(data, attrs=attrs)
+
+
+def _verdict(out) -> bool | None:
+    return None if out is None or out.undetermined else bool(out.jammed)
 
 
 def _or_zeros(arr, n, d):

@@ -42,9 +42,17 @@ The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated o
 sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
 subtracted), in units of the mean diameter, averaged over the non-rattlers (rattlers are fixed
 and excluded; Donev's tables include them, L2280-L2290). In the strict test dr_i includes the
-affine part of a cell deformation, as the LP variables of the text do; the accumulated strain
-is reported too. The verdict is "jammed" when no sequence reaches a mean of ``threshold`` (a
-judgement, as the text says, L1789-L1814).
+affine part of a cell deformation, as the LP variables of the text do. The strain accumulated
+over the sequence, |eps|_2 (the largest relative displacement the cell deformation gives two
+touching particles, in units of their distance D), counts as well: with one particle per cell,
+e.g. the square or simple cubic lattice sheared at decreasing volume (Donev Table 4.1: not
+strictly jammed), that particle is its own bulk and no displacement relative to the bulk can
+see the cell deform. The strain does not depend on the supercell (L1216-L1303), where the
+affine part of the mean displacement grows with the cell. The verdict is "jammed" when no
+sequence reaches ``threshold`` with its mean displacement or its strain (a judgement, as the
+text says, L1789-L1814). It is undetermined (reported with the reason) when no sequence
+reached it but one could not go on: a step that keeps overlapping after MAX_HALVINGS halvings,
+or an LP strain that violates Tr eps <= 0 beyond the LP's accuracy (:class:`VolumeIncrease`).
 
 Round-off: a pair already in contact may approach by the LP feasibility tolerance (~1e-10);
 the collision time is therefore computed for a distance (1 - 1e-11) times the smaller of the
@@ -61,10 +69,11 @@ import json
 import logging
 import os
 import time
+from collections import Counter
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from multiprocessing import get_context
 
@@ -73,8 +82,9 @@ import numpy as np
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.jamming.contacts import ContactNetwork, contact_network
+from hardpack.jamming.highs import FALLBACKS, recording_fallbacks
 from hardpack.jamming.ideal import cell_length
-from hardpack.jamming.lp import random_load, random_strain_load, solve_motion
+from hardpack.jamming.lp import VolumeIncrease, random_load, random_strain_load, solve_motion
 
 log = logging.getLogger(__name__)
 
@@ -84,12 +94,20 @@ APPROACH_SLACK = 1e-11
 #: thread pools (a second thread each, or as many as Snakemake gives the job) took 2.6 times as
 #: long per LP on 2 cores; with one thread each, as long as one process alone (N = 1e4 in 3D)
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
-#: layout of a saved test state (1: sequences went on from the moved packing, with LP warm starts)
-STATE_VERSION = 2
+#: layout of a saved test state (1: sequences went on from the moved packing, with LP warm starts;
+#: 2: without the undetermined reason and the fallback counts)
+STATE_VERSION = 3
+#: halvings of a step that round-off makes overlap before the sequence is given up (undetermined)
+MAX_HALVINGS = 60
 
 
 @dataclass
 class SequentialOutcome:
+    """Result of one sequential test. ``jammed`` is False also when ``undetermined`` holds a
+    reason: no sequence reached the threshold, but one of them could not go on (a step that
+    round-off kept overlapping, or an LP whose strain violates the volume constraint), so
+    jamming is not shown either."""
+
     test: str
     jammed: bool
     threshold: float
@@ -105,6 +123,18 @@ class SequentialOutcome:
     n_lp_highs: int = 0  # LPs HiGHS solved (the others: hardpack.jamming.workingset)
     seconds: float = 0.0
     method: str = "sequential"
+    undetermined: str = ""  # why the test could not decide ("" when it did)
+    fallbacks: Counter = field(default_factory=Counter)  # hardpack.jamming.highs.FALLBACKS
+
+    def size(self, sequence: int) -> float:
+        """How far loading sequence ``sequence`` unjammed the packing, compared with the
+        threshold (module docstring): the larger of its mean displacement / D and its strain."""
+        return max(self.mean_displacement[sequence], self.strain_norm[sequence])
+
+    @property
+    def unjammed(self) -> bool:
+        """Some loading sequence reached the threshold."""
+        return any(self.size(k) >= self.threshold for k in range(len(self.steps)))
 
 
 def collision_step(net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None) -> float:
@@ -203,7 +233,7 @@ def sequential_test(
               random_strain_load(rng, d, cell_length(packing.lattice)) if strict else None)
              for _ in range(n_loads)]
     todo = []  # (sequence, load, strain load): B and -B for each load
-    if max(out.mean_displacement, default=0.0) < threshold:  # else settled before a resume
+    if moving.any() and not out.unjammed:  # else settled before a resume, or nothing to load
         for sequence in range(first, 2 * n_loads):
             load, strain_load = loads[sequence // 2]
             sign = 1.0 if sequence % 2 == 0 else -1.0
@@ -216,10 +246,13 @@ def sequential_test(
         _record(out, result, moving, 2.0 * packing.radii.mean())
         if save is not None:
             save(_state(out, start_rng, sequence + 1, earlier + time.perf_counter() - t0))
-        if out.mean_displacement[-1] >= threshold:
+        if out.size(-1) >= threshold:
             break  # step 10: the verdict is settled
-    # no particle left to load: every one is a rattler, nothing is jammed (Alg. 13 step 3)
-    out.jammed = bool(moving.any() and max(out.mean_displacement, default=0.0) < threshold)
+    if not moving.any():  # every particle is a rattler: no backbone, nothing is jammed (Alg. 13 step 3)
+        out.method = "no backbone: every particle is a rattler"
+    out.jammed = bool(moving.any() and not out.unjammed and not out.undetermined)
+    if out.unjammed:
+        out.undetermined = ""  # a sequence beyond the threshold settles it, whatever another did
     out.seconds = earlier + time.perf_counter() - t0
     return out
 
@@ -233,6 +266,8 @@ class _Sequence:
     steps: int  # LPs solved
     n_lp_highs: int  # of which HiGHS solved
     final: Packing  # the packing at its end
+    undetermined: str  # why it had to stop before its end ("" if it did not)
+    fallbacks: Counter  # the numerical fallbacks of its LPs
 
 
 def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequence: int,
@@ -240,7 +275,18 @@ def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequ
                       threshold: float, beta: float, max_steps: int) -> _Sequence:
     """Steps 5-7 of Algorithm 14 from ``packing`` under ``load`` (and ``strain_load``: strict
     test). Each LP warm-starts from the previous one's basis; the first starts cold, and a
-    strict one goes through the strain continuation of :func:`solve_motion`."""
+    strict one goes through the strain continuation of :func:`solve_motion`. The fallbacks of
+    its LPs are recorded here (also in a worker process) and returned with it."""
+    with recording_fallbacks() as fallbacks:
+        result = _steps(packing, delta, rattlers, sequence, load, strain_load, box=box,
+                        threshold=threshold, beta=beta, max_steps=max_steps)
+    return replace(result, fallbacks=fallbacks)
+
+
+def _steps(packing: Packing, delta: float, rattlers: np.ndarray, sequence: int, load: np.ndarray,
+           strain_load: np.ndarray | None, *, box: float, threshold: float, beta: float,
+           max_steps: int) -> _Sequence:
+    """The LPs and steps of :func:`_loading_sequence`."""
     d = packing.dim
     moving = ~rattlers
     diameter = 2.0 * packing.radii.mean()
@@ -250,22 +296,36 @@ def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequ
     total = np.zeros((packing.n_particles, d))
     strain_total = None if strain_load is None else np.zeros((d, d))
     steps = highs = 0
+    undetermined = ""
     for _step in range(max_steps):
         net = contact_network(current, delta)
         if warm is not None:  # particles that left the cell come back through the other side
             warm = warm.rewrapped(_wraps(current, net))
-        mot = solve_motion(net, moving, load, fixed=rattlers, box=box, cell_length=cell_length(current.lattice),
-                           strain_load=strain_load, warm=warm)
+        try:
+            mot = solve_motion(net, moving, load, fixed=rattlers, box=box,
+                               cell_length=cell_length(current.lattice), strain_load=strain_load, warm=warm)
+        except VolumeIncrease as exc:
+            undetermined = f"loading sequence {name}, LP {steps + 1}: {exc}"
+            break
         warm = mot.warm
         highs += mot.solver == "highs"
         steps += 1
-        tau = min(
+        if not (np.isfinite(mot.displacement).all() and (mot.strain is None or np.isfinite(mot.strain).all())):
+            undetermined = f"loading sequence {name}, LP {steps}: the LP motion is not finite"
+            break
+        tau = min(  # inf: the motion is zero, nothing moves
             collision_step(net, mot.displacement, mot.strain),
             list_step(net, current.radii, mot.displacement, mot.strain),
             volume_step(mot.strain),
         )
-        if np.isfinite(tau) and tau > 0:
-            current, tau = _advance(current, net, mot.displacement, mot.strain, tau)
+        if np.isfinite(tau):
+            moved = _advance(current, net, mot.displacement, mot.strain, tau)
+            if moved is None:
+                undetermined = (f"loading sequence {name}, LP {steps}: a step of {tau:.3g} times the LP "
+                                f"motion overlaps even after {MAX_HALVINGS} halvings (round-off), so "
+                                "the sequence cannot go on")
+                break
+            current, tau = moved
         else:
             tau = 0.0
         step = tau * mot.displacement
@@ -277,11 +337,14 @@ def _loading_sequence(packing: Packing, delta: float, rattlers: np.ndarray, sequ
         total += step
         if strain_total is not None:
             strain_total += tau * mot.strain
-        if _mean_size(total, moving, diameter) >= threshold:
+        strain_size = 0.0 if strain_total is None else np.linalg.norm(strain_total, 2)
+        if max(_mean_size(total, moving, diameter), strain_size) >= threshold:
             break  # step 10: unjammed beyond the threshold, the verdict is settled
         if largest <= beta * diameter:
             break
-    return _Sequence(total, strain_total, steps, highs, current)
+    if undetermined:
+        log.warning("%s test: %s", test, undetermined)
+    return _Sequence(total, strain_total, steps, highs, current, undetermined, Counter())
 
 
 def _wraps(packing: Packing, net: ContactNetwork) -> np.ndarray:
@@ -338,19 +401,23 @@ def _record(out: SequentialOutcome, result: _Sequence, moving: np.ndarray, diame
     rel = _relative(result.total, moving)
     size = np.linalg.norm(rel, axis=1) / diameter
     size[~moving] = 0.0
-    mean = float(size[moving].mean()) if moving.any() else 0.0
-    if mean > max(out.mean_displacement, default=-1.0):
+    mean = float(size[moving].mean())
+    strain = 0.0 if result.strain is None else float(np.linalg.norm(result.strain, 2))
+    if not out.steps or max(mean, strain) > max(out.size(k) for k in range(len(out.steps))):
         out.motion, out.strain = rel, result.strain
     out.mean_displacement.append(mean)
     out.max_displacement.append(float(size.max(initial=0.0)))
     out.steps.append(result.steps)
-    out.strain_norm.append(0.0 if result.strain is None else float(np.linalg.norm(result.strain, 2)))
+    out.strain_norm.append(strain)
     out.displacement = np.maximum(out.displacement, size)
     out.n_lp += result.steps
     out.n_lp_highs += result.n_lp_highs
     out.final = result.final
-    log.info("%s test: loading sequence %d moved the particles by %.3g D on average "
-             "(threshold %.3g D)", out.test, len(out.steps), mean, out.threshold)
+    out.fallbacks.update(result.fallbacks)
+    if result.undetermined and not out.undetermined:
+        out.undetermined = result.undetermined
+    log.info("%s test: loading sequence %d moved the particles by %.3g D on average and strained "
+             "the cell by %.3g (threshold %.3g)", out.test, len(out.steps), mean, strain, out.threshold)
 
 
 def _state(out: SequentialOutcome, start_rng: str, next_sequence: int, seconds: float) -> dict:
@@ -362,7 +429,8 @@ def _state(out: SequentialOutcome, start_rng: str, next_sequence: int, seconds: 
         "mean_displacement": np.asarray(out.mean_displacement), "strain_norm": np.asarray(out.strain_norm),
         "max_displacement": np.asarray(out.max_displacement), "steps": np.asarray(out.steps),
         "displacement": out.displacement, "motion": out.motion,
-        "n_lp": out.n_lp, "n_lp_highs": out.n_lp_highs,
+        "n_lp": out.n_lp, "n_lp_highs": out.n_lp_highs, "undetermined": out.undetermined,
+        **{f"fallback_{name}": out.fallbacks[name] for name in FALLBACKS},
     }
     if out.strain is not None:
         state["strain"] = out.strain
@@ -373,9 +441,9 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     """Load a :func:`_state` into ``out`` and ``rng``; returns (the generator's state at the
     test's start, the next sequence, the seconds spent)."""
     if state.get("version") != STATE_VERSION:
-        raise InvalidInputError("the checkpoint holds a sequential test saved by an older hardpack, "
-                                "whose loading sequences went on from the moved packing; delete it "
-                                "to start the verification afresh")
+        raise InvalidInputError(f"the checkpoint holds a sequential test saved by an older hardpack "
+                                f"(state layout {state.get('version', 1)}, this one reads {STATE_VERSION}: "
+                                "see STATE_VERSION); delete it to start the verification afresh")
     rng.bit_generator.state = json.loads(state["rng"])
     out.mean_displacement = [float(v) for v in state["mean_displacement"]]
     out.strain_norm = [float(v) for v in state["strain_norm"]]
@@ -383,6 +451,8 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     out.steps = [int(v) for v in state["steps"]]
     out.displacement, out.motion, out.strain = state["displacement"], state["motion"], state.get("strain")
     out.n_lp, out.n_lp_highs = int(state["n_lp"]), int(state["n_lp_highs"])
+    out.undetermined = str(state["undetermined"])
+    out.fallbacks = Counter({name: int(state[f"fallback_{name}"]) for name in FALLBACKS})
     out.final = packing.replace(positions=state["positions"], lattice=state["lattice"])
     return state["rng"], int(state["next_sequence"]), float(state["seconds"])
 
@@ -401,12 +471,15 @@ def _mean_size(total: np.ndarray, moving: np.ndarray, diameter: float) -> float:
 
 
 def _advance(packing: Packing, net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None,
-             tau: float) -> tuple[Packing, float]:
-    """The packing moved by tau (dR, eps); tau is halved if round-off would create an overlap."""
-    for _ in range(60):
+             tau: float) -> tuple[Packing, float] | None:
+    """The packing moved by tau (dR, eps) and that tau; tau is halved if round-off would create
+    an overlap. None if it still overlaps after MAX_HALVINGS halvings (tau 1e-18 times smaller):
+    then not round-off but the motion itself is at fault, and the caller must not read the
+    missing step as a jammed packing."""
+    for _ in range(MAX_HALVINGS):
         lattice = packing.lattice if eps is None else (np.eye(packing.dim) + tau * eps) @ packing.lattice
         try:
             return packing.replace(positions=net.positions + tau * disp, lattice=lattice), tau
         except InvalidInputError:
             tau *= 0.5
-    return packing, 0.0
+    return None

@@ -15,6 +15,11 @@ Steps (Donev dissertation ch. 4, seeds/000_chapters/ch04-05.txt):
 4. self-stress forces, contact number, isostaticity and pressure of the backbone
    (:mod:`hardpack.jamming.forces`); a backbone without a self-stress gets the forces of the
    nearest jamming point (near contacts within ``force_delta`` that close there carry force).
+
+When every particle is a rattler there is no backbone and nothing can be jammed (Alg. 13 step
+3): the collective and strict tests solve no LP and say "not jammed". The numerical fallbacks
+of the LPs (:data:`hardpack.jamming.highs.FALLBACKS`) are counted in the result, and a test that
+could not decide says "undetermined" with its reason.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
 from hardpack.jamming.contacts import check_delta, contact_network
 from hardpack.jamming.forces import jamming_point_forces, self_stress, statics
+from hardpack.jamming.highs import FALLBACKS, recording_fallbacks
 from hardpack.jamming.ideal import ideal_test
 from hardpack.jamming.rattlers import remove_rattlers
 from hardpack.jamming.result import CATEGORIES, JammingResult
@@ -193,6 +199,24 @@ def verify(
         )
 
     rng = np.random.default_rng(int(seed))
+    with recording_fallbacks() as fallbacks:
+        result = _verify(packing, tests, rng, method=method, delta=delta, contact_delta=contact_delta,
+                         dr_large=dr_large, box=box, threshold=threshold, n_loads=n_loads,
+                         max_steps=max_steps, beta=beta, workers=workers, checkpoint=checkpoint,
+                         seed=int(seed), force_delta=force_delta, md_pressure=md_pressure)
+    for test in (result.collective_test, result.strict_test):
+        fallbacks.update(getattr(test, "fallbacks", {}))  # the sequential test's, from its sequences
+    result.fallbacks = {name: int(fallbacks[name]) for name in FALLBACKS}
+    return result
+
+
+def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method: str, delta: float,
+            contact_delta: float, dr_large: float, box: float, threshold: float, n_loads: int,
+            max_steps: int, beta: float, workers: int, checkpoint, seed: int, force_delta,
+            md_pressure) -> JammingResult:
+    """The steps of the module docstring, with the arguments :func:`verify` checked."""
+    diameter = 2.0 * float(packing.radii.mean())
+    sequential = method == "sequential"
     seconds = {}
     t0 = time.perf_counter()
     net = contact_network(packing, contact_delta)
@@ -227,7 +251,7 @@ def verify(
         kwargs = {"rattlers": ~local_active, "threshold": threshold, "beta": beta,
                   "n_loads": n_loads, "max_steps": max_steps, "workers": workers, **common}
         saved = _Saved(checkpoint, ckpt.fingerprint(
-            packing, run="verify", delta=delta, seed=int(seed), tests=list(tests), dr_large=dr_large,
+            packing, run="verify", delta=delta, seed=seed, tests=list(tests), dr_large=dr_large,
             box=box, threshold=threshold, n_loads=n_loads, max_steps=max_steps, beta=beta,
             contact_delta=contact_delta))
         if "collective" in tests:
@@ -261,7 +285,7 @@ def verify(
     if checkpoint is not None:
         ckpt.remove(checkpoint)
     params = {
-        "method": method, "delta": delta, "dr_large": dr_large, "box": box, "seed": int(seed),
+        "method": method, "delta": delta, "dr_large": dr_large, "box": box, "seed": seed,
         "tests": list(tests), "mean_diameter": diameter,
         "threshold": threshold if sequential else None,
         "n_loads": n_loads if sequential else None,

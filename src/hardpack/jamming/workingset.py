@@ -275,18 +275,44 @@ def _row_scale(a: sp.csc_matrix) -> np.ndarray:
     return scale
 
 
+def structurally_regular(a: sp.spmatrix) -> bool:
+    """True when the pattern of the square matrix ``a`` has a perfect matching of its rows and
+    columns (structural rank n), the condition under which SuperLU may be given it."""
+    return bool(np.all(_matching(a) >= 0))
+
+
+def _matching(a: sp.spmatrix) -> np.ndarray:
+    """The row matched to each column by a maximum matching of the pattern of ``a`` (-1: none)."""
+    return maximum_bipartite_matching(sp.csr_matrix(a), perm_type="row")
+
+
 def _factorise(a: sp.csc_matrix):
     """LU of a square matrix (:class:`_ScaledLU`), or (None, positions of dependent columns,
-    their pivot rows)."""
-    try:
-        lu = _ScaledLU(a)
-        probe = lu
-    except RuntimeError:  # exactly singular: locate the dependent columns on a regularised copy
-        # (SuperLU's BLAS may print "On entry to DGEMV parameter number 2 had an illegal value"
-        # on its way to this error; the failed factor is discarded, so the message is harmless)
-        lu = None
+    their pivot rows).
+
+    SuperLU is given the matrix itself only when its pattern is structurally regular (a perfect
+    matching of rows and columns exists; 2 ms at n = 3e4). A structurally singular matrix -- a
+    basis whose columns leave some rows empty or too few, common among the many equivalent
+    contacts of a crystal -- makes SuperLU's partial pivoting go on past the missing pivot with
+    inconsistent supernode sizes, which calls BLAS with negative dimensions (OpenBLAS prints
+    "On entry to DGEMV parameter number 2 had an illegal value", or DTRSV parameter 6) before
+    it reports "Factor is exactly singular". Such a matrix, and a numerically singular one
+    (exact cancellations, again in crystals), is probed on a regularised copy
+    (:func:`_regulariser`), whose tiny pivots locate the dependent columns."""
+    row_of = _matching(a)
+    lu = None
+    if np.all(row_of >= 0):
+        try:
+            lu = _ScaledLU(a)
+        except RuntimeError:  # numerically singular: exact zero pivot
+            lu = None
+    probe = lu
+    if lu is None:
         scale = float(abs(a).max()) if a.nnz else 1.0
-        probe = _ScaledLU(a + _regulariser(a, 1e-13 * scale))
+        try:
+            probe = _ScaledLU(a + _regulariser(a, 1e-13 * scale, row_of))
+        except RuntimeError:
+            raise LPFailure("the basis and its regularised copy are both exactly singular") from None
     pivots, pivot_cols, pivot_rows = probe.pivots()
     tiny = np.flatnonzero(pivots <= PIVOT_TOL * pivots.max(initial=0.0))
     if lu is not None and tiny.size == 0:
@@ -296,19 +322,28 @@ def _factorise(a: sp.csc_matrix):
     return None, pivot_cols[tiny], pivot_rows[tiny]
 
 
-def _regulariser(a: sp.csc_matrix, eps: float) -> sp.csc_matrix:
-    """eps on n entries that make the pattern of ``a`` structurally regular: the entries of a
-    maximum matching of its rows and columns (inside the pattern, so the fill of the LU stays
-    that of ``a``), plus eps pairing the rows and columns the matching leaves out. eps * I
-    would do the same on paper, but the diagonal of a rigidity matrix pairs unrelated
-    particles and contacts: at N = 1e4 in 3D its fill made SuperLU run > 16 min instead of 6 s."""
+def _regulariser(a: sp.csc_matrix, eps: float, row_of: np.ndarray | None = None) -> sp.csc_matrix:
+    """Entries of size eps on n positions that make the pattern of ``a`` structurally regular:
+    the entries of a maximum matching of its rows and columns (``row_of``, :func:`_matching`;
+    inside the pattern, so the fill of the LU stays that of ``a``), plus entries pairing the
+    rows and columns the matching leaves out. eps * I would do the same on paper, but the
+    diagonal of a rigidity matrix pairs unrelated particles and contacts: at N = 1e4 in 3D its
+    fill made SuperLU run > 16 min instead of 6 s.
+
+    The magnitudes are drawn from [1, 2) eps with random signs (a fixed seed: reproducible).
+    With a rank deficiency k the copy then has k singular values of order eps, one tiny pivot
+    each; equal entries, as a crystal's rigidity matrix has, can cancel the order-eps^k term of
+    the determinant, leaving singular values ~eps^2 (measured on FCC and BCC supercell bases:
+    5 of 81 such copies were still exactly singular with equal entries, none with random ones)."""
     n = a.shape[0]
-    row_of = maximum_bipartite_matching(sp.csr_matrix(a), perm_type="row")  # row matched to each column
+    row_of = _matching(a) if row_of is None else row_of
     cols = np.flatnonzero(row_of >= 0)
     free_cols = np.flatnonzero(row_of < 0)
     free_rows = np.setdiff1d(np.arange(n), row_of[cols])
     rows = np.concatenate([row_of[cols], free_rows])
-    return sp.csc_matrix((np.full(n, eps), (rows, np.concatenate([cols, free_cols]))), shape=(n, n))
+    rng = np.random.default_rng(0)
+    values = eps * rng.uniform(1.0, 2.0, n) * rng.choice([-1.0, 1.0], n)
+    return sp.csc_matrix((values, (rows, np.concatenate([cols, free_cols]))), shape=(n, n))
 
 
 def _repaired_lu(cols: _Columns, basis: np.ndarray):
@@ -612,4 +647,4 @@ def _compressed(block: sp.csr_matrix | sp.csc_matrix) -> tuple:
     return block.nnz, block.indptr.astype(np.int32), block.indices.astype(np.int32), block.data
 
 
-__all__ = ["WarmStart", "WorkingSetSolution", "solve_working_set"]
+__all__ = ["WarmStart", "WorkingSetSolution", "solve_working_set", "structurally_regular"]

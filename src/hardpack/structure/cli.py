@@ -18,7 +18,7 @@ def cmd_structure(args) -> int:
 
     ds = load_dataset(args.packing, kind="packing")
     packing = dataset_to_packing(ds, source=str(args.packing))
-    rattlers = None
+    rattlers, no_backbone = None, {}
     if args.jamming:
         verdict = load_dataset(args.jamming, kind="jamming")
         if "rattler" not in verdict or verdict.sizes.get("particle") != packing.n_particles:
@@ -26,15 +26,22 @@ def cmd_structure(args) -> int:
                 f"{args.jamming} has no per-particle 'rattler' mask for the {packing.n_particles} "
                 f"particles of {args.packing}; pass the output of `hardpack verify` on that packing")
         rattlers = np.asarray(verdict["rattler"].values).astype(bool)
-        if rattlers.all():
-            log.warning("%s flags every particle as a rattler (verdict: %s); analysing all particles",
-                        args.jamming, verdict.attrs.get("verdict", "?"))
-            rattlers = None
-    out = analyse(packing, r_max=args.rmax, k_max=args.kmax, rattlers=rattlers,
+        if rattlers.all():  # no backbone: its quantities do not exist (not those of all particles)
+            no_backbone = dict(backbone="none: the jamming verdict flags every particle as a rattler",
+                               jamming_verdict=str(verdict.attrs.get("verdict", "not jammed")),
+                               n_rattlers=int(rattlers.sum()))
+            log.warning("%s flags all %d particles as rattlers (verdict: %s): no backbone, so the "
+                        "backbone's Z(l) and near-contact fit are left out (alpha = NaN)",
+                        args.jamming, rattlers.size, no_backbone["jamming_verdict"])
+    out = analyse(packing, r_max=args.rmax, k_max=args.kmax, rattlers=None if no_backbone else rattlers,
                   contact_tol=args.contact_tol, gap_max=args.gap_max, dr=args.dr,
                   order=not args.no_order)
+    if no_backbone:
+        for name in ("alpha", "alpha_err", "alpha_amplitude"):  # the fit is of the backbone
+            out[name] = np.nan
     write_dataset(out, args.out, attrs=dict(source=str(args.packing),
-                                            rattler_mask=str(args.jamming or "") if rattlers is not None else "none"))
+                                            rattler_mask=str(args.jamming) if args.jamming else "none",
+                                            **no_backbone))
     log.info("wrote %s", args.out)
     return 0
 
