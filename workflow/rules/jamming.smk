@@ -78,7 +78,8 @@ rule jamming_summary:
     shell:
         "hardpack combine {input} --index seed --variable z_mean --variable rattler_fraction"
         " --variable isostaticity_gap --variable local --variable collective --variable strict"
-        " --attr ensemble={wildcards.ensemble} --attr distribution='{params.distribution}'"
+        " --variable fallback_lp_default_tolerances --variable fallback_lp_working_set_to_highs"
+        " --variable fallback_uniform_forces_lp_failed --attr ensemble={wildcards.ensemble} --attr distribution='{params.distribution}'"
         " --out {output} 2> {log}"
 
 VALIDATION_INPUTS["jamming"] = expand("results/ensembles/{ensemble}/jamming_summary.nc", ensemble=ENSEMBLES)

@@ -43,6 +43,23 @@ def verdict_fraction(values) -> float:
     return float(np.mean(values == 1)) if np.all(np.isfinite(values)) else math.nan
 
 
+def verdict_notes(summary) -> str:
+    """Undetermined verdicts (code -2) and numerical fallbacks of an ensemble's jamming tests, for
+    a row's detail (empty when there were none)."""
+    notes = []
+    for test in ("collective", "strict"):
+        if test in summary:
+            undetermined = int(np.sum(np.asarray(summary[test].values) == -2))
+            if undetermined:
+                notes.append(f"{undetermined} {test} verdict(s) undetermined (counted as not jammed)")
+    for name in summary.data_vars:
+        if str(name).startswith("fallback_"):
+            count = int(np.nansum(summary[name].values))
+            if count:
+                notes.append(f"{str(name).removeprefix('fallback_')}: {count}")
+    return "; ".join(notes)
+
+
 def largest_magnitude(values) -> float:
     """The value of largest magnitude (NaN if any is missing): a per-packing claim must hold for
     every seed."""
@@ -60,6 +77,8 @@ def jamming_rows(summaries) -> list[Row]:
             continue
         n, seeds, label = n_particles(s), s.sizes["sample"], s.attrs.get("ensemble", "")
         size = f"N = {n}, {seeds} seeds"
+        if verdict_notes(s):
+            size += f"; {verdict_notes(s)}"
         gaps = np.asarray(s["isostaticity_gap"].values, float)
         if f"donev-ch9-isostatic-{system}" in targets:
             out.append(evaluate(

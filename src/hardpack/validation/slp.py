@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from hardpack.validation.jamming import fraction_statistics, verdict_fraction
+from hardpack.validation.jamming import fraction_statistics, verdict_fraction, verdict_notes
 from hardpack.validation.packings import n_particles, system_key
 from hardpack.validation.rows import Row, evaluate
 from hardpack.validation.targets import load_targets
@@ -47,7 +45,7 @@ def mrj_jamming_rows(summaries) -> list[Row]:
             continue
         label, d = s.attrs.get("ensemble", ""), key[1]
         n, seeds = n_particles(s), s.sizes["sample"]
-        size = f"N = {n}, {seeds} seeds"
+        size = f"N = {n}, {seeds} seeds" + (f"; {verdict_notes(s)}" if verdict_notes(s) else "")
         rattler_target = (f"tj-t1-slp-rattlers-d{d}" if key[0] == "monodisperse" else
                           "tj-sec5-poly2d-rattlers" if key == ("us_omega2", 2) else None)
         if rattler_target in targets:
