@@ -28,7 +28,7 @@ def cmd_slp(args) -> int:
     }
     attrs = dict(args.attr or [])
     attrs.update(params, init=str(args.init), converged=result.converged, n_steps=result.n_steps,
-                 n_rejected=result.n_rejected, jamming_claim=result.jamming_claim,
+                 n_rejected=result.n_rejected,
                  wall_seconds=result.wall_seconds, cpu_seconds=result.cpu_seconds, lp_solver=f"scipy {scipy.__version__} HiGHS ({args.lp_method})")
     init_attrs = load_dataset(args.init).attrs
     for key in ("seed", "ensemble", "distribution", "distribution_params", "init_phi"):
@@ -55,7 +55,7 @@ def register(subparsers) -> None:
     p.add_argument("--displacement-bound", type=float, default=0.5,
                    help="|u| bound per component in units of the mean diameter")
     p.add_argument("--isotropic", action="store_true",
-                   help="isotropic shrink only (collectively, not strictly, jammed end states)")
+                   help="isotropic shrink only, no shear (the paper's isotropically shrinking cell)")
     p.add_argument("--lp-method", choices=METHODS, default="highs-ipm",
                    help="HiGHS solver (interior point with crossover: fastest on these degenerate LPs)")
     p.add_argument("--tol", type=float, default=1e-10,
