@@ -249,7 +249,7 @@ rule slp_diluted:
     threads: 1
     resources:
         mem_mb=2000,
-        runtime=180,
+        runtime=360,  # minutes; N = 1000: ~12 CPU-min per round
     log:
         "results/logs/slp_diluted/{ensemble}_seed{seed}.log",
     shell:
