@@ -39,6 +39,11 @@ def test_shipped_configs_are_valid(name):
         (lambda c: c["ensembles"]["mono3d"]["distribution"].update(kind="gaussian"), "distribution.kind: 'gaussian' is not one of"),
         (lambda c: c["ensembles"]["mono3d"].update(distribution={"kind": "uniform_size"}), "distribution: 'omega' is a required property"),
         (lambda c: c["ensembles"].update({"3bad": c["ensembles"]["mono3d"]}), "'3bad' does not match"),
+        (lambda c: c["slp"]["diluted"].update(fractoin=0.01), "slp.diluted: Additional properties.*'fractoin'"),
+        (lambda c: c["slp"]["diluted"].update(rounds=0), "slp.diluted.rounds: 0 is less than the minimum of 1"),
+        (lambda c: c["slp"]["diluted"].pop("fraction"), "slp.diluted: 'fraction' is a required property"),
+        (lambda c: c["slp"]["mrj"]["systems"]["slp_poly2d"].update(distribution={"kind": "uniform_size"}),
+         "distribution: 'omega' is a required property"),
     ],
 )
 def test_bad_configs_are_refused_naming_the_key(mutate, expected):
@@ -67,3 +72,19 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
                          capture_output=True, text=True, timeout=300)
     assert out.returncode != 0
     assert "grwoth_rate" in out.stdout + out.stderr
+
+
+@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
+@pytest.mark.parametrize("mutate, expected", [
+    (lambda c: c["slp"]["diluted"].update(ensemble="uv3d_w4"), "must be one of slp.mrj.ensembles"),
+    (lambda c: c["slp"]["diluted"].update(seeds=[1, 7]), r"slp.diluted.seeds \[7\] are not seeds"),
+])
+def test_snakemake_refuses_a_diluted_study_without_its_mrj_packings(tmp_path, mutate, expected):
+    cfg = load("smoke.yaml")
+    mutate(cfg)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(cfg))
+    out = subprocess.run(["snakemake", "-n", "--configfile", str(bad)], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode != 0
+    assert __import__("re").search(expected, out.stdout + out.stderr), out.stdout + out.stderr

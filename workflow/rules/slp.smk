@@ -69,16 +69,27 @@ if SLP_MRJ:
     for _name in SLP_MRJ["ensembles"]:
         if _name not in ENSEMBLES:
             raise ValueError(f"config: slp.mrj.ensembles names {_name!r}, which is not an ensemble")
-    for _name in SLP_SYSTEMS:
+    for _name, _system in SLP_SYSTEMS.items():
         if _name in ENSEMBLES:
             raise ValueError(f"config: slp.mrj.systems.{_name} has the name of an ensemble; rename it")
-MONODISPERSE = json.dumps({"kind": "monodisperse"})
+        if "distribution" in _system:
+            try:
+                from_spec(_system["distribution"])
+            except ValueError as exc:
+                raise ValueError(f"config: slp.mrj.systems.{_name}.distribution: {exc}") from None
+SLP_MONODISPERSE = {"kind": "monodisperse"}
+
+
+def system_distribution(name):
+    """Size distribution (JSON) of SLP-only system ``name``: its own or monodisperse."""
+    return json.dumps(SLP_SYSTEMS[name].get("distribution", SLP_MONODISPERSE))
 
 
 wildcard_constraints:
     system="[A-Za-z][A-Za-z0-9_]*",
     d=r"\d+",
     k=r"\d+",
+    r=r"\d+",
 
 
 rule slp_mrj_init:
@@ -136,18 +147,20 @@ rule slp_mrj_summary:
 
 
 rule slp_system_init:
-    """Dilute monodisperse RSA start of an SLP-only Table I system (a dimension without LS ensemble)."""
+    """Dilute RSA start of an SLP-only Table I system (a dimension or size distribution without LS
+    ensemble, e.g. the 2D polydisperse disks of Torquato & Jiao 2010, Sec. V.A)."""
     output:
         "results/slp/mrj/{system}/init_seed{seed}.nc",
     params:
         n=lambda w: SLP_SYSTEMS[w.system]["N"],
         d=lambda w: SLP_SYSTEMS[w.system]["d"],
         phi=SLP_MRJ["init_phi"] if SLP_MRJ else None,
+        distribution=lambda w: system_distribution(w.system),
     log:
         "results/logs/slp_system_init/{system}_seed{seed}.log",
     shell:
         "hardpack init --n {params.n} --d {params.d} --phi {params.phi} --seed {wildcards.seed}"
-        " --attr ensemble={wildcards.system} --out {output} 2> {log}"
+        " --distribution '{params.distribution}' --attr ensemble={wildcards.system} --out {output} 2> {log}"
 
 
 rule slp_system:
@@ -200,12 +213,89 @@ rule slp_system_summary:
         variables=lambda w: ("--variable n_steps --variable wall_seconds --variable cpu_seconds" if w.kind == "slp" else
                              "--variable z_mean --variable rattler_fraction --variable isostaticity_gap"
                              " --variable local --variable collective --variable strict"),
-        distribution=MONODISPERSE,
+        distribution=lambda w: system_distribution(w.system),
     log:
         "results/logs/slp_system_summary/{system}_{kind}.log",
     shell:
         "hardpack combine {input} --index seed {params.variables} --attr ensemble={wildcards.system}"
         " --attr distribution='{params.distribution}' --out {output} 2> {log}"
+
+
+SLP_DILUTED = SLP.get("diluted")
+if SLP_DILUTED:
+    if not SLP_MRJ or SLP_DILUTED["ensemble"] not in SLP_MRJ["ensembles"]:
+        raise ValueError(f"config: slp.diluted.ensemble {SLP_DILUTED['ensemble']!r} must be one of "
+                         "slp.mrj.ensembles (its SLP MRJ packings are the starts)")
+    _missing = set(SLP_DILUTED["seeds"]) - set(ENSEMBLES[SLP_DILUTED["ensemble"]]["seeds"])
+    if _missing:
+        raise ValueError(f"config: slp.diluted.seeds {sorted(_missing)} are not seeds of ensemble "
+                         f"{SLP_DILUTED['ensemble']!r}")
+SLP_DILUTED_ROUNDS = range(1, SLP_DILUTED["rounds"] + 1) if SLP_DILUTED else []
+
+
+rule slp_diluted:
+    """Torquato & Jiao 2010, Sec. VI: remove a fraction of the spheres of one SLP MRJ packing at
+    random, re-jam by SLP (the Table I settings), repeat; one packing per round."""
+    input:
+        "results/ensembles/{ensemble}/slp/seed{seed}.nc",
+    output:
+        expand("results/slp/diluted/{{ensemble}}/seed{{seed}}/round{r}.nc", r=SLP_DILUTED_ROUNDS),
+    params:
+        flags=slp_flags(SLP_MRJ) if SLP_DILUTED else "",
+        fraction=SLP_DILUTED["fraction"] if SLP_DILUTED else None,
+        rounds=SLP_DILUTED["rounds"] if SLP_DILUTED else None,
+        out_dir="results/slp/diluted/{ensemble}/seed{seed}",
+        checkpoint="results/slp/diluted/{ensemble}/checkpoint_seed{seed}.ckpt",  # a killed job resumes
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=360,  # minutes; N = 1000: ~12 CPU-min per round
+    log:
+        "results/logs/slp_diluted/{ensemble}_seed{seed}.log",
+    shell:
+        "hardpack slp-dilute --init {input} --out-dir {params.out_dir} --fraction {params.fraction}"
+        " --rounds {params.rounds} --seed {wildcards.seed} {params.flags} --checkpoint {params.checkpoint} 2> {log}"
+
+
+rule verify_slp_diluted:
+    """LP jamming tests of one diluted-MRJ packing, by sequential loading (see verify_jamming_slp)."""
+    input:
+        "results/slp/diluted/{ensemble}/seed{seed}/round{r}.nc",
+    output:
+        "results/slp/diluted/{ensemble}/seed{seed}/jamming_round{r}.nc",
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=60,
+    params:
+        checkpoint=checkpoint_beside,
+    log:
+        "results/logs/verify_slp_diluted/{ensemble}_seed{seed}_round{r}.log",
+    shell:
+        "hardpack verify {input} --out {output} --seed {wildcards.seed} --method sequential"
+        " --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
+def slp_diluted_files(prefix):
+    """The MRJ start (round 0) and every round of every diluted seed: packings ('') or verdicts ('jamming_')."""
+    ensemble = SLP_DILUTED["ensemble"]
+    start = "results/ensembles/{e}/slp{j}/seed{s}.nc".format
+    return [path for seed in SLP_DILUTED["seeds"] for path in (
+        [start(e=ensemble, j="_jamming" if prefix else "", s=seed)]
+        + [f"results/slp/diluted/{ensemble}/seed{seed}/{prefix}round{r}.nc" for r in SLP_DILUTED_ROUNDS])]
+
+
+rule slp_diluted_summary:
+    """phi, phi without rattlers, backbone Z, verdicts and T of every diluted-MRJ round, over (seed, round)."""
+    input:
+        packings=slp_diluted_files("") if SLP_DILUTED else [],
+        verdicts=slp_diluted_files("jamming_") if SLP_DILUTED else [],
+    output:
+        "results/slp/diluted_summary.nc",
+    log:
+        "results/logs/slp_diluted_summary.log",
+    script:
+        "../scripts/slp_diluted_summary.py"
 
 
 SLP_ORDER = SLP.get("order_map")
@@ -308,9 +398,10 @@ rule fig_slp_vs_ls:
 
 
 rule fig_slp_order_map:
-    """Fig. 6: translational order T against phi of the SLP order-map packings."""
+    """Fig. 6: translational order T against phi of the SLP order-map and diluted-MRJ packings."""
     input:
-        "results/slp/order_map_summary.nc",
+        order_map=["results/slp/order_map_summary.nc"] if SLP_ORDER else [],
+        diluted=["results/slp/diluted_summary.nc"] if SLP_DILUTED else [],
     output:
         pdf="results/figures/slp_order_map.pdf",
         png=report("results/figures/slp_order_map.png", caption="../report/slp_order_map.rst", category="6 SLP"),
@@ -332,5 +423,8 @@ if SLP_MRJ:
         expand("results/ensembles/{ensemble}/slp_jamming_summary.nc", ensemble=SLP_MRJ["ensembles"])
         + expand("results/slp/mrj/{system}/slp_jamming_summary.nc", system=SLP_SYSTEMS))
 if SLP_ORDER:
-    FIGURES.append("results/figures/slp_order_map.pdf")
     VALIDATION_INPUTS["slp_order_map"] = ["results/slp/order_map_summary.nc"]
+if SLP_DILUTED:
+    VALIDATION_INPUTS["slp_diluted"] = ["results/slp/diluted_summary.nc"]
+if SLP_ORDER or SLP_DILUTED:  # the diluted-MRJ summary is built for this figure
+    FIGURES.append("results/figures/slp_order_map.pdf")

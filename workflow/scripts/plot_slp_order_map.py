@@ -1,4 +1,4 @@
-"""Snakemake script: the phi-T order map figure (Torquato & Jiao Fig. 6) from its summary."""
+"""Snakemake script: the phi-T order map figure (Torquato & Jiao Fig. 6) from its summaries."""
 
 import logging
 
@@ -7,4 +7,7 @@ from hardpack.plots.slp import plot_order_map
 from hardpack.plots.style import save
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
-save(plot_order_map(load_dataset(snakemake.input[0], kind="slp_order_map")), snakemake.output.pdf, snakemake.output.png)
+order_map = [load_dataset(path, kind="slp_order_map") for path in snakemake.input.order_map]
+diluted = [load_dataset(path, kind="slp_diluted") for path in snakemake.input.diluted]
+fig = plot_order_map(order_map[0] if order_map else None, diluted[0] if diluted else None)
+save(fig, snakemake.output.pdf, snakemake.output.png)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
 from hardpack.plots.style import figure
@@ -54,8 +56,12 @@ def plot_slp_vs_ls(pairs: dict):
     labelled = False
     for k, n in enumerate(names):
         d = int(pairs[n][0]["d"].values[0]) if "d" in pairs[n][0] else None
+        spec = json.loads(pairs[n][0].attrs.get("distribution", "{}"))
         targets = load_targets()
-        if f"tj-t1-slp-phi-d{d}" in targets:
+        if d == 2 and spec.get("kind") == "uniform_size" and spec.get("omega") == 2:
+            ax.plot(k - 0.25, targets["tj-sec5-poly2d-phi"].published, "D", mfc="none", color="C0",
+                    label="Torquato & Jiao SLP, 2D disks in [D, 2D] (Sec. V.A)")
+        elif f"tj-t1-slp-phi-d{d}" in targets and spec.get("kind", "monodisperse") == "monodisperse":
             slp_pub, ls_pub = targets[f"tj-t1-slp-phi-d{d}"], targets[f"tj-t1-ls-phi-d{d}"]
             ax.errorbar(k - 0.25, slp_pub.published, yerr=slp_pub.tolerance, fmt="s", mfc="none", color="C0",
                         capsize=3, label="Torquato & Jiao SLP (Table I)" if not labelled else None)
@@ -67,11 +73,11 @@ def plot_slp_vs_ls(pairs: dict):
                         for n in names])
     ax.set_ylabel(r"jamming density $\phi_J$")
     ax.set_xlabel("ensemble")
-    ax.legend()
+    ax.legend(fontsize=6, loc="center")
     return fig
 
 
-def plot_order_map(summary):
+def plot_order_map(summary, diluted=None):
     """Left: translational order T against phi (Fig. 6 of Torquato & Jiao), one marker per
     packing. Right: phi against the influence radius gamma / D (the SLP densities vs influence
     radius of the paper's sec. V), one marker per packing with the mean per radius.
@@ -80,11 +86,53 @@ def plot_order_map(summary):
     LP solver); filled when the packing passed the strict jamming test. Coinciding packings (e.g.
     several seeds ending in the same crystal) are labelled with their count. FCC (phi = 0.74048,
     T = 1) and the paper's MRJ density 0.64 (L1620-1624) are marked for reference.
+
+    ``diluted`` (:func:`hardpack.slp.diluted.diluted_summary`, optional) adds the diluted-MRJ
+    packings of the paper's Sec. VI on the left as red squares (its Fig. 6 symbol), each seed's
+    rounds joined from its MRJ start, with the paper's low end phi = 0.60 (0.595 without
+    rattlers) marked. Either summary may be None, not both.
     """
+    if summary is None and diluted is None:
+        raise ValueError("plot_order_map needs an order-map or a diluted-MRJ summary")
     fig, (ax, ax_r) = figure(1, 2, figsize=(9.0, 3.8))
+    if diluted is not None:
+        _plot_diluted(ax, diluted)
+    ax.plot([np.pi / np.sqrt(18)], [1.0], "k*", ms=10, label="FCC")
+    ax.axvline(0.64, color="0.5", ls=":", lw=1, label=r"MRJ $\phi$ = 0.64 (paper)")
+    ax.set_xlabel(r"packing density $\phi$")
+    ax.set_ylabel("translational order T")
+    ax_r.set_xlabel(r"influence radius $\gamma$ / D")
+    ax_r.set_ylabel(r"packing density $\phi$")
+    if summary is not None:
+        _plot_settings(ax, ax_r, summary)
+        ax_r.legend(fontsize=6, loc="best")
+    ax.legend(fontsize=5.5, loc="upper left")
+    return fig
+
+
+def _plot_diluted(ax, diluted):
+    """Red squares: the rounds of each seed of the diluted-MRJ study, filled when strictly jammed."""
+    colour = "darkred"
+    phi, t, strict = (diluted[k].transpose("seed", "round").values for k in ("phi", "T", "strict"))
+    for k in range(phi.shape[0]):
+        ax.plot(phi[k], t[k], "-", color=colour, lw=0.6, alpha=0.5)
+    later = np.asarray(diluted["round"].values) > 0
+    for jammed in (True, False):
+        sel = (strict == 1) == jammed
+        sel[:, ~later] = False
+        if sel.any():
+            ax.scatter(phi[sel], t[sel], s=22, marker="s", edgecolors=colour, facecolors=colour if jammed else "none",
+                       label=f"diluted MRJ (Sec. VI), f = {diluted.attrs.get('fraction', '?')}, "
+                             f"rounds 1-{int(diluted['round'].max())}" + ("" if jammed else " (not strictly jammed)"))
+    ax.axvline(0.60, color=colour, ls=":", lw=1, label=r"diluted MRJ $\phi$ = 0.60 (paper)")
+    ax.set_title(f"SLP jammed packings, d = 3; diluted from N = {int(diluted['N'].max())}")
+
+
+def _plot_settings(ax, ax_r, summary):
+    """The order-map packings, one colour and marker per SLP setting (plot_order_map)."""
     keys = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method", "N")
     settings = list(zip(*(summary[k].values.tolist() for k in keys)))
-    strict = summary["strict"].values.astype(bool)
+    strict = summary["strict"].values == 1
     phi, t, alpha = summary["phi"].values, summary["T"].values, summary["alpha"].values
     for n, setting in enumerate(dict.fromkeys(settings)):
         radius, strain, shear, disp, method, size = setting
@@ -107,16 +155,7 @@ def plot_order_map(summary):
             ax.annotate(f"x{count}", (x, y), textcoords="offset points", xytext=(5, -9), fontsize=6)
     radii = np.unique(alpha)
     ax_r.plot(radii, [phi[alpha == r].mean() for r in radii], "k_", ms=16, mew=1.5, label="mean")
-    ax.plot([np.pi / np.sqrt(18)], [1.0], "k*", ms=10, label="FCC")
-    ax.axvline(0.64, color="0.5", ls=":", lw=1, label=r"MRJ $\phi$ = 0.64 (paper)")
     ax_r.axhline(np.pi / np.sqrt(18), color="k", ls="--", lw=1, label="FCC / HCP")
     ax_r.axhline(0.64, color="0.5", ls=":", lw=1, label="MRJ 0.64 (paper)")
-    ax.set_xlabel(r"packing density $\phi$")
-    ax.set_ylabel("translational order T")
-    ax_r.set_xlabel(r"influence radius $\gamma$ / D")
-    ax_r.set_ylabel(r"packing density $\phi$")
     sizes = ", ".join(str(n) for n in np.unique(summary["N"].values))
     ax.set_title(f"SLP jammed packings, d = 3, N = {sizes}: {summary.sizes['packing']} packings")
-    ax.legend(fontsize=5.5, loc="upper left")
-    ax_r.legend(fontsize=6, loc="best")
-    return fig

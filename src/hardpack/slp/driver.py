@@ -51,12 +51,19 @@ MIN_TRUST_SCALE = 2.0**-30
 
 @dataclass(frozen=True)
 class SLPResult:
+    """The end state of :func:`run_slp` and how it got there.
+
+    It carries no jamming verdict: an SLP fixed point is only a packing in which no LP step gains
+    density, and whether it is collectively or strictly jammed is decided by the LP jamming tests
+    (:func:`hardpack.jamming.verify`, ``hardpack verify``), as Torquato & Jiao (2010, Sec. III.C)
+    test their packings.
+    """
+
     packing: Packing
     history: xr.Dataset
     converged: bool
     n_steps: int
     n_rejected: int
-    jamming_claim: str
     wall_seconds: float
     cpu_seconds: float
 
@@ -79,8 +86,9 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
     """Densify ``packing`` by sequential LPs until the predicted density gain is below ``tol``.
 
     ``alpha``: influence-sphere radius over the pair's mean diameter (gamma_mn = alpha D_mn);
-    ``bounds``: full trust-region widths; ``deforming``: symmetric strain (strictly jammed end
-    states) or isotropic shrink only (collectively jammed end states); ``method``: the HiGHS
+    ``bounds``: full trust-region widths; ``deforming``: symmetric strain (the paper's deforming
+    cell) or isotropic shrink only (whose end states the paper reports collectively, not
+    strictly, jammed; Sec. III.C); ``method``: the HiGHS
     solver of :func:`hardpack.slp.lp.solve_step`; ``checkpoint``: path of a resumable checkpoint
     (module docstring), removed when the run ends unless ``keep_checkpoint`` (then the caller
     removes it once the result is written). On SIGINT or SIGTERM the run writes its checkpoint
@@ -171,7 +179,7 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
         ckpt.remove(checkpoint)
     return SLPResult(
         packing=current, history=history, converged=converged, n_steps=len(records),
-        n_rejected=n_rejected, jamming_claim="strict" if deforming else "collective",
+        n_rejected=n_rejected,
         wall_seconds=wall_before + time.perf_counter() - start,
         cpu_seconds=cpu_before + time.process_time() - cpu_start,
     )
