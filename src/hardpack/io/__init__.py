@@ -4,6 +4,7 @@ from hardpack.io.provenance import provenance
 from hardpack.io.store import (
     combine_ensemble,
     dataset_to_packing,
+    load_judged_packing,
     load_dataset,
     load_packing,
     packing_to_dataset,
@@ -13,5 +14,5 @@ from hardpack.io.store import (
 
 __all__ = [
     "provenance", "packing_to_dataset", "dataset_to_packing", "save_packing", "load_packing",
-    "load_dataset", "write_dataset", "combine_ensemble",
+    "load_dataset", "load_judged_packing", "write_dataset", "combine_ensemble",
 ]

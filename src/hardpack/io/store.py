@@ -18,6 +18,7 @@ old file or the new one, never a half-written one.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -137,6 +138,17 @@ def load_packing(path, **packing_kwargs) -> Packing:
     """Load and validate a packing written by :func:`save_packing`."""
     ds = load_dataset(path, kind="packing")
     return dataset_to_packing(ds, source=str(path), **packing_kwargs)
+
+
+def load_judged_packing(path, verdict_path) -> tuple[xr.Dataset, Packing, xr.Dataset]:
+    """A packing file with the jamming verdict that judges it (``hardpack verify`` output):
+    (packing dataset, packing, verdict dataset). Refuses a verdict of another packing (its
+    ``source`` attribute names another file)."""
+    ds, verdict = load_dataset(path, kind="packing"), load_dataset(verdict_path, kind="jamming")
+    source = verdict.attrs.get("source")
+    if source is not None and os.path.normpath(source) != os.path.normpath(str(path)):
+        raise InvalidInputError(f"{verdict_path} judges {source}, not {path}")
+    return ds, dataset_to_packing(ds, source=str(path)), verdict
 
 
 def _check_members(dsets, names, index) -> None:

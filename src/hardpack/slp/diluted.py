@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import logging
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,7 +43,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry import ball_volume
 from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
-from hardpack.io import load_dataset, load_packing
+from hardpack.io import load_judged_packing
 from hardpack.slp.driver import run_slp
 from hardpack.slp.lp import Bounds
 
@@ -217,11 +216,7 @@ def diluted_summary(packing_paths, verdict_paths) -> xr.Dataset:
             f"{len(verdict_paths)} verdicts")
     cells, attrs = {}, {}
     for path, verdict_path in zip(packing_paths, verdict_paths):
-        ds, verdict = load_dataset(path, kind="packing"), load_dataset(verdict_path, kind="jamming")
-        source = verdict.attrs.get("source")
-        if source is not None and os.path.normpath(source) != os.path.normpath(str(path)):
-            raise InvalidInputError(f"{verdict_path} judges {source}, not {path}")
-        packing = load_packing(path)
+        ds, packing, verdict = load_judged_packing(path, verdict_path)
         rattler = np.asarray(verdict["rattler"].values, bool)
         if rattler.shape != (packing.n_particles,):
             raise InvalidInputError(f"{verdict_path} has {rattler.size} spheres, {path} has {packing.n_particles}")

@@ -10,13 +10,12 @@ it (influence radius alpha = gamma / D, bound widths, LP solver) and its jamming
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import xarray as xr
 
 from hardpack.errors import InvalidInputError
-from hardpack.io import load_dataset, load_packing
+from hardpack.io import load_judged_packing
 from hardpack.structure.order import translational_order
 
 SETTINGS = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method", "seed")
@@ -32,11 +31,7 @@ def order_map_summary(packing_paths, verdict_paths) -> xr.Dataset:
             f"{len(verdict_paths)} verdicts")
     rows = {name: [] for name in ("phi", "N", "T", *SETTINGS, *VERDICT)}
     for path, verdict_path in zip(packing_paths, verdict_paths):
-        ds, verdict = load_dataset(path, kind="packing"), load_dataset(verdict_path, kind="jamming")
-        source = verdict.attrs.get("source")
-        if source is not None and os.path.normpath(source) != os.path.normpath(str(path)):
-            raise InvalidInputError(f"{verdict_path} judges {source}, not {path}")
-        packing = load_packing(path)
+        ds, packing, verdict = load_judged_packing(path, verdict_path)
         if packing.dim != 3:
             raise InvalidInputError(f"{path}: the order map is 3D (FCC reference), got d = {packing.dim}")
         rows["phi"].append(packing.phi)
