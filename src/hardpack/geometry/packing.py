@@ -267,8 +267,14 @@ class Packing:
         return s
 
     def wrapped(self) -> "Packing":
-        """The same packing with every centre inside the unit cell (along the periodic axes)."""
-        return self.replace(positions=self.fractional() @ self.lattice.T)
+        """The same packing with every centre inside the unit cell along the periodic axes
+        (coordinates along walled axes are kept bit for bit: periodic lattice vectors have no
+        component along them)."""
+        positions = self.fractional() @ self.lattice.T
+        if self.boundary.kind != "periodic":
+            walled = ~self.boundary.periodic_axes(self.dim)
+            positions[:, walled] = self.positions[:, walled]
+        return self.replace(positions=positions)
 
     def replace(self, **changes) -> "Packing":
         """A validated copy with some fields replaced (e.g. positions, radii, shape, lattice)."""
@@ -278,6 +284,9 @@ class Packing:
         )
         if "radii" not in changes:
             fields["shape"] = self.shape
+        elif self.shape.kind != "sphere" and "shape" not in changes:
+            raise InvalidInputError(f"this packing holds {self.shape.name}: replace(radii=...) would make them "
+                                    "spheres; pass shape=Spheres(radii) to do that on purpose")
         fields.update(changes)
         return Packing(**fields)
 
