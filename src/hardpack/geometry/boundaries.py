@@ -60,10 +60,11 @@ def _no_walls() -> ContainmentReport:
     return ContainmentReport(0, -1, "no walls", float("-inf"))
 
 
-def _report(overlap: np.ndarray, walls: list, tol: float) -> ContainmentReport:
-    """Report of the relative overlaps (N,) of the particles with the walls named per particle."""
+def _report(overlap: np.ndarray, wall_of, tol: float) -> ContainmentReport:
+    """Report of the relative overlaps (N,) of the particles with their nearest walls; ``wall_of(i)``
+    names the wall of particle i."""
     i = int(np.argmax(overlap))
-    return ContainmentReport(int((overlap > tol).sum()), i, walls[i], float(overlap[i]))
+    return ContainmentReport(int((overlap > tol).sum()), i, wall_of(i), float(overlap[i]))
 
 
 @dataclass(frozen=True)
@@ -143,7 +144,7 @@ class HardWalls:
         nearest = np.argmin(h, axis=1)
         overlap = 1.0 - h[np.arange(len(h)), nearest] / radii
         names = [f"the wall x_{k} = 0" for k in axes] + [f"the wall x_{k} = {v:.6g}" for k, v in zip(axes, length)]
-        return _report(overlap, [names[w] for w in nearest], tol)
+        return _report(overlap, lambda i: names[nearest[i]], tol)
 
     def __str__(self) -> str:
         return f"hard walls on axes {list(self.axes)}"
@@ -199,7 +200,7 @@ class SphericalContainer:
         """Relative overlap 1 - (R - |x - c|) / r of every sphere with the container wall."""
         dx = positions - np.array(self.centre)
         h = self.radius - np.sqrt(np.einsum("ij,ij->i", dx, dx))
-        return _report(1.0 - h / radii, ["the container wall"] * len(h), tol)
+        return _report(1.0 - h / radii, lambda i: "the container wall", tol)
 
     def __str__(self) -> str:
         return f"spherical container (centre {list(self.centre)}, radius {self.radius:.6g})"
