@@ -253,6 +253,7 @@ def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     from hardpack.geometry.balls import ball_volume
     from hardpack.geometry.neighbours import pairs_within
 
+    packing.require_periodic_spheres("the jamming backbone of an LS compression")
     pairs = pairs_within(packing, rel_gap=gap)
     i, j = np.asarray(pairs.i), np.asarray(pairs.j)
     n, d = packing.n_particles, packing.dim

@@ -63,6 +63,7 @@ def check_packing(packing: Packing) -> None:
     """Refuse packings the engine cannot run: sheared cells, fewer than 2 particles, overlaps."""
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
+    packing.require_periodic_spheres("the MD engine")
     if not packing.is_orthorhombic:
         raise InvalidInputError(
             "the MD engine supports orthorhombic (diagonal) periodic cells only; this lattice is "
@@ -85,6 +86,7 @@ class Simulation:
                  overlap_tol: float = DEFAULT_OVERLAP_TOL, contact_windows: int = 0):
         """contact_windows > 0 logs every collision and keeps the per-pair impulse sums of the
         last ``contact_windows`` windows in :attr:`contacts` (:mod:`hardpack.md.contacts`)."""
+        packing.require_periodic_spheres("the MD engine")
         self.lattice = np.array(packing.lattice)
         self.species = packing.species
         self.box = np.diag(self.lattice).copy()

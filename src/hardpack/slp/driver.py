@@ -94,6 +94,7 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
     removes it once the result is written). On SIGINT or SIGTERM the run writes its checkpoint
     before the next LP and raises :class:`hardpack.io.interrupt.Interrupted`.
     """
+    packing.require_periodic_spheres("SLP")
     if not (0 < tol < 1):
         raise InvalidInputError(f"tol must be in (0, 1), got {tol}")
     if not (0 < reject_overlap < 0.5):
