@@ -1,6 +1,7 @@
 """Config files against the JSON schema; the Snakemake DAG builds for both configs."""
 
 import copy
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -55,36 +56,41 @@ def test_bad_configs_are_refused_naming_the_key(mutate, expected):
 
 
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
-def test_snakemake_dry_run_lists_the_dag(tmp_path):
-    out = subprocess.run(["snakemake", "-n", "--forceall", "--configfile", "config/smoke.yaml"], cwd=ROOT,
+@pytest.mark.parametrize("configfile", ["config/config.yaml", "config/smoke.yaml"])
+def test_snakemake_dry_run_lists_the_dag(configfile):
+    out = subprocess.run(["snakemake", "-n", "--forceall", "--configfile", configfile], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
-    assert "init_packing" in out.stdout and "fig_size_distributions" in out.stdout
+    assert re.search(r"^init +\d+$", out.stdout, re.M) and "fig_size_distributions" in out.stdout
 
 
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
-def test_snakemake_refuses_unknown_config_key(tmp_path):
-    cfg = load("smoke.yaml")
-    cfg["ensembles"]["mono3d"]["grwoth_rate"] = 0.1
-    bad = tmp_path / "bad.yaml"
-    bad.write_text(yaml.safe_dump(cfg))
-    out = subprocess.run(["snakemake", "-n", "--configfile", str(bad)], cwd=ROOT,
+@pytest.mark.parametrize("configfile", ["config/config.yaml", "config/smoke.yaml"])
+def test_snakemake_lint_finds_nothing(configfile):
+    """`snakemake --lint` exits non-zero on any finding (rules mixed with functions, a rule without
+    log or software environment, hard-coded path prefixes in params, ...)."""
+    out = subprocess.run(["snakemake", "--lint", "--configfile", configfile], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
-    assert out.returncode != 0
-    assert "grwoth_rate" in out.stdout + out.stderr
+    assert out.returncode == 0 and "Lints for" not in out.stdout + out.stderr, out.stdout + out.stderr
 
 
-@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
-@pytest.mark.parametrize("mutate, expected", [
-    (lambda c: c["slp"]["diluted"].update(ensemble="uv3d_w4"), "must be one of slp.mrj.ensembles"),
-    (lambda c: c["slp"]["diluted"].update(seeds=[1, 7]), r"slp.diluted.seeds \[7\] are not seeds"),
-])
-def test_snakemake_refuses_a_diluted_study_without_its_mrj_packings(tmp_path, mutate, expected):
-    cfg = load("smoke.yaml")
-    mutate(cfg)
-    bad = tmp_path / "bad.yaml"
-    bad.write_text(yaml.safe_dump(cfg))
-    out = subprocess.run(["snakemake", "-n", "--configfile", str(bad)], cwd=ROOT,
-                         capture_output=True, text=True, timeout=300)
-    assert out.returncode != 0
-    assert __import__("re").search(expected, out.stdout + out.stderr), out.stdout + out.stderr
+def _rules():
+    """{rule name: its text} of every rule of the workflow's rule files."""
+    rules = {}
+    for path in sorted((ROOT / "workflow" / "rules").glob("*.smk")):
+        for block in re.split(r"^(?=rule )", path.read_text(), flags=re.M)[1:]:
+            rules[re.match(r"rule (\w+):", block).group(1)] = block
+    return rules
+
+
+def test_every_rule_logs_and_benchmarks_by_its_name():
+    """One log convention and one benchmark convention: results/logs/{rule}/... and
+    results/benchmarks/{rule}/... (or {rule}.log / {rule}.tsv without wildcards)."""
+    rules = _rules()
+    assert {"init", "compress", "slp", "verify", "structure", "combine", "validation"} <= set(rules)
+    for name, text in rules.items():
+        for directive, folder, suffix in (("log", "logs", "log"), ("benchmark", "benchmarks", "tsv")):
+            match = re.search(rf"^    {directive}:\n        \"([^\"]+)\"", text, re.M)
+            assert match, f"rule {name} has no {directive} directive"
+            assert re.fullmatch(rf"results/{folder}/{name}(/.+)?\.{suffix}", match.group(1)), (name, match.group(1))
+
