@@ -94,3 +94,49 @@ def test_every_rule_logs_and_benchmarks_by_its_name():
             assert match, f"rule {name} has no {directive} directive"
             assert re.fullmatch(rf"results/{folder}/{name}(/.+)?\.{suffix}", match.group(1)), (name, match.group(1))
 
+
+def test_pipeline_times_sums_the_benchmark_files_per_rule(tmp_path):
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("pipeline_times", ROOT / "benchmarks" / "pipeline_times.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    header = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    files = {"verify/ls/mono3d/seed1.tsv": "12.5\t0:00:12\t1\t1\t1\t1\t0\t0\t90\t11.0\n",
+             "verify/slp_diluted/mono3d/seed1/round2.tsv": "7.5\t0:00:07\t1\t1\t1\t1\t0\t0\t90\t6.0\n",
+             "validation.tsv": "1.0\t0:00:01\t1\t1\t1\t1\t0\t0\t90\t0.5\n"}
+    for name, line in files.items():
+        path = tmp_path / "results" / "benchmarks" / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(header + line)
+    times = module.job_times(tmp_path)
+    assert sorted(times) == ["validation", "verify"]
+    assert sorted(times["verify"]) == [(7.5, 6.0), (12.5, 11.0)] and times["validation"] == [(1.0, 0.5)]
+
+
+@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
+def test_snakemake_refuses_unknown_config_key(tmp_path):
+    cfg = load("smoke.yaml")
+    cfg["ensembles"]["mono3d"]["grwoth_rate"] = 0.1
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(cfg))
+    out = subprocess.run(["snakemake", "-n", "--configfile", str(bad)], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode != 0
+    assert "grwoth_rate" in out.stdout + out.stderr
+
+
+@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
+@pytest.mark.parametrize("mutate, expected", [
+    (lambda c: c["slp"]["diluted"].update(ensemble="uv3d_w4"), "must be one of slp.mrj.ensembles"),
+    (lambda c: c["slp"]["diluted"].update(seeds=[1, 7]), r"slp.diluted.seeds \[7\] are not seeds"),
+])
+def test_snakemake_refuses_a_diluted_study_without_its_mrj_packings(tmp_path, mutate, expected):
+    cfg = load("smoke.yaml")
+    mutate(cfg)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(cfg))
+    out = subprocess.run(["snakemake", "-n", "--configfile", str(bad)], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode != 0
+    assert __import__("re").search(expected, out.stdout + out.stderr), out.stdout + out.stderr
