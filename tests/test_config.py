@@ -130,8 +130,10 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
 @pytest.mark.parametrize("mutate, expected", [
     (lambda c: c["slp"]["diluted"].update(ensemble="uv3d_w4"), "must be one of slp.mrj.ensembles"),
     (lambda c: c["slp"]["diluted"].update(seeds=[1, 7]), r"slp.diluted.seeds \[7\] are not seeds"),
+    (lambda c: c["freeenergy"]["simplex"].update(ensemble="mono9d"), r"freeenergy.simplex.ensemble 'mono9d' is not one"),
+    (lambda c: c["freeenergy"]["simplex"].update(seeds=[1, 7]), r"freeenergy.simplex.seeds \[7\] are not seeds"),
 ])
-def test_snakemake_refuses_a_diluted_study_without_its_mrj_packings(tmp_path, mutate, expected):
+def test_snakemake_refuses_a_study_without_its_input_packings(tmp_path, mutate, expected):
     cfg = load("smoke.yaml")
     mutate(cfg)
     bad = tmp_path / "bad.yaml"
