@@ -12,7 +12,9 @@ deleted too.
 
     python benchmarks/pipeline_times.py [--root DIR] [--cores 2]
 
-Job wall times include the waits on a machine shared with other work; CPU times do not.
+Job wall times include the waits on a machine shared with other work; CPU times do not. Snakemake
+samples the CPU time of a job's processes (every 0.5 s for the first 15 s, then every 30 s), so the
+CPU used after the last sample is missing: CPU times are lower bounds, by up to 30 s per job.
 """
 
 from __future__ import annotations
