@@ -71,11 +71,11 @@ def check_config():
         for name in SLP_MRJ["ensembles"]:
             if name not in ENSEMBLES:
                 raise ValueError(f"config: slp.mrj.ensembles names {name!r}, which is not an ensemble")
-        for name, system in SLP_MRJ.get("systems", {}).items():
+        for name, spec in SLP_MRJ.get("systems", {}).items():
             if name in ENSEMBLES:
                 raise ValueError(f"config: slp.mrj.systems.{name} has the name of an ensemble; rename it")
-            if "distribution" in system:
-                _check_distribution(f"slp.mrj.systems.{name}", system["distribution"])
+            if "distribution" in spec:
+                _check_distribution(f"slp.mrj.systems.{name}", spec["distribution"])
     if SLP_DILUTED:
         if not SLP_MRJ or SLP_DILUTED["ensemble"] not in SLP_MRJ["ensembles"]:
             raise ValueError(f"config: slp.diluted.ensemble {SLP_DILUTED['ensemble']!r} must be one of "
@@ -147,10 +147,10 @@ def _systems():
             systems["slp_mrj"][name] = _system(ens["N"], ens["d"], ens["seeds"], SLP_MRJ["init_phi"],
                                                ens["distribution"], attrs={"ensemble": name},
                                                slp=slp_flags(SLP_MRJ), slp_minutes=60)
-        for name, system in SLP_MRJ.get("systems", {}).items():
+        for name, spec in SLP_MRJ.get("systems", {}).items():
             # 3D N = 2000 (not in the default study): 1.3 CPU-h for 520 LPs, not converged
-            systems["slp_mrj"][name] = _system(system["N"], system["d"], system["seeds"], SLP_MRJ["init_phi"],
-                                               system.get("distribution", MONODISPERSE), attrs={"ensemble": name},
+            systems["slp_mrj"][name] = _system(spec["N"], spec["d"], spec["seeds"], SLP_MRJ["init_phi"],
+                                               spec.get("distribution", MONODISPERSE), attrs={"ensemble": name},
                                                slp=slp_flags(SLP_MRJ), slp_minutes=180)
     if SLP_DENSEST:
         for run in SLP_DENSEST["runs"]:
@@ -179,6 +179,7 @@ PACKED = {"ls": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted
 
 
 def system(wildcards):
+    """The spec of the system {study}/{name} of a job."""
     return SYSTEMS[wildcards.study][wildcards.name]
 
 
@@ -322,8 +323,8 @@ def poly_protocol(wildcards):
 
 def poly_jam_files(protocol, family):
     runs = POLY_PROTOCOLS[protocol]
-    return [f"results/poly_{protocol}/{family}_w{poly_width(w)}/{system}/seed{seed}.nc"
-            for w in runs["widths"][family] for seed in runs["seeds"] for system in POLY_SYSTEMS]
+    return [f"results/poly_{protocol}/{family}_w{poly_width(w)}/{member}/seed{seed}.nc"
+            for w in runs["widths"][family] for seed in runs["seeds"] for member in POLY_SYSTEMS]
 
 
 def poly_jam_mem_mb(wildcards):
