@@ -186,7 +186,7 @@ class Simulation:
             "kT": 2.0 * res.ke_end / (d * n), "kT_mean": kt_mean, "events": self.events, "stale": res.stale,
             "exits": res.exits, "grazing": res.grazing, "max_overlap": res.max_overlap, "shell": shell_used,
             "neighbours": res.mean_neighbours, "wall_time": self.wall_time,
-            "growth_rate": self.growth_rate,
+            "growth_rate": self.growth_rate, "virial": res.virial, "ke_integral": res.ke_integral,
         }
         for k in RECORD_FIELDS:
             self.records[k].append(record[k])

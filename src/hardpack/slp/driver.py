@@ -118,9 +118,10 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
         scale, first, n_rejected = float(state["scale"]), int(state["next_step"]), int(state["n_rejected"])
         records = [tuple(r) for r in state["records"].tolist()]
         wall_before, cpu_before = float(state["wall_seconds"]), float(state["cpu_seconds"])
-        log.info("resumed from %s at SLP step %d (phi = %.8f)", checkpoint, first, current.phi)
     last_save = time.perf_counter()
     with interrupt.deferred():
+        if state is not None:  # announced once a signal can no longer stop the run before a save
+            log.info("resumed from %s at SLP step %d (phi = %.8f)", checkpoint, first, current.phi)
         for step in range(first, int(max_steps)):
             if interrupt.requested() is not None:
                 if checkpoint is not None:
