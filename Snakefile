@@ -22,6 +22,10 @@ include: "workflow/rules/polydisperse.smk"  # polydisperse vs bi- and tridispers
 include: "workflow/rules/validation.smk"    # validation report and gate
 
 
+localrules:
+    all,
+
+
 rule all:
     input:
         final_outputs(),

@@ -146,24 +146,24 @@ def _systems():
             ens = ENSEMBLES[name]
             systems["slp_mrj"][name] = _system(ens["N"], ens["d"], ens["seeds"], SLP_MRJ["init_phi"],
                                                ens["distribution"], attrs={"ensemble": name},
-                                               slp=slp_flags(SLP_MRJ), slp_minutes=60)
+                                               slp=slp_flags(SLP_MRJ))
         for name, spec in SLP_MRJ.get("systems", {}).items():
             # 3D N = 2000 (not in the default study): 1.3 CPU-h for 520 LPs, not converged
             systems["slp_mrj"][name] = _system(spec["N"], spec["d"], spec["seeds"], SLP_MRJ["init_phi"],
                                                spec.get("distribution", MONODISPERSE), attrs={"ensemble": name},
-                                               slp=slp_flags(SLP_MRJ), slp_minutes=180)
+                                               slp=slp_flags(SLP_MRJ))
     if SLP_DENSEST:
         for run in SLP_DENSEST["runs"]:
             d = run["d"]
             systems["slp_densest"][f"d{d}"] = _system(run.get("N", 3**d), d, run["seeds"], run["init_phi"],
-                                                      attrs={"d": d}, slp=slp_flags(SLP_DENSEST), slp_minutes=30)
+                                                      attrs={"d": d}, slp=slp_flags(SLP_DENSEST))
     if SLP_ORDER:
         for k, setting in enumerate(SLP_ORDER["settings"]):
             n = order_map_n(k)
             systems["slp_order_map"][f"n{n}"] = _system(n, 3, SLP_ORDER["seeds"], SLP_ORDER["init_phi"], attrs={})
             systems["slp_order_map"][f"s{k}"] = _system(
                 n, 3, SLP_ORDER["seeds"], start=f"results/slp_order_map/n{n}/init/seed{{seed}}.nc",
-                attrs={"setting": k}, slp=slp_flags(setting), slp_minutes=20)
+                attrs={"setting": k}, slp=slp_flags(setting))
     if SLP_DILUTED:
         name, ens = SLP_DILUTED["ensemble"], ENSEMBLES[SLP_DILUTED["ensemble"]]
         systems["slp_diluted"][name] = _system(
@@ -233,32 +233,6 @@ def order_map_files(step):
             for path in seed_files("slp_order_map", name, step)]
 
 
-# Resources of the generic jobs, from the system's N.
-
-def ls_mem_mb(wildcards):
-    return 500 + system(wildcards)["N"] // 5
-
-
-def ls_runtime(wildcards):
-    """Minutes: the slow final stage costs ~N / 20 minutes on one core (3D, Gamma_f = 1e-4)."""
-    return 30 + system(wildcards)["N"] // 10
-
-
-def lp_mem_mb(wildcards):
-    return 1000 + system(wildcards)["N"]
-
-
-def lp_threads(wildcards):
-    """Loading sequences run side by side (hardpack verify --workers) for large packings, whose
-    strict sequences take a minute or more each (N = 1e4 in 3D: 1-1.5 min, 2-3 LPs)."""
-    return 2 if system(wildcards)["N"] >= 5000 else 1
-
-
-def lp_runtime(wildcards):
-    """Minutes: collective + strict tests take ~10 s at N = 1000 (benchmarks/bench_jamming.py)."""
-    return 10 + system(wildcards)["N"] // 200
-
-
 # ---------------------------------------------------------------------------------------------
 # Free energies (BCMD, Donev, Stillinger & Torquato 2007) and the polydisperse study (Ogarko ch. 3).
 
@@ -325,25 +299,6 @@ def poly_jam_files(protocol, family):
     runs = POLY_PROTOCOLS[protocol]
     return [f"results/poly_{protocol}/{family}_w{poly_width(w)}/{member}/seed{seed}.nc"
             for w in runs["widths"][family] for seed in runs["seeds"] for member in POLY_SYSTEMS]
-
-
-def poly_jam_mem_mb(wildcards):
-    return 500 + poly_protocol(wildcards)["N"] // 5
-
-
-def poly_jam_runtime(wildcards):
-    """Minutes for one system. Measured: 3-11 CPU s at N = 500 (US omega = 2 and 10, final Gamma =
-    0.002), 6-7 CPU min at final Gamma = 2e-5 and 13-18 at 1e-5; the collisions grow as N / Gamma, and
-    the budget is ~20x the measured time at Gamma = 0.002, for loaded machines and wide UV
-    distributions."""
-    runs = poly_protocol(wildcards)
-    return 10 + int(runs["N"] // 100 * max(1.0, 0.002 / runs["final_growth_rate"]))
-
-
-def poly_fluid_runtime(wildcards):
-    """Minutes: 3 systems x len(phi) runs of `collisions` collisions at ~1e6 collisions per CPU second."""
-    runs = 3 * len(POLY_FLUID["phi"])
-    return 10 + runs * (POLY_FLUID["collisions"] + 50 * POLY_FLUID["N"]) // 2_000_000
 
 
 # ---------------------------------------------------------------------------------------------
@@ -492,3 +447,111 @@ def final_outputs():
     outputs += [path for paths in validation_inputs().values() for path in paths]
     outputs.append("results/validation/gate.txt")
     return list(dict.fromkeys(outputs))
+
+
+# ---------------------------------------------------------------------------------------------
+# Job resources (threads, mem_mb, runtime in minutes) of every rule, from one cost model: the
+# expected wall minutes of a job on one core of the shared 2-core development machine, from the
+# job's system (N, d, growth rate, rounds, collisions, ...), calibrated on the full study's job
+# records (docs/cluster.md has the records and the fits). The limit is RUNTIME_SAFETY times the
+# expectation plus RUNTIME_SLACK (start-up, a slower node), times the attempt: a job killed at its
+# time limit is retried with a longer one and resumes from its checkpoint.
+
+RUNTIME_SAFETY = 3
+RUNTIME_SLACK = 5         # minutes
+MEM_FLOOR_MB = 500        # a hardpack process (numpy, numba, xarray): max_rss 270-280 MB measured
+MD_SECONDS_PER_UNIT = 4e-5  # LS compression: seconds per particle per unit of 1 / Gamma, in 3D
+#: cost per collision against 3D (NVE rates, benchmarks/bench_md.py: 1.43e6, 8.0e5, 3.1e5, 1.7e5, 1.3e5 coll/s)
+MD_DIMENSION_COST = {2: 0.6, 3: 1.0, 4: 2.6, 5: 4.7, 6: 6.2}
+SLP_MINUTES_PER_N2 = 1.6e-5  # SLP to convergence, 3D: 1.6 min at N = 500, 6-24 min at N = 1000
+#: SLP cost against 3D at the same N (2D N = 500: 12 s; 4D N = 250: 1.5 min; 5D N = 243: 6 min; 6D N = 250: 25 min)
+SLP_DIMENSION_COST = {2: 0.05, 3: 1.0, 4: 1.5, 5: 6.5, 6: 25.0}
+#: rules that never take long: they run as one cluster job per group (--group-components in the
+#: slurm profile), with these expected minutes
+TINY_MINUTES = 0.3
+
+
+def md_minutes(n, d, gamma):
+    """Expected minutes of an LS compression of n particles whose slowest growth rate is gamma:
+    the collisions to jamming grow as n / gamma (3D N = 1e4 at 1e-4: 46-58 min; N = 1000 at 3e-4:
+    3 min)."""
+    return 0.5 + MD_SECONDS_PER_UNIT * n / gamma * MD_DIMENSION_COST[d] / 60
+
+
+def slp_minutes(n, d):
+    """Expected minutes of an SLP run to convergence (Torquato & Jiao 2010 settings)."""
+    return 0.3 + SLP_MINUTES_PER_N2 * n**2 * SLP_DIMENSION_COST[d]
+
+
+def lp_minutes(n):
+    """Expected minutes of the sequential jamming test and contact forces (3D N = 1000: under a
+    second; N = 1e4: 4.5 min with two workers plus 0.5 min of forces)."""
+    return 0.3 + 5.0 * (n / 1e4) ** 2
+
+
+def _slowest_rate(spec):
+    rates = [float(r) for r in re.findall(r"--(?:final-)?growth-rate ([0-9.e+-]+)", spec["compress"])]
+    return min(rates)
+
+
+#: expected minutes of one job of each rule (rules not listed are TINY_MINUTES)
+EXPECTED_MINUTES = {
+    "compress": lambda w: md_minutes(system(w)["N"], system(w)["d"], _slowest_rate(system(w))),
+    "poly_jam": lambda w: md_minutes(poly_protocol(w)["N"], 3, poly_protocol(w)["final_growth_rate"]),
+    "slp": lambda w: slp_minutes(system(w)["N"], system(w)["d"]),
+    "slp_dilute": lambda w: system(w)["rounds"] * slp_minutes(system(w)["N"], system(w)["d"]),
+    "verify": lambda w: lp_minutes(system(w)["N"]),
+    "structure": lambda w: 0.3 + system(w)["N"] / 2e4,
+    "bcmd_fcc": lambda w: 0.3 + 4 * int(w.reps) ** 3 / 500,
+    "fcc_eos": lambda w: 0.3 + FREEENERGY["density"]["eos_collisions"] / 6e7,
+    "bcmd_simplex": lambda w: 0.3 + 3.0 * SYSTEMS["ls"][w.ensemble]["N"] / 1000,
+    "poly_fluid": lambda w: 0.3 + 3 * len(POLY_FLUID["phi"]) * (POLY_FLUID["collisions"] + 50 * POLY_FLUID["N"]) / 6e6,
+}
+
+
+def expected_minutes(rule, wildcards):
+    """Expected wall minutes of one job of ``rule`` on one core (the cost model above)."""
+    cost = EXPECTED_MINUTES.get(rule)
+    return cost(wildcards) if cost else TINY_MINUTES
+
+
+def job_runtime(rule):
+    """`resources: runtime=` of a rule: minutes, RUNTIME_SAFETY x expected + RUNTIME_SLACK, x attempt."""
+    return lambda wildcards, attempt: attempt * math.ceil(RUNTIME_SAFETY * expected_minutes(rule, wildcards)
+                                                          + RUNTIME_SLACK)
+
+
+def job_particles(rule, wildcards):
+    """The number of particles a job of ``rule`` holds in memory (0 for the tiny rules)."""
+    if rule in ("init", "compress", "slp", "slp_dilute", "verify", "structure"):
+        return system(wildcards)["N"]
+    if rule == "poly_jam":
+        return poly_protocol(wildcards)["N"]
+    if rule in ("bcmd_fcc", "fcc_eos"):
+        return 4 * int(wildcards.reps) ** 3
+    if rule == "bcmd_simplex":
+        return SYSTEMS["ls"][wildcards.ensemble]["N"]
+    if rule == "poly_fluid":
+        return POLY_FLUID["N"]
+    return 0
+
+
+#: MB per particle of each rule's process (LS engine 3D N = 1e4: 257 MB in all; an LP jamming
+#: worker at N = 1e4: ~1 GB; SLP keeps its LPs' constraint matrices)
+MEM_MB_PER_PARTICLE = {"verify": 0.12, "slp": 1.5, "slp_dilute": 1.5, "bcmd_simplex": 0.5}
+
+
+def job_mem_mb(rule):
+    """`resources: mem_mb=` of a rule: MEM_FLOOR_MB plus MB per particle, per process (a verify
+    job's loading-sequence workers are one process per thread besides the main one)."""
+    def mem_mb(wildcards, threads):
+        processes = threads + 1 if rule == "verify" and threads > 1 else 1
+        per_particle = MEM_MB_PER_PARTICLE.get(rule, 0.1)
+        return math.ceil(MEM_FLOOR_MB + processes * per_particle * job_particles(rule, wildcards))
+    return mem_mb
+
+
+def verify_threads(wildcards):
+    """Loading sequences run side by side (hardpack verify --workers) for large packings, whose
+    strict sequences take a minute or more each (N = 1e4 in 3D: 1-1.5 min, 2-3 LPs)."""
+    return 2 if system(wildcards)["N"] >= 5000 else 1

@@ -7,6 +7,12 @@ rule lattice:
     """FCC crystal of 4 reps^3 spheres at contact: the cell centres of the BCMD runs."""
     output:
         "results/bcmd_fcc/reps{reps}/lattice.nc",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("lattice"),
+        runtime=job_runtime("lattice"),
+    group:
+        "setup"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -31,8 +37,8 @@ rule bcmd_fcc:
         gamma0=FREEENERGY["gamma0"] if FREEENERGY else None,
     threads: 1
     resources:
-        mem_mb=500,
-        runtime=20,
+        mem_mb=job_mem_mb("bcmd_fcc"),
+        runtime=job_runtime("bcmd_fcc"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -52,10 +58,11 @@ rule fcc_eos:
         "results/bcmd_fcc/reps{reps}/eos/phi{phi}.nc",
     params:
         collisions=FREEENERGY["density"]["eos_collisions"] if FREEENERGY else None,
+        checkpoint=checkpoint_beside,
     threads: 1
     resources:
-        mem_mb=500,
-        runtime=20,
+        mem_mb=job_mem_mb("fcc_eos"),
+        runtime=job_runtime("fcc_eos"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -64,7 +71,7 @@ rule fcc_eos:
         "results/benchmarks/fcc_eos/reps{reps}/phi{phi}.tsv"
     shell:
         "hardpack eos --init {input} --phi {wildcards.phi} --seed 1"
-        " --collisions {params.collisions} --out {output} > {log} 2>&1"
+        " --collisions {params.collisions} --out {output} --checkpoint {params.checkpoint} > {log} 2>&1"
 
 
 rule bcmd_simplex:
@@ -80,8 +87,8 @@ rule bcmd_simplex:
         s=FREEENERGY["simplex"] if FREEENERGY else None,
     threads: 1
     resources:
-        mem_mb=1000,
-        runtime=30,
+        mem_mb=job_mem_mb("bcmd_simplex"),
+        runtime=job_runtime("bcmd_simplex"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -101,8 +108,10 @@ rule bcmd_ladder:
         "results/bcmd_ladder/ladder.nc",
     threads: 1
     resources:
-        mem_mb=500,
-        runtime=10,
+        mem_mb=job_mem_mb("bcmd_ladder"),
+        runtime=job_runtime("bcmd_ladder"),
+    group:
+        "setup"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -121,6 +130,12 @@ rule fig_bcmd_fcc:
     output:
         pdf="results/figures/bcmd_fcc.pdf",
         png=report("results/figures/bcmd_fcc.png", caption="../report/bcmd_fcc.rst", category="4 free energies"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_bcmd_fcc"),
+        runtime=job_runtime("fig_bcmd_fcc"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -139,6 +154,12 @@ rule fig_bcmd_density:
     output:
         pdf="results/figures/bcmd_fcc_density.pdf",
         png=report("results/figures/bcmd_fcc_density.png", caption="../report/bcmd_fcc_density.rst", category="4 free energies"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_bcmd_density"),
+        runtime=job_runtime("fig_bcmd_density"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:

@@ -11,6 +11,12 @@ rule fig_size_distributions:
         png=report("results/figures/size_distributions.png", caption="../report/size_distributions.rst", category="1 generation"),
     params:
         distributions={name: ens["distribution"] for name, ens in ENSEMBLES.items()},
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_size_distributions"),
+        runtime=job_runtime("fig_size_distributions"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -29,6 +35,12 @@ rule fig_jamming_vs_d:
     output:
         pdf="results/figures/jamming_vs_d.pdf",
         png=report("results/figures/jamming_vs_d.png", caption="../report/jamming_vs_d.rst", category="2 jamming"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_jamming_vs_d"),
+        runtime=job_runtime("fig_jamming_vs_d"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -49,6 +61,12 @@ rule fig_rates:
         png=report("results/figures/ls_rates_{kind}.png", caption="../report/ls_rates.rst", category="1 generation"),
     wildcard_constraints:
         kind="phij|eos",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_rates"),
+        runtime=job_runtime("fig_rates"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -70,6 +88,12 @@ rule fig_structure:
         kind="g2|zl|sk|channels",
     params:
         kind=lambda w: w.kind,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_structure"),
+        runtime=job_runtime("fig_structure"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:

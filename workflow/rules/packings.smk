@@ -15,6 +15,12 @@ rule init:
         attrs=lambda w: attr_options(system(w)["attrs"]),
     wildcard_constraints:
         study="ls|slp_mrj|slp_densest|slp_order_map",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("init"),
+        runtime=job_runtime("init"),
+    group:
+        "setup"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -42,8 +48,8 @@ rule compress:
         study="ls|ls_rates",
     threads: 1
     resources:
-        mem_mb=ls_mem_mb,
-        runtime=ls_runtime,
+        mem_mb=job_mem_mb("compress"),
+        runtime=job_runtime("compress"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -71,8 +77,8 @@ rule slp:
         study="slp_mrj|slp_densest|slp_order_map",
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=lambda w: system(w)["slp_minutes"],
+        mem_mb=job_mem_mb("slp"),
+        runtime=job_runtime("slp"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -101,8 +107,8 @@ rule slp_dilute:
         study="slp_diluted",
     threads: 1
     resources:
-        mem_mb=2000,
-        runtime=360,  # minutes; N = 1000: ~12 CPU-min per round
+        mem_mb=job_mem_mb("slp_dilute"),
+        runtime=job_runtime("slp_dilute"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -131,10 +137,10 @@ rule verify:
     wildcard_constraints:
         study="|".join(PACKED),
         sample=r"seed\d+(/round\d+)?",
-    threads: lp_threads
+    threads: verify_threads
     resources:
-        mem_mb=lp_mem_mb,
-        runtime=lp_runtime,
+        mem_mb=job_mem_mb("verify"),
+        runtime=job_runtime("verify"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -160,8 +166,8 @@ rule structure:
         study="ls",
     threads: 1
     resources:
-        mem_mb=lp_mem_mb,
-        runtime=lambda w: 10 + system(w)["N"] // 500,
+        mem_mb=job_mem_mb("structure"),
+        runtime=job_runtime("structure"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -183,6 +189,12 @@ rule combine:
         options=lambda w: COMBINED[w.key]["options"],
     wildcard_constraints:
         key=one_of(COMBINED),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("combine"),
+        runtime=job_runtime("combine"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:

@@ -27,8 +27,8 @@ rule poly_jam:
         system="|".join(POLY_SYSTEMS),
     threads: 1
     resources:
-        mem_mb=poly_jam_mem_mb,
-        runtime=poly_jam_runtime,
+        mem_mb=job_mem_mb("poly_jam"),
+        runtime=job_runtime("poly_jam"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -57,8 +57,8 @@ rule poly_fluid:
         width=POLY_WIDTH,
     threads: 1
     resources:
-        mem_mb=lambda w: 500 + POLY_FLUID["N"] // 5,
-        runtime=poly_fluid_runtime,
+        mem_mb=job_mem_mb("poly_fluid"),
+        runtime=job_runtime("poly_fluid"),
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -81,6 +81,12 @@ rule eos_summary:
         kind=lambda w: EOS_SUMMARIES[w.key]["kind"],
     wildcard_constraints:
         key=one_of(EOS_SUMMARIES),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("eos_summary"),
+        runtime=job_runtime("eos_summary"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -99,6 +105,12 @@ rule fig_phij_vs_omega:
         pdf="results/figures/phij_vs_omega.pdf",
         png=report("results/figures/phij_vs_omega.png", caption="../report/polydisperse_phij.rst",
                    category="3 polydisperse"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_phij_vs_omega"),
+        runtime=job_runtime("fig_phij_vs_omega"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -117,6 +129,12 @@ rule fig_eos_vs_bmcsl:
         pdf="results/figures/eos_vs_bmcsl.pdf",
         png=report("results/figures/eos_vs_bmcsl.png", caption="../report/polydisperse_eos.rst",
                    category="3 polydisperse"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_eos_vs_bmcsl"),
+        runtime=job_runtime("fig_eos_vs_bmcsl"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -135,6 +153,12 @@ rule fig_crystallisation:
         pdf="results/figures/crystallisation_vs_omega.pdf",
         png=report("results/figures/crystallisation_vs_omega.png",
                    caption="../report/polydisperse_crystallisation.rst", category="3 polydisperse"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_crystallisation"),
+        runtime=job_runtime("fig_crystallisation"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:

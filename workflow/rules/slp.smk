@@ -10,6 +10,12 @@ rule slp_order_map_summary:
         verdicts=order_map_files("verdict"),
     output:
         summary("slp_order_map/order_map"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("slp_order_map_summary"),
+        runtime=job_runtime("slp_order_map_summary"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -27,6 +33,12 @@ rule slp_diluted_summary:
         verdicts=lambda w: diluted_files(w.name, "verdict"),
     output:
         "results/slp_diluted/{name}/diluted_summary.nc",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("slp_diluted_summary"),
+        runtime=job_runtime("slp_diluted_summary"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -44,6 +56,12 @@ rule fig_slp_densest:
     output:
         pdf="results/figures/slp_densest.pdf",
         png=report("results/figures/slp_densest.png", caption="../report/slp_densest.rst", category="6 SLP"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_slp_densest"),
+        runtime=job_runtime("fig_slp_densest"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -63,6 +81,12 @@ rule fig_slp_vs_ls:
     output:
         pdf="results/figures/slp_vs_ls.pdf",
         png=report("results/figures/slp_vs_ls.png", caption="../report/slp_vs_ls.rst", category="6 SLP"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_slp_vs_ls"),
+        runtime=job_runtime("fig_slp_vs_ls"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -81,6 +105,12 @@ rule fig_slp_order_map:
     output:
         pdf="results/figures/slp_order_map.pdf",
         png=report("results/figures/slp_order_map.png", caption="../report/slp_order_map.rst", category="6 SLP"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_slp_order_map"),
+        runtime=job_runtime("fig_slp_order_map"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:

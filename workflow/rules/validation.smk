@@ -13,6 +13,12 @@ rule validation_report:
         md="results/validation/report.md",
     params:
         inputs=validation_arguments(),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("validation_report"),
+        runtime=job_runtime("validation_report"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -32,6 +38,12 @@ rule validation:
         "results/validation/gate.txt",
     params:
         min_applicable=VALIDATION.get("min_applicable", 30),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("validation"),
+        runtime=job_runtime("validation"),
+    group:
+        "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
