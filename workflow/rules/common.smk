@@ -521,19 +521,15 @@ def job_runtime(rule):
                                                           + RUNTIME_SLACK)
 
 
-def job_particles(rule, wildcards):
-    """The number of particles a job of ``rule`` holds in memory (0 for the tiny rules)."""
-    if rule in ("init", "compress", "slp", "slp_dilute", "verify", "structure"):
-        return system(wildcards)["N"]
-    if rule == "poly_jam":
-        return poly_protocol(wildcards)["N"]
-    if rule in ("bcmd_fcc", "fcc_eos"):
-        return 4 * int(wildcards.reps) ** 3
-    if rule == "bcmd_simplex":
-        return SYSTEMS["ls"][wildcards.ensemble]["N"]
-    if rule == "poly_fluid":
-        return POLY_FLUID["N"]
-    return 0
+#: the number of particles a job holds in memory (jobs not listed: none to speak of)
+PARTICLES = {
+    **dict.fromkeys(("init", "compress", "slp", "slp_dilute", "verify", "structure"), lambda w: system(w)["N"]),
+    "poly_jam": lambda w: poly_protocol(w)["N"],
+    "bcmd_fcc": lambda w: 4 * int(w.reps) ** 3,
+    "fcc_eos": lambda w: 4 * int(w.reps) ** 3,
+    "bcmd_simplex": lambda w: SYSTEMS["ls"][w.ensemble]["N"],
+    "poly_fluid": lambda w: POLY_FLUID["N"],
+}
 
 
 #: MB per particle of each rule's process (LS engine 3D N = 1e4: 257 MB in all; an LP jamming
@@ -547,7 +543,8 @@ def job_mem_mb(rule):
     def mem_mb(wildcards, threads):
         processes = threads + 1 if rule == "verify" and threads > 1 else 1
         per_particle = MEM_MB_PER_PARTICLE.get(rule, 0.1)
-        return math.ceil(MEM_FLOOR_MB + processes * per_particle * job_particles(rule, wildcards))
+        particles = PARTICLES[rule](wildcards) if rule in PARTICLES else 0
+        return math.ceil(MEM_FLOOR_MB + processes * per_particle * particles)
     return mem_mb
 
 
