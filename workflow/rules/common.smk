@@ -459,7 +459,7 @@ def final_outputs():
 
 RUNTIME_SAFETY = 3
 RUNTIME_SLACK = 5         # minutes
-MEM_FLOOR_MB = 500        # a hardpack process (numpy, numba, xarray): max_rss 270-280 MB measured
+MEM_FLOOR_MB = 500        # a hardpack process (numpy, numba, xarray): max_rss 174-312 MB in the smoke study
 MD_SECONDS_PER_UNIT = 3e-5  # LS compression: seconds per particle per unit of 1 / Gamma, in 3D
 #: cost per collision against 3D (NVE rates, benchmarks/bench_md.py: 1.43e6, 8.0e5, 3.1e5, 1.7e5, 1.3e5 coll/s)
 MD_DIMENSION_COST = {2: 0.6, 3: 1.0, 4: 2.6, 5: 4.7, 6: 6.2}

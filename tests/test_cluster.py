@@ -1,0 +1,96 @@
+"""Cluster runs: every rule's resources come from the cost model, its limits cover the measured
+jobs of the full study, the profiles say what docs/cluster.md says. (A real SLURM run is in .ci/run.)"""
+
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+needs_snakemake = pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
+
+
+def _rules():
+    """{rule name: its text} of every rule of the workflow's rule files."""
+    rules = {}
+    for path in sorted((ROOT / "workflow" / "rules").glob("*.smk")):
+        for block in re.split(r"^(?=rule )", path.read_text(), flags=re.M)[1:]:
+            rules[re.match(r"rule (\w+):", block).group(1)] = block
+    return rules
+
+
+def _expected_minutes_rules():
+    common = (ROOT / "workflow" / "rules" / "common.smk").read_text()
+    table = common.split("EXPECTED_MINUTES = {", 1)[1].split("\n}", 1)[0]
+    return set(re.findall(r'^    "(\w+)":', table, re.M))
+
+
+def test_every_rule_takes_its_resources_from_the_cost_model_under_its_own_name():
+    for name, text in _rules().items():
+        assert re.search(r"^    threads: \w+$", text, re.M), f"rule {name} sets no threads"
+        assert f'mem_mb=job_mem_mb("{name}")' in text, f"rule {name}: mem_mb not from job_mem_mb(\"{name}\")"
+        assert f'runtime=job_runtime("{name}")' in text, f"rule {name}: runtime not from job_runtime(\"{name}\")"
+
+
+def test_a_rule_without_its_own_cost_runs_in_a_job_group_and_the_profile_sizes_every_group():
+    costed = _expected_minutes_rules()
+    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
+    groups = {}
+    for name, text in _rules().items():
+        group = re.search(r'^    group:\n        "(\w+)"', text, re.M)
+        assert (group is None) == (name in costed), f"rule {name}: grouped rules are the tiny ones, without a cost"
+        if group:
+            groups[name] = group.group(1)
+    assert set(groups.values()) == set(profile["group-components"]), groups
+
+
+def test_slurm_profile_settings():
+    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
+    assert profile["executor"] == "slurm" and profile["retries"] >= 1 and profile["rerun-incomplete"]
+    assert {"slurm_partition", "slurm_account", "mem_mb", "runtime"} <= set(profile["default-resources"])
+    # squeue: without slurmdbd sacct knows no job, and it misses jobs cancelled by scancel
+    assert profile["slurm-status-command"] == "squeue"
+    assert profile["set-resource-scopes"] == {"group_cores": "local"} and profile["resources"]["group_cores"] == 1
+
+
+def _dry_run(*args):
+    out = subprocess.run(["snakemake", "-n", "--forceall", "--cores", "64", *args], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    return out.stdout + out.stderr
+
+
+def _job_resources(text, output):
+    """(threads, runtime, mem_mb) of the job writing ``output`` in a dry run's listing."""
+    block = next(b for b in re.split(r"\n(?=\s*(?:local)?rule \w+:)", text) if f"output: {output}" in b)
+    threads = re.search(r"^\s*threads: (\d+)", block, re.M)
+    resources = re.search(r"resources: .*", block).group(0)
+    runtime = int(re.search(r"\bruntime=(\d+)", resources).group(1))
+    return (int(threads.group(1)) if threads else 1), runtime, int(re.search(r"\bmem_mb=(\d+)", resources).group(1))
+
+
+@needs_snakemake
+def test_time_limits_cover_the_measured_jobs_of_the_full_study_twice():
+    """Measured wall minutes of the longest jobs of each kind (docs/cluster.md: the full study's
+    records on the loaded 2-core machine) against the limits of the first attempt."""
+    text = _dry_run()
+    assert "workflow specific profile" not in text  # workflow/profiles/default is not loaded implicitly
+    measured = {
+        "results/ls/mono3d_large/jammed/seed1.nc": 58,                          # LS N = 1e4, Gamma_f = 1e-4
+        "results/ls_rates/mono3d_gamma0.0003/jammed/seed1.nc": 3.1,             # N = 1000, Gamma = 3e-4
+        "results/poly_crystallisation/uniform_size_w10/poly/seed2.nc": 18.3,    # N = 500, Gamma_f = 1e-5
+        "results/poly_phij/uniform_size_w1.2/poly/seed2.nc": 1.9,               # N = 1000, Gamma_f = 2e-3
+        "results/slp_mrj/mono3d/slp/seed4.nc": 24.3,                            # SLP 3D N = 1000
+        "results/slp_mrj/slp_mono6d/slp/seed1.nc": 25,                          # SLP 6D N = 250
+        "results/slp_densest/d5/slp/seed0.nc": 6.3,                             # SLP 5D N = 243
+        "results/ls/mono3d_large/verdict/seed1.nc": 5,                          # jamming test N = 1e4
+        "results/poly_fluid/uniform_volume_w10/fluid.nc": 2.3,
+    }
+    for output, minutes in measured.items():
+        _, runtime, _ = _job_resources(text, output)
+        assert runtime >= 2 * minutes, f"{output}: limit {runtime} min for a job measured at {minutes} min"
+    threads, _, mem_mb = _job_resources(text, "results/ls/mono3d_large/verdict/seed1.nc")
+    assert threads == 2 and mem_mb >= 3000  # two ~1 GB loading-sequence workers besides the main process
