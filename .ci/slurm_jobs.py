@@ -26,7 +26,7 @@ def main(snakemake_log: str, slurmctld_log: str) -> None:
     text = open(snakemake_log).read()
     ctld = open(slurmctld_log).read()
     stats = job_stats(text)
-    submissions = re.findall(r"has been submitted with SLURM jobid (\d+) \(log: \S*/slurm_logs/(rule|group)_(\w+?)/", text)
+    submissions = re.findall(r"has been submitted with SLURM jobid (\d+) \(log: \S*/slurm_logs/(rule|group)_([^/]+)/", text)
     single = Counter(name for _, kind, name in submissions if kind == "rule")
     groups = Counter(name.split("_")[0] for _, kind, name in submissions if kind == "group")
     members = Counter()

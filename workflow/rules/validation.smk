@@ -18,7 +18,7 @@ rule validation_report:
         mem_mb=job_mem_mb("validation_report"),
         runtime=job_runtime("validation_report"),
     group:
-        "summaries"
+        "validation"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -43,7 +43,7 @@ rule validation:
         mem_mb=job_mem_mb("validation"),
         runtime=job_runtime("validation"),
     group:
-        "summaries"
+        "validation"
     conda:
         "../envs/hardpack.yaml"
     log:
