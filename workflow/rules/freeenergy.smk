@@ -135,7 +135,7 @@ rule fig_bcmd_fcc:
         mem_mb=job_mem_mb("fig_bcmd_fcc"),
         runtime=job_runtime("fig_bcmd_fcc"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -159,7 +159,7 @@ rule fig_bcmd_density:
         mem_mb=job_mem_mb("fig_bcmd_density"),
         runtime=job_runtime("fig_bcmd_density"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:

@@ -16,7 +16,7 @@ rule fig_size_distributions:
         mem_mb=job_mem_mb("fig_size_distributions"),
         runtime=job_runtime("fig_size_distributions"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -40,7 +40,7 @@ rule fig_jamming_vs_d:
         mem_mb=job_mem_mb("fig_jamming_vs_d"),
         runtime=job_runtime("fig_jamming_vs_d"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -66,7 +66,7 @@ rule fig_rates:
         mem_mb=job_mem_mb("fig_rates"),
         runtime=job_runtime("fig_rates"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -93,7 +93,7 @@ rule fig_structure:
         mem_mb=job_mem_mb("fig_structure"),
         runtime=job_runtime("fig_structure"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:

@@ -110,7 +110,7 @@ rule fig_phij_vs_omega:
         mem_mb=job_mem_mb("fig_phij_vs_omega"),
         runtime=job_runtime("fig_phij_vs_omega"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -134,7 +134,7 @@ rule fig_eos_vs_bmcsl:
         mem_mb=job_mem_mb("fig_eos_vs_bmcsl"),
         runtime=job_runtime("fig_eos_vs_bmcsl"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -158,7 +158,7 @@ rule fig_crystallisation:
         mem_mb=job_mem_mb("fig_crystallisation"),
         runtime=job_runtime("fig_crystallisation"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:

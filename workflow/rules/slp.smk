@@ -61,7 +61,7 @@ rule fig_slp_densest:
         mem_mb=job_mem_mb("fig_slp_densest"),
         runtime=job_runtime("fig_slp_densest"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -86,7 +86,7 @@ rule fig_slp_vs_ls:
         mem_mb=job_mem_mb("fig_slp_vs_ls"),
         runtime=job_runtime("fig_slp_vs_ls"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
@@ -110,7 +110,7 @@ rule fig_slp_order_map:
         mem_mb=job_mem_mb("fig_slp_order_map"),
         runtime=job_runtime("fig_slp_order_map"),
     group:
-        "summaries"
+        "figures"
     conda:
         "../envs/hardpack.yaml"
     log:
