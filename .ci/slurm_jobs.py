@@ -26,7 +26,8 @@ def main(snakemake_log: str, slurmctld_log: str) -> None:
     text = open(snakemake_log).read()
     ctld = open(slurmctld_log).read()
     stats = job_stats(text)
-    submissions = re.findall(r"has been submitted with SLURM jobid (\d+) \(log: \S*/slurm_logs/(rule|group)_([^/]+)/", text)
+    submitted_as = r"has been submitted with SLURM jobid (\d+) \(log: \S*/slurm_logs/(rule|group)_([^/]+)/"
+    submissions = re.findall(submitted_as, text)
     single = Counter(name for _, kind, name in submissions if kind == "rule")
     groups = Counter(name.split("_")[0] for _, kind, name in submissions if kind == "group")
     members = Counter()
@@ -48,10 +49,11 @@ def main(snakemake_log: str, slurmctld_log: str) -> None:
             problems.append(f"SLURM job {jobid} ({kind} {name}) did not complete with exit status 0")
     if problems:
         sys.exit("slurm jobs:\n  " + "\n  ".join(problems))
+    per_rule = ", ".join(f"{r} {n}" for r, n in sorted(single.items()))
+    per_group = ", ".join(f"{g} {n}" for g, n in sorted(groups.items()))
     print(f"{sum(stats.values())} Snakemake jobs ran as {len(submissions)} SLURM jobs, all completed with exit "
-          f"status 0: {sum(single.values())} compute jobs one each ({', '.join(f'{r} {n}' for r, n in sorted(single.items()))}), "
-          f"{sum(members.values())} tiny jobs in {sum(groups.values())} group jobs "
-          f"({', '.join(f'{g} {n}' for g, n in sorted(groups.items()))})")
+          f"status 0: {sum(single.values())} compute jobs one each ({per_rule}), "
+          f"{sum(members.values())} tiny jobs in {sum(groups.values())} group jobs ({per_group})")
 
 
 if __name__ == "__main__":
