@@ -1,4 +1,4 @@
-"""Geometry: the packing model, d-ball volumes, periodic neighbour search and crystal lattices."""
+"""Geometry: the packing model, d-ball volumes, the neighbour layer (:mod:`.neighbours`) and crystal lattices."""
 
 from hardpack.geometry.balls import ball_volume, unit_ball_volume
 from hardpack.geometry.lattices import lattice_packing

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hardpack.errors import InvalidInputError
-from hardpack.geometry.neighbours import pairs_within
+from hardpack.geometry.neighbours import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
 
 
@@ -126,10 +126,6 @@ def contact_network(packing: Packing, delta: float) -> ContactNetwork:
             "Finish or repair the packing (e.g. rerun the generator to a higher pressure)"
         )
     pairs = pairs_within(packing, rel_gap=delta)
-    x = packing.fractional() @ packing.lattice.T
-    if packing.is_orthorhombic:  # the same guard as pairs_within's periodic tree
-        box = np.diag(packing.lattice)
-        x = np.where(x >= box, 0.0, x)
     return ContactNetwork(
         i=pairs.i.astype(np.int64),
         j=pairs.j.astype(np.int64),
@@ -137,7 +133,7 @@ def contact_network(packing: Packing, delta: float) -> ContactNetwork:
         separation=pairs.separation,
         distance=pairs.distance,
         contact_distance=pairs.contact,
-        positions=x,
+        positions=wrapped_positions(packing),
         lattice=np.array(packing.lattice, dtype=float),
         delta=delta,
     )

@@ -120,8 +120,7 @@ def influence_pairs(packing, alpha: float, bounds: Bounds, deforming: bool = Tru
     keep = pairs.distance < limit
     if keep.all():
         return pairs
-    return type(pairs)(pairs.i[keep], pairs.j[keep], pairs.shift[keep], pairs.separation[keep],
-                       pairs.distance[keep], pairs.contact[keep])
+    return pairs.subset(keep)
 
 
 METHODS = ("highs-ipm", "highs-ds", "highs")

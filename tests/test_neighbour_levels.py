@@ -1,11 +1,18 @@
-"""Equal-particles-per-cell level assignment (Ogarko ch. 2.1, Eqs. 2.6-2.8, Appendix L1492-1532)."""
+"""Hierarchical levels by Ogarko's rules (dissertation, Sec. 2.1.2-2.1.3 and the appendix of ch. 2.1)."""
 
 import numpy as np
 import pytest
 
 from hardpack.distributions import bidisperse, uniform_size, uniform_volume
 from hardpack.errors import InvalidInputError
-from hardpack.hgrid.levels import assign_levels, assign_with_threshold, optimal_levels
+from hardpack.geometry.neighbours import (
+    assign_levels,
+    assign_with_threshold,
+    build_grid,
+    geometric_levels,
+    insertion_levels,
+    optimal_levels,
+)
 
 
 def system(dist, n=125_001, nu=0.62, d=3):
@@ -86,3 +93,57 @@ def test_refusals():
         optimal_levels([1.0, 2.0], 10.0, 3, K=-1)
     with pytest.raises(InvalidInputError):
         assign_with_threshold([1.0, 2.0], 10.0, 3, np.nan)
+
+
+def test_every_rule_assigns_by_the_insertion_rule(uv50):
+    """Whatever the cell sizes, a particle lives on the lowest level whose cell size is at least its
+    diameter (Eq. 2.3), and each level's cell size is the largest diameter on it."""
+    radii, volume = uv50
+    for a in (optimal_levels(radii, volume, 3), assign_levels(radii, volume, 3, 4),
+              geometric_levels(radii, volume, 3, 2.0), geometric_levels(radii, volume, 3, 3.7)):
+        assert np.array_equal(a.level, insertion_levels(radii, a.cell_sizes))
+        assert np.array_equal(a.cell_sizes, [2 * radii[a.level == h].max() for h in range(a.n_levels)])
+
+
+def test_geometric_cell_sizes():
+    """Cell sizes s_{h+1} = q s_h (Eq. 2.43) from the smallest diameter: level h holds the radii in
+    [r_min q^h, r_min q^(h+1)), the levels nobody occupies dropped (here [4, 8))."""
+    radii = np.array([1.0, 1.5, np.nextafter(2.0, 0.0), 2.0, 3.9, 8.0, 15.9, 16.0])
+    a = geometric_levels(radii, 1e4, 3, 2.0)
+    assert a.level.tolist() == [0, 0, 0, 1, 1, 2, 2, 3]
+    assert a.cell_sizes.tolist() == [2 * np.nextafter(2.0, 0.0), 7.8, 31.8, 32.0]
+    r = uniform_volume(50.0).sample(20000)
+    classes = np.floor(np.log(r / r.min()) / np.log(2.0))
+    assert np.array_equal(geometric_levels(r, 1e6, 3, 2.0).level, np.unique(classes, return_inverse=True)[1])
+    assert geometric_levels(np.full(10, 0.5), 10.0, 3, 2.0).n_levels == 1
+    with pytest.raises(InvalidInputError, match="ratio"):
+        geometric_levels(r, 1e6, 3, 1.0)
+
+
+def test_grid_uses_the_optimal_number_of_levels(uv50):
+    """The static grid of the pair search takes Ogarko's ONL (Eq. 2.7) for its interaction radii, and
+    a single level for equal ones."""
+    radii, volume = uv50
+    side = volume ** (1 / 3)
+    frac = np.random.default_rng(1).random((radii.size, 3))
+    grid = build_grid(frac, np.eye(3) * side, radii)
+    assert grid.n_levels == 7
+    assert np.array_equal(grid.level, optimal_levels(radii, volume, 3).level)
+    assert build_grid(frac, np.eye(3) * side, np.full(radii.size, 2.0)).n_levels == 1
+
+
+def test_md_engine_levels_are_geometric():
+    """The MD engine's bounding-sphere grid: geometric cell sizes of ratio 2 over the bounding radii
+    (Eq. 2.43), each level capped at its largest bounding radius (plus head room)."""
+    from hardpack.md.engine import GRID_HEADROOM, LEVEL_RATIO, Engine
+
+    rng = np.random.default_rng(3)
+    radii = uniform_volume(10.0).sample(600, rng)
+    box = np.full(3, (np.sum(4 / 3 * np.pi * radii**3) / 0.2) ** (1 / 3))
+    eng = Engine(rng.random((600, 3)) * box, rng.normal(size=(600, 3)), radii, box)
+    eng._new_bounds(0.2)
+    bound = radii + 0.2 * eng.sfac
+    expected = geometric_levels(bound, float(np.prod(box)), 3, LEVEL_RATIO)
+    assert eng.ncl.shape[0] == expected.n_levels > 1
+    assert np.array_equal(eng.lvl, expected.level)
+    np.testing.assert_array_equal(eng.rcap, np.minimum(0.5 * expected.cell_sizes * GRID_HEADROOM, box[0] / 4))
