@@ -45,8 +45,8 @@ from scipy.optimize import brentq
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
-from hardpack.geometry.neighbours import pairs_within
-from hardpack.structure import _cells
+from hardpack.geometry.neighbours import build_grid, pairs_within
+from hardpack.geometry.neighbours.grid import pair_histograms, stencil
 
 DEFAULT_CONTACT_TOL = 1e-9
 
@@ -95,10 +95,10 @@ def pair_correlation(packing, r_max: float | None = None, dr: float | None = Non
         raise InvalidInputError(f"{max(n_r, n_x)} bins requested; increase dr/dx or lower r_max/x_max")
     radii = np.ascontiguousarray(packing.radii, dtype=float)
     cutoff = max(n_r * dr, n_x * dx * 2.0 * radii.max())
-    grid = _cells.build_grid(packing, cutoff)
-    hist_r, hist_x, n_contacts = _cells.pair_histograms(
-        grid.x, radii, grid.lattice, grid.n_cells, grid.strides, grid.cell_start, grid.order,
-        grid.offsets, cutoff, dr, n_r, dx, n_x, float(contact_tol), bool(self_images),
+    grid = build_grid(packing.fractional(), packing.lattice, np.full(radii.size, 0.5 * cutoff), per_cell=2)
+    hist_r, hist_x, n_contacts = pair_histograms(
+        grid.x, radii, grid.lattice, grid.n_cells[0], grid.strides[0], grid.cell_start, grid.order,
+        stencil(grid, cutoff), cutoff, dr, n_r, dx, n_x, float(contact_tol), bool(self_images),
     )
     n, d, volume = packing.n_particles, packing.dim, packing.volume
     vd = unit_ball_volume(d)

@@ -42,7 +42,8 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import ball_volume
-from hardpack.structure import _cells
+from hardpack.geometry.neighbours import build_grid
+from hardpack.geometry.neighbours.grid import window_counts
 
 _PARTICLE_CHUNK = 8192  # particles per phase table
 _MATRIX_ELEMENTS = 2**21  # rows x particles per GEMM block (operand ~32 MB)
@@ -274,9 +275,10 @@ def number_variance(packing, window_radii, n_windows: int = 10000, seed: int = 0
         raise InvalidInputError(f"n_windows must be >= 2, got {n_windows}")
     rng = np.random.default_rng(seed)
     centres = rng.random((int(n_windows), packing.dim))
-    grid = _cells.build_grid(packing, float(radii[-1]), per_cutoff=2)
-    counts = _cells.window_counts(centres, grid.x, grid.lattice, grid.n_cells, grid.strides,
-                                  grid.cell_start, grid.order, grid.offsets, radii).astype(float)
+    grid = build_grid(packing.fractional(), packing.lattice, np.full(packing.n_particles, 0.5 * radii[-1]),
+                      per_cell=2)
+    counts = window_counts(centres, grid.x, grid.lattice, 1.0 / grid.heights, grid.n_cells, grid.strides,
+                           grid.cell_offset, grid.cell_start, grid.order, radii).astype(float)
     m = counts.shape[0]
     mean = counts.mean(axis=0)
     dev2 = (counts - mean) ** 2
