@@ -22,13 +22,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from hardpack.errors import InvalidInputError
+from hardpack.geometry.neighbours import cell_counts, geometric_levels
 from hardpack.md import kernel
 
 #: cells per particle of a level above which its grid is coarsened (dilute systems)
 MAX_CELLS_PER_PARTICLE = 2.0
 #: skins scale like (a_i + <a>)^-SKIN_SIZE_EXPONENT (see Engine.skin_factors)
 SKIN_SIZE_EXPONENT = 1.0
-#: ratio of the bounding radii spanned by one grid level (hierarchical grid for wide distributions)
+#: ratio of the bounding radii spanned by one grid level (hierarchical grid for wide distributions;
+#: geometric cell sizes, :func:`hardpack.geometry.neighbours.geometric_levels`)
 LEVEL_RATIO = 2.0
 #: cell width of a level in units of its bounding-radius cap: a rebuild scans the cells within
 #: R_i + rcap of the centre (3^d on its own level; width 1 with up to 5^d cells was 1.6x slower)
@@ -85,18 +87,6 @@ def image_vectors(box: np.ndarray) -> np.ndarray:
     """Table of periodic shifts L * n indexed by the image code (:func:`image_shifts`)."""
     d = len(box)
     return image_shifts(np.arange(4**d), d) * box[None, :]
-
-
-def grid_levels(bound_radii: np.ndarray) -> np.ndarray:
-    """Grid level of every particle: bounding radii in classes of ratio LEVEL_RATIO from the
-    smallest (level 0), so each level's cells fit its largest bounding sphere without holding
-    many much smaller ones (a hierarchical grid, Ogarko ch. 2.1; monodisperse and moderately
-    polydisperse systems get one level). Empty classes are dropped (levels renumbered 0, 1, ...
-    over the occupied ones): a discrete distribution such as a tridisperse equivalent of a wide
-    one leaves gaps between its classes, and a level without particles has no grid."""
-    ratio = bound_radii / bound_radii.min()
-    classes = np.floor(np.log(ratio) / np.log(LEVEL_RATIO) + 1e-12).astype(np.int64)
-    return np.unique(classes, return_inverse=True)[1].astype(np.int64).reshape(classes.shape)
 
 
 class Engine:
@@ -202,8 +192,11 @@ class Engine:
         """Grid levels, their bounding-radius caps and cells for the coming complete rebuild.
 
         Particles are put on levels by their bounding radius R = a + skin s_i (s_i from
-        :meth:`skin_factors`), in classes of ratio LEVEL_RATIO (one level unless the radii differ
-        by more than that). Level h caps the bounding radii of its particles at rcap_h =
+        :meth:`skin_factors`), in classes of ratio LEVEL_RATIO from the smallest (Ogarko's
+        insertion rule with geometric cell sizes, :func:`hardpack.geometry.neighbours.geometric_levels`;
+        one level unless the radii differ by more than that; empty classes are no levels, so a
+        discrete distribution with gaps between its sizes gets one level per occupied class).
+        Level h caps the bounding radii of its particles at rcap_h =
         max_h(a + skin s) GRID_HEADROOM (head room for growth) and has cells of width >= 2 rcap_h
         (at most MAX_CELLS_PER_PARTICLE per particle of the level), so a particle's own level is
         searched in 3^d cells and the other levels in the cells within R_i + rcap_l.
@@ -220,16 +213,11 @@ class Engine:
                 f"{2 * amax:.4g} must stay below half the shortest box side {lmin:.4g} (so that a "
                 "pair touches through one periodic image only); use more particles or a larger box"
             )
-        lvl = grid_levels(bound)
-        nlev = int(lvl.max()) + 1
-        count = np.bincount(lvl, minlength=nlev)
-        self.rcap = np.minimum(np.array([bound[lvl == h].max() for h in range(nlev)]) * GRID_HEADROOM,
-                               0.25 * lmin)
-        ncl = np.maximum(np.floor(self.box[None, :] / (CELL_WIDTH * self.rcap[:, None])), 1).astype(np.int64)
-        for h in range(nlev):  # coarsen levels that would have many empty cells
-            excess = np.prod(ncl[h].astype(float)) / (MAX_CELLS_PER_PARTICLE * count[h])
-            if excess > 1.0:
-                ncl[h] = np.maximum(np.floor(ncl[h] / excess ** (1.0 / self.d)), 1).astype(np.int64)
+        levels = geometric_levels(bound, float(np.prod(self.box)), self.d, LEVEL_RATIO)
+        lvl = levels.level
+        count = np.bincount(lvl, minlength=levels.n_levels)
+        self.rcap = np.minimum(0.5 * levels.cell_sizes * GRID_HEADROOM, 0.25 * lmin)
+        ncl = cell_counts(self.box, CELL_WIDTH * self.rcap, count, MAX_CELLS_PER_PARTICLE)
         self.lvl = lvl.astype(np.int32)
         self.ncl = ncl
         self.coff = np.concatenate([[0], np.cumsum(np.prod(ncl, axis=1))]).astype(np.int64)
