@@ -83,26 +83,30 @@ def _from_cell_sizes(radii, volume: float, d: int, cell_sizes, m: float) -> Leve
     """Levels by the insertion rule (Eq. 2.3) for these cell sizes, empty levels dropped and each cell size
     shrunk to the largest diameter on its level."""
     level = insertion_levels(radii, cell_sizes)
-    occupied, level = np.unique(level, return_inverse=True)
-    level = level.reshape(-1)
-    n_levels = occupied.size
-    sizes = np.zeros(n_levels)
-    np.maximum.at(sizes, level, 2.0 * radii)
-    m_h = np.bincount(level, minlength=n_levels) * sizes**d / volume
-    return LevelAssignment(level, sizes, float(m), m_h)
+    counts = np.bincount(level)
+    occupied = counts > 0
+    level = (np.cumsum(occupied) - 1)[level]
+    counts = counts[occupied]
+    sizes = np.array([2.0 * radii[level == h].max() for h in range(counts.size)])
+    return LevelAssignment(level, sizes, float(m), counts * sizes**d / volume)
+
+
+def _check_radii(radii, volume, d) -> np.ndarray:
+    r = np.asarray(radii, dtype=float)
+    if r.ndim != 1 or r.size == 0 or not (np.isfinite(r).all() and (r > 0).all()):
+        raise InvalidInputError("radii must be a non-empty 1-d array of positive finite values")
+    if int(d) != d or d < 1:
+        raise InvalidInputError(f"dimension d must be a positive integer, got {d!r}")
+    if not (np.isfinite(volume) and volume > 0):
+        raise InvalidInputError(f"box volume must be positive and finite, got {volume!r}")
+    return r
 
 
 class _Groups:
     """Radii grouped into distinct values (ascending) with counts."""
 
     def __init__(self, radii, volume, d):
-        r = np.asarray(radii, dtype=float)
-        if r.ndim != 1 or r.size == 0 or not (np.isfinite(r).all() and (r > 0).all()):
-            raise InvalidInputError("radii must be a non-empty 1-d array of positive finite values")
-        if int(d) != d or d < 1:
-            raise InvalidInputError(f"dimension d must be a positive integer, got {d!r}")
-        if not (np.isfinite(volume) and volume > 0):
-            raise InvalidInputError(f"box volume must be positive and finite, got {volume!r}")
+        r = _check_radii(radii, volume, d)
         self.radii, self.volume, self.d = r, float(volume), int(d)
         self.values, counts = np.unique(r, return_counts=True)
         self.counts = counts.astype(float)
@@ -175,14 +179,14 @@ def geometric_levels(radii, volume: float, d: int, ratio: float) -> LevelAssignm
     """Levels of cell sizes in geometric progression s_{h+1} = ratio s_h (Eq. 2.43), anchored at the
     smallest diameter: level h holds the radii in [r_min ratio^h, r_min ratio^(h+1)) (module docstring).
     ``m`` of the result is the largest realised occupancy m_h."""
-    groups = _Groups(radii, volume, d)
+    r = _check_radii(radii, volume, d)
     if not (np.isfinite(ratio) and ratio > 1):
         raise InvalidInputError(f"the ratio of successive cell sizes must be > 1, got {ratio!r}")
-    r_min, r_max = groups.values[0], groups.values[-1]
+    r_min, r_max = r.min(), r.max()
     n_bounds = int(np.ceil(np.log(r_max / r_min) / np.log(ratio))) + 2
     # s_h just below 2 r_min ratio^(h+1): then 2 r <= s_h exactly when r < r_min ratio^(h+1)
     sizes = np.nextafter(2.0 * r_min * ratio ** np.arange(1, n_bounds + 1), 0.0)
-    a = _from_cell_sizes(groups.radii, groups.volume, groups.d, sizes, 0.0)
+    a = _from_cell_sizes(r, float(volume), int(d), sizes, 0.0)
     return LevelAssignment(a.level, a.cell_sizes, float(a.m_per_level.max()), a.m_per_level)
 
 
