@@ -1,6 +1,7 @@
 """Config files against the JSON schema; the Snakemake DAG builds for both configs."""
 
 import copy
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -55,11 +56,62 @@ def test_bad_configs_are_refused_naming_the_key(mutate, expected):
 
 
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
-def test_snakemake_dry_run_lists_the_dag(tmp_path):
-    out = subprocess.run(["snakemake", "-n", "--forceall", "--configfile", "config/smoke.yaml"], cwd=ROOT,
+@pytest.mark.parametrize("configfile", ["config/config.yaml", "config/smoke.yaml"])
+def test_snakemake_dry_run_lists_the_dag(configfile):
+    out = subprocess.run(["snakemake", "-n", "--forceall", "--configfile", configfile], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
-    assert "init_packing" in out.stdout and "fig_size_distributions" in out.stdout
+    assert re.search(r"^init +\d+$", out.stdout, re.M) and "fig_size_distributions" in out.stdout
+
+
+@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
+@pytest.mark.parametrize("configfile", ["config/config.yaml", "config/smoke.yaml"])
+def test_snakemake_lint_finds_nothing(configfile):
+    """`snakemake --lint` exits non-zero on any finding (rules mixed with functions, a rule without
+    log or software environment, hard-coded path prefixes in params, ...)."""
+    out = subprocess.run(["snakemake", "--lint", "--configfile", configfile], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0 and "Lints for" not in out.stdout + out.stderr, out.stdout + out.stderr
+
+
+def _rules():
+    """{rule name: its text} of every rule of the workflow's rule files."""
+    rules = {}
+    for path in sorted((ROOT / "workflow" / "rules").glob("*.smk")):
+        for block in re.split(r"^(?=rule )", path.read_text(), flags=re.M)[1:]:
+            rules[re.match(r"rule (\w+):", block).group(1)] = block
+    return rules
+
+
+def test_every_rule_logs_and_benchmarks_by_its_name():
+    """One log convention and one benchmark convention: results/logs/{rule}/... and
+    results/benchmarks/{rule}/... (or {rule}.log / {rule}.tsv without wildcards)."""
+    rules = _rules()
+    assert {"init", "compress", "slp", "verify", "structure", "combine", "validation"} <= set(rules)
+    for name, text in rules.items():
+        for directive, folder, suffix in (("log", "logs", "log"), ("benchmark", "benchmarks", "tsv")):
+            match = re.search(rf"^    {directive}:\n        \"([^\"]+)\"", text, re.M)
+            assert match, f"rule {name} has no {directive} directive"
+            assert re.fullmatch(rf"results/{folder}/{name}(/.+)?\.{suffix}", match.group(1)), (name, match.group(1))
+
+
+def test_pipeline_times_sums_the_benchmark_files_per_rule(tmp_path):
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("pipeline_times", ROOT / "benchmarks" / "pipeline_times.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    header = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    files = {"verify/ls/mono3d/seed1.tsv": "12.5\t0:00:12\t1\t1\t1\t1\t0\t0\t90\t11.0\n",
+             "verify/slp_diluted/mono3d/seed1/round2.tsv": "7.5\t0:00:07\t1\t1\t1\t1\t0\t0\t90\t6.0\n",
+             "validation.tsv": "1.0\t0:00:01\t1\t1\t1\t1\t0\t0\t90\t0.5\n"}
+    for name, line in files.items():
+        path = tmp_path / "results" / "benchmarks" / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(header + line)
+    times = module.job_times(tmp_path)
+    assert sorted(times) == ["validation", "verify"]
+    assert sorted(times["verify"]) == [(7.5, 6.0), (12.5, 11.0)] and times["validation"] == [(1.0, 0.5)]
 
 
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
@@ -78,8 +130,10 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
 @pytest.mark.parametrize("mutate, expected", [
     (lambda c: c["slp"]["diluted"].update(ensemble="uv3d_w4"), "must be one of slp.mrj.ensembles"),
     (lambda c: c["slp"]["diluted"].update(seeds=[1, 7]), r"slp.diluted.seeds \[7\] are not seeds"),
+    (lambda c: c["freeenergy"]["simplex"].update(ensemble="mono9d"), r"freeenergy.simplex.ensemble 'mono9d' is not one"),
+    (lambda c: c["freeenergy"]["simplex"].update(seeds=[1, 7]), r"freeenergy.simplex.seeds \[7\] are not seeds"),
 ])
-def test_snakemake_refuses_a_diluted_study_without_its_mrj_packings(tmp_path, mutate, expected):
+def test_snakemake_refuses_a_study_without_its_input_packings(tmp_path, mutate, expected):
     cfg = load("smoke.yaml")
     mutate(cfg)
     bad = tmp_path / "bad.yaml"

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from hardpack import InvalidInputError, Packing
-from hardpack.geometry import ball_volume, lattice_packing, pairs_within, unit_ball_volume
+from hardpack.geometry import Spheres, ball_volume, lattice_packing, pairs_within, unit_ball_volume
 
 
 @pytest.mark.parametrize(
@@ -101,7 +101,9 @@ def test_overlap_within_tolerance_is_accepted():
         (dict(positions=[["a", 0]], radii=[1], lattice=np.eye(2)), "positions must be numeric"),
         (dict(positions=[[0, 0]], radii=[1], lattice=5 * np.eye(2), boundary="box"), "boundary 'box'"),
         (dict(positions=[[0, 0]], radii=[1], lattice=5 * np.eye(2), species=[0.5]), "species must be an integer"),
-        (dict(positions=[[0, 0]], radii=[1], lattice=5 * np.eye(2), orientations=np.eye(2)), "reserved for ellipsoids"),
+        (dict(positions=[[0, 0]], radii=[1], lattice=5 * np.eye(2), shape=Spheres([1])), "either radii .* or shape"),
+        (dict(positions=[[0, 0]], lattice=5 * np.eye(2)), "needs radii .* or shape"),
+        (dict(positions=[[0, 0]], radii=[1]), "needs a lattice"),
     ],
 )
 def test_bad_input_is_refused_with_a_message(kwargs, message):

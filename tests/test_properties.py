@@ -3,6 +3,10 @@
 - Packing: random valid packings in random (sheared) lattices keep their arrays bit for bit, their
   volume fraction is unchanged by wrapping the centres into the cell and by a unimodular change of
   lattice basis (the same periodic packing), and overlapping or non-finite inputs are refused.
+- Shapes and boundaries: random spheres or ellipsoids (2D, 3D) in periodic cells, between hard
+  walls on random axes or in a spherical container are valid, keep phi when wrapped along the
+  periodic axes, and come back bit for bit from the store; quaternions within round-off of unit
+  are normalised once and then kept bit for bit.
 - Store: save/load keeps every array bit for bit (and its dtype) and the attributes.
 - Config schema: a random unknown key anywhere in config/smoke.yaml, or a value of the wrong type
   at any leaf, is refused.
@@ -21,6 +25,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from hardpack.errors import InvalidInputError
+from hardpack.geometry import Ellipsoids, HardWalls, SphericalContainer
 from hardpack.geometry.packing import Packing
 from hardpack.io import load_dataset, load_packing, save_packing
 
@@ -29,11 +34,14 @@ FAST = settings(max_examples=40, deadline=None, suppress_health_check=[HealthChe
 
 
 # ---------------------------------------------------------------- random valid packings
-def _min_image_distances(x, lattice):
+def _min_image_distances(x, lattice, periodic=None):
     """Smallest distance of every pair (i, j), and of every particle to its own images, over the
-    lattice shifts n in {-2..2}^d (enough for the mildly sheared cells drawn below)."""
+    lattice shifts n in {-2..2}^d (enough for the mildly sheared cells drawn below); n_k = 0 along
+    the axes that are not ``periodic``."""
     d = lattice.shape[0]
-    shifts = np.array(list(itertools.product(range(-2, 3), repeat=d)), float) @ lattice.T
+    periodic = np.ones(d, bool) if periodic is None else periodic
+    shifts = np.array([n for n in itertools.product(range(-2, 3), repeat=d)
+                       if not np.any(np.array(n)[~periodic])], float) @ lattice.T
     sep = x[None, :, None, :] - x[:, None, None, :] + shifts[None, None, :, :]
     dist = np.linalg.norm(sep, axis=-1)
     zero = np.all(shifts == 0, axis=1)
@@ -125,6 +133,82 @@ def test_non_finite_inputs_are_refused(case, name, bad, data):
     target[data.draw(st.integers(0, target.size - 1))] = bad
     with pytest.raises(InvalidInputError, match="non-finite value"):
         Packing(**arrays)
+
+
+@st.composite
+def shaped_packings(draw, max_n=6):
+    """Spheres or ellipsoids (d = 2, 3) in a periodic cube, between hard walls on a random set of
+    axes, or in a spherical container touching the box faces; bounding spheres disjoint and inside."""
+    d = draw(st.sampled_from([2, 3]))
+    n = draw(st.integers(1, max_n))
+    box = draw(st.floats(3.0, 8.0))
+    kind = draw(st.sampled_from(["periodic", "walls", "container"]))
+    unit = st.floats(0.0, 1.0, exclude_max=True, allow_nan=False)
+    x = box * np.array(draw(st.lists(st.lists(unit, min_size=d, max_size=d), min_size=n, max_size=n)))
+    lattice = box * np.eye(d)
+    if kind == "periodic":
+        boundary, periodic, room = "periodic", np.ones(d, bool), np.full(n, np.inf)
+    elif kind == "walls":
+        axes = draw(st.lists(st.integers(0, d - 1), min_size=1, max_size=d, unique=True))
+        boundary = HardWalls(axes)
+        periodic = boundary.periodic_axes(d)
+        room = np.minimum(x[:, ~periodic], box - x[:, ~periodic]).min(axis=1)
+    else:
+        boundary, periodic = SphericalContainer(np.full(d, box / 2), box / 2), np.zeros(d, bool)
+        room = box / 2 - np.linalg.norm(x - box / 2, axis=1)
+    dist = _min_image_distances(x, lattice, periodic)
+    bound = np.minimum(0.49 * dist.min(axis=1), 0.99 * room)
+    assume(bound.min() > 1e-3)
+    factors = np.array(draw(st.lists(st.floats(0.05, 1.0), min_size=n * d, max_size=n * d))).reshape(n, d)
+    if draw(st.booleans()):
+        return Packing(x, bound * factors[:, 0], lattice, boundary=boundary)
+    semiaxes = bound[:, None] * factors
+    if d == 2:
+        orient = np.array(draw(st.lists(st.floats(-10, 10), min_size=n, max_size=n)))
+    else:
+        q = np.array(draw(st.lists(st.floats(-1, 1), min_size=4 * n, max_size=4 * n))).reshape(n, 4)
+        assume(np.linalg.norm(q, axis=1).min() > 0.1)
+        orient = q / np.linalg.norm(q, axis=1)[:, None]
+    return Packing(x, lattice=lattice, shape=Ellipsoids(semiaxes, orient), boundary=boundary)
+
+
+@FAST
+@given(shaped_packings(), st.data())
+def test_shaped_packings_keep_phi_when_wrapped_along_periodic_axes(p, data):
+    n, d = p.n_particles, p.dim
+    periodic = p.boundary.periodic_axes(d)
+    images = np.array(data.draw(st.lists(st.integers(-3, 3), min_size=n * d, max_size=n * d))).reshape(n, d)
+    shifted = p.replace(positions=p.positions + (images * periodic) @ p.lattice.T)
+    wrapped = shifted.wrapped()
+    assert wrapped.phi == p.phi
+    s = wrapped.fractional()[:, periodic]
+    assert np.all((s >= 0) & (s < 1))
+    assert np.array_equal(wrapped.positions[:, ~periodic], p.positions[:, ~periodic])
+
+
+@settings(max_examples=25, deadline=None)
+@given(shaped_packings())
+def test_shapes_and_boundaries_round_trip_bit_exact(p):
+    with tempfile.TemporaryDirectory() as folder:
+        q = load_packing(save_packing(p, Path(folder) / "p.nc"))
+    assert q.boundary == p.boundary and q.shape.kind == p.shape.kind
+    arrays = ("positions", "lattice") + (("radii",) if p.shape.kind == "sphere" else ())
+    for a, b in [(getattr(p, k), getattr(q, k)) for k in arrays] + (
+            [] if p.shape.kind == "sphere" else
+            [(p.shape.semiaxes, q.shape.semiaxes), (p.shape.orientations, q.shape.orientations)]):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+    assert q.phi == p.phi
+
+
+@FAST
+@given(st.lists(st.floats(-1, 1), min_size=4, max_size=4), st.floats(-0.99e-10, 0.99e-10))
+def test_quaternions_near_unit_are_normalised_once(q, excess):
+    q = np.array(q)
+    assume(np.linalg.norm(q) > 0.1)
+    w = q / np.linalg.norm(q) * (1 + excess)
+    once = Ellipsoids(np.ones((1, 3)), w[None]).orientations
+    assert abs(np.linalg.norm(once) - 1) < 1e-15
+    assert np.array_equal(Ellipsoids(np.ones((1, 3)), once).orientations, once)
 
 
 # ---------------------------------------------------------------- netCDF store

@@ -43,6 +43,18 @@ def test_cli_writes_structure_of_a_crystal(tmp_path):
         assert np.all(ds.S.values[~bragg] < 1e-16)
 
 
+def test_cli_stores_the_attributes_it_is_given(tmp_path):
+    """The workflow names each structure dataset's ensemble (`--attr ensemble=NAME`); the validation
+    and the figures group by it."""
+    src, out = tmp_path / "sc.nc", tmp_path / "sc_structure.nc"
+    save_packing(lattice_packing("sc", 3), src)
+    assert run(["structure", str(src), "--out", str(out), "--no-order", "--attr", "ensemble=mono3d",
+                "--attr", "note=x"]) == 0
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["ensemble"] == "mono3d" and ds.attrs["note"] == "x"
+        assert ds.attrs["source"] == str(src)
+
+
 def test_cli_refuses_a_verdict_of_another_packing(tmp_path):
     src = tmp_path / "sc.nc"
     save_packing(lattice_packing("sc", 3), src)

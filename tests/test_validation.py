@@ -265,6 +265,26 @@ def test_jamming_rows_pass_for_isostatic_packings_and_fail_otherwise():
     assert set(disks) == {"donev-ch9-isostatic-binary2d", "donev-4.7.2-collective-binary2d"}
 
 
+def test_structure_rows_group_by_the_ensemble_attribute_not_the_path():
+    """Two ensembles whose packings sit at the same depth of any folder layout get one set of rows
+    each, labelled by their `ensemble` attribute; a dataset without one is refused."""
+    from hardpack.structure.analysis import analyse
+    from hardpack.validation.structure import structure_rows
+
+    base = analyse(lattice_packing("bcc", (4, 4, 4)), channels=False, order=False)
+    members = []
+    for name in ("first", "second"):
+        for seed in (1, 2):
+            ds = base.copy()
+            ds.attrs = dict(base.attrs, source=f"results/x/jammed/seed{seed}.nc", ensemble=name)
+            members.append(ds)
+    labels = [r.label for r in structure_rows(members)]
+    assert sorted(set(labels)) == ["first", "second"] and labels.count("first") == labels.count("second")
+    del members[0].attrs["ensemble"]
+    with pytest.raises(InvalidInputError, match="no 'ensemble' attribute.*--attr ensemble=NAME"):
+        structure_rows(members)
+
+
 def test_structure_rows_on_a_bcc_crystal_fail_the_amorphous_signatures():
     """BCC (shells 1, 1.155, 1.633, 1.915, 2) has no sub-peak at sqrt(3) and no near-contact power
     law: those rows must fail. The CS fluid S(0) is the compressibility-route value."""
@@ -279,7 +299,7 @@ def test_structure_rows_on_a_bcc_crystal_fail_the_amorphous_signatures():
     members = []
     for seed in (1, 2):
         ds = analyse(lattice_packing("bcc", (8, 8, 8)), channels=False, order=False)
-        ds.attrs["source"] = f"results/ensembles/bcc/jammed/seed{seed}.nc"
+        ds.attrs.update(source=f"results/ls/bcc/jammed/seed{seed}.nc", ensemble="bcc")
         members.append(ds)
     rows = {r.target: r for r in structure_rows(members)}
     assert rows["donev-ch9-near-contact-exponent"].status == FAIL

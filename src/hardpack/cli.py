@@ -57,7 +57,7 @@ def cmd_init(args) -> int:
 
 
 def cmd_info(args) -> int:
-    """Summary of a hardpack netCDF file: N, d, phi, radii and provenance.
+    """Summary of a hardpack netCDF file: N, d, phi, particle shapes, boundary and provenance.
 
     A diagnostic: it also reads packings whose particles overlap, and reports the overlaps.
     """
@@ -70,15 +70,28 @@ def cmd_info(args) -> int:
         from hardpack.io import dataset_to_packing
 
         p = dataset_to_packing(ds, source=str(args.file), allow_overlap=True)
-        r = p.radii
         print(f"  N = {p.n_particles}, d = {p.dim}, phi = {p.phi:.10g}")
-        print(f"  radii: min {r.min():.6g}, max {r.max():.6g}, mean {r.mean():.6g}, "
-              f"ratio {r.max() / r.min():.4g}")
-        print(f"  cell volume {p.volume:.6g}, orthorhombic: {p.is_orthorhombic}")
-        report = p.overlap_report()
-        note = (" (shown for diagnosis: every other command refuses an overlapping packing)"
-                if report.n_overlapping else "")
-        print(f"  overlaps: {report}{note}")
+        if p.shape.kind == "sphere":
+            r = p.radii
+            print(f"  radii: min {r.min():.6g}, max {r.max():.6g}, mean {r.mean():.6g}, "
+                  f"ratio {r.max() / r.min():.4g}")
+        else:
+            a = p.shape.semiaxes
+            aspect = a.max(axis=1) / a.min(axis=1)
+            print(f"  {p.shape.name}: semiaxes min {a.min():.6g}, max {a.max():.6g}; aspect ratio "
+                  f"min {aspect.min():.6g}, max {aspect.max():.6g}")
+        print(f"  boundary: {p.boundary}")
+        region = "container volume" if p.boundary.kind == "spherical_container" else "cell volume"
+        print(f"  {region} {p.volume:.6g}, orthorhombic: {p.is_orthorhombic}")
+        diagnosis = " (shown for diagnosis: every other command refuses an overlapping packing)"
+        try:
+            report = p.overlap_report()
+            print(f"  overlaps: {report}{diagnosis if report.n_overlapping else ''}")
+            if p.boundary.kind != "periodic":
+                walls = p.containment_report()
+                print(f"  walls: {walls}{diagnosis if walls.n_outside else ''}")
+        except NotImplementedError as exc:
+            print(f"  overlaps: undecided ({exc})")
     else:
         print("  " + ", ".join(f"{k}: {v}" for k, v in ds.sizes.items()))
         for name, var in ds.data_vars.items():

@@ -1,24 +1,26 @@
-# Study 6: the validation report, every reproduced number beside its published target
-# (src/hardpack/validation/targets.yaml), and the gate. Each study file registers its summaries in
-# VALIDATION_INPUTS (row-builder name -> paths). The report is written first and the gate runs as
-# its own rule, so that a failing gate keeps the report to read.
-
-VALIDATION = config.get("validation", {})
+# The validation report, every reproduced number beside its published target
+# (src/hardpack/validation/targets.yaml), and the gate. validation_inputs() in common.smk lists the
+# summaries by row builder. The report is written first and the gate runs as its own rule, so that
+# a failing gate keeps the report to read.
 
 
 rule validation_report:
     """results/validation/validation.nc and report.md from every summary the config produces."""
     input:
-        [path for paths in VALIDATION_INPUTS.values() for path in paths],
+        [path for paths in validation_inputs().values() for path in paths],
     output:
         nc="results/validation/validation.nc",
         md="results/validation/report.md",
     params:
-        inputs=" ".join(f"{name}={path}" for name, paths in VALIDATION_INPUTS.items() for path in paths),
+        inputs=validation_arguments(),
+    conda:
+        "../envs/hardpack.yaml"
     log:
         "results/logs/validation_report.log",
+    benchmark:
+        "results/benchmarks/validation_report.tsv"
     shell:
-        "hardpack validate {params.inputs} --out-nc {output.nc} --out-md {output.md} --no-gate 2> {log}"
+        "hardpack validate {params.inputs} --out-nc {output.nc} --out-md {output.md} --no-gate > {log} 2>&1"
 
 
 rule validation:
@@ -30,9 +32,13 @@ rule validation:
         "results/validation/gate.txt",
     params:
         min_applicable=VALIDATION.get("min_applicable", 30),
+    conda:
+        "../envs/hardpack.yaml"
     log:
-        "results/logs/validation_gate.log",
+        "results/logs/validation.log",
+    benchmark:
+        "results/benchmarks/validation.tsv"
     shell:
-        "hardpack validate --check {input} --min-applicable {params.min_applicable} 2> {log}"
+        "hardpack validate --check {input} --min-applicable {params.min_applicable} > {log} 2>&1"
         " && echo 'validation gate passed' > {output}"
         " || (cat {log} >&2; exit 1)"

@@ -1,4 +1,7 @@
-"""Snakemake script: SLP vs LS jamming densities per ensemble, plus SLP-only systems (Table I)."""
+"""Snakemake script: SLP vs LS jamming densities per ensemble, plus SLP-only systems (Table I).
+
+SLP and LS summaries are paired by their ``ensemble`` attribute; an SLP system without an LS
+ensemble of its name is drawn alone."""
 
 import logging
 
@@ -7,11 +10,9 @@ from hardpack.plots.slp import plot_slp_vs_ls
 from hardpack.plots.style import save
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+ls = {ds.attrs["ensemble"]: ds for ds in (load_dataset(p, kind="ensemble") for p in snakemake.input.ls)}
 pairs = {}
-for slp_path, ls_path in zip(snakemake.input.slp, snakemake.input.ls):
-    slp, ls = load_dataset(slp_path, kind="ensemble"), load_dataset(ls_path, kind="ensemble")
-    pairs[slp.attrs["ensemble"]] = (slp, ls)
-for path in snakemake.input.systems:
+for path in snakemake.input.slp:
     slp = load_dataset(path, kind="ensemble")
-    pairs[slp.attrs["ensemble"]] = (slp, None)
+    pairs[slp.attrs["ensemble"]] = (slp, ls.get(slp.attrs["ensemble"]))
 save(plot_slp_vs_ls(pairs), snakemake.output.pdf, snakemake.output.png)

@@ -1,4 +1,5 @@
-"""Snakemake script: one structure figure (snakemake.params.kind) over the ensembles' seeds."""
+"""Snakemake script: one structure figure (snakemake.params.kind) over the ensembles' seeds, grouped
+by the structure datasets' ``ensemble`` attribute."""
 
 import logging
 from collections import defaultdict
@@ -10,7 +11,8 @@ from hardpack.plots.style import save
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
 ensembles = defaultdict(list)
 for path in snakemake.input:
-    ensembles[path.split("/")[2]].append(load_dataset(path, kind="structure"))
+    ds = load_dataset(path, kind="structure")
+    ensembles[ds.attrs["ensemble"]].append(ds)
 plot = {"g2": structure.plot_g2_near_contact, "zl": structure.plot_coordination,
         "sk": structure.plot_structure_factor, "channels": structure.plot_channels}[snakemake.params.kind]
 save(plot(dict(ensembles)), snakemake.output.pdf, snakemake.output.png)

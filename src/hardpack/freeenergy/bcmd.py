@@ -72,6 +72,7 @@ class Neighbours:
 def cell_neighbours(packing: Packing, dmu_max: float) -> Neighbours:
     """Pairs whose cells of radius (1 + dmu_max) R overlap, both directions, self-images
     dropped (a particle and its own image move together and never collide)."""
+    packing.require_periodic_spheres("BCMD")
     pl = pairs_within(packing, rel_gap=dmu_max)
     keep = pl.i != pl.j
     i, j, sep = pl.i[keep], pl.j[keep], pl.separation[keep]
@@ -146,6 +147,7 @@ def run_bcmd(
     clock = time.perf_counter()
     if not isinstance(packing, Packing):
         raise InvalidInputError("packing must be a hardpack Packing")
+    packing.require_periodic_spheres("BCMD")
     d, n = packing.dim, packing.n_particles
     if frozen not in FROZEN_MODES:
         raise InvalidInputError(f"frozen must be one of {FROZEN_MODES}, got {frozen!r}")

@@ -81,6 +81,7 @@ def simplex_reference(backbone: Packing, delta: float, contact_tol: float) -> Si
     jamming verifier's tolerance); contact_tol must be well below delta so that shrinking by
     (1 - delta) opens every contact to a gap of about delta.
     """
+    backbone.require_periodic_spheres("the exact simplex free energy")
     delta = float(delta)
     if not 0.0 < delta < 1e-2:
         raise InvalidInputError(f"delta = {delta!r} must be in (0, 0.01): the simplex is linear")
@@ -130,6 +131,7 @@ def simplex_test(
     backbone that is not isostatic gets no BCMD run (a summary with NaNs and isostatic = 0).
     """
     t0 = time.perf_counter()
+    packing.require_periodic_spheres("the exact simplex free energy")
     backbone = remove_rattlers(packing, rattler)
     ref = simplex_reference(backbone, delta, contact_tol)
     n, d = ref.n_particles, backbone.dim

@@ -1,4 +1,4 @@
-"""The packing model: N hard spheres in d dimensions in a periodic cell.
+"""The packing model: N hard particles in d dimensions in a cell with a boundary.
 
 Conventions (used everywhere in hardpack):
 
@@ -7,29 +7,54 @@ Conventions (used everywhere in hardpack):
   dissertation ch. 3.2.2.1): a point with fractional coordinates s has Cartesian position
   x = lattice @ s, and the periodic images of x are x + lattice @ n for integer vectors n.
   A general (sheared) lattice is allowed, so strict-jamming tests and SLP can deform the cell.
-- ``radii`` are the sphere radii, shape (N,).
+- ``shape`` describes every particle (:mod:`hardpack.geometry.shapes`): :class:`Spheres` (a radius
+  each; ``packing.radii``) or :class:`Ellipsoids` (semiaxes and an orientation each).
+  ``Packing(positions, radii, lattice)`` builds spheres; ``Packing(positions, lattice=L,
+  shape=Ellipsoids(semiaxes, orientations))`` any other shape.
+- ``boundary`` (:mod:`hardpack.geometry.boundaries`) is ``"periodic"`` (every lattice vector is a
+  period), :class:`HardWalls` (hard walls on some axes, periodic along the others) or
+  :class:`SphericalContainer`. Lattice images exist only along periodic axes.
 - ``species`` is an optional integer label per particle (e.g. large/small of a binary mixture).
-- ``boundary`` is "periodic" (the only one implemented so far; hard-wall containers will add
-  "hardwall"). ``orientations`` is reserved for ellipsoids and must be None for spheres.
 
-Overlap tolerance: two spheres overlap when their distance is below (r_i + r_j)(1 - tol). The
-default relative tolerance ``DEFAULT_OVERLAP_TOL = 1e-9`` is far above double-precision round-off
-after a collision (~1e-14) and far below any physical gap that matters (LS packings at reduced
-pressure 1e12 have relative gaps of ~1e-12 that round-off may turn into overlaps of ~1e-14).
+Only hard spheres in periodic cells are simulated so far; modules that handle nothing else call
+:meth:`Packing.require_periodic_spheres`, which refuses other packings by name.
+
+Overlap tolerance: two spheres overlap when their distance is below (r_i + r_j)(1 - tol), a sphere
+and a wall when its centre is closer than r (1 - tol) to the wall. The default relative tolerance
+``DEFAULT_OVERLAP_TOL = 1e-9`` is far above double-precision round-off after a collision (~1e-14)
+and far below any physical gap that matters (LS packings at reduced pressure 1e12 have relative
+gaps of ~1e-12 that round-off may turn into overlaps of ~1e-14).
+
+Ellipsoids are checked exactly only as far as their bounding spheres decide: particles whose
+bounding spheres are disjoint (or inside the walls) do not overlap (or cross a wall). Any other
+case needs the ellipsoid contact function (Perram-Wertheim overlap and containment potentials,
+Donev 2006, Sec. 2.2.2 and 2.2.5.1) and raises :class:`NotImplementedError` until it exists.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from hardpack.errors import InvalidInputError
-from hardpack.geometry.balls import ball_volume
+from hardpack.geometry.boundaries import (
+    ContainmentReport,
+    HardWalls,
+    Periodic,
+    SphericalContainer,
+    as_boundary,
+)
+from hardpack.geometry.shapes import Ellipsoids, Spheres, as_finite_array
 
 DEFAULT_OVERLAP_TOL = 1e-9
 MIN_DIM, MAX_DIM = 1, 12
-BOUNDARIES = ("periodic",)
+SHAPES = (Spheres, Ellipsoids)
+PENDING_ELLIPSOID_CONTACT = (
+    "needs the ellipsoid contact function (Perram-Wertheim overlap and containment potentials, "
+    "Donev 2006, Sec. 2.2.2 and 2.2.5.1), which is not implemented yet: it comes with hard-ellipsoid "
+    "support"
+)
 
 
 @dataclass(frozen=True)
@@ -55,42 +80,53 @@ class OverlapReport:
         )
 
 
-def _as_float_array(name: str, value, shape_hint: str) -> np.ndarray:
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be numeric with shape {shape_hint}: {exc}") from None
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        where = np.argwhere(bad)[0].tolist()
-        raise InvalidInputError(
-            f"{name} contains a non-finite value (NaN or inf) at index {where}; "
-            "every entry must be a finite number"
-        )
-    return arr
+def _particle_shape(radii, shape, n: int, d: int):
+    """The validated shape of n particles in d dimensions from ``radii`` (spheres) or ``shape``."""
+    if shape is None:
+        if radii is None:
+            raise InvalidInputError("a packing needs radii (for spheres) or shape=... (e.g. "
+                                    "hardpack.geometry.Ellipsoids(semiaxes, orientations))")
+        shape = Spheres(radii)
+    elif radii is not None:
+        raise InvalidInputError("give either radii (spheres) or shape, not both")
+    elif not isinstance(shape, SHAPES):
+        raise InvalidInputError(f"shape must be one of {[c.__name__ for c in SHAPES]} from "
+                                f"hardpack.geometry.shapes, got {type(shape).__name__}")
+    if shape.n_particles != n:
+        arrays = "radii" if shape.kind == "sphere" else "semiaxes and orientations"
+        held = shape.radii.shape if shape.kind == "sphere" else (shape.n_particles,)
+        raise InvalidInputError(f"{arrays} must have shape ({n},) to match {n} positions, got shape {held}")
+    if shape.dim is not None and shape.dim != d:
+        raise InvalidInputError(f"the shapes are {shape.dim}-dimensional ({shape.dim} semiaxes per "
+                                f"particle) but the positions are {d}-dimensional")
+    return shape
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class Packing:
-    """N spheres in a d-dimensional periodic cell (see the module docstring for conventions).
+    """N particles in a d-dimensional cell (see the module docstring for conventions).
+
+    ``Packing(positions, radii, lattice)`` is a sphere packing in a periodic cell;
+    ``shape=`` (instead of ``radii``) gives other particle shapes and ``boundary=`` hard walls or
+    a container.
 
     Construction validates everything and refuses bad input with :class:`InvalidInputError`.
-    Overlaps beyond ``overlap_tol`` are refused unless ``allow_overlap=True`` (e.g. for an
-    intermediate SLP step or a deliberately overlapping test configuration).
-    The arrays are stored read-only; engines work on copies.
+    Overlaps (between particles, or of a particle with a wall) beyond ``overlap_tol`` are refused
+    unless ``allow_overlap=True`` (e.g. for an intermediate SLP step or a deliberately overlapping
+    test configuration). The arrays are stored read-only; engines work on copies.
     """
 
     positions: np.ndarray
-    radii: np.ndarray
+    shape: Spheres | Ellipsoids
     lattice: np.ndarray
-    species: np.ndarray | None = None
-    boundary: str = "periodic"
-    orientations: np.ndarray | None = None
-    allow_overlap: bool = field(default=False, repr=False)
-    overlap_tol: float = field(default=DEFAULT_OVERLAP_TOL, repr=False)
+    species: np.ndarray | None
+    boundary: Periodic | HardWalls | SphericalContainer
+    allow_overlap: bool
+    overlap_tol: float
 
-    def __post_init__(self):
-        pos = _as_float_array("positions", self.positions, "(N, d)")
+    def __init__(self, positions, radii=None, lattice=None, species=None, boundary="periodic",
+                 allow_overlap: bool = False, overlap_tol: float = DEFAULT_OVERLAP_TOL, *, shape=None):
+        pos = as_finite_array("positions", positions, "(N, d)")
         if pos.ndim != 2:
             raise InvalidInputError(
                 f"positions must have shape (N, d), got an array of shape {pos.shape}; "
@@ -103,17 +139,11 @@ class Packing:
             raise InvalidInputError(
                 f"dimension d = {d} is not supported; hardpack handles d = {MIN_DIM}..{MAX_DIM}"
             )
-        radii = _as_float_array("radii", self.radii, "(N,)")
-        if radii.shape != (n,):
-            raise InvalidInputError(
-                f"radii must have shape ({n},) to match {n} positions, got shape {radii.shape}"
-            )
-        if (radii <= 0).any():
-            i = int(np.argmin(radii))
-            raise InvalidInputError(
-                f"radii must be positive; particle {i} has radius {float(radii[i])!r}"
-            )
-        lat = _as_float_array("lattice", self.lattice, "(d, d)")
+        shape = _particle_shape(radii, shape, n, d)
+        if lattice is None:
+            raise InvalidInputError("a packing needs a lattice: the d x d matrix whose columns are the "
+                                    "lattice vectors (the cell)")
+        lat = as_finite_array("lattice", lattice, "(d, d)")
         if lat.shape != (d, d):
             raise InvalidInputError(
                 f"lattice must be a ({d}, {d}) matrix whose columns are the lattice vectors, "
@@ -126,16 +156,8 @@ class Packing:
                 f"lattice is singular (det = {det:.3e}): its columns must be {d} linearly "
                 "independent lattice vectors"
             )
-        if self.boundary not in BOUNDARIES:
-            raise InvalidInputError(
-                f"boundary {self.boundary!r} is not supported; choose one of {BOUNDARIES}"
-            )
-        if self.orientations is not None:
-            raise InvalidInputError(
-                "orientations are reserved for ellipsoids, which are not implemented yet; "
-                "pass orientations=None for spheres"
-            )
-        species = self.species
+        boundary = as_boundary(boundary)
+        boundary.check(lat)
         if species is not None:
             species = np.array(species)
             if species.shape != (n,) or not np.issubdtype(species.dtype, np.integer):
@@ -144,21 +166,35 @@ class Packing:
                     f"{species.dtype} and shape {species.shape}"
                 )
             species = species.astype(np.int32)
-        if not (0 <= self.overlap_tol < 1):
-            raise InvalidInputError(f"overlap_tol must be in [0, 1), got {self.overlap_tol}")
-        for name, arr in (("positions", pos), ("radii", radii), ("lattice", lat), ("species", species)):
+        if not (0 <= overlap_tol < 1):
+            raise InvalidInputError(f"overlap_tol must be in [0, 1), got {overlap_tol}")
+        for name, arr in (("positions", pos), ("lattice", lat), ("species", species)):
             if arr is not None:
                 arr.setflags(write=False)
-                object.__setattr__(self, name, arr)
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "shape", shape)
+        object.__setattr__(self, "boundary", boundary)
+        object.__setattr__(self, "allow_overlap", bool(allow_overlap))
+        object.__setattr__(self, "overlap_tol", overlap_tol)
         if not self.allow_overlap:
-            report = self.overlap_report(self.overlap_tol)
-            if report.n_overlapping:
-                raise InvalidInputError(
-                    f"particles overlap beyond the tolerance {self.overlap_tol:g}: {report}. "
-                    "Hard particles must not overlap: regenerate the packing or shrink the radii "
-                    "(`hardpack info FILE` lists the overlaps); in Python, Packing(..., "
-                    "allow_overlap=True) accepts a deliberately overlapping configuration"
-                )
+            self._refuse_overlaps()
+
+    def _refuse_overlaps(self) -> None:
+        walls = self.containment_report(self.overlap_tol)
+        if walls.n_outside:
+            raise InvalidInputError(
+                f"particles cross the boundary beyond the tolerance {self.overlap_tol:g}: {walls}. "
+                "Hard particles must stay inside their walls or container: move them in or shrink "
+                "them; in Python, Packing(..., allow_overlap=True) accepts such a configuration"
+            )
+        report = self.overlap_report(self.overlap_tol)
+        if report.n_overlapping:
+            raise InvalidInputError(
+                f"particles overlap beyond the tolerance {self.overlap_tol:g}: {report}. "
+                "Hard particles must not overlap: regenerate the packing or shrink the radii "
+                "(`hardpack info FILE` lists the overlaps); in Python, Packing(..., "
+                "allow_overlap=True) accepts a deliberately overlapping configuration"
+            )
 
     # ------------------------------------------------------------------ basic properties
     @property
@@ -170,14 +206,25 @@ class Packing:
         return self.positions.shape[1]
 
     @property
+    def radii(self) -> np.ndarray:
+        """Sphere radii (N,); refused for other shapes (see ``shape``)."""
+        if self.shape.kind != "sphere":
+            raise InvalidInputError(
+                f"this packing holds {self.shape.name}, which have no radii: use packing.shape "
+                "(semiaxes, orientations), or packing.shape.bounding_radii for neighbour search"
+            )
+        return self.shape.radii
+
+    @property
     def volume(self) -> float:
-        """Cell volume |det(lattice)|."""
-        return float(abs(np.linalg.det(self.lattice)))
+        """Volume of the region the particles fill: |det(lattice)| for a periodic cell or hard
+        walls, V_d(R) for a spherical container."""
+        return self.boundary.volume(self.lattice)
 
     @property
     def phi(self) -> float:
-        """Volume fraction sum_i V_d(r_i) / |det lattice|."""
-        return float(ball_volume(self.radii, self.dim).sum() / self.volume)
+        """Volume fraction: the particles' volume (per shape) over :attr:`volume`."""
+        return float(self.shape.volumes(self.dim).sum() / self.volume)
 
     @property
     def heights(self) -> np.ndarray:
@@ -193,46 +240,78 @@ class Packing:
         off = self.lattice - np.diag(np.diag(self.lattice))
         return bool(np.all(off == 0) and np.all(np.diag(self.lattice) > 0))
 
+    def require_periodic_spheres(self, user: str) -> None:
+        """Refuse this packing, naming ``user`` (e.g. "the MD engine"), unless it is hard spheres
+        in a periodic cell: the only model the simulation and analysis modules handle so far."""
+        if self.shape.kind != "sphere":
+            raise InvalidInputError(f"{self.shape.name} are not supported by {user} yet; it handles hard "
+                                    "spheres only")
+        if self.boundary.kind != "periodic":
+            raise InvalidInputError(f"{self.boundary.name} are not supported by {user} yet; it handles "
+                                    f"periodic cells only (this packing has {self.boundary})")
+
     # ------------------------------------------------------------------ coordinates
     def fractional(self) -> np.ndarray:
-        """Fractional coordinates s = lattice^-1 x, wrapped into [0, 1)."""
+        """Fractional coordinates s = lattice^-1 x, wrapped into [0, 1) along the periodic axes
+        (along walled axes they are as they stand: in [0, 1] for particles inside the walls)."""
         s = np.linalg.solve(self.lattice, self.positions.T).T
-        s -= np.floor(s)
-        s[s >= 1.0] = 0.0  # floor can leave exactly 1.0 by round-off
+        if self.boundary.kind == "periodic":
+            s -= np.floor(s)
+            s[s >= 1.0] = 0.0  # floor can leave exactly 1.0 by round-off
+        else:
+            periodic = self.boundary.periodic_axes(self.dim)
+            w = s[:, periodic]
+            w -= np.floor(w)
+            w[w >= 1.0] = 0.0
+            s[:, periodic] = w
         return s
 
     def wrapped(self) -> "Packing":
-        """The same packing with every centre inside the unit cell."""
-        return self.replace(positions=self.fractional() @ self.lattice.T)
+        """The same packing with every centre inside the unit cell along the periodic axes
+        (coordinates along walled axes are kept bit for bit: periodic lattice vectors have no
+        component along them)."""
+        positions = self.fractional() @ self.lattice.T
+        if self.boundary.kind != "periodic":
+            walled = ~self.boundary.periodic_axes(self.dim)
+            positions[:, walled] = self.positions[:, walled]
+        return self.replace(positions=positions)
 
     def replace(self, **changes) -> "Packing":
-        """A validated copy with some fields replaced (e.g. positions, radii, lattice)."""
+        """A validated copy with some fields replaced (e.g. positions, radii, shape, lattice)."""
         fields = dict(
-            positions=self.positions, radii=self.radii, lattice=self.lattice,
-            species=self.species, boundary=self.boundary, orientations=self.orientations,
-            allow_overlap=self.allow_overlap, overlap_tol=self.overlap_tol,
+            positions=self.positions, lattice=self.lattice, species=self.species,
+            boundary=self.boundary, allow_overlap=self.allow_overlap, overlap_tol=self.overlap_tol,
         )
+        if "radii" not in changes:
+            fields["shape"] = self.shape
+        elif self.shape.kind != "sphere" and "shape" not in changes:
+            raise InvalidInputError(f"this packing holds {self.shape.name}: replace(radii=...) would make them "
+                                    "spheres; pass shape=Spheres(radii) to do that on purpose")
         fields.update(changes)
         return Packing(**fields)
 
     def tiled(self, reps) -> "Packing":
-        """The periodic packing repeated ``reps`` times along each lattice vector (int or d ints):
-        N prod(reps) particles in the cell with columns reps_k * a_k, same phi and contacts."""
+        """The packing repeated ``reps`` times along each lattice vector (int or d ints):
+        N prod(reps) particles in the cell with columns reps_k * a_k, same phi and contacts.
+        Only periodic axes can be repeated (reps 1 along walled axes)."""
         reps = np.broadcast_to(np.asarray(reps), (self.dim,))
         if not np.issubdtype(reps.dtype, np.integer) or (reps < 1).any():
             raise InvalidInputError(f"reps must be positive integers, one per lattice vector, got {reps.tolist()}")
+        if (reps[~self.boundary.periodic_axes(self.dim)] > 1).any():
+            raise InvalidInputError(f"reps must be 1 along the axes without periodic images ({self.boundary}), "
+                                    f"got {reps.tolist()}")
         shifts = np.stack(np.meshgrid(*[np.arange(r) for r in reps], indexing="ij"), -1).reshape(-1, self.dim)
         offsets = shifts @ self.lattice.T  # (K, d) Cartesian translations
         k = len(shifts)
         return self.replace(
             positions=(self.positions[None, :, :] + offsets[:, None, :]).reshape(-1, self.dim),
-            radii=np.tile(self.radii, k), lattice=self.lattice * reps[None, :],
+            shape=self.shape.take(np.tile(np.arange(self.n_particles), k)), lattice=self.lattice * reps[None, :],
             species=None if self.species is None else np.tile(self.species, k),
-            orientations=None if self.orientations is None else np.concatenate([self.orientations] * k),
         )
 
     def minimum_image(self, dx: np.ndarray) -> np.ndarray:
-        """Reduce separation vectors (..., d) by lattice vectors: s - round(s) in fractional space.
+        """Reduce separation vectors (..., d) by lattice vectors: s - round(s) in fractional space,
+        along the periodic axes only.
 
         This is the exact minimum image for orthorhombic cells; for sheared cells it is the
         nearest image only when the cell is reasonably reduced. Use
@@ -240,7 +319,11 @@ class Packing:
         """
         dx = np.asarray(dx, dtype=float)
         s = np.linalg.solve(self.lattice, dx.reshape(-1, self.dim).T).T
-        s -= np.round(s)
+        if self.boundary.kind == "periodic":
+            s -= np.round(s)
+        else:
+            periodic = self.boundary.periodic_axes(self.dim)
+            s[:, periodic] -= np.round(s[:, periodic])
         return (s @ self.lattice.T).reshape(dx.shape)
 
     def separation(self, i: int, j: int) -> np.ndarray:
@@ -248,15 +331,46 @@ class Packing:
         return self.minimum_image(self.positions[j] - self.positions[i])
 
     # ------------------------------------------------------------------ overlaps
+    def _search_spheres(self) -> "Packing":
+        """A periodic sphere packing whose pairs within contact are the candidate pairs of this one:
+        the packing itself for spheres in a periodic cell; otherwise the bounding spheres, with the
+        walled lattice vectors stretched so that no image across a wall comes within range
+        (centres inside the walls keep their coordinates bit for bit)."""
+        if self.shape.kind == "sphere" and self.boundary.kind == "periodic":
+            return self
+        radii = self.shape.bounding_radii
+        x, lat = self.positions, self.lattice
+        walled = np.flatnonzero(~self.boundary.periodic_axes(self.dim))
+        if len(walled):
+            x, lat = x.copy(), lat.copy()
+            reach = 4.0 * radii.max()  # > the pair search range 2 r_max
+            for k in walled:
+                x[:, k] -= min(0.0, x[:, k].min())
+                lat[k, k] = max(lat[k, k], x[:, k].max()) + reach
+        return Packing(x, radii, lat, allow_overlap=True)
+
     def overlap_report(self, tol: float = DEFAULT_OVERLAP_TOL) -> OverlapReport:
-        """Count pairs with distance < (r_i + r_j)(1 - tol), with all periodic images.
+        """Count pairs with distance < (r_i + r_j)(1 - tol), with every periodic image.
 
         The worst pair (largest relative overlap 1 - dist/(r_i + r_j)) is named even when it
         is within tolerance, so callers can report how close the packing is to touching.
+        Ellipsoids: a packing whose bounding spheres are disjoint has no overlaps; any other
+        raises NotImplementedError (the ellipsoid contact function is pending).
         """
         from hardpack.geometry.neighbours import pairs_within
 
-        pairs = pairs_within(self, rel_gap=0.0)
+        pairs = pairs_within(self._search_spheres(), rel_gap=0.0)
+        if self.shape.kind != "sphere":
+            undecided = np.flatnonzero(pairs.distance < pairs.contact)
+            if len(undecided):
+                k = undecided[0]
+                raise NotImplementedError(
+                    f"{len(undecided)} pair(s) of {self.shape.name} have overlapping bounding spheres "
+                    f"(e.g. particles {pairs.i[k]} and {pairs.j[k]}); deciding whether they overlap "
+                    f"{PENDING_ELLIPSOID_CONTACT}. Only {self.shape.name} with disjoint bounding spheres "
+                    "can be checked now; Packing(..., allow_overlap=True) skips the check"
+                )
+            return OverlapReport(0, -1, -1, (), float("-inf"))
         if len(pairs.i) == 0:
             return OverlapReport(0, -1, -1, (), float("-inf"))
         rel = 1.0 - pairs.distance / pairs.contact
@@ -269,8 +383,27 @@ class Packing:
             overlap=float(rel[k]),
         )
 
+    def containment_report(self, tol: float = DEFAULT_OVERLAP_TOL) -> ContainmentReport:
+        """Count particles crossing a hard wall or the container by more than ``tol`` of their
+        radius (see :mod:`hardpack.geometry.boundaries`); the worst particle is named.
+
+        Ellipsoids: a packing whose bounding spheres are inside has none; any other raises
+        NotImplementedError (the ellipsoid contact function is pending).
+        """
+        if self.shape.kind == "sphere":
+            return self.boundary.containment(self.positions, self.shape.radii, self.lattice, tol)
+        report = self.boundary.containment(self.positions, self.shape.bounding_radii, self.lattice, 0.0)
+        if report.n_outside:
+            raise NotImplementedError(
+                f"the bounding spheres of {report.n_outside} of the {self.shape.name} cross the boundary "
+                f"(e.g. particle {report.worst} and {report.wall}); deciding whether the particles cross it "
+                f"{PENDING_ELLIPSOID_CONTACT}. Packing(..., allow_overlap=True) skips the check"
+            )
+        return ContainmentReport(0, -1, "every bounding sphere is inside", float("-inf"))
+
     def __repr__(self) -> str:
-        return (
-            f"Packing(N={self.n_particles}, d={self.dim}, phi={self.phi:.6f}, "
-            f"radii=[{self.radii.min():.4g}, {self.radii.max():.4g}], boundary={self.boundary!r})"
-        )
+        if self.shape.kind == "sphere":
+            sizes = f"radii=[{self.radii.min():.4g}, {self.radii.max():.4g}]"
+        else:
+            sizes = f"{self.shape.kind}s, semiaxes=[{self.shape.semiaxes.min():.4g}, {self.shape.semiaxes.max():.4g}]"
+        return f"Packing(N={self.n_particles}, d={self.dim}, phi={self.phi:.6f}, {sizes}, boundary={str(self.boundary)!r})"

@@ -1,14 +1,32 @@
 """Packings and results as xarray Datasets in netCDF files.
 
-Packing layout (``hardpack_kind = "packing"``, ``hardpack_format = 1``):
+Packing layout (``hardpack_kind = "packing"``, ``hardpack_format = 2``):
 
 - ``position(particle, dim)``: Cartesian centres
-- ``radius(particle)``
 - ``lattice(dim, vector)``: column ``vector = k`` is the k-th lattice vector
 - ``species(particle)``: optional integer labels
-- attributes: ``N``, ``d``, ``phi``, ``boundary`` and the provenance of
+- the particle shapes, named by the attribute ``shape_kind``
+  (:mod:`hardpack.geometry.shapes`):
+
+  - ``"sphere"``: ``radius(particle)``
+  - ``"ellipsoid"``: ``semiaxis(particle, axis)`` (body-frame semiaxes) and the orientation,
+    ``quaternion(particle, component)`` in 3D (unit quaternions s, p1, p2, p3) or
+    ``angle(particle)`` in 2D (radians from the x axis to the first semiaxis)
+
+- the boundary, named by the attribute ``boundary`` (:mod:`hardpack.geometry.boundaries`):
+
+  - ``"periodic"``: nothing more
+  - ``"hard_walls"``: ``wall(dim)``, 1 on the axes with hard walls at 0 and L_k, 0 on the periodic ones
+  - ``"spherical_container"``: ``container_centre(dim)`` and the scalar ``container_radius``
+
+- attributes: ``N``, ``d``, ``phi``, ``shape_kind``, ``boundary`` and the provenance of
   :func:`hardpack.io.provenance` plus whatever protocol parameters the producer adds
   (``seed``, ``distribution``, ``growth_rate``, ...).
+
+Format 1 (before particle shapes and boundaries) is format 2 without ``shape_kind``, for spheres
+in a periodic cell only; such files load as they always did. A file of a newer format than this
+code knows is refused with a request to update hardpack. Every number is stored as float64, so a
+packing comes back bit for bit.
 
 Every write is atomic: the dataset goes to a temporary file in the destination folder, is
 flushed to disk, and replaces the destination with :func:`os.replace`; a crash leaves either the
@@ -25,11 +43,15 @@ import numpy as np
 import xarray as xr
 
 from hardpack.errors import InvalidInputError, StoreError
+from hardpack.geometry.boundaries import HardWalls, SphericalContainer
 from hardpack.geometry.packing import Packing
+from hardpack.geometry.shapes import Ellipsoids, Spheres
 from hardpack.io.atomic import atomic_path
 from hardpack.io.provenance import provenance
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+_SHAPE_VARIABLES = ("radius", "semiaxis", "quaternion", "angle")
+_BOUNDARY_VARIABLES = ("wall", "container_centre", "container_radius")
 
 
 def _netcdf_attr(value):
@@ -49,12 +71,35 @@ def _clean_attrs(attrs: dict) -> dict:
     return {str(k): _netcdf_attr(v) for k, v in attrs.items() if v is not None}
 
 
+def _shape_variables(shape, d: int) -> dict:
+    if shape.kind == "sphere":
+        return {"radius": (("particle",), np.asarray(shape.radii))}
+    if shape.kind == "ellipsoid":
+        data = {"semiaxis": (("particle", "axis"), np.asarray(shape.semiaxes))}
+        if d == 2:
+            data["angle"] = (("particle",), np.asarray(shape.orientations))
+        else:
+            data["quaternion"] = (("particle", "component"), np.asarray(shape.orientations))
+        return data
+    raise InvalidInputError(f"cannot store particles of kind {shape.kind!r}")
+
+
+def _boundary_variables(boundary, d: int) -> dict:
+    if boundary.kind == "hard_walls":
+        return {"wall": (("dim",), (~boundary.periodic_axes(d)).astype(np.int8))}
+    if boundary.kind == "spherical_container":
+        return {"container_centre": (("dim",), np.array(boundary.centre)),
+                "container_radius": ((), np.float64(boundary.radius))}
+    return {}
+
+
 def packing_to_dataset(packing: Packing, attrs: dict | None = None, extra: dict | None = None) -> xr.Dataset:
     """Dataset of a packing (layout in the module docstring); ``extra`` adds data variables."""
     data = {
         "position": (("particle", "dim"), np.asarray(packing.positions)),
-        "radius": (("particle",), np.asarray(packing.radii)),
+        **_shape_variables(packing.shape, packing.dim),
         "lattice": (("dim", "vector"), np.asarray(packing.lattice)),
+        **_boundary_variables(packing.boundary, packing.dim),
     }
     if packing.species is not None:
         data["species"] = (("particle",), np.asarray(packing.species))
@@ -63,29 +108,84 @@ def packing_to_dataset(packing: Packing, attrs: dict | None = None, extra: dict 
         ds[name] = value
     ds.attrs.update(
         hardpack_kind="packing", hardpack_format=FORMAT_VERSION, N=packing.n_particles,
-        d=packing.dim, phi=packing.phi, boundary=packing.boundary,
+        d=packing.dim, phi=packing.phi, shape_kind=packing.shape.kind, boundary=packing.boundary.kind,
     )
     ds.attrs.update(_clean_attrs(attrs or {}))
     return ds
 
 
-def dataset_to_packing(ds: xr.Dataset, source: str = "dataset", **packing_kwargs) -> Packing:
-    """Rebuild (and validate) a packing from its Dataset; errors name ``source``."""
-    missing = [v for v in ("position", "radius", "lattice") if v not in ds]
+def _require(ds: xr.Dataset, source: str, names, what: str) -> None:
+    missing = [v for v in names if v not in ds]
     if missing:
         raise StoreError(
-            f"{source} is not a hardpack packing: variable(s) {missing} missing "
+            f"{source} is not a hardpack packing: variable(s) {missing} of {what} missing "
             f"(found {sorted(ds.data_vars)})"
         )
+
+
+def _stray(ds: xr.Dataset, source: str, names, what: str) -> None:
+    """Refuse variables of another shape or boundary than the attributes say (a damaged file)."""
+    found = [v for v in names if v in ds]
+    if found:
+        raise StoreError(f"{source} has variable(s) {found}, which do not belong to {what}; the file is "
+                         "inconsistent (written by another program or edited?)")
+
+
+def _shape_from(ds: xr.Dataset, source: str):
+    kind = ds.attrs.get("shape_kind", "sphere")
+    if kind == "sphere":
+        _require(ds, source, ["radius"], "spheres")
+        _stray(ds, source, ["semiaxis", "quaternion", "angle"], "spheres")
+        return Spheres(ds["radius"].values)
+    if kind == "ellipsoid":
+        _require(ds, source, ["semiaxis"], "ellipsoids")
+        _stray(ds, source, ["radius"], "ellipsoids")
+        orient = "angle" if ds.sizes.get("axis") == 2 else "quaternion"
+        _require(ds, source, [orient], f"{ds.sizes.get('axis')}-dimensional ellipsoids")
+        _stray(ds, source, [{"angle": "quaternion", "quaternion": "angle"}[orient]],
+               f"{ds.sizes.get('axis')}-dimensional ellipsoids")
+        dims = ("particle", "component") if orient == "quaternion" else ("particle",)
+        return Ellipsoids(ds["semiaxis"].transpose("particle", "axis").values,
+                          ds[orient].transpose(*dims).values)
+    raise StoreError(f"{source} holds particles of shape_kind {kind!r}, which this hardpack does not know "
+                     "(known: 'sphere', 'ellipsoid'); update hardpack")
+
+
+def _boundary_from(ds: xr.Dataset, source: str):
+    kind = ds.attrs.get("boundary", "periodic")
+    if kind == "periodic":
+        _stray(ds, source, _BOUNDARY_VARIABLES, "a periodic cell")
+        return "periodic"
+    if kind == "hard_walls":
+        _require(ds, source, ["wall"], "hard walls")
+        _stray(ds, source, ["container_centre", "container_radius"], "hard walls")
+        return HardWalls(tuple(np.flatnonzero(ds["wall"].values).tolist()))
+    if kind == "spherical_container":
+        _require(ds, source, ["container_centre", "container_radius"], "a spherical container")
+        _stray(ds, source, ["wall"], "a spherical container")
+        return SphericalContainer(ds["container_centre"].values, ds["container_radius"].values)
+    raise StoreError(f"{source} has boundary {kind!r}, which this hardpack does not know (known: 'periodic', "
+                     "'hard_walls', 'spherical_container'); update hardpack")
+
+
+def dataset_to_packing(ds: xr.Dataset, source: str = "dataset", **packing_kwargs) -> Packing:
+    """Rebuild (and validate) a packing from its Dataset (format 1 or 2); errors name ``source``."""
+    _require(ds, source, ["position", "lattice"], "every packing")
+    version = ds.attrs.get("hardpack_format", 1)
+    if not isinstance(version, (int, np.integer)) or version > FORMAT_VERSION:
+        raise StoreError(f"{source} is a packing of format {version!r}; this hardpack reads formats up "
+                         f"to {FORMAT_VERSION}: update hardpack")
     try:
         return Packing(
             positions=ds["position"].transpose("particle", "dim").values,
-            radii=ds["radius"].values,
+            shape=_shape_from(ds, source),
             lattice=ds["lattice"].transpose("dim", "vector").values,
             species=ds["species"].values if "species" in ds else None,
-            boundary=ds.attrs.get("boundary", "periodic"),
+            boundary=_boundary_from(ds, source),
             **packing_kwargs,
         )
+    except StoreError:
+        raise
     except InvalidInputError as exc:
         raise StoreError(f"{source} holds an invalid packing: {exc}") from None
 
@@ -175,6 +275,14 @@ def _check_members(dsets, names, index) -> None:
         listing = "; ".join(f"d = {d}: {', '.join(files)}" for d, files in dims.items())
         raise InvalidInputError(f"the files are of different dimensions ({listing}); combine one "
                                 "dimension at a time, or add d to --index to tabulate them together")
+    for attr, default, what in (("shape_kind", "sphere", "particle shapes"), ("boundary", "periodic", "boundaries")):
+        groups: dict = {}
+        for ds, name in zip(dsets, names):
+            groups.setdefault(str(ds.attrs.get(attr, default)), []).append(name)
+        if len(groups) > 1 and attr not in index:
+            listing = "; ".join(f"{attr} = {k}: {', '.join(files)}" for k, files in groups.items())
+            raise InvalidInputError(f"the files hold different {what} ({listing}); combine one kind at a "
+                                    f"time, or add {attr} to --index to tabulate them together")
     rows: dict = {}
     for ds, name in zip(dsets, names):
         row = tuple(repr(np.asarray(ds.attrs[k]).tolist()) for k in index)
@@ -197,7 +305,8 @@ def combine_ensemble(sources, index=("seed",), variables=None) -> xr.Dataset:
 
     Refused, with the files named: a file given twice, two files with the same index values,
     files of different ``hardpack_kind`` (e.g. a jamming verdict among packings) or without one,
-    and files of different dimension d unless ``d`` is an index.
+    and files of different dimension d, particle shapes (``shape_kind``) or boundaries
+    (``boundary``) unless that attribute is an index.
     """
     dsets, names = [], []
     for src in sources:
@@ -225,7 +334,7 @@ def combine_ensemble(sources, index=("seed",), variables=None) -> xr.Dataset:
     out = xr.Dataset(scalars, coords=coords)
     shapes = {(ds.sizes.get("particle"), ds.sizes.get("dim")) for ds in dsets}
     if len(shapes) == 1 and None not in next(iter(shapes)):
-        for var in ("position", "radius", "lattice"):
+        for var in ("position", "radius", "semiaxis", "quaternion", "angle", "lattice"):
             if all(var in ds for ds in dsets):
                 out[var] = xr.concat([ds[var] for ds in dsets], dim="sample")
     out.attrs["hardpack_kind"] = "ensemble"

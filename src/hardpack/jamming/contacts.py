@@ -118,6 +118,7 @@ def contact_network(packing: Packing, delta: float) -> ContactNetwork:
             f"expected a hardpack Packing, got {type(packing).__name__}; build one with "
             "hardpack.Packing(positions, radii, lattice) or hardpack.io.load_packing(path)"
         )
+    packing.require_periodic_spheres("the jamming tests")
     delta = check_delta(delta)
     report = packing.overlap_report(packing.overlap_tol)
     if report.n_overlapping:

@@ -159,6 +159,7 @@ def verify(
         raise InvalidInputError(
             f"verify expects a hardpack Packing, got {type(packing).__name__}"
         )
+    packing.require_periodic_spheres("the jamming tests")
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
     delta = check_delta((SEQUENTIAL_DELTA if method == "sequential" else DEFAULT_DELTA) if delta is None else delta)

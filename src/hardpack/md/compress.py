@@ -253,6 +253,7 @@ def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     from hardpack.geometry.balls import ball_volume
     from hardpack.geometry.neighbours import pairs_within
 
+    packing.require_periodic_spheres("the jamming backbone of an LS compression")
     pairs = pairs_within(packing, rel_gap=gap)
     i, j = np.asarray(pairs.i), np.asarray(pairs.j)
     n, d = packing.n_particles, packing.dim
@@ -356,16 +357,16 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
                           overlap_tol=overlap_tol, final_growth_rate=final_growth_rate,
                           switch_pressure=float(switch_pressure) if final_growth_rate else None,
                           contact_windows=int(contact_windows) if contact_forces else 0)
-    if checkpoint is not None:
-        state = ckpt.load(checkpoint, fp)
-        if state is not None:
-            sim.restore(state)
-            log.info("resumed from %s at window %d (%d collisions)", checkpoint, sim.windows,
-                     sim.collisions)
+    state = None if checkpoint is None else ckpt.load(checkpoint, fp)
+    if state is not None:
+        sim.restore(state)
     started = time.perf_counter()
     last_ckpt = last_log = started
     last_coll = sim.collisions
     with interrupt.deferred():
+        if state is not None:  # announced once a signal can no longer stop the run before a save
+            log.info("resumed from %s at window %d (%d collisions)", checkpoint, sim.windows,
+                     sim.collisions)
         while (reason := _stop_reason(stop, sim, started)) is None:
             budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
             if stop.max_collisions is not None:

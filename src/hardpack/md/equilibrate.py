@@ -1,9 +1,12 @@
 """Equilibrium (NVE, fixed phi) runs: the reduced pressure Z with a block-average error bar.
 
 With Gamma = 0 collisions conserve energy and momentum exactly, so no rescaling is done and kT
-stays 1. After ``n_equilibration`` collisions the run is cut into ``n_blocks`` windows of equal
-numbers of collisions; each window gives Z = 1 + sum r_ij . J_ij / (2 * integral of KE dt)
-(note 000 sec. 2.5), and the error is the standard error of the block means, std/sqrt(n_blocks)
+stays 1. After ``n_equilibration`` collisions the run is cut into ``n_blocks`` blocks of equal
+numbers of collisions; each block gives Z = 1 + sum r_ij . J_ij / (2 * integral of KE dt)
+(the collisional stress averaged over a time window, Donev 2006, dissertation ch. 3, in its
+reduced-pressure form, which we derive), summed over the short
+MD windows that make up the block (so that a checkpoint can be written within a block), and the
+error is the standard error of the block means, std/sqrt(n_blocks)
 (blocks of many collisions per particle are much longer than the pressure's correlation time).
 
 With ``checkpoint`` the run is resumable like :func:`hardpack.md.compress`: its state is saved at
@@ -70,27 +73,40 @@ def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int
     block = max(1, int(n_collisions) // int(n_blocks))
     per_window = max(1, round(20 * sim.n))  # keep windows short enough for frequent checks
     fp = ckpt.fingerprint(packing, run="equilibrate", seed=int(seed), n_collisions=int(n_collisions),
-                          n_blocks=int(n_blocks), n_equilibration=n_eq, overlap_tol=overlap_tol)
+                          n_blocks=int(n_blocks), n_equilibration=n_eq, overlap_tol=overlap_tol,
+                          window=per_window)
     z: list[float] = []
+    partial = np.zeros(3)  # the current block so far: virial, integral of KE dt, collisions
     start_time, start_coll = 0.0, n_eq
     state = None if checkpoint is None else ckpt.load(checkpoint, fp)
     if state is not None:
         z = list(np.atleast_1d(state.pop("Z_blocks")))[:int(state.pop("n_blocks_done"))]
         start_time = float(state.pop("start_time"))
+        partial = np.asarray(state.pop("block_partial"), dtype=float)
         sim.restore(state)
-        log.info("resumed from %s after %d collisions (%d blocks done)", checkpoint, sim.collisions, len(z))
     last_save = time.perf_counter()
     with interrupt.deferred():
+        if state is not None:  # announced once a signal can no longer stop the run before a save
+            log.info("resumed from %s after %d collisions (%d blocks done)", checkpoint, sim.collisions,
+                     len(z))
         while len(z) < int(n_blocks):
             if sim.collisions < n_eq:
                 sim.run_window(min(per_window, n_eq - sim.collisions))
                 start_time, start_coll = sim.time, sim.collisions
             else:
-                z.append(sim.run_window(block)["Z"])
-            if checkpoint is not None and sim.checkpoint_ready and len(z) < int(n_blocks) and (
+                before = sim.collisions
+                rec = sim.run_window(min(per_window, block - int(partial[2])))
+                partial += (rec["virial"], rec["ke_integral"], sim.collisions - before)
+                if partial[2] >= block:
+                    z.append(1.0 + partial[0] / (2.0 * partial[1]) if partial[1] > 0.0 else np.inf)
+                    partial[:] = 0.0
+            if len(z) == int(n_blocks):
+                break  # done: a signal received during the last windows stops nothing
+            if checkpoint is not None and sim.checkpoint_ready and (
                     interrupt.requested() is not None or time.perf_counter() - last_save >= checkpoint_interval):
                 ckpt.save(checkpoint, fp, sim.state() | {"Z_blocks": np.asarray(z, dtype=float),
-                                                          "n_blocks_done": len(z), "start_time": start_time})
+                                                          "n_blocks_done": len(z), "start_time": start_time,
+                                                          "block_partial": partial.copy()})
                 last_save = time.perf_counter()
             if interrupt.requested() is not None and (checkpoint is None or sim.checkpoint_ready):
                 raise interrupt.stop(checkpoint, f"{sim.collisions} of {n_eq + block * int(n_blocks)} "

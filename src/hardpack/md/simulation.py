@@ -63,6 +63,7 @@ def check_packing(packing: Packing) -> None:
     """Refuse packings the engine cannot run: sheared cells, fewer than 2 particles, overlaps."""
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
+    packing.require_periodic_spheres("the MD engine")
     if not packing.is_orthorhombic:
         raise InvalidInputError(
             "the MD engine supports orthorhombic (diagonal) periodic cells only; this lattice is "
@@ -85,6 +86,7 @@ class Simulation:
                  overlap_tol: float = DEFAULT_OVERLAP_TOL, contact_windows: int = 0):
         """contact_windows > 0 logs every collision and keeps the per-pair impulse sums of the
         last ``contact_windows`` windows in :attr:`contacts` (:mod:`hardpack.md.contacts`)."""
+        packing.require_periodic_spheres("the MD engine")
         self.lattice = np.array(packing.lattice)
         self.species = packing.species
         self.box = np.diag(self.lattice).copy()
@@ -184,7 +186,7 @@ class Simulation:
             "kT": 2.0 * res.ke_end / (d * n), "kT_mean": kt_mean, "events": self.events, "stale": res.stale,
             "exits": res.exits, "grazing": res.grazing, "max_overlap": res.max_overlap, "shell": shell_used,
             "neighbours": res.mean_neighbours, "wall_time": self.wall_time,
-            "growth_rate": self.growth_rate,
+            "growth_rate": self.growth_rate, "virial": res.virial, "ke_integral": res.ke_integral,
         }
         for k in RECORD_FIELDS:
             self.records[k].append(record[k])

@@ -133,6 +133,7 @@ def run_diluted(packing: Packing, fraction: float, rounds: int, seed: int, alpha
     list of DilutedRound
         Rounds 1..``rounds`` in order.
     """
+    packing.require_periodic_spheres("the diluted-MRJ protocol")
     if int(seed) != seed or seed < 0:
         raise InvalidInputError(f"seed must be a non-negative integer, got {seed}")
     n_remove = removal_count(packing.n_particles, fraction, rounds)

@@ -94,6 +94,7 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
     removes it once the result is written). On SIGINT or SIGTERM the run writes its checkpoint
     before the next LP and raises :class:`hardpack.io.interrupt.Interrupted`.
     """
+    packing.require_periodic_spheres("SLP")
     if not (0 < tol < 1):
         raise InvalidInputError(f"tol must be in (0, 1), got {tol}")
     if not (0 < reject_overlap < 0.5):
@@ -117,9 +118,10 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
         scale, first, n_rejected = float(state["scale"]), int(state["next_step"]), int(state["n_rejected"])
         records = [tuple(r) for r in state["records"].tolist()]
         wall_before, cpu_before = float(state["wall_seconds"]), float(state["cpu_seconds"])
-        log.info("resumed from %s at SLP step %d (phi = %.8f)", checkpoint, first, current.phi)
     last_save = time.perf_counter()
     with interrupt.deferred():
+        if state is not None:  # announced once a signal can no longer stop the run before a save
+            log.info("resumed from %s at SLP step %d (phi = %.8f)", checkpoint, first, current.phi)
         for step in range(first, int(max_steps)):
             if interrupt.requested() is not None:
                 if checkpoint is not None:

@@ -111,6 +111,7 @@ def redundancy_radius(bounds: Bounds, d: int, mean_diameter: float, contact: np.
 
 def influence_pairs(packing, alpha: float, bounds: Bounds, deforming: bool = True):
     """Pairs (all images) with centre distance < alpha D_mn whose row can bind (``redundancy_radius``)."""
+    packing.require_periodic_spheres("SLP")
     d = packing.dim
     mean_diameter = 2.0 * packing.radii.mean()
     d_max = 2.0 * packing.radii.max()

@@ -40,6 +40,7 @@ def analyse(packing, r_max: float | None = None, k_max: float | None = None, rat
     (rattler-free backbone when a rattler mask is given; NaN when the window holds no gaps) and,
     with ``channels`` in d = 2, 3, the histogram of channel radii R / r (Ogarko ch. 4, bin 0.01).
     """
+    packing.require_periodic_spheres("the structure analysis")
     diameter = 2.0 * float(np.mean(packing.radii))
     k_max = 20.0 / diameter if k_max is None else k_max
     g2 = pair_correlation(packing, r_max=r_max, dr=dr, contact_tol=contact_tol)

@@ -39,7 +39,7 @@ def cmd_structure(args) -> int:
     if no_backbone:
         for name in ("alpha", "alpha_err", "alpha_amplitude"):  # the fit is of the backbone
             out[name] = np.nan
-    write_dataset(out, args.out, attrs=dict(source=str(args.packing),
+    write_dataset(out, args.out, attrs=dict(args.attr or [], source=str(args.packing),
                                             rattler_mask=str(args.jamming) if args.jamming else "none",
                                             **no_backbone))
     log.info("wrote %s", args.out)
@@ -47,6 +47,8 @@ def cmd_structure(args) -> int:
 
 
 def register(subparsers) -> None:
+    from hardpack.cli import _key_value
+
     p = subparsers.add_parser("structure", help=cmd_structure.__doc__)
     p.add_argument("packing", help="packing netCDF file")
     p.add_argument("--out", required=True, help="output netCDF file")
@@ -59,4 +61,7 @@ def register(subparsers) -> None:
     p.add_argument("--jamming", default=None, metavar="VERDICT.nc",
                    help="jamming verdict of this packing (hardpack verify) whose rattlers are excluded")
     p.add_argument("--no-order", action="store_true", help="skip the order metrics")
+    p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",
+                   help="extra attribute stored in the file (repeatable), e.g. ensemble=mono3d: the "
+                        "validation and the figures group structure datasets by their ensemble")
     p.set_defaults(func=cmd_structure)

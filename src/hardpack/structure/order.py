@@ -130,6 +130,7 @@ def _reference_shells(d: int, n_shells: int):
 def translational_order(packing, n_shells: int = 7, width: float | None = None) -> float:
     """Translational order metric T (module docstring); ``width`` in units of the NN distance
     (default 0.98 times the smallest spacing of the first ``n_shells`` reference shells)."""
+    packing.require_periodic_spheres("the structure analysis")
     if int(n_shells) != n_shells or n_shells < 1:
         raise InvalidInputError(f"n_shells must be a positive integer, got {n_shells!r}")
     d = packing.dim

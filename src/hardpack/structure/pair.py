@@ -84,6 +84,7 @@ def pair_correlation(packing, r_max: float | None = None, dr: float | None = Non
     (bin centres), variables ``g2``, ``pair_count``, ``ideal_count`` on r, the same with suffix
     ``_scaled`` on x, and scalars ``n_contacts`` and ``z_contacts`` (the delta-peak weight).
     """
+    packing.require_periodic_spheres("the structure analysis")
     diameter = 2.0 * float(np.mean(packing.radii))
     r_max = _positive("r_max", 5.0 * diameter if r_max is None else r_max)
     dr = _positive("dr", diameter / 200.0 if dr is None else dr)
@@ -148,6 +149,7 @@ def cumulative_coordination(packing, gap_max: float = 0.5, rattlers=None,
     ``Z_backbone``), and scalars ``z_contacts_all`` / ``z_contacts_backbone`` (pairs with
     |gap| <= contact_tol). Self-image contacts count twice for their particle, as they should.
     """
+    packing.require_periodic_spheres("the structure analysis")
     gap_max = _positive("gap_max", gap_max)
     gap_min = _positive("gap_min", gap_min)
     if gap_min >= gap_max:

@@ -203,6 +203,7 @@ def _density_modes(s, heads, t_lo, t_hi):
 
 def structure_factor_vectors(packing, k_max: float, max_vectors: int = 5 * 10**7):
     """S at every allowed wavevector with 0 < |k| <= k_max: returns (n, k vectors, S)."""
+    packing.require_periodic_spheres("the structure analysis")
     recip, heads, t_lo, t_hi = _heads(packing.lattice, k_max, max_vectors)
     rho = _density_modes(packing.fractional(), heads, t_lo, t_hi)
     n, k, inside = _expand(recip, heads, t_lo, t_hi, k_max)
@@ -268,6 +269,7 @@ def number_variance(packing, window_radii, n_windows: int = 10000, seed: int = 0
     Returns a Dataset on dim ``R`` with ``variance``, ``variance_err``, ``mean`` and the
     ideal-gas reference ``variance_binomial`` = N p (1 - p).
     """
+    packing.require_periodic_spheres("the structure analysis")
     radii = np.sort(np.asarray(window_radii, dtype=float).ravel())
     if radii.size == 0 or not np.all(np.isfinite(radii)) or radii[0] <= 0:
         raise InvalidInputError("window_radii must be positive finite numbers")

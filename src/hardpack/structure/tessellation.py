@@ -66,6 +66,7 @@ def cutoff_neighbours(packing, cutoff: float = 1.2) -> NeighbourList:
     FCC/HCP/SC shell (sqrt 2), as in Steinhardt's lattice values; in jammed packings it sits
     near the first minimum of g2 at 1.25 D (Donev ch. 9, ch7-9 L1788).
     """
+    packing.require_periodic_spheres("the structure analysis")
     if not np.isfinite(cutoff) or cutoff <= 0:
         raise InvalidInputError(f"cutoff must be a positive finite number, got {cutoff!r}")
     pairs = pairs_within(packing, rel_gap=cutoff - 1.0)
@@ -100,6 +101,7 @@ def regular_neighbours(packing, weighted: bool = True, margin: float | None = No
     simplices around the original particles are certified. Particles whose power cell is empty
     (possible for very unequal radii) have no neighbours.
     """
+    packing.require_periodic_spheres("the structure analysis")
     n, d = packing.n_particles, packing.dim
     if d < 2:
         raise InvalidInputError("a triangulation needs d >= 2")

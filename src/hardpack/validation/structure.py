@@ -1,8 +1,9 @@
 """Validation rows of the structure study on the LS packings (Donev 2006, ch. 9-10).
 
-Input: the per-packing structure Datasets (``hardpack structure``), grouped by ensemble (the
-directory of their ``source`` packing). Rows are made for 3D monodisperse ensembles, the systems
-the published numbers describe (targets ``donev-ch9-*`` and ``donev-ch10-s0``):
+Input: the per-packing structure Datasets (``hardpack structure``), grouped by their ``ensemble``
+attribute (``hardpack structure --attr ensemble=NAME``). Rows are made for 3D monodisperse
+ensembles, the systems the published numbers describe (targets ``donev-ch9-*`` and
+``donev-ch10-s0``):
 
 - the near-contact exponent alpha of Z(l) - Z_c = a l^alpha, rattlers removed, per seed;
 - the split second peak of g2: the maxima of the seed-averaged g2(r / (r_i + r_j)) (bins of
@@ -18,7 +19,6 @@ from __future__ import annotations
 import math
 from collections import defaultdict
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -36,9 +36,12 @@ def fluid_s0(phi: float) -> float:
 
 
 def _ensemble(ds) -> str:
-    parts = Path(str(ds.attrs.get("source", ""))).parts
-    return parts[-3] if len(parts) >= 3 else "packings"
-
+    """The ensemble a structure Dataset belongs to: its ``ensemble`` attribute."""
+    if "ensemble" not in ds.attrs:
+        raise InvalidInputError(
+            f"the structure dataset of {ds.attrs.get('source', 'a packing')} has no 'ensemble' attribute, "
+            "so its ensemble is unknown; write it with `hardpack structure ... --attr ensemble=NAME`")
+    return str(ds.attrs["ensemble"])
 
 
 def pooled_s0(members: list) -> tuple[float, float]:

@@ -1,0 +1,224 @@
+"""Boundaries of a packing: a periodic cell, hard walls on some axes, or a spherical container.
+
+The lattice (d x d, columns = lattice vectors) is always there; the boundary says what its faces
+are (Donev 2006, Sec. 3.2.2.1: each dimension of the unit cell is periodic or a hard wall;
+Ch. 7: a spherical container inside a box that only serves the cell lists).
+
+- :class:`Periodic`: every lattice vector is a period (the only boundary before format 2).
+- :class:`HardWalls`: hard planar walls at x_k = 0 and x_k = L_k for each walled axis k, periodic
+  along the other lattice vectors (a slit for one walled axis in 3D, a channel for two, a closed
+  box for all). The lattice must be orthorhombic along the walled axes: lattice vector k is
+  L_k e_k and no other lattice vector has a component along e_k. The periodic vectors may be
+  sheared among themselves.
+- :class:`SphericalContainer`: a hard spherical wall of radius R about ``centre``; no axis is
+  periodic. The lattice must be an orthorhombic box [0, L_1] x ... x [0, L_d] that holds the
+  container; it is a pseudo-boundary for cell lists (Donev 2006, Ch. 7) and plays no part in
+  the physics: the volume fraction is over the container, V_d(R).
+
+A particle and a wall are checked like a pair: the relative overlap of a sphere of radius r whose
+centre is at distance h from a flat wall (or whose centre is at distance |x - c| from the centre
+of a container of radius R, h = R - |x - c|) is 1 - h / r, positive when it crosses the wall.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.balls import ball_volume
+from hardpack.geometry.shapes import as_finite_array
+
+
+@dataclass(frozen=True)
+class ContainmentReport:
+    """Result of a wall check: how many particles cross a wall and the worst one.
+
+    ``overlap`` = 1 - h / r of the worst particle (positive means it crosses ``wall``); ``worst``
+    is -1 when no particle is named (a periodic cell has no walls; ``wall`` then says why).
+    """
+
+    n_outside: int
+    worst: int
+    wall: str
+    overlap: float
+
+    def __str__(self) -> str:
+        if self.worst < 0:
+            return self.wall
+        if self.overlap <= 0:
+            return (f"no particle crosses a wall; closest: particle {self.worst}, at a gap of "
+                    f"{-self.overlap:.3e} of its radius from {self.wall}")
+        head = (f"{self.n_outside} particle(s) cross a wall" if self.n_outside
+                else "no particle crosses a wall beyond the tolerance")
+        return f"{head}; worst: particle {self.worst} crosses {self.wall} by {self.overlap:.3e} of its radius"
+
+
+def _no_walls() -> ContainmentReport:
+    return ContainmentReport(0, -1, "no walls", float("-inf"))
+
+
+def _report(overlap: np.ndarray, wall_of, tol: float) -> ContainmentReport:
+    """Report of the relative overlaps (N,) of the particles with their nearest walls; ``wall_of(i)``
+    names the wall of particle i."""
+    i = int(np.argmax(overlap))
+    return ContainmentReport(int((overlap > tol).sum()), i, wall_of(i), float(overlap[i]))
+
+
+@dataclass(frozen=True)
+class Periodic:
+    """A periodic cell: every lattice vector is a period."""
+
+    kind: ClassVar[str] = "periodic"
+    name: ClassVar[str] = "periodic cells"
+
+    def check(self, lattice: np.ndarray) -> None:
+        """Every lattice suits a periodic cell (the packing checks it is non-singular)."""
+
+    def periodic_axes(self, d: int) -> np.ndarray:
+        return np.ones(d, dtype=bool)
+
+    def volume(self, lattice: np.ndarray) -> float:
+        return float(abs(np.linalg.det(lattice)))
+
+    def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
+        return _no_walls()
+
+    def __str__(self) -> str:
+        return "periodic"
+
+
+@dataclass(frozen=True)
+class HardWalls:
+    """Hard walls at x_k = 0 and x_k = L_k for every axis k in ``axes``; periodic along the others."""
+
+    axes: tuple
+    kind: ClassVar[str] = "hard_walls"
+    name: ClassVar[str] = "hard walls"
+
+    def __post_init__(self):
+        axes = np.atleast_1d(np.asarray(self.axes))
+        if axes.size == 0:
+            raise InvalidInputError("hard walls need at least one walled axis; a cell without walls "
+                                    "is boundary='periodic'")
+        if axes.ndim != 1 or axes.dtype.kind not in "iu" or (axes < 0).any() or len(set(axes.tolist())) != axes.size:
+            raise InvalidInputError(
+                f"hard-wall axes must be distinct non-negative axis numbers (0 = x, 1 = y, ...), "
+                f"got {self.axes!r}"
+            )
+        axes = sorted(int(k) for k in axes)
+        object.__setattr__(self, "axes", tuple(axes))
+
+    def check(self, lattice: np.ndarray) -> None:
+        """Refuse a lattice that is not orthorhombic along the walled axes."""
+        d = lattice.shape[0]
+        if self.axes[-1] >= d:
+            raise InvalidInputError(f"hard-wall axis {self.axes[-1]} does not exist in {d} dimensions "
+                                    f"(axes are 0..{d - 1})")
+        for k in self.axes:
+            others = np.delete(np.arange(d), k)
+            if not (lattice[k, k] > 0 and np.all(lattice[others, k] == 0) and np.all(lattice[k, others] == 0)):
+                raise InvalidInputError(
+                    f"with hard walls on axis {k} the lattice must be orthorhombic along it: lattice "
+                    f"vector {k} (column {k}) must be L e_{k} with L > 0 and no other lattice vector may "
+                    f"have a component along e_{k} (row {k} zero off the diagonal); got column "
+                    f"{lattice[:, k].tolist()} and row {lattice[k].tolist()}"
+                )
+
+    def periodic_axes(self, d: int) -> np.ndarray:
+        mask = np.ones(d, dtype=bool)
+        mask[list(self.axes)] = False
+        return mask
+
+    def volume(self, lattice: np.ndarray) -> float:
+        return float(abs(np.linalg.det(lattice)))
+
+    def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
+        """Relative overlap 1 - h / r of every sphere with its nearest wall (h = centre-wall distance)."""
+        axes = list(self.axes)
+        x = positions[:, axes]
+        length = np.diag(lattice)[axes]
+        h = np.concatenate([x, length - x], axis=1)  # distance to the wall at 0, then at L, per axis
+        nearest = np.argmin(h, axis=1)
+        overlap = 1.0 - h[np.arange(len(h)), nearest] / radii
+        names = [f"the wall x_{k} = 0" for k in axes] + [f"the wall x_{k} = {v:.6g}" for k, v in zip(axes, length)]
+        return _report(overlap, lambda i: names[nearest[i]], tol)
+
+    def __str__(self) -> str:
+        return f"hard walls on axes {list(self.axes)}"
+
+
+@dataclass(frozen=True)
+class SphericalContainer:
+    """A hard spherical wall of ``radius`` about ``centre``, inside the orthorhombic lattice box."""
+
+    centre: tuple
+    radius: float
+    kind: ClassVar[str] = "spherical_container"
+    name: ClassVar[str] = "spherical containers"
+
+    def __post_init__(self):
+        centre = as_finite_array("container centre", self.centre, "(d,)")
+        radius = as_finite_array("container radius", self.radius, "()")
+        if centre.ndim != 1 or radius.ndim != 0:
+            raise InvalidInputError(f"a spherical container needs a centre of d coordinates and one radius, "
+                                    f"got centre of shape {centre.shape} and radius of shape {radius.shape}")
+        if not radius > 0:
+            raise InvalidInputError(f"the container radius must be positive, got {float(radius)!r}")
+        object.__setattr__(self, "centre", tuple(float(v) for v in centre))
+        object.__setattr__(self, "radius", float(radius))
+
+    def check(self, lattice: np.ndarray) -> None:
+        """Refuse a lattice that is not an orthorhombic box holding the container."""
+        d = lattice.shape[0]
+        if len(self.centre) != d:
+            raise InvalidInputError(f"the container centre has {len(self.centre)} coordinates; the packing "
+                                    f"is {d}-dimensional")
+        box = np.diag(lattice)
+        if not (np.all(lattice == np.diag(box)) and np.all(box > 0)):
+            raise InvalidInputError(
+                "a spherical container sits in an orthorhombic box (a diagonal lattice with positive "
+                f"entries, used for cell lists); got lattice {lattice.tolist()}"
+            )
+        c = np.array(self.centre)
+        if np.any(c - self.radius < 0) or np.any(c + self.radius > box):
+            raise InvalidInputError(
+                f"the container (centre {list(self.centre)}, radius {self.radius:g}) must lie inside the "
+                f"box [0, L_k] of the lattice, L = {box.tolist()}; enlarge the box or move the centre"
+            )
+
+    def periodic_axes(self, d: int) -> np.ndarray:
+        return np.zeros(d, dtype=bool)
+
+    def volume(self, lattice: np.ndarray) -> float:
+        """The container's volume V_d(R) (the box is only a pseudo-boundary)."""
+        return float(ball_volume(self.radius, lattice.shape[0]))
+
+    def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
+        """Relative overlap 1 - (R - |x - c|) / r of every sphere with the container wall."""
+        dx = positions - np.array(self.centre)
+        h = self.radius - np.sqrt(np.einsum("ij,ij->i", dx, dx))
+        return _report(1.0 - h / radii, lambda i: "the container wall", tol)
+
+    def __str__(self) -> str:
+        return f"spherical container (centre {list(self.centre)}, radius {self.radius:.6g})"
+
+
+BOUNDARY_KINDS = ("periodic", "hard_walls", "spherical_container")
+
+
+def as_boundary(value):
+    """A boundary object from ``value``: one of the classes above, or the string ``"periodic"``."""
+    if isinstance(value, (Periodic, HardWalls, SphericalContainer)):
+        return value
+    if isinstance(value, str) and value == "periodic":
+        return PERIODIC
+    raise InvalidInputError(
+        f"boundary {value!r} is not supported; pass 'periodic', HardWalls(axes) or "
+        "SphericalContainer(centre, radius) (hardpack.geometry.boundaries)"
+    )
+
+
+PERIODIC = Periodic()

@@ -1,0 +1,494 @@
+# Everything of the workflow that is not a rule: the config checks, the systems of every study
+# (parsed from the config once), the input and parameter functions, the summaries, and the final
+# outputs of the workflow (final_outputs(), figures(), validation_inputs()). The rule files hold
+# rules only and read what they need from here.
+#
+# One results layout, by study (a generator or an analysis) and system name:
+#   results/{study}/{name}/{step}/seed{seed}.nc     one file per seed and step (init, jammed, slp, verdict, ...)
+#   results/{study}/{name}/{step}_summary.nc        a step over the seeds of one system
+#   results/{study}/{step}_summary.nc               a step over the systems of a study
+#   results/figures/{figure}.pdf|png, results/validation/
+#   results/logs/{rule}/{wildcards}.log             stdout and stderr of each job
+#   results/benchmarks/{rule}/{wildcards}.tsv       time and memory of each job (benchmarks/pipeline_times.py)
+# A file's ensemble name is in its `ensemble` attribute; nothing reads it from the path.
+
+import json
+import math
+import os
+import re
+import shlex
+
+from snakemake.utils import validate
+
+from hardpack.distributions import from_spec
+
+
+validate(config, "../schemas/config.schema.yaml")
+
+
+wildcard_constraints:
+    study=r"[a-z][a-z_]*",
+    name=r"[A-Za-z][A-Za-z0-9_.]*",
+    ensemble=r"[A-Za-z][A-Za-z0-9_]*",
+    seed=r"\d+",
+    reps=r"\d+",
+    phi=r"[0-9.]+",
+
+
+ENSEMBLES = config["ensembles"]
+SLP = config.get("slp", {})
+SLP_MRJ = SLP.get("mrj")
+SLP_DILUTED = SLP.get("diluted")
+SLP_DENSEST = SLP.get("densest")
+SLP_ORDER = SLP.get("order_map")
+RATES = config.get("rates")
+FREEENERGY = config.get("freeenergy")
+POLY = config.get("polydisperse", {})
+VALIDATION = config.get("validation", {})
+MONODISPERSE = {"kind": "monodisperse"}
+
+
+# ---------------------------------------------------------------------------------------------
+# Config checks the JSON schema cannot express (cross references); each names the key to fix.
+
+def _check_distribution(where, spec):
+    try:
+        from_spec(spec)
+    except ValueError as exc:
+        raise ValueError(f"config: {where}.distribution: {exc}") from None
+
+
+def check_config():
+    """Refuse a config whose sections contradict each other."""
+    for name, ens in ENSEMBLES.items():
+        _check_distribution(f"ensembles.{name}", ens["distribution"])
+    if RATES and RATES["ensemble"] not in ENSEMBLES:
+        raise ValueError(f"config: rates.ensemble {RATES['ensemble']!r} is not one of the ensembles "
+                         f"{sorted(ENSEMBLES)}")
+    if SLP_DENSEST and len({run["d"] for run in SLP_DENSEST["runs"]}) != len(SLP_DENSEST["runs"]):
+        raise ValueError("config: slp.densest.runs lists a dimension twice")
+    if SLP_MRJ:
+        for name in SLP_MRJ["ensembles"]:
+            if name not in ENSEMBLES:
+                raise ValueError(f"config: slp.mrj.ensembles names {name!r}, which is not an ensemble")
+        for name, spec in SLP_MRJ.get("systems", {}).items():
+            if name in ENSEMBLES:
+                raise ValueError(f"config: slp.mrj.systems.{name} has the name of an ensemble; rename it")
+            if "distribution" in spec:
+                _check_distribution(f"slp.mrj.systems.{name}", spec["distribution"])
+    if SLP_DILUTED:
+        if not SLP_MRJ or SLP_DILUTED["ensemble"] not in SLP_MRJ["ensembles"]:
+            raise ValueError(f"config: slp.diluted.ensemble {SLP_DILUTED['ensemble']!r} must be one of "
+                             "slp.mrj.ensembles (its SLP MRJ packings are the starts)")
+        missing = set(SLP_DILUTED["seeds"]) - set(ENSEMBLES[SLP_DILUTED["ensemble"]]["seeds"])
+        if missing:
+            raise ValueError(f"config: slp.diluted.seeds {sorted(missing)} are not seeds of ensemble "
+                             f"{SLP_DILUTED['ensemble']!r}")
+    if FREEENERGY:
+        simplex = FREEENERGY["simplex"]
+        if simplex["ensemble"] not in ENSEMBLES:
+            raise ValueError(f"config: freeenergy.simplex.ensemble {simplex['ensemble']!r} is not one of "
+                             f"the ensembles {sorted(ENSEMBLES)}")
+        missing = set(simplex["seeds"]) - set(ENSEMBLES[simplex["ensemble"]]["seeds"])
+        if missing:
+            raise ValueError(f"config: freeenergy.simplex.seeds {sorted(missing)} are not seeds of ensemble "
+                             f"{simplex['ensemble']!r} (its LS packings are the inputs)")
+
+
+check_config()
+
+
+# ---------------------------------------------------------------------------------------------
+# The systems of the packing studies: SYSTEMS[study][name] holds what the generic jobs of a
+# system need (N, d, seeds, the start packing, init and generator options, `--attr` attributes).
+#   ls             LS ensembles (config ensembles): init -> jammed (+ timeseries) -> verdict -> structure
+#   ls_rates       the growth-rate scan, single-stage LS from an ensemble's starts
+#   slp_mrj        SLP MRJ packings beside LS ensembles and of the SLP-only systems (Table I)
+#   slp_densest    SLP from N = 3^d starts (Table II), names d{d}
+#   slp_order_map  starts n{N}, one SLP run per setting s{k} (Fig. 6)
+#   slp_diluted    diluted-MRJ rounds from an ensemble's SLP MRJ packings (Sec. VI)
+
+def slp_flags(settings):
+    """The `hardpack slp` options of one (alpha, bounds) setting."""
+    b = settings["bounds"]
+    return (f"--alpha {settings['alpha']} --strain-bound {b['strain']} --shear-bound {b['shear']}"
+            f" --displacement-bound {b['displacement']} --lp-method {settings.get('lp_method', 'highs-ipm')}")
+
+
+def _ls_compress(ens):
+    final = (f" --final-growth-rate {ens['final_growth_rate']} --switch-pressure {ens['switch_pressure']}"
+             if "final_growth_rate" in ens else "")
+    return f"--growth-rate {ens['growth_rate']}{final} --max-pressure {ens['max_pressure']} --contact-forces"
+
+
+def _system(n, d, seeds, init_phi=None, distribution=MONODISPERSE, **extra):
+    return dict(N=n, d=d, seeds=list(seeds), init_phi=init_phi, distribution=distribution, **extra)
+
+
+def order_map_n(k):
+    """Cell size N of order-map setting k: its own ``N`` or the map's default."""
+    return SLP_ORDER["settings"][k].get("N", SLP_ORDER["N"])
+
+
+def _systems():
+    systems = {"ls": {}, "ls_rates": {}, "slp_mrj": {}, "slp_densest": {}, "slp_order_map": {}, "slp_diluted": {}}
+    for name, ens in ENSEMBLES.items():
+        systems["ls"][name] = _system(ens["N"], ens["d"], ens["seeds"], ens["init_phi"], ens["distribution"],
+                                      attrs={"ensemble": name}, compress=_ls_compress(ens))
+    if RATES:
+        name, ens = RATES["ensemble"], ENSEMBLES[RATES["ensemble"]]
+        for gamma in RATES["growth_rates"]:
+            systems["ls_rates"][f"{name}_gamma{gamma}"] = _system(
+                ens["N"], ens["d"], RATES["seeds"], start=f"results/ls/{name}/init/seed{{seed}}.nc",
+                compress=f"--growth-rate {gamma} --max-pressure {ens['max_pressure']}")
+    if SLP_MRJ:
+        for name in SLP_MRJ["ensembles"]:
+            ens = ENSEMBLES[name]
+            systems["slp_mrj"][name] = _system(ens["N"], ens["d"], ens["seeds"], SLP_MRJ["init_phi"],
+                                               ens["distribution"], attrs={"ensemble": name},
+                                               slp=slp_flags(SLP_MRJ), slp_minutes=60)
+        for name, spec in SLP_MRJ.get("systems", {}).items():
+            # 3D N = 2000 (not in the default study): 1.3 CPU-h for 520 LPs, not converged
+            systems["slp_mrj"][name] = _system(spec["N"], spec["d"], spec["seeds"], SLP_MRJ["init_phi"],
+                                               spec.get("distribution", MONODISPERSE), attrs={"ensemble": name},
+                                               slp=slp_flags(SLP_MRJ), slp_minutes=180)
+    if SLP_DENSEST:
+        for run in SLP_DENSEST["runs"]:
+            d = run["d"]
+            systems["slp_densest"][f"d{d}"] = _system(run.get("N", 3**d), d, run["seeds"], run["init_phi"],
+                                                      attrs={"d": d}, slp=slp_flags(SLP_DENSEST), slp_minutes=30)
+    if SLP_ORDER:
+        for k, setting in enumerate(SLP_ORDER["settings"]):
+            n = order_map_n(k)
+            systems["slp_order_map"][f"n{n}"] = _system(n, 3, SLP_ORDER["seeds"], SLP_ORDER["init_phi"], attrs={})
+            systems["slp_order_map"][f"s{k}"] = _system(
+                n, 3, SLP_ORDER["seeds"], start=f"results/slp_order_map/n{n}/init/seed{{seed}}.nc",
+                attrs={"setting": k}, slp=slp_flags(setting), slp_minutes=20)
+    if SLP_DILUTED:
+        name, ens = SLP_DILUTED["ensemble"], ENSEMBLES[SLP_DILUTED["ensemble"]]
+        systems["slp_diluted"][name] = _system(
+            ens["N"], ens["d"], SLP_DILUTED["seeds"], start=f"results/slp_mrj/{name}/slp/seed{{seed}}.nc",
+            rounds=SLP_DILUTED["rounds"], slp=slp_flags(SLP_MRJ),
+            dilute=f"--fraction {SLP_DILUTED['fraction']} --rounds {SLP_DILUTED['rounds']}")
+    return systems
+
+
+SYSTEMS = _systems()
+#: the packing step each study's verdicts judge
+PACKED = {"ls": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted": "slp"}
+
+
+def system(wildcards):
+    """The spec of the system {study}/{name} of a job."""
+    return SYSTEMS[wildcards.study][wildcards.name]
+
+
+def seed_files(study, name, step):
+    """One file per seed of a system: results/{study}/{name}/{step}/seed{seed}.nc."""
+    return [f"results/{study}/{name}/{step}/seed{seed}.nc" for seed in SYSTEMS[study][name]["seeds"]]
+
+
+def attr_options(attrs):
+    """`--attr KEY=VALUE` options, quoted for the shell."""
+    return " ".join(f"--attr {shlex.quote(f'{key}={value}')}" for key, value in attrs.items())
+
+
+def start_packing(wildcards):
+    """The packing a generator job starts from: the system's own init file unless it names another."""
+    start = system(wildcards).get("start", f"results/{wildcards.study}/{wildcards.name}/init/seed{{seed}}.nc")
+    return start.format(seed=wildcards.seed)
+
+
+def packed_file(wildcards):
+    """The packing a verdict judges: results/{study}/{name}/{packed step}/{sample}.nc."""
+    return f"results/{wildcards.study}/{wildcards.name}/{PACKED[wildcards.study]}/{wildcards.sample}.nc"
+
+
+def sample_seed(wildcards):
+    """The seed of a sample (seed{seed} or seed{seed}/round{r})."""
+    return int(re.match(r"seed(\d+)", wildcards.sample).group(1))
+
+
+def checkpoint_beside(wildcards, output):
+    """params function: the checkpoint of a resumable job, beside its first output (.nc -> .ckpt);
+    a killed job started again resumes from it, and the job removes it when it succeeds."""
+    return output[0].removesuffix(".nc") + ".ckpt"
+
+
+def diluted_rounds(name):
+    return range(1, SYSTEMS["slp_diluted"][name]["rounds"] + 1)
+
+
+def diluted_files(name, step):
+    """The MRJ start (round 0) and every round of every diluted seed: packings (step 'slp') or
+    their verdicts (step 'verdict')."""
+    return [path for seed in SYSTEMS["slp_diluted"][name]["seeds"] for path in (
+        [f"results/slp_mrj/{name}/{step}/seed{seed}.nc"]
+        + [f"results/slp_diluted/{name}/{step}/seed{seed}/round{r}.nc" for r in diluted_rounds(name)])]
+
+
+def order_map_files(step):
+    """Files of every order-map run (setting s{k}), in setting order."""
+    return [path for name, spec in SYSTEMS["slp_order_map"].items() if "slp" in spec
+            for path in seed_files("slp_order_map", name, step)]
+
+
+# Resources of the generic jobs, from the system's N.
+
+def ls_mem_mb(wildcards):
+    return 500 + system(wildcards)["N"] // 5
+
+
+def ls_runtime(wildcards):
+    """Minutes: the slow final stage costs ~N / 20 minutes on one core (3D, Gamma_f = 1e-4)."""
+    return 30 + system(wildcards)["N"] // 10
+
+
+def lp_mem_mb(wildcards):
+    return 1000 + system(wildcards)["N"]
+
+
+def lp_threads(wildcards):
+    """Loading sequences run side by side (hardpack verify --workers) for large packings, whose
+    strict sequences take a minute or more each (N = 1e4 in 3D: 1-1.5 min, 2-3 LPs)."""
+    return 2 if system(wildcards)["N"] >= 5000 else 1
+
+
+def lp_runtime(wildcards):
+    """Minutes: collective + strict tests take ~10 s at N = 1000 (benchmarks/bench_jamming.py)."""
+    return 10 + system(wildcards)["N"] // 200
+
+
+# ---------------------------------------------------------------------------------------------
+# Free energies (BCMD, Donev, Stillinger & Torquato 2007) and the polydisperse study (Ogarko ch. 3).
+
+PHI_CP = math.pi / math.sqrt(18)
+
+
+def fcc_dmu_max(phi):
+    """Initial cell size: the paper's 1 at melting, 10 disjoint-cell points near jamming."""
+    return min(1.0, 10.0 * ((PHI_CP / float(phi)) ** (1 / 3) - 1))
+
+
+def bcmd_options(wildcards):
+    """`hardpack bcmd` size options of an FCC condition: the melting density (phi = 0.545), the
+    jamming limit (delta = 1e-6), or one density phi{phi} of the free energy vs density."""
+    if wildcards.condition == "melting":
+        return "--phi 0.545 --dmu-max 1 --theta 1"
+    if wildcards.condition == "jamming":
+        return "--delta 1e-6 --dmu-max 1e-5 --theta 0.5"
+    phi = wildcards.condition.removeprefix("phi")
+    return f"--phi {phi} --dmu-max {fcc_dmu_max(phi)} --theta 1"
+
+
+def bcmd_files(condition):
+    if condition in ("melting", "jamming"):
+        return [f"results/bcmd_fcc/reps{reps}/{condition}/seed{seed}.nc"
+                for reps in FREEENERGY["fcc_reps"] for seed in FREEENERGY["seeds"]]
+    dens = FREEENERGY["density"]
+    if condition == "density":
+        return [f"results/bcmd_fcc/reps{dens['reps']}/phi{phi}/seed{seed}.nc"
+                for phi in dens["phi"] for seed in dens["seeds"]]
+    return [f"results/bcmd_fcc/reps{dens['reps']}/eos/phi{phi}.nc" for phi in dens["phi"]]
+
+
+def simplex_files(ensemble):
+    return [f"results/bcmd_simplex/{ensemble}/{frozen}/seed{seed}.nc"
+            for seed in FREEENERGY["simplex"]["seeds"] for frozen in ("particle", "cm")]
+
+
+#: jam protocols of the polydisperse study by study name: the equivalence runs and the slow
+#: crystallisation runs, and their `hardpack eos-summary --kind`
+POLY_PROTOCOLS = {"phij": POLY.get("jam", {}), "crystallisation": POLY.get("crystallisation", {})}
+POLY_SUMMARY_KIND = {"phij": "jam", "crystallisation": "crystallisation"}
+POLY_FLUID = POLY.get("fluid", {})
+POLY_SYSTEMS = ["poly", "bi", "tri"]
+POLY_WIDTH_NAME = {"uniform_size": "omega", "uniform_volume": "omega", "lognormal": "sigma"}
+POLY_FAMILY = "uniform_size|uniform_volume|lognormal"
+POLY_WIDTH = r"[0-9]+(\.[0-9]+)?"
+
+
+def poly_width(value):
+    return f"{float(value):g}"
+
+
+def poly_spec(wildcards):
+    """The size distribution (JSON) of a polydisperse case {family}_w{width}."""
+    return json.dumps({"kind": wildcards.family, POLY_WIDTH_NAME[wildcards.family]: float(wildcards.width)})
+
+
+def poly_protocol(wildcards):
+    return POLY_PROTOCOLS[wildcards.protocol]
+
+
+def poly_jam_files(protocol, family):
+    runs = POLY_PROTOCOLS[protocol]
+    return [f"results/poly_{protocol}/{family}_w{poly_width(w)}/{member}/seed{seed}.nc"
+            for w in runs["widths"][family] for seed in runs["seeds"] for member in POLY_SYSTEMS]
+
+
+def poly_jam_mem_mb(wildcards):
+    return 500 + poly_protocol(wildcards)["N"] // 5
+
+
+def poly_jam_runtime(wildcards):
+    """Minutes for one system. Measured: 3-11 CPU s at N = 500 (US omega = 2 and 10, final Gamma =
+    0.002), 6-7 CPU min at final Gamma = 2e-5 and 13-18 at 1e-5; the collisions grow as N / Gamma, and
+    the budget is ~20x the measured time at Gamma = 0.002, for loaded machines and wide UV
+    distributions."""
+    runs = poly_protocol(wildcards)
+    return 10 + int(runs["N"] // 100 * max(1.0, 0.002 / runs["final_growth_rate"]))
+
+
+def poly_fluid_runtime(wildcards):
+    """Minutes: 3 systems x len(phi) runs of `collisions` collisions at ~1e6 collisions per CPU second."""
+    runs = 3 * len(POLY_FLUID["phi"])
+    return 10 + runs * (POLY_FLUID["collisions"] + 50 * POLY_FLUID["N"]) // 2_000_000
+
+
+# ---------------------------------------------------------------------------------------------
+# Summaries: results/{key}_summary.nc. COMBINED are written by `hardpack combine` (the per-seed
+# files as one Dataset indexed by their attributes), EOS_SUMMARIES by `hardpack eos-summary`.
+
+JAMMING_VARIABLES = ("z_mean", "rattler_fraction", "isostaticity_gap", "local", "collective", "strict",
+                     "fallback_lp_default_tolerances", "fallback_lp_working_set_to_highs",
+                     "fallback_uniform_forces_lp_failed")
+
+
+def _combined(inputs, index, variables=(), attrs=None):
+    options = [f"--index {' '.join(index)}", *(f"--variable {v}" for v in variables), attr_options(attrs or {})]
+    return {"inputs": inputs, "options": " ".join(o for o in options if o)}
+
+
+def _combined_summaries():
+    table = {}
+    for name, spec in SYSTEMS["ls"].items():
+        attrs = {"ensemble": name, "distribution": json.dumps(spec["distribution"])}
+        table[f"ls/{name}/init"] = _combined(seed_files("ls", name, "init"), ["seed"], ["init_phi"],
+                                             {"ensemble": name})
+        table[f"ls/{name}/jammed"] = _combined(seed_files("ls", name, "jammed"), ["seed"],
+                                               ["Z", "phi_J_est", "collisions", "wall_time", "growth_rate"], attrs)
+        table[f"ls/{name}/verdict"] = _combined(seed_files("ls", name, "verdict"), ["seed"], JAMMING_VARIABLES, attrs)
+    for name, spec in SYSTEMS["slp_mrj"].items():
+        attrs = {"ensemble": name, "distribution": json.dumps(spec["distribution"])}
+        table[f"slp_mrj/{name}/slp"] = _combined(seed_files("slp_mrj", name, "slp"), ["seed"],
+                                                 ["n_steps", "wall_seconds", "cpu_seconds"], attrs)
+        table[f"slp_mrj/{name}/verdict"] = _combined(seed_files("slp_mrj", name, "verdict"), ["seed"],
+                                                     JAMMING_VARIABLES, attrs)
+    if SLP_DENSEST:
+        table["slp_densest/slp"] = _combined(
+            [path for name in SYSTEMS["slp_densest"] for path in seed_files("slp_densest", name, "slp")],
+            ["d", "seed"], ["n_steps", "n_rejected", "wall_seconds", "cpu_seconds", "converged"])
+    if FREEENERGY:
+        for state in ("melting", "jamming"):
+            table[f"bcmd_fcc/{state}"] = _combined(bcmd_files(state), ["n_particles", "seed"],
+                                                   ["delta_f", "excess", "f", "n_events", "seconds"], {"state": state})
+        table["bcmd_fcc/density"] = _combined(bcmd_files("density"), ["phi", "seed"],
+                                              ["delta_f", "excess", "n_particles", "n_events", "seconds"],
+                                              {"state": "density"})
+        table["bcmd_fcc/eos"] = _combined(bcmd_files("eos"), ["phi"], ["Z", "Z_err", "N", "wall_time"], {"state": "eos"})
+        ensemble = FREEENERGY["simplex"]["ensemble"]
+        table[f"bcmd_simplex/{ensemble}/simplex"] = _combined(
+            simplex_files(ensemble), ["seed", "frozen"],
+            ["exact", "bcmd", "rel_diff", "isostatic", "isostaticity_gap", "n_backbone", "dim", "n_events",
+             "seconds_bcmd", "next_gap"])
+    return table
+
+
+def _eos_summaries():
+    table = {}
+    for protocol, runs in POLY_PROTOCOLS.items():
+        for family in runs.get("widths", {}):
+            table[f"poly_{protocol}/{family}"] = {"inputs": poly_jam_files(protocol, family),
+                                                  "kind": POLY_SUMMARY_KIND[protocol]}
+    if POLY_FLUID.get("widths"):
+        table["poly_fluid/fluid"] = {"kind": "fluid", "inputs": [
+            f"results/poly_fluid/{family}_w{poly_width(w)}/fluid.nc"
+            for family, widths in POLY_FLUID["widths"].items() for w in widths]}
+    return table
+
+
+COMBINED = _combined_summaries()
+EOS_SUMMARIES = _eos_summaries()
+
+
+def summary(key):
+    return f"results/{key}_summary.nc"
+
+
+def one_of(keys):
+    """A wildcard constraint matching exactly ``keys`` (never an empty match)."""
+    return "|".join(re.escape(k) for k in keys) or "(?!)"
+
+
+# ---------------------------------------------------------------------------------------------
+# Final outputs: the figures the config enables, the summaries the validation report reads (by
+# row builder, hardpack.validation.cli.ROW_BUILDERS), and the validation gate.
+
+def monodisperse_ensembles():
+    return [name for name, ens in ENSEMBLES.items() if ens["distribution"]["kind"] == "monodisperse"]
+
+
+def structure_files():
+    return [path for name in SYSTEMS["ls"] for path in seed_files("ls", name, "structure")]
+
+
+def rate_timeseries():
+    return [path for name in SYSTEMS["ls_rates"] for path in seed_files("ls_rates", name, "timeseries")]
+
+
+def figures():
+    """The figures the config enables (results/figures/*.pdf; each has a .png beside it)."""
+    names = ["size_distributions"]
+    names += ["jamming_vs_d"] if monodisperse_ensembles() else []
+    names += ["ls_rates_phij", "ls_rates_eos"] if RATES else []
+    names += [f"structure_{kind}" for kind in ("g2", "zl", "sk", "channels")]
+    names += ["slp_densest"] if SLP_DENSEST else []
+    names += ["slp_vs_ls"] if SLP_MRJ else []
+    names += ["slp_order_map"] if SLP_ORDER or SLP_DILUTED else []
+    names += ["bcmd_fcc", "bcmd_fcc_density"] if FREEENERGY else []
+    names += ["phij_vs_omega"] if POLY_PROTOCOLS["phij"].get("widths") else []
+    names += ["crystallisation_vs_omega"] if POLY_PROTOCOLS["crystallisation"].get("widths", {}).get("uniform_size") else []
+    names += ["eos_vs_bmcsl"] if POLY_FLUID.get("widths") else []
+    return [f"results/figures/{name}.pdf" for name in names]
+
+
+def validation_inputs():
+    """Row-builder name -> the summaries it reads, for every study the config enables."""
+    inputs = {
+        "ls": [summary(f"ls/{name}/jammed") for name in SYSTEMS["ls"]],
+        "jamming": [summary(f"ls/{name}/verdict") for name in SYSTEMS["ls"]],
+        "structure": structure_files(),
+    }
+    if SLP_DENSEST:
+        inputs["slp_densest"] = [summary("slp_densest/slp")]
+    if SLP_MRJ:
+        inputs["slp_mrj"] = [summary(f"slp_mrj/{name}/slp") for name in SYSTEMS["slp_mrj"]]
+        inputs["slp_jamming"] = [summary(f"slp_mrj/{name}/verdict") for name in SYSTEMS["slp_mrj"]]
+    if SLP_ORDER:
+        inputs["slp_order_map"] = [summary("slp_order_map/order_map")]
+    if SLP_DILUTED:
+        inputs["slp_diluted"] = [summary(f"slp_diluted/{SLP_DILUTED['ensemble']}/diluted")]
+    if FREEENERGY:
+        inputs["bcmd"] = [summary("bcmd_fcc/melting"), summary("bcmd_fcc/jamming")]
+        inputs["bcmd_density"] = [summary("bcmd_fcc/density"), summary("bcmd_fcc/eos")]
+        inputs["bcmd_simplex"] = [summary(f"bcmd_simplex/{FREEENERGY['simplex']['ensemble']}/simplex")]
+        inputs["bcmd_ladder"] = ["results/bcmd_ladder/ladder.nc"]
+    poly = [summary(key) for key in EOS_SUMMARIES]
+    if poly:
+        inputs["polydisperse"] = poly
+    return inputs
+
+
+def validation_arguments():
+    """The `hardpack validate` inputs NAME=PATH."""
+    return " ".join(f"{name}={path}" for name, paths in validation_inputs().items() for path in paths)
+
+
+def final_outputs():
+    """What `all` builds: every LS ensemble's summaries, the figures, the validation inputs and the gate."""
+    outputs = [summary(f"ls/{name}/{step}") for name in SYSTEMS["ls"] for step in ("init", "jammed", "verdict")]
+    outputs += figures()
+    outputs += [path for paths in validation_inputs().values() for path in paths]
+    outputs.append("results/validation/gate.txt")
+    return list(dict.fromkeys(outputs))
