@@ -119,19 +119,24 @@ def test_refuses_bad_input():
     levels = build_grid(s, np.eye(3) * 7, r).levels
     with pytest.raises(InvalidInputError, match="assign the levels again"):
         build_grid(s[:5], np.eye(3) * 7, r[:5], levels=levels)
+    with pytest.raises(InvalidInputError, match="in \\[0, 1\\) along the periodic axes"):
+        build_grid(s + 1.0, np.eye(3) * 7, r)
+    with pytest.raises(InvalidInputError, match="periodic must be 3 booleans"):
+        build_grid(s, np.eye(3) * 7, r, periodic=[True, False])
+    build_grid(s + [0.0, 0.0, 1.0], np.eye(3) * 7, r, periodic=np.array([True, True, False]))  # not wrapped
 
 
 def test_rsa_places_everything_without_overlap():
-    """RSA of UV omega = 20 at phi = 0.5 (largest first): no pair closer than contact, but many
-    near contact (RSA is dense here)."""
+    """RSA of UV omega = 20 at phi = 0.5 (largest first), checked by cKDTree: no pair closer than contact,
+    but many near contact (RSA is dense here); the same seed gives the same packing, another seed another."""
     r = uniform_volume(20.0).sample(20000, np.random.default_rng(2))
     box = np.full(3, (ball_volume(r, 3).sum() / 0.5) ** (1 / 3))
     x = random_sequential_addition(r, box, seed=5)
     assert np.all((x >= 0) & (x < box))
-    assert len(search(x, r, box)[0]) == 0  # the search itself is checked against cKDTree above
-    assert len(search(x, r, box, skin=0.05)[0]) > 1000
-    again = random_sequential_addition(r, box, seed=5)
-    assert np.array_equal(x, again)
+    assert len(reference_pairs(x, r * (1 - 1e-12), box, 0.0)) == 0
+    assert len(reference_pairs(x, r, box, 0.05)) > 1000
+    assert np.array_equal(x, random_sequential_addition(r, box, seed=5))
+    assert not np.array_equal(x, random_sequential_addition(r, box, seed=6))
 
 
 def test_rsa_refuses_above_saturation():

@@ -3,7 +3,9 @@
 The reference loops over every pair i <= j and every lattice image n that can matter (|n_k| <=
 range / h_k + 1, h_k the perpendicular widths of the cell) and keeps |x_j + L n - x_i| within range: O(N^2)
 per image, no cells, no levels. Cells are random and sheared, radii polydisperse up to omega = 50 (several
-hierarchical levels), and small cells put a particle next to its own images.
+hierarchical levels), and small cells put a particle next to its own images. The packing model decides what
+is searched: images only along the periodic axes of the boundary (none across hard walls, none in a
+spherical container), and the bounding radii of the shape (ellipsoids).
 """
 
 import itertools
@@ -12,19 +14,21 @@ import numpy as np
 import pytest
 
 from hardpack.distributions import uniform_size, uniform_volume
-from hardpack.geometry import Packing, pairs_within
+from hardpack.geometry import HardWalls, Packing, SphericalContainer, pairs_within
 from hardpack.geometry.balls import ball_volume
 from hardpack.geometry.neighbours import build_grid
+from hardpack.geometry.shapes import Ellipsoids
 
 
 def brute_force(packing, rel_gap=0.0, cutoff=None):
-    """{(i, j, n): distance} of every pair i < j, and i == j with n lexicographically positive."""
+    """{(i, j, n): distance} of every pair i < j, and i == j with n lexicographically positive; images n
+    along the periodic axes only, r the bounding radii."""
     lat = packing.lattice
     x = packing.fractional() @ lat.T
-    r = packing.radii
+    r = packing.shape.bounding_radii
     reach = cutoff if cutoff is not None else (1.0 + rel_gap) * 2.0 * r.max()
     heights = 1.0 / np.linalg.norm(np.linalg.inv(lat), axis=1)
-    ks = np.ceil(reach / heights).astype(int) + 1
+    ks = np.where(packing.boundary.periodic_axes(packing.dim), np.ceil(reach / heights).astype(int) + 1, 0)
     upper = np.triu(np.ones((len(r), len(r)), dtype=bool))
     limit = cutoff if cutoff is not None else (1.0 + rel_gap) * (r[:, None] + r[None, :])
     found = {}
@@ -120,3 +124,60 @@ def test_contacts_of_small_cells_with_self_images():
     p = Packing(np.array([[0.3, 0.6]]), np.array([0.5]), np.eye(2))
     pl = check(p, rel_gap=1e-9)
     assert len(pl) == 2 and set(map(tuple, pl.shift.tolist())) == {(0, 1), (1, 0)}
+
+
+def walled_packing(n, d, walls, phi, seed):
+    """Random polydisperse centres between hard walls on ``walls``: the walled lattice vectors L_k e_k, the
+    periodic ones sheared among themselves; some centres a little outside the walls (overlapping input)."""
+    rng = np.random.default_rng(seed)
+    radii = rng.permutation(uniform_volume(10.0).sample(n, rng))
+    periodic = np.ones(d, dtype=bool)
+    periodic[list(walls)] = False
+    lat = np.eye(d) + 0.7 * rng.uniform(-1.0, 1.0, (d, d)) * np.outer(periodic, periodic)
+    lat *= (ball_volume(radii, d).sum() / phi / abs(np.linalg.det(lat))) ** (1.0 / d)
+    s = rng.random((n, d)) * 1.1 - 0.05
+    s[:, periodic] = s[:, periodic] * 3.0 - 1.0
+    return Packing(s @ lat.T, radii, lat, boundary=HardWalls(walls), allow_overlap=True)
+
+
+@pytest.mark.parametrize("d, walls", [(2, (0,)), (3, (2,)), (3, (0, 1)), (3, (0, 1, 2)), (4, (1, 3))])
+def test_hard_walls_have_no_images_across_them(d, walls):
+    """Images only along the periodic axes: a periodic search of the same cell finds pairs across the walls
+    that the walled search must not report."""
+    p = walled_packing(300 if d < 4 else 150, d, walls, 0.3, seed=d + len(walls))
+    pl = check(p, rel_gap=0.2)
+    assert np.all(pl.shift[:, list(walls)] == 0)
+    periodic = pairs_within(p.replace(boundary="periodic", positions=p.fractional().clip(0, 0.999) @ p.lattice.T),
+                            rel_gap=0.2)
+    assert np.any(periodic.shift[:, list(walls)] != 0)  # the comparison is not vacuous
+    check(p, cutoff=2.5 * p.radii.max())
+
+
+def test_spherical_container_has_no_images():
+    rng = np.random.default_rng(4)
+    radii = uniform_volume(5.0).sample(400, rng)
+    box = np.array([10.0, 10.0, 10.0])
+    p = Packing(rng.random((400, 3)) * box, radii * 0.6, np.diag(box),
+                boundary=SphericalContainer((5.0, 5.0, 5.0), 5.0), allow_overlap=True)
+    pl = check(p, rel_gap=0.5)
+    assert len(pl) > 100 and np.all(pl.shift == 0)
+
+
+def test_a_disk_between_walls_touches_only_its_periodic_images():
+    """A disk of radius 1/2 in a unit cell with walls on x: one self-contact (along y), not two."""
+    p = Packing(np.array([[0.5, 0.3]]), np.array([0.5]), np.eye(2), boundary=HardWalls((0,)))
+    pl = check(p, rel_gap=1e-9)
+    assert pl.shift.tolist() == [[0, 1]]
+
+
+def test_ellipsoids_are_searched_by_their_bounding_spheres():
+    """Pairs of ellipsoids are the pairs of their bounding spheres (radius = the largest semiaxis)."""
+    rng = np.random.default_rng(5)
+    axes = rng.uniform(0.2, 1.0, (300, 3))
+    q = rng.normal(size=(300, 4))
+    shape = Ellipsoids(axes, q / np.linalg.norm(q, axis=1)[:, None])
+    lat = np.array([[9.0, 2.0, 0.0], [0.0, 8.0, 1.0], [0.0, 0.0, 10.0]])
+    p = Packing(rng.random((300, 3)) @ lat.T, lattice=lat, shape=shape, allow_overlap=True)
+    pl = check(p)
+    assert len(pl) > 50
+    np.testing.assert_array_equal(pl.contact, axes.max(axis=1)[pl.i] + axes.max(axis=1)[pl.j])

@@ -331,24 +331,6 @@ class Packing:
         return self.minimum_image(self.positions[j] - self.positions[i])
 
     # ------------------------------------------------------------------ overlaps
-    def _search_spheres(self) -> "Packing":
-        """A periodic sphere packing whose pairs within contact are the candidate pairs of this one:
-        the packing itself for spheres in a periodic cell; otherwise the bounding spheres, with the
-        walled lattice vectors stretched so that no image across a wall comes within range
-        (centres inside the walls keep their coordinates bit for bit)."""
-        if self.shape.kind == "sphere" and self.boundary.kind == "periodic":
-            return self
-        radii = self.shape.bounding_radii
-        x, lat = self.positions, self.lattice
-        walled = np.flatnonzero(~self.boundary.periodic_axes(self.dim))
-        if len(walled):
-            x, lat = x.copy(), lat.copy()
-            reach = 4.0 * radii.max()  # > the pair search range 2 r_max
-            for k in walled:
-                x[:, k] -= min(0.0, x[:, k].min())
-                lat[k, k] = max(lat[k, k], x[:, k].max()) + reach
-        return Packing(x, radii, lat, allow_overlap=True)
-
     def overlap_report(self, tol: float = DEFAULT_OVERLAP_TOL) -> OverlapReport:
         """Count pairs with distance < (r_i + r_j)(1 - tol), with every periodic image.
 
@@ -359,7 +341,7 @@ class Packing:
         """
         from hardpack.geometry.neighbours import pairs_within
 
-        pairs = pairs_within(self._search_spheres(), rel_gap=0.0)
+        pairs = pairs_within(self, rel_gap=0.0)  # bounding spheres, images along periodic axes only
         if self.shape.kind != "sphere":
             undecided = np.flatnonzero(pairs.distance < pairs.contact)
             if len(undecided):

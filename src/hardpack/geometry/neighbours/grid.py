@@ -20,6 +20,11 @@ once, self-images and several images of one neighbour included, even when the ra
 cell (small cells, sheared cells). A level with more than ``max_cells_per_particle`` cells per particle
 on it gets proportionally fewer, larger cells (:func:`cell_counts`).
 
+Axes without periodic images (hard walls, a spherical container: ``periodic[k]`` False) have no
+images: their cell index is clamped to [0, n_k - 1], for points and search ranges alike, so a point
+outside the cell along such an axis (an overlapping configuration) sits in the nearest boundary cell
+and is still found.
+
 Particles are sorted by (level, cell): those of flat cell c (levels one after the other, each in C order)
 are order[cell_start[c]:cell_start[c + 1]] (compressed rows; Ogarko uses a hash table of linked lists).
 Incremental use (random sequential addition, :mod:`.rsa`) keeps linked lists over the same cells instead.
@@ -75,6 +80,7 @@ class Grid:
     """Particles of a periodic cell sorted into the cells of their levels (module docstring).
 
     ``x`` are the wrapped Cartesian centres frac @ lattice.T that pair separations refer to;
+    ``periodic[k]`` says whether lattice vector k is a period (images exist along it);
     ``level_reach[h]`` is the largest interaction radius on level h; ``n_cells[h, k]`` the cells of
     level h along lattice vector k; ``strides`` their flat-index strides and ``cell_offset[h]`` the
     first flat index of level h.
@@ -82,6 +88,7 @@ class Grid:
 
     lattice: np.ndarray  # (d, d), columns are the lattice vectors
     heights: np.ndarray  # (d,)
+    periodic: np.ndarray  # (d,) bool
     frac: np.ndarray  # (N, d) in [0, 1)
     x: np.ndarray  # (N, d)
     reach: np.ndarray  # (N,) interaction radii
@@ -104,9 +111,10 @@ class Grid:
 
 
 def _flat_cells(frac, level, n_cells, strides, cell_offset) -> np.ndarray:
-    """Flat cell index of fractional points (M, d) in [0, 1) on the given levels (M,)."""
+    """Flat cell index of fractional points (M, d) on the given levels (M,): floor(s n) clamped to
+    [0, n - 1] (points outside [0, 1) only along axes without images)."""
     n = n_cells[level]
-    coords = np.minimum((frac * n).astype(np.int64), n - 1)
+    coords = np.clip(np.floor(frac * n), 0, n - 1).astype(np.int64)
     return cell_offset[level] + np.sum(coords * strides[level], axis=1)
 
 
@@ -115,14 +123,16 @@ def perpendicular_widths(lattice) -> np.ndarray:
     return 1.0 / np.linalg.norm(np.linalg.inv(lattice), axis=1)
 
 
-def build_grid(frac, lattice, reach, *, levels=None, K: float = 0.3, per_cell: int = 1,
+def build_grid(frac, lattice, reach, *, periodic=None, levels=None, K: float = 0.3, per_cell: int = 1,
                max_cells_per_particle: float = MAX_CELLS_PER_PARTICLE) -> Grid:
     """Sort points with interaction radii ``reach`` into the hierarchical grid (module docstring).
 
-    frac: (N, d) fractional coordinates in [0, 1) (e.g. ``Packing.fractional()``); lattice: (d, d) with the
-    lattice vectors as columns. levels: None for the optimal number of levels (Eq. 2.7 with this K), an
-    integer L (1: the single-level linked-cell grid) or a :class:`LevelAssignment` of these radii.
-    per_cell: cells per nominal cell size (2 halves the cells: fewer distance tests for long ranges).
+    frac: (N, d) fractional coordinates, in [0, 1) along the periodic axes (e.g. ``Packing.fractional()``);
+    lattice: (d, d) with the lattice vectors as columns. periodic: (d,) booleans, the lattice vectors that
+    are periods (default: all; e.g. ``Packing.boundary.periodic_axes(d)``). levels: None for the optimal
+    number of levels (Eq. 2.7 with this K), an integer L (1: the single-level linked-cell grid) or a
+    :class:`LevelAssignment` of these radii. per_cell: cells per nominal cell size (2 halves the cells:
+    fewer distance tests for long ranges).
     """
     frac = np.ascontiguousarray(frac, dtype=float)
     lattice = np.ascontiguousarray(lattice, dtype=float)
@@ -130,6 +140,13 @@ def build_grid(frac, lattice, reach, *, levels=None, K: float = 0.3, per_cell: i
     n, d = frac.shape
     if reach.shape != (n,) or not (np.isfinite(reach).all() and (reach > 0).all()):
         raise InvalidInputError(f"interaction radii must be {n} positive finite numbers")
+    periodic = np.ones(d, dtype=bool) if periodic is None else np.asarray(periodic)
+    if periodic.shape != (d,) or periodic.dtype != bool:
+        raise InvalidInputError(f"periodic must be {d} booleans (one per lattice vector), got {periodic!r}")
+    wrapped = frac[:, periodic]
+    if not (np.isfinite(frac).all() and (wrapped >= 0).all() and (wrapped < 1).all()):
+        raise InvalidInputError("fractional coordinates must be finite and in [0, 1) along the periodic axes: "
+                                "wrap them (Packing.fractional() does)")
     heights = perpendicular_widths(lattice)
     volume = float(abs(np.linalg.det(lattice)))
     assignment = choose_levels(reach, volume, d, levels, K)
@@ -140,7 +157,7 @@ def build_grid(frac, lattice, reach, *, levels=None, K: float = 0.3, per_cell: i
     cell_offset = np.concatenate([[0], np.cumsum(np.prod(n_cells, axis=1))]).astype(np.int64)
     flat = _flat_cells(frac, level, n_cells, strides, cell_offset)
     cell_start = np.concatenate([[0], np.cumsum(np.bincount(flat, minlength=int(cell_offset[-1])))])
-    return Grid(lattice=lattice, heights=heights, frac=frac, x=frac @ lattice.T, reach=reach,
+    return Grid(lattice=lattice, heights=heights, periodic=periodic, frac=frac, x=frac @ lattice.T, reach=reach,
                 levels=assignment, level_reach=0.5 * assignment.cell_sizes, n_cells=n_cells,
                 strides=strides, cell_offset=cell_offset, cell_start=cell_start.astype(np.int64),
                 order=np.argsort(flat, kind="stable").astype(np.int64))
@@ -164,6 +181,17 @@ def search_range(s, beta, inv_heights, n_cells, h, lo, hi):
         w = beta * inv_heights[k]
         lo[k] = int(np.floor((s[k] - w) * n_cells[h, k]))
         hi[k] = int(np.floor((s[k] + w) * n_cells[h, k]))
+
+
+@numba.njit(cache=True)
+def clamp_range(periodic, n_cells, h, lo, hi):
+    """Clamp the cell range [lo, hi] of level h to the stored cells [0, n - 1] along the axes without
+    images (``periodic[k]`` False), where cell indices are clamped the same way."""
+    for k in range(lo.shape[0]):
+        if not periodic[k]:
+            top = n_cells[h, k] - 1
+            lo[k] = min(max(lo[k], 0), top)
+            hi[k] = min(max(hi[k], 0), top)
 
 
 @numba.njit(cache=True)
@@ -201,13 +229,13 @@ def _grow(buf, m):
 
 
 @numba.njit(cache=True)
-def pair_kernel(frac, x, lattice, inv_heights, reach, level, level_reach, n_cells, strides, cell_offset,
-                cell_start, pad):
+def pair_kernel(frac, x, lattice, inv_heights, periodic, reach, level, level_reach, n_cells, strides,
+                cell_offset, cell_start, pad):
     """Every pair of points with |x_q + lattice @ n - x_p| <= (a_p + a_q) pad, each once (Top-Down,
     Ogarko Sec. 2.1.2): a point searches its own level and every lower one, in the cells of the search
     box of half-width beta = a_p + (largest a on that level) (Eq. 2.4, with the level's actual largest
     radius). On its own level it keeps partners q > p and its own images n with the first non-zero n_k
-    positive.
+    positive. Along axes without images (``periodic[k]`` False) the range is clamped to the stored cells.
 
     The points must be sorted by flat cell (the arrays in the order of the grid's ``order``;
     ``cell_start`` indexes them directly). Cells are visited a row (along the last lattice direction,
@@ -231,6 +259,7 @@ def pair_kernel(frac, x, lattice, inv_heights, reach, level, level_reach, n_cell
         h = level[p]
         for lv in range(h + 1):
             search_range(frac[p], (reach[p] + level_reach[lv]) * pad, inv_heights, n_cells, lv, lo, hi)
+            clamp_range(periodic, n_cells, lv, lo, hi)
             n_last = n_cells[lv, last]
             for k in range(d):
                 c[k] = lo[k]

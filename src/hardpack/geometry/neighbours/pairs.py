@@ -1,6 +1,10 @@
-"""Periodic pair lists: every pair (i, j, image n) with |x_j + L n - x_i| <= (1 + rel_gap)(r_i + r_j), or
+"""Pair lists: every pair (i, j, image n) with |x_j + L n - x_i| <= (1 + rel_gap)(r_i + r_j), or
 <= a fixed cutoff.
 
+The packing says what to search: the radii r are its shape's bounding radii
+(``packing.shape.bounding_radii``: the radii of spheres; for other shapes the pairs are candidates whose
+bounding spheres come within range), and images n exist only along the periodic axes of its boundary
+(``packing.boundary.periodic_axes``; none in a spherical container, none across hard walls).
 All periodic images are included, so a particle's contact with its own image (small cells, e.g. SLP
 packings of N = 3^d spheres) and several images of the same neighbour are found, in cells of any shape.
 Each unordered contact appears once: pairs with i < j (any n), and self-images i == j with n
@@ -21,14 +25,15 @@ from hardpack.geometry.neighbours.grid import RANGE_PAD, Grid, build_grid, pair_
 @dataclass(frozen=True)
 class PairList:
     """Pairs within range, sorted by (i, j, shift). ``separation[k] = x_j + lattice @ shift[k] - x_i``
-    (Cartesian, x the wrapped centres of :func:`wrapped_positions`)."""
+    (Cartesian, x the wrapped centres of :func:`wrapped_positions`); ``contact[k]`` = r_i + r_j of the
+    bounding radii (the sphere radii for spheres)."""
 
     i: np.ndarray
     j: np.ndarray
     shift: np.ndarray  # (M, d) integer lattice images
     separation: np.ndarray  # (M, d)
     distance: np.ndarray  # (M,)
-    contact: np.ndarray  # (M,) r_i + r_j
+    contact: np.ndarray  # (M,) r_i + r_j (bounding radii)
 
     def __len__(self) -> int:
         return len(self.i)
@@ -66,7 +71,7 @@ def grid_pairs(grid: Grid) -> GridPairs:
     d = grid.x.shape[1]
     order = grid.order
     rows, tests, visits = pair_kernel(
-        grid.frac[order], grid.x[order], grid.lattice, 1.0 / grid.heights, grid.reach[order],
+        grid.frac[order], grid.x[order], grid.lattice, 1.0 / grid.heights, grid.periodic, grid.reach[order],
         grid.level.astype(np.int64)[order], grid.level_reach, grid.n_cells, grid.strides, grid.cell_offset,
         grid.cell_start, 1.0 + RANGE_PAD)
     p, q, n = order[rows[:, 0]], order[rows[:, 1]], rows[:, 2:]
@@ -78,12 +83,15 @@ def grid_pairs(grid: Grid) -> GridPairs:
 
 
 def wrapped_positions(packing) -> np.ndarray:
-    """The centres inside the unit cell, frac @ lattice.T, that pair separations refer to."""
+    """The centres frac @ lattice.T that pair separations refer to: inside the unit cell along the periodic
+    axes (``Packing.fractional``)."""
     return packing.fractional() @ packing.lattice.T
 
 
 def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None, *, levels=None) -> PairList:
-    """All pairs with distance <= (1 + rel_gap)(r_i + r_j), or <= ``cutoff`` if given.
+    """All pairs with distance <= (1 + rel_gap)(r_i + r_j), or <= ``cutoff`` if given, with every image
+    along the periodic axes of ``packing.boundary``; r the bounding radii of ``packing.shape`` (module
+    docstring).
 
     ``rel_gap`` is the relative gap tolerance (Donev's contact tolerance, e.g. 1e-9 for contacts
     of an LS packing); ``cutoff`` an absolute centre-distance range (e.g. for g2 or the SLP
@@ -92,7 +100,7 @@ def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None, *, 
     """
     if not np.isfinite(rel_gap) or rel_gap < -1:
         raise InvalidInputError(f"rel_gap must be a finite number >= -1, got {rel_gap}")
-    radii = np.asarray(packing.radii, dtype=float)
+    radii = np.asarray(packing.shape.radii, dtype=float)
     if cutoff is None:
         reach = (1.0 + rel_gap) * radii
         if not reach.max() > 0:
@@ -102,7 +110,8 @@ def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None, *, 
             raise InvalidInputError(f"search cutoff must be positive and finite, got {cutoff}")
         reach = np.full(radii.size, 0.5 * cutoff)
     lattice = np.asarray(packing.lattice, dtype=float)
-    grid = build_grid(packing.fractional(), lattice, reach, levels=levels)
+    grid = build_grid(packing.fractional(), lattice, reach, periodic=packing.boundary.periodic_axes(packing.dim),
+                      levels=levels)
     found = grid_pairs(grid)
     ii, jj, shift = found.i, found.j, found.shift
     x = grid.x
