@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from hardpack.errors import InvalidInputError
@@ -64,11 +65,39 @@ class GridPairs:
         return len(self.i)
 
 
+@numba.njit(cache=True)
+def _separations(x, lattice, i, j, shift):
+    """separation[r] = x[j_r] + lattice @ shift[r] - x[i_r] and its length, in one pass."""
+    m, d = shift.shape
+    separation = np.empty((m, d))
+    distance = np.empty(m)
+    for r in range(m):
+        acc = 0.0
+        for k in range(d):
+            s = x[j[r], k] - x[i[r], k]
+            for b in range(d):
+                s += lattice[k, b] * shift[r, b]
+            separation[r, k] = s
+            acc += s * s
+        distance[r] = np.sqrt(acc)
+    return separation, distance
+
+
+def _pair_order(i, j, n, n_points: int) -> np.ndarray:
+    """The permutation sorting rows by (i, j, n): one stable sort of the key i N + j, and a lexicographic
+    sort only when some (i, j) occurs with several images (ranges wider than half the cell)."""
+    key = i * np.int64(n_points) + j
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    if np.any(key[1:] == key[:-1]):
+        order = np.lexsort(tuple(n[:, k] for k in range(n.shape[1] - 1, -1, -1)) + (j, i))
+    return order
+
+
 def grid_pairs(grid: Grid) -> GridPairs:
     """Every pair with |x_j + L n - x_i| <= a_i + a_j (up to a relative 1e-9 of round-off margin) for the
     interaction radii a of ``grid``, once: i < j, or i == j with n lexicographically positive; sorted by
     (i, j, n)."""
-    d = grid.x.shape[1]
     order = grid.order
     rows, tests, visits = pair_kernel(
         grid.frac[order], grid.x[order], grid.lattice, 1.0 / grid.heights, grid.periodic, grid.reach[order],
@@ -78,7 +107,7 @@ def grid_pairs(grid: Grid) -> GridPairs:
     swap = p > q
     i, j = np.where(swap, q, p), np.where(swap, p, q)
     n[swap] *= -1
-    order = np.lexsort(tuple(n[:, k] for k in range(d - 1, -1, -1)) + (j, i))
+    order = _pair_order(i, j, n, grid.x.shape[0])
     return GridPairs(i[order], j[order], n[order], int(tests), int(visits))
 
 
@@ -100,7 +129,7 @@ def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None, *, 
     """
     if not np.isfinite(rel_gap) or rel_gap < -1:
         raise InvalidInputError(f"rel_gap must be a finite number >= -1, got {rel_gap}")
-    radii = np.asarray(packing.shape.radii, dtype=float)
+    radii = np.asarray(packing.shape.bounding_radii, dtype=float)
     if cutoff is None:
         reach = (1.0 + rel_gap) * radii
         if not reach.max() > 0:
@@ -114,9 +143,7 @@ def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None, *, 
                       levels=levels)
     found = grid_pairs(grid)
     ii, jj, shift = found.i, found.j, found.shift
-    x = grid.x
-    sep = x[jj] - x[ii] + shift @ lattice.T
-    dist = np.sqrt(np.einsum("ij,ij->i", sep, sep))
+    sep, dist = _separations(grid.x, grid.lattice, ii, jj, shift)
     contact = radii[ii] + radii[jj]
     limit = cutoff if cutoff is not None else (1.0 + rel_gap) * contact
     keep = dist <= limit
