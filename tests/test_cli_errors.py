@@ -113,13 +113,13 @@ def test_every_long_command_checks_its_outputs(tmp_path, capsys, start):
     folder = str(tmp_path)
     commands = [
         ["eos", "--init", str(start), "--out", folder, "--seed", "1", "--collisions", "10000000"],
-        ["eos-jam", "--distribution", '{"kind": "monodisperse"}', "--seed", "1", "--systems", "poly",
+        ["poly-jam", "--distribution", '{"kind": "monodisperse"}', "--seed", "1", "--systems", "poly",
          "--out", folder],
         ["slp", "--init", str(start), "--out", folder],
         ["verify", str(start), "--out", folder, "--method", "sequential"],
         ["bcmd", str(start), "--out", folder, "--dmu-max", "1"],
         ["structure", str(start), "--out", folder],
-        ["eos-fluid", "--distribution", '{"kind": "monodisperse"}', "--phi", "0.3", "--seed", "1",
+        ["poly-fluid", "--distribution", '{"kind": "monodisperse"}', "--phi", "0.3", "--seed", "1",
          "--out", folder],
     ]
     for args in commands:

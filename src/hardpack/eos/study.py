@@ -159,7 +159,7 @@ JAM_STUDIES = ("jam", "crystallisation")
 
 
 def jam_summary(packings, study: str = "jam") -> xr.Dataset:
-    """Jammed packings of one family (Datasets written by ``hardpack eos-jam``) as one Dataset over
+    """Jammed packings of one family (Datasets written by ``hardpack poly-jam``) as one Dataset over
     (width, system, seed): phi_J (the final phi; phi_J - phi ~ 3 phi / Z <= 1e-11 at Z = 1e12) and
     the run statistics. Missing combinations are NaN. ``study`` (attribute) tells the validation
     what the runs test: "jam", the equivalence of the mixtures at one protocol, or

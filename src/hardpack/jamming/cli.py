@@ -23,7 +23,7 @@ PRESSURE_ATTRS = ("reduced_pressure", "pressure", "final_pressure", "Z")
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "verify",
-        help="LP jamming tests (local/collective/strict), rattlers, forces of a packing",
+        help="LP jamming tests (local/collective/strict), rattlers and contact forces of a packing.",
         description=__doc__.splitlines()[0],
     )
     p.add_argument("packing", help="packing netCDF file (hardpack.io.save_packing)")
@@ -49,10 +49,10 @@ def register(subparsers) -> None:
     p.add_argument("--workers", type=int, default=1,
                    help="sequential method: loading sequences run at once, one process each "
                         "(default 1; the result does not depend on it)")
-    p.set_defaults(func=run)
+    p.set_defaults(func=cmd_verify)
 
 
-def run(args) -> int:
+def cmd_verify(args) -> int:
     from hardpack.io import dataset_to_packing, load_dataset, write_dataset
 
     try:
