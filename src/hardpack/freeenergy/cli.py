@@ -11,7 +11,6 @@ excess over the ideal gas; writes the per-segment series (hardpack.freeenergy.bc
 
 from __future__ import annotations
 
-import sys
 
 from hardpack.errors import InvalidInputError
 from hardpack.freeenergy.bcmd import FROZEN_MODES, run_bcmd
@@ -118,20 +117,16 @@ def cmd_bcmd_simplex(args) -> int:
     from hardpack.freeenergy.isostatic import simplex_test
     from hardpack.io import load_dataset, load_packing, write_dataset
 
-    try:
-        packing = load_packing(args.packing)
-        verdict = load_dataset(args.jamming, kind="jamming")
-        tol = args.contact_tol
-        if tol is None:
-            tol = min(float(verdict.attrs["delta"]), args.delta / 10)
-        ds = simplex_test(
-            packing, verdict["rattler"].values.astype(bool), delta=args.delta, contact_tol=tol,
-            dmu_max_ratio=args.dmu_max_ratio, gamma0=args.gamma0, theta=args.theta,
-            frozen=args.frozen, seed=args.seed,
-        )
-    except InvalidInputError as exc:
-        print(f"hardpack bcmd-simplex: error: {exc}", file=sys.stderr)
-        return 2
+    packing = load_packing(args.packing)
+    verdict = load_dataset(args.jamming, kind="jamming")
+    tol = args.contact_tol
+    if tol is None:
+        tol = min(float(verdict.attrs["delta"]), args.delta / 10)
+    ds = simplex_test(
+        packing, verdict["rattler"].values.astype(bool), delta=args.delta, contact_tol=tol,
+        dmu_max_ratio=args.dmu_max_ratio, gamma0=args.gamma0, theta=args.theta,
+        frozen=args.frozen, seed=args.seed,
+    )
     ds.attrs.update(source=str(args.packing), verdict=str(args.jamming), seed=args.seed)
     write_dataset(ds, args.out, seed=args.seed)
     a = ds.attrs
@@ -161,21 +156,17 @@ def _sized(packing, phi, delta):
 def cmd_bcmd(args) -> int:
     from hardpack.io import load_packing, write_dataset
 
-    try:
-        packing = _sized(load_packing(args.packing), args.phi, args.delta)
-        res = run_bcmd(
-            packing,
-            dmu_max=args.dmu_max,
-            dmu_min=args.dmu_min,
-            gamma0=args.gamma0,
-            theta=args.theta,
-            frozen=args.frozen,
-            seed=args.seed,
-            reset_ratio=args.reset_ratio,
-        )
-    except InvalidInputError as exc:
-        print(f"hardpack bcmd: error: {exc}", file=sys.stderr)
-        return 2
+    packing = _sized(load_packing(args.packing), args.phi, args.delta)
+    res = run_bcmd(
+        packing,
+        dmu_max=args.dmu_max,
+        dmu_min=args.dmu_min,
+        gamma0=args.gamma0,
+        theta=args.theta,
+        frozen=args.frozen,
+        seed=args.seed,
+        reset_ratio=args.reset_ratio,
+    )
     ds = res.dataset
     ds.attrs["source"] = str(args.packing)
     if args.delta is not None:
