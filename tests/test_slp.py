@@ -13,7 +13,7 @@ from hardpack.geometry import ball_volume, pairs_within
 from hardpack.initial import random_packing
 from hardpack.slp import Bounds, run_slp, solve_step
 from hardpack.slp.driver import _apply
-from hardpack.slp.lp import influence_pairs, redundancy_radius
+from hardpack.slp.lp import redundancy_radius
 
 SMALL = Bounds(strain=0.01, shear=0.01, displacement=0.05)  # Table II settings (L1493-1495)
 
@@ -196,7 +196,15 @@ def test_table_i_3d_mrj_protocol_gives_a_strictly_jammed_isostatic_packing():
     assert verdict.statics.isostaticity_gap_strict == 0
 
 
-def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path, monkeypatch):
+@pytest.fixture(scope="module")
+def uninterrupted():
+    """An SLP run of 30 spheres (3D, MRJ-like settings) without checkpoints: its arguments and
+    result, the reference of the resume tests."""
+    args = (random_packing(30, 3, monodisperse(), 0.3, seed=4), 1.5, Bounds(0.1, 0.1, 0.5))
+    return args, run_slp(*args)
+
+
+def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path, monkeypatch, uninterrupted):
     """A run interrupted after 20 LPs (checkpoint after every step) and started again with the
     same arguments continues from its checkpoint (20 LPs fewer) and ends with the packing and
     history of the uninterrupted run, bit for bit (every step is a deterministic function of
@@ -204,9 +212,8 @@ def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path,
     refused."""
     import hardpack.slp.driver as driver
 
-    start = random_packing(30, 3, monodisperse(), 0.3, seed=4)
-    args = (start, 1.5, Bounds(0.1, 0.1, 0.5))
-    whole = run_slp(*args)
+    args, whole = uninterrupted
+    start = args[0]
     ckpt = tmp_path / "slp.ckpt"
     solve = driver.solve_step
     calls = []
@@ -236,16 +243,15 @@ def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path,
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
-def test_a_signal_writes_the_checkpoint_and_the_run_resumes_identically(tmp_path, monkeypatch, sig):
+def test_a_signal_writes_the_checkpoint_and_the_run_resumes_identically(tmp_path, monkeypatch, sig,
+                                                                         uninterrupted):
     """SIGTERM or SIGINT during LP 20 (no timed checkpoint): the run writes its checkpoint before
     LP 21 and raises Interrupted; started again it does only the remaining LPs and ends with the
     uninterrupted run's packing, bit for bit."""
     import hardpack.slp.driver as driver
     from hardpack.io.interrupt import Interrupted
 
-    start = random_packing(30, 3, monodisperse(), 0.3, seed=4)
-    args = (start, 1.5, Bounds(0.1, 0.1, 0.5))
-    whole = run_slp(*args)
+    args, whole = uninterrupted
     ckpt = tmp_path / "slp.ckpt"
     solve = driver.solve_step
     calls = []
