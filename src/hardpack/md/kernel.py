@@ -48,9 +48,9 @@ after t = 1/|kappa|; windows end before 0.5/|kappa| (engine), so such roots are 
 Collision law (derived here for growing spheres; Donev 2006, Algorithm 12 steps 4-5, as printed,
 with n from A to B, pushes an approaching pair together, so the sign is reversed here):
 n = r / |r| at contact, v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with
-equal masses the impulse on j is J = -v_n n (v_j += J, v_i -= J), which reverses the CONTACT normal velocity v_n -> -v_n.
-Kinetic energy changes by -v_n g (heating when growing). Collisions with v_n >= 0 are skipped
-(mispredicted or grazing, Alg. 12 step 3).
+equal masses the impulse on j is J = -v_n n (v_j += J, v_i -= J), which reverses the CONTACT
+normal velocity v_n -> -v_n. Kinetic energy changes by -v_n g (heating when growing). Collisions
+with v_n >= 0 are skipped (mispredicted or grazing, Alg. 12 step 3).
 """
 
 from __future__ import annotations
