@@ -1,4 +1,4 @@
-"""LP contact forces against the time-averaged contact forces the MD measured (issue 4).
+"""LP contact forces against the time-averaged contact forces the MD measured.
 
 Near jamming the collision impulses a pair exchanges, averaged over time, are the contact force of
 the packing up to one common factor (Donev 2006, sec. 1.1 and Fig. 1.1; hardpack.md.contacts). The LP
