@@ -47,7 +47,7 @@ def _omoments(O1, O2) -> tuple[np.ndarray, np.ndarray]:
 
 def carnahan_starling(phi):
     """Carnahan-Starling Z_CS = (1 + phi + phi^2 - phi^3)/(1 - phi)^3 = 1 + 4 phi g_CS, with
-    g_CS = (1 - phi/2)/(1 - phi)^3 (Ogarko 2014, Eqs. 3.7-3.8). Monodisperse 3D fluid, phi <~ 0.55."""
+    g_CS = (1 - phi/2)/(1 - phi)^3 (Ogarko 2014, below Eq. 3.8). Monodisperse 3D fluid, phi <~ 0.55."""
     x = _phi(phi)
     return (1 + x + x**2 - x**3) / (1 - x) ** 3
 
