@@ -1,9 +1,9 @@
-"""EOS-vs-moments study (Ogarko ch. 3, issue 6): equivalent systems, fluid Z against BMCSL, jamming of
+"""EOS-vs-moments study (Ogarko 2014, ch. 3): equivalent systems, fluid Z against BMCSL, jamming of
 poly vs tridisperse systems, summaries, validation rows and the CLI.
 
-Physics tolerances: BMCSL (Eq. 3.9) is within 1 % of simulations for phi < 0.54 (L4494-4502,
-L5707-5710); maximally equivalent tridisperse systems jam within 1 % of the polydisperse ones
-(L5753-5757). Slow tests use N = 1000 (fluid) and N = 500 (jamming).
+Physics tolerances: BMCSL (Eq. 3.9) is within 1 % of simulations for phi < 0.54 (Ogarko 2014,
+Fig. 3.1, sec. 3.2); maximally equivalent tridisperse systems jam within 1 % of the polydisperse ones
+(sec. 3.2 and Fig. 3.9(a)). Slow tests use N = 1000 (fluid) and N = 500 (jamming).
 """
 
 import argparse
@@ -53,7 +53,7 @@ def test_refuses_bad_systems():
 )
 def test_fluid_pressure_within_one_percent_of_bmcsl(spec, system):
     """Equilibrium Z at phi = 0.45, N = 1000, 300k collisions (standard error ~0.25 %): within 1 % of
-    BMCSL for the realised radii (L5707-5710)."""
+    BMCSL for the realised radii (Ogarko 2014, sec. 3.2)."""
     row = study.fluid_pressure(spec, system, 0.45, seed=4, n=1000, collisions=300_000)
     assert row["phi"] == pytest.approx(0.45, rel=1e-12)
     assert row["Z_err"] < 0.004 * row["Z"]
@@ -255,7 +255,7 @@ def test_cli_jam_resumes_a_killed_compression(tmp_path, monkeypatch, caplog):
 
 
 def test_uniform_size_equivalent_is_gauss_legendre():
-    """Sanity link to the closed forms (note sec. 2.4): TUS radii <a>(1 +- omega0 sqrt(3/5)), 5:8:5."""
+    """Sanity link to the closed forms (Ogarko 2014, Eqs. 3.39-40): TUS radii <a>(1 +- omega0 sqrt(3/5)), 5:8:5."""
     tri = study.system_distribution({"kind": "uniform_size", "omega": 3}, "tri")
     w0 = (3 - 1) / (3 + 1)
     assert np.array(tri.radii) == pytest.approx([1 - w0 * np.sqrt(0.6), 1.0, 1 + w0 * np.sqrt(0.6)], rel=1e-9)

@@ -63,7 +63,7 @@ def test_jamming_gap_of_uniformly_shrunk_packing(jammed_disks):
     s = 1e-9
     disks = jammed_disks
     shrunk = disks.replace(radii=disks.radii * (1 - s))
-    # the cage extends to ~ M s D / f_min (elongated corners, L580-L583): dr_large = 1e-3 D
+    # the cage extends to ~ M s D / f_min (elongated corners, Donev 2006, sec. 4.3.2): dr_large = 1e-3 D
     r = verify(shrunk, delta=1e-6, dr_large=1e-3)
     assert r.collective
     assert r.statics.jamming_gap == pytest.approx(s / (1 - s), rel=1e-6)

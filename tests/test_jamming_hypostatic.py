@@ -2,8 +2,8 @@
 nearest jamming point; the working-set LP solver against HiGHS.
 
 References: a contact network with fewer than d(N-1) + 1 contacts cannot be jammed (Donev
-L534, Eq. 4.8); the honeycomb lattice (Z = 3 < 4) is not collectively jammed (Table 4.1). An
-isostatic network has a unique self-stress (Ch. 5, L2894-L2899), so when one of its contacts is
+2006, Eq. 4.8); the honeycomb lattice (Z = 3 < 4) is not collectively jammed (Table 4.1). An
+isostatic network has a unique self-stress (Donev 2006, sec. 5.4.1.2), so when one of its contacts is
 opened by 1e-7 D the self-stress of the nearest jamming point must be exactly that one.
 """
 
@@ -77,7 +77,7 @@ def test_hypostatic_honeycomb_unjams_under_sequential_loading():
 def test_jammed_disks_stay_within_their_gaps(jammed_disks):
     """The exactly jammed isostatic disks: no load moves the backbone by more than round-off in
     the collective test (threshold 1e-3), while the fixed cell lets the strict test shear them
-    (Donev L2012-L2017: fixed-cell packings are not strictly jammed)."""
+    (Donev 2006, sec. 4.7.2.1: fixed-cell packings are not strictly jammed)."""
     r = verify(jammed_disks, method="sequential", seed=1)
     assert r.collective and max(r.collective_test.mean_displacement) < 1e-8
     assert not r.strict and r.strict_test.n_lp <= 3

@@ -1,4 +1,4 @@
-"""LP contact forces vs the MD's time-averaged collision forces (issue 4, 'forces' must-show).
+"""LP contact forces vs the MD's time-averaged collision forces.
 
 An isostatic backbone has a unique self-stress, so the LP forces and the MD forces must agree
 contact by contact after one fitted factor, and the virial of the scaled LP forces must equal the

@@ -4,7 +4,7 @@
 # resume: the slow runs take up to ~20 CPU min each); one job per (family, width) measures the
 # fluid Z(phi) of the three against BMCSL. The same jobs with a slow final stage
 # (study poly_crystallisation) look for the large-species crystallisation of the bidisperse
-# equivalents (Ogarko L4851-4865). Summaries, figures and validation rows follow.
+# equivalents (Ogarko 2014, sec. 3.1.3). Summaries, figures and validation rows follow.
 
 
 rule poly_jam:

@@ -1,6 +1,6 @@
 """Numba event loop of bounding-cell MD (BCMD) for one schedule segment.
 
-Model (note ``bcmd_free_energy.md`` sec. 2 steps 3-4): sphere i has a fixed cell centre; its
+Model (Donev 2006, dissertation sec. 6.3.1, for spheres): sphere i has a fixed cell centre; its
 displacement ``dr_i`` from that centre is stored separately (precision at small Delta mu) and
 must satisfy |dr_i| <= rho_i(s) = R_i (dmu0 - gamma s), a spherical hard wall whose radius
 shrinks at speed gamma R_i (s: time since the segment start). Pairs (i, j) of the static
@@ -18,7 +18,7 @@ contact-time roots are the md kernel's: pairs use ``contact_root`` (constant rad
 early rejection against the best time so far); the cell wall solves the md bounding-sphere exit
 equation |dr + v s| = rho - adot s (adot = gamma R_i) in a form stable right after a bounce
 (:func:`_wall_root`).
-Moving-wall law (Donev [C:589-613]): v_n' = 2 w - v_n along the outward normal, w = -gamma R_i.
+Moving-wall law (Donev 2006, sec. 6.3.3): v_n' = 2 w - v_n along the outward normal, w = -gamma R_i.
 """
 
 from __future__ import annotations

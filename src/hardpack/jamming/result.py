@@ -24,7 +24,7 @@ class JammingResult:
     """Everything :func:`verify` measured. ``None`` marks a test that was not run.
 
     - ``local``/``collective``/``strict``: True when a (sub)packing is jammed in that sense
-      (Donev L268-L285: a packing with a jammed backbone counts as jammed).
+      (Donev 2006, sec. 4.2.4.1: a packing with a jammed backbone counts as jammed).
     - ``rattler``: particles outside the backbone (local rattlers, plus rattling clusters the
       collective test removed when it found a jammed backbone).
     - ``network``: all contacts within delta; ``forces.forces`` is the backbone self-stress.

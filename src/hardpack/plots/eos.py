@@ -75,7 +75,7 @@ def plot_phij_vs_width(summaries):
 
 
 def plot_crystallisation(summary, threshold: float):
-    """Slow runs (Ogarko L4851-4865): left, phi_J vs omega of poly / bi / tri with the published fit;
+    """Slow runs (Ogarko 2014, sec. 3.1.3): left, phi_J vs omega of poly / bi / tri with the published fit;
     right, the q6 crystallinity of the large particles (mean over seeds, each seed a small marker)
     with the ``threshold`` the validation counts as partial crystallisation."""
     stats = seed_statistics(summary)
