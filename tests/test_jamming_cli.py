@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-
 import pytest
 
+from hardpack.cli import main
 from hardpack.geometry.lattices import lattice_packing
 from hardpack.io import load_dataset, save_packing
-from hardpack.cli import main
 
 
 def _main(argv) -> int:

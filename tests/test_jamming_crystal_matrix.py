@@ -152,7 +152,7 @@ def _contacts(packing: Packing):
     """Every contact (i, j, lattice n, r_ij) once (|x_j + lattice n - x_i| = 1 to 1e-9), from
     the geometry alone: for each pair the images around the nearest one, up to 1 / height + 1/2
     cells away along each lattice vector (|r| <= 1 needs that)."""
-    d, lat, n = packing.dim, packing.lattice, packing.n_particles
+    lat, n = packing.lattice, packing.n_particles
     frac = packing.fractional()
     i, j = np.triu_indices(n)  # i <= j
     nearest = -np.rint(frac[j] - frac[i])  # frac_j - frac_i + nearest in [-1/2, 1/2]

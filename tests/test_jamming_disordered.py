@@ -21,10 +21,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-md = pytest.importorskip("hardpack.md", reason="hardpack.md (the LS engine) is not available")
-if not hasattr(md, "compress"):  # pragma: no cover - engine present but without its driver
-    pytest.skip("hardpack.md.compress is not available yet", allow_module_level=True)
-
+from hardpack import md
 from hardpack.distributions import bidisperse, monodisperse
 from hardpack.initial import random_packing
 from hardpack.jamming import verify

@@ -43,8 +43,9 @@ def test_lp_forces_match_md_forces_of_an_isostatic_ls_packing():
 
 def test_a_wrong_force_network_is_detected():
     """Same contacts, forces permuted: the fitted virial no longer matches the MD pressure."""
-    from hardpack.geometry.lattices import lattice_packing
     import xarray as xr
+
+    from hardpack.geometry.lattices import lattice_packing
 
     p = lattice_packing("fcc", (2, 2, 2))
     result = verify(p)

@@ -2,15 +2,14 @@
 
 import math
 
+import mpmath
 import numpy as np
 import pytest
 
 from hardpack.distributions import Discrete, LogNormal, bidisperse, monodisperse, uniform_size, uniform_volume
 from hardpack.eos import moments as mo
-from hardpack.validation.analytic import moment_table_rows
-from hardpack.validation.targets import load_targets
 from hardpack.errors import InvalidInputError
-
+from hardpack.validation.analytic import moment_table_rows
 
 OMEGAS_31 = (1.2, 1.4, 2, 4, 5, 7, 8, 10, 20, 50, 100)
 #: the printed cells our values do not round to (Table 3.3 omega = 4 n2 and delta1; Table 3.4
@@ -40,7 +39,6 @@ def test_uniform_size_bidisperse_equivalent_is_equimolar():
 def test_independent_high_precision_tridisperse_solve_agrees():
     """The five misprinted cells, recomputed with 50-digit Gauss quadrature from the exact moments
     (an independent route to the 3-node equivalent), agree with ours to 1e-10."""
-    mpmath = pytest.importorskip("mpmath")
     mpmath.mp.dps = 50
     for family, x, name in (("UV", 4, "n2"), ("UV", 4, "delta1"), ("LN", 0.15, "n1"), ("LN", 0.5, "delta2"),
                             ("LN", 1.0, "n2")):

@@ -25,7 +25,7 @@ from hardpack.geometry.balls import ball_volume
 
 @njit(cache=True)
 def _shrink(x, v, a, b, c, xi_max, xi_min, wall_ratio, fraction, redraw_every, seed):
-    np.random.seed(seed)
+    np.random.seed(seed)  # noqa: NPY002 (numba kernels have only the legacy generator)
     n = x.shape[0]
     m = a.shape[0]
     xi = xi_max
@@ -65,7 +65,7 @@ def _shrink(x, v, a, b, c, xi_max, xi_min, wall_ratio, fraction, redraw_every, s
                 t_redraw += tau
                 speed = np.sqrt(np.sum(v * v))
                 for k in range(n):
-                    v[k] = np.random.normal()
+                    v[k] = np.random.normal()  # noqa: NPY002
                 v *= speed / np.sqrt(np.sum(v * v))
                 continue
             x += v * best

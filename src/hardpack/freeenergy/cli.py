@@ -11,7 +11,6 @@ excess over the ideal gas; writes the per-segment series (hardpack.freeenergy.bc
 
 from __future__ import annotations
 
-
 from hardpack.errors import InvalidInputError
 from hardpack.freeenergy.bcmd import FROZEN_MODES, run_bcmd
 

@@ -16,7 +16,6 @@ import argparse
 import logging
 import sys
 
-
 log = logging.getLogger(__name__)
 
 

@@ -223,7 +223,8 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
 
     Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
-    out of the hot path; the heap update is :func:`hardpack.md.heap.heap_set`, inlined): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
+    out of the hot path; the heap update is :func:`hardpack.md.heap.heap_set`, inlined):
+    (1) only if ``rebuild_lists``: N complete-update steps, each the partial
     NNL update of one particle (wrap, new bounding sphere, re-bin on its grid level, list every
     overlapping bounding sphere already binned; together a complete update, Alg. 9); the
     bounding radius is

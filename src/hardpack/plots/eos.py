@@ -62,7 +62,8 @@ def plot_phij_vs_width(summaries):
             top.set_xscale("log")
             top.xaxis.set_major_formatter(ScalarFormatter())
             top.xaxis.set_minor_formatter(NullFormatter())
-            top.set_xticks([t for t in (1, 1.2, 1.5, 2, 3, 4, 5, 8, 10, 20, 50, 100) if widths.min() <= t <= widths.max()])
+            ticks = (1, 1.2, 1.5, 2, 3, 4, 5, 8, 10, 20, 50, 100)
+            top.set_xticks([t for t in ticks if widths.min() <= t <= widths.max()])
             bottom.set_xlabel(r"$\omega = a_{\max}/a_{\min}$")
         else:
             bottom.set_xlabel(r"$\sigma$ (log-normal)")

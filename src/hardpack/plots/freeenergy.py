@@ -50,9 +50,9 @@ def plot_fcc_finite_size(summaries: dict):
 def plot_fcc_density(bcmd, eos):
     """FCC free energy vs density: (a) excess over the ideal gas vs phi, (b) BCMD's Delta f =
     f_c(Delta mu_d) - f vs the distance to jamming delta (log scale; f = -3 ln delta - f_J
-    + ..., so Delta f tends to the jamming constant as delta -> 0), with the EOS integration of the engine's pressure from the published
-    melting value and the cell limit with the published jamming constant
-    (hardpack.freeenergy.crystal)."""
+    + ..., so Delta f tends to the jamming constant as delta -> 0), with the EOS integration of
+    the engine's pressure from the published melting value and the cell limit with the published
+    jamming constant (hardpack.freeenergy.crystal)."""
     fig, (ax1, ax2) = figure(1, 2, figsize=(9.0, 3.6))
     phi_b, ex_b = bcmd["phi"].values, bcmd["excess"].values
     phi_e, z = eos["phi"].values, eos["Z"].values

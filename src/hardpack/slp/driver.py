@@ -40,9 +40,9 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
+from hardpack.geometry.reduction import lll_reduce
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt
-from hardpack.geometry.reduction import lll_reduce
 from hardpack.slp.lp import Bounds, solve_step
 
 log = logging.getLogger(__name__)

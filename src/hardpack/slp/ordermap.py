@@ -10,7 +10,6 @@ it (influence radius alpha = gamma / D, bound widths, LP solver) and its jamming
 
 from __future__ import annotations
 
-
 import numpy as np
 import xarray as xr
 

@@ -15,6 +15,7 @@ from hardpack.validation.packings import n_particles, system_key
 from hardpack.validation.rows import Row, evaluate
 from hardpack.validation.targets import load_targets
 
+
 def _system(key) -> str | None:
     """Target suffix of a recognised system: d<d> for monodisperse spheres, binary2d."""
     if key is None:
