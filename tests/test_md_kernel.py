@@ -9,8 +9,8 @@ radii, independently of the kernel's quadratic formulas.
 import numpy as np
 import pytest
 
+from hardpack.events.roots import exit_time, pair_time
 from hardpack.md.engine import Engine
-from hardpack.md.kernel import exit_time, pair_time
 
 
 def pt(r, u, sig0, g):

@@ -14,7 +14,7 @@ v_0..v_{d-1}, s_i)``, displacement and velocity at the particle's own last updat
 
 Events follow the md engine's scheme (one predicted event per particle in a 4-ary min-heap with
 the keys stored in heap order, lazy invalidation by the partner's collision counter); the
-contact-time roots are the md kernel's: pairs use ``contact_root`` (constant radii, g = 0, with its
+contact-time roots are :mod:`hardpack.events.roots`': pairs use ``contact_root`` (constant radii, g = 0, with its
 early rejection against the best time so far); the cell wall solves the md bounding-sphere exit
 equation |dr + v s| = rho - adot s (adot = gamma R_i) in a form stable right after a bounce
 (:func:`_wall_root`).
@@ -26,8 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hardpack.md.heap import heap_set
-from hardpack.md.kernel import contact_root
+from hardpack.events.heap import heap_set
+from hardpack.events.roots import contact_root
 
 WALL = -1  # event: the particle hits its cell wall
 NONE = -2  # nothing predicted

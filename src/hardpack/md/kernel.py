@@ -61,7 +61,8 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from hardpack.md.heap import heap_set
+from hardpack.events.heap import heap_set
+from hardpack.events.roots import contact_root, exit_root
 
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
@@ -134,87 +135,6 @@ def prefetch_row(typingctx, arr, idx):
     return sig, codegen
 
 
-# --------------------------------------------------------------------------------- root finding
-@njit(cache=True)
-def pair_time(r, u, sig0, g):
-    """First contact time >= 0 of a pair (see module docstring); inf if none. r, u: (d,) arrays."""
-    rr = 0.0
-    ru = 0.0
-    uu = 0.0
-    for k in range(r.shape[0]):
-        rr += r[k] * r[k]
-        ru += r[k] * u[k]
-        uu += u[k] * u[k]
-    return contact_root(rr, ru, uu, sig0, g, np.inf)
-
-
-@njit(cache=True, inline="always")
-def contact_root(rr, ru, uu, sig0, g, tmax):
-    """First contact time in [0, tmax), else inf (module docstring). When A >= 0 the root is at
-    least C / (-2B), which rejects most pairs before the square root."""
-    b = ru - sig0 * g
-    a = uu - g * g
-    if b >= 0.0 and a >= 0.0:
-        return np.inf
-    c = rr - sig0 * sig0
-    if c <= 0.0:
-        if b < 0.0:
-            return 0.0
-        disc = b * b - a * c
-        disc = max(disc, 0.0)
-        return (b + np.sqrt(disc)) / (-a)
-    if a >= 0.0 and c >= -2.0 * b * tmax:
-        return np.inf
-    disc = b * b - a * c
-    if disc < 0.0:
-        return np.inf
-    if b < 0.0:
-        return c / (-b + np.sqrt(disc))
-    return (b + np.sqrt(disc)) / (-a)  # A < 0 here; same root, no cancellation when B >= 0
-
-
-@njit(cache=True)
-def exit_time(dr, v, rrem, adot):
-    """Time for a sphere (centre offset dr from its bounding centre, velocity v, radius growing at
-    adot) to touch its bounding sphere, whose radius exceeds the particle's by rrem now.
-
-    |dr + v t| = rrem - adot t  ->  A t^2 + 2 B t + C = 0 with A = v.v - adot^2,
-    B = dr.v + rrem adot, C = dr.dr - rrem^2 < 0; first root t = -C / (B + sqrt(B^2 - AC))
-    (derived here, valid for any sign of A). For shrinking particles (adot < 0) the root is
-    genuine because rrem - adot t stays positive.
-    """
-    dd = 0.0
-    dv = 0.0
-    vv = 0.0
-    for k in range(dr.shape[0]):
-        dd += dr[k] * dr[k]
-        dv += dr[k] * v[k]
-        vv += v[k] * v[k]
-    return _exit_root(dd, dv, vv, rrem, adot)
-
-
-@njit(cache=True, inline="always")
-def _exit_root(dd, dv, vv, rrem, adot):
-    c = dd - rrem * rrem
-    if c >= 0.0:
-        return 0.0
-    a = vv - adot * adot
-    b = dv + rrem * adot
-    disc = b * b - a * c
-    if disc < 0.0:
-        if adot > 0.0:  # round-off: a growing sphere always leaves
-            disc = 0.0
-        else:
-            return np.inf
-    den = b + np.sqrt(disc)
-    if den > 0.0:
-        return -c / den
-    if adot > 0.0:
-        return 0.0
-    return np.inf
-
-
-# --------------------------------------------------------------------------------- event loop
 @njit(cache=True)
 def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
@@ -223,7 +143,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
 
     Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
-    out of the hot path; the heap update is :func:`hardpack.md.heap.heap_set`, inlined):
+    out of the hot path; the heap update is :func:`hardpack.events.heap.heap_set`, inlined):
     (1) only if ``rebuild_lists``: N complete-update steps, each the partial
     NNL update of one particle (wrap, new bounding sphere, re-bin on its grid level, list every
     overlapping bounding sphere already binned; together a complete update, Alg. 9); the
@@ -509,7 +429,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 dd += dx * dx
                 dv += dx * vk
                 vv += vk * vk
-            best = _exit_root(dd, dv, vv, rrem, adot)
+            best = exit_root(dd, dv, vv, rrem, adot)
             partner = EXIT if best < np.inf else NONE
             for m in range(nn[i]):
                 e = nb[i, m]
