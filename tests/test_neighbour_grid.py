@@ -90,7 +90,7 @@ def test_hgrid_does_far_less_work_than_single_level():
 def test_search_box_of_figure_2_1():
     """Fig. 2.1: 2-D, s_1 = 3; particle B (r = 4) at (10.3, 14.4) searches level 1 with
     beta = r_B + s_1/2 = 5.5 (Eq. 2.4): cells (1, 2)..(5, 6). The caption's start (1, 3) contradicts
-    the equation (a level-1 particle at y in [8.9, 9) can touch B), as note 002 sec. 1.2 explains."""
+    the equation (a level-1 particle at y in [8.9, 9) can touch B)."""
     lo, hi = np.empty(2, np.int64), np.empty(2, np.int64)
     box = np.array([300.0, 300.0])
     search_range(np.array([10.3, 14.4]) / box, 4.0 + 1.5, 1.0 / box, np.array([[100, 100]]), 0, lo, hi)

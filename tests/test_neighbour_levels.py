@@ -16,7 +16,7 @@ from hardpack.geometry.neighbours import (
 
 
 def system(dist, n=125_001, nu=0.62, d=3):
-    """ch. 2.1 benchmark systems (L1214-1240): N = 125001 systematic-sampled radii at nu = 0.62."""
+    """Benchmark systems of Ogarko 2014, Sec. 2.1.4: N = 125001 systematic-sampled radii at nu = 0.62."""
     radii = dist.sample(n)
     volume = np.sum(4 / 3 * np.pi * radii**3) / nu
     return radii, volume
@@ -28,8 +28,8 @@ def uv50():
 
 
 def test_optimal_number_of_levels_uv50(uv50):
-    """UV, omega = 50: ONL = 7 from L (m + K) with K = 0.3 (L1199-1204); m_h equal within +-2 % at L = 7
-    (the text's spread with dm = 1e-3, L1529-1532)."""
+    """UV, omega = 50: ONL = 7 from L (m + K) with K = 0.3 (Ogarko 2014, Sec. 2.1.3); m_h equal within +-2 % at L = 7
+    (the spread stated with dm = 1e-3 in the appendix of Ogarko 2014, ch. 2.1)."""
     best = optimal_levels(*uv50, d=3, K=0.3)
     assert best.n_levels == 7
     m_h = best.m_per_level
@@ -37,7 +37,7 @@ def test_optimal_number_of_levels_uv50(uv50):
 
 
 def test_optimal_number_of_levels_us50():
-    """US, omega = 50: the measured optimum is L = 3 (L1360-1363); Eq. 2.7 predicts the same."""
+    """US, omega = 50: the measured optimum is L = 3 (Ogarko 2014, Sec. 2.1.4); Eq. 2.7 predicts the same."""
     assert optimal_levels(*system(uniform_size(50.0)), d=3, K=0.3).n_levels == 3
 
 

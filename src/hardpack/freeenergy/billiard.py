@@ -1,5 +1,5 @@
 """Point billiard in a polytope intersected with a shrinking ball: the BCMD volume identity in
-its barest form (Donev ch. 6 sec. 6.3.3 / App. A, Fig. 6.1, [C:579-661]; note sec. 5.2 item 2).
+its barest form (Donev 2006, dissertation sec. 6.3.3 and Fig. 6.1; Donev et al. 2007, Appendix A).
 
 A point moves freely inside P = {x : A x <= b} intersected with the ball |x - c| <= xi(t),
 reflecting elastically off the planes and with v_n' = 2 w - v_n off the ball wall moving at
@@ -25,7 +25,7 @@ from hardpack.geometry.balls import ball_volume
 
 @njit(cache=True)
 def _shrink(x, v, a, b, c, xi_max, xi_min, wall_ratio, fraction, redraw_every, seed):
-    np.random.seed(seed)
+    np.random.seed(seed)  # noqa: NPY002 (numba kernels have only the legacy generator)
     n = x.shape[0]
     m = a.shape[0]
     xi = xi_max
@@ -65,7 +65,7 @@ def _shrink(x, v, a, b, c, xi_max, xi_min, wall_ratio, fraction, redraw_every, s
                 t_redraw += tau
                 speed = np.sqrt(np.sum(v * v))
                 for k in range(n):
-                    v[k] = np.random.normal()
+                    v[k] = np.random.normal()  # noqa: NPY002
                 v *= speed / np.sqrt(np.sum(v * v))
                 continue
             x += v * best
@@ -106,7 +106,7 @@ def volume_estimate(
 
     Requires the ball B(centre, xi_max) to contain P and B(centre, xi_min) to lie inside P (the
     caller checks; the estimate is meaningless otherwise). wall_ratio: wall speed / particle
-    speed (adiabaticity, note sec. 2 step 6). Returns (estimate, number of bounces).
+    speed (adiabaticity). Returns (estimate, number of bounces).
     """
     a = np.ascontiguousarray(a, dtype=float)
     b = np.ascontiguousarray(b, dtype=float)

@@ -1,9 +1,9 @@
 """BCMD against the exact jamming simplex of a rattler-free isostatic packing.
 
-Donev dissertation ch. 6 sec. 6.4.2 and Table 6.1 ([C:1062-1146]; note ``bcmd_free_energy.md``
-sec. 3.3 and 5.2 items 6-7): remove the rattlers, freeze one particle, shrink the spheres by
-(1 - delta) around their jammed positions and compare BCMD's Delta f = (d/2) ln(K/K_0), run from
-Delta mu_max down to the disjoint-cell point Delta mu_min, with the exact
+Donev 2006, dissertation sec. 6.4.2 and Table 6.1 (Donev et al. 2007, Sec. 4.3): remove the
+rattlers, freeze one particle, shrink the spheres by (1 - delta) around their jammed positions
+and compare BCMD's Delta f = (d/2) ln(K/K_0), run from Delta mu_max down to the disjoint-cell
+point Delta mu_min, with the exact
 
     Delta f_exact = [ln|P| - sum_{i moving} ln |B_d(Delta mu_min R_i)|] / N_eff,
 
@@ -13,9 +13,10 @@ are the final disjoint cells. For unit-diameter spheres and exact contacts this 
 f_J - f_c^J (Eq. 6.18); using the actual gaps removes the O(gap / delta) error of a packing
 jammed at finite pressure, leaving only the O(delta) linearisation error.
 
-Frozen centre of mass instead of a frozen particle (note sec. 1.7, App. B [C:745-784]): the
-coordinate Jacobian N^d shifts the per-particle value by d ln N / N, so the CM-frame BCMD run is
-compared with Delta f_exact + d ln N / N (Donev: 4.9690 - 4.9479 = 3 ln 978 / 978).
+Frozen centre of mass instead of a frozen particle (Donev 2006, sec. 6.3.4.1; Donev et al. 2007,
+Appendix B): the coordinate Jacobian N^d shifts the per-particle value by d ln N / N, so the
+CM-frame BCMD run is compared with Delta f_exact + d ln N / N (Donev 2006, sec. 6.4.2:
+4.9690 - 4.9479 = 3 ln 978 / 978).
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
 """Exact volume of a simplex and the jamming-simplex constant f_J of an isostatic packing.
 
-Donev dissertation ch. 6 (seeds/000_chapters/ch06.txt), note ``bcmd_free_energy.md`` sec. 1.3:
+Donev 2006, dissertation sec. 6.2.2:
 
-- H-representation (Eq. 6.5, [C:289-308]): for the simplex {x in R^n : A x <= b}, A of shape
+- H-representation (Eq. 6.5, sec. 6.2.2.2): for the simplex {x in R^n : A x <= b}, A of shape
   (n+1, n), set the square matrix At = [A b] and a = At^{-T} e_{n+1} (the last row of At^{-1}).
   Then V^{-1} = n! |det At| prod_i a_i. Derivation (checked here): y = b - A x >= 0 satisfies
   [x; -1] = -At^{-1} y, whose last component gives a^T y = 1, so the simplex is bounded exactly
   when every a_i > 0; the function refuses anything else.
-- Jamming simplex (Eqs. 6.3-6.4, [C:164-189]): P_x = {x : A^T x <= e} with A the N_f x M
+- Jamming simplex (Eqs. 6.3-6.4, sec. 6.2.2): P_x = {x : A^T x <= e} with A the N_f x M
   rigidity matrix (journal sign convention; the chapter's A^T x >= -e is its mirror image and has
   the same volume). With M = N_f + 1 the augmented matrix is At = [A; e^T] and the contact forces
   f~ = At^{-1} e_{M} (force balance A f~ = 0, unit sum) are the a_i above, so
@@ -85,7 +85,7 @@ def log_simplex_volume(a, b) -> float:
 
 @dataclass(frozen=True)
 class JammingSimplex:
-    """Result of :func:`jamming_simplex` (note sec. 1.3).
+    """Result of :func:`jamming_simplex` (Donev 2006, sec. 6.2.2).
 
     log_volume: ln|P_x|; forces: f~ (unit sum, length M); f_j: ln|P_x| / n_eff;
     f_j_minus_fcj: f_J - f_c^J with f_c^J = ln V_p, the quantity BCMD measures (Eq. 6.18).

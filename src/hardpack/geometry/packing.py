@@ -388,4 +388,5 @@ class Packing:
             sizes = f"radii=[{self.radii.min():.4g}, {self.radii.max():.4g}]"
         else:
             sizes = f"{self.shape.kind}s, semiaxes=[{self.shape.semiaxes.min():.4g}, {self.shape.semiaxes.max():.4g}]"
-        return f"Packing(N={self.n_particles}, d={self.dim}, phi={self.phi:.6f}, {sizes}, boundary={str(self.boundary)!r})"
+        return (f"Packing(N={self.n_particles}, d={self.dim}, phi={self.phi:.6f}, {sizes}, "
+                f"boundary={str(self.boundary)!r})")

@@ -2,8 +2,8 @@
 
 A pair {i, j} (any periodic image n, including a particle's own image in small cells) is a
 potential contact when ``|r_ij| <= (1 + delta) D_ij`` with ``D_ij = r_i + r_j``
-(Donev dissertation Eq. 4.5, seeds/000_chapters/ch04-05.txt L338-L346; the polydisperse
-D_ij is the note's [rec], 000_ch4-5_jamming.md sec. 2.1). Periodic images follow L887-L894:
+(Donev 2006, dissertation Eq. 4.5, written there for monodisperse D; the polydisperse
+D_ij = (D_i + D_j)/2 is the one of sec. 4.5.1.1). Periodic images follow sec. 4.4.3:
 a contact between i and the image of j shifted by ``lattice @ n`` is stored as (i, j, n).
 
 Convention used throughout :mod:`hardpack.jamming`: positions are the packing's *wrapped*

@@ -5,14 +5,14 @@ Forces: two LPs on the backbone's equilibrium matrix A (particle rows only, fixe
 1. Jamming-gap LP: ``mu* = min h^T f  s.t.  A f = 0, f >= 0, D^T f = 1``. It is the dual of
    "grow every diameter by the largest common factor 1 + mu with linearised contacts",
    ``max mu  s.t.  A^T dR >= mu D - h`` (the growth LP behind SLP/CALiPPSO; Donev's estimate
-   Eq. 5.19, seeds/000_chapters/ch04-05.txt L3527-L3531, up to its normalisation), so f is the
+   Eq. 5.19 in Donev 2006, dissertation sec. 5.5.5.2, up to its normalisation), so f is the
    force network the packing would carry at the jamming point it is closest to. Because
    A f = 0, f^T h does not change when particles move inside their cage, so mu* does not depend
    on where the snapshot sits in the cage.
 2. Among optimal f (h^T f <= mu* (1 + 1e-6) + 1e-14 D), the most uniform one:
-   ``max t  s.t.  f >= t`` -- Donev's self-stress LP (5.9), L3114-L3127. For an isostatic
+   ``max t  s.t.  f >= t`` -- Donev's self-stress LP (5.9), sec. 5.5.1.1. For an isostatic
    backbone both LPs return the unique self-stress; for crystals (h = 0) step 2 picks uniform
-   forces. t > 0 certifies a strict self-stress (L3160-L3165).
+   forces. t > 0 certifies a strict self-stress (sec. 5.5.1.1).
 
 When the backbone is rigid with few self-stresses (K = M - d(N_b - 1) <= 12, one of them
 positive), both LPs are solved in the K coordinates of the self-stress basis from one sparse LU
@@ -25,14 +25,14 @@ over the backbone contacts.
 Statics (each checked by the tests):
 
 - virial ``p V = (1/d) sum_c f_c |r_c|``, stress ``sigma = (1/V) sum_c f_c |r_c| u u^T``
-  (Eq. 4.24, L1325-L1351); with balanced forces this equals the boundary form (4.23).
+  (Eq. 4.24, sec. 4.4.6.2); with balanced forces this equals the boundary form (4.23).
 - free-volume reduced pressure ``p = PV/(NkT) = (N_b - 1) / (N mu*)``: for homogeneous gaps the
   basin {A^T dR >= -h} scales like mu*, its volume like mu*^(d (N_b - 1)), and a relative length
   dilation eps raises mu* by eps, so beta P = d(N_b - 1) / (d V mu*) (derived here; to first order
   it is Salsburg-Wood / Donev Eq. 1.1 and 5.24, p = d / (1 - phi/phi_J) with 1 - phi/phi_J = d mu*).
   It is exact for uniformly shrunk jammed packings; for thermal snapshots with very unequal gaps the
   basin is not a scaled copy of itself and the estimate is only indicative.
-- isostaticity counts (Eqs. 4.8, 4.9, L497-L535): N_f = d(N_b - 1) in a fixed cell and
+- isostaticity counts (Eqs. 4.8, 4.9, sec. 4.3.1.1): N_f = d(N_b - 1) in a fixed cell and
   N_f + d(d+1)/2 - 1 with a deformable cell; an isostatic backbone has M_b = N_f + 1, and
   ``gap = M_b - N_f - 1`` is 0 (isostatic), > 0 (hyperstatic) or < 0 (hypostatic).
 """

@@ -1,6 +1,6 @@
 """Algorithm 13 (randomised LP test for ideal packings): collective or strict jamming.
 
-Donev dissertation sec. 4.6.1, seeds/000_chapters/ch04-05.txt L1649-L1677:
+Donev 2006, dissertation sec. 4.6.1 (Algorithm 13):
 
 1. collective: strain fixed at 0; strict: strain variables and Tr eps <= 0 (LP 4.10 + 4.17);
 3. no particles left -> not jammed;
@@ -14,7 +14,7 @@ Donev dissertation sec. 4.6.1, seeds/000_chapters/ch04-05.txt L1649-L1677:
 
 Displacements are measured *relative to the bulk*: the LP pins the mean displacement, and the
 componentwise median over the tested particles is then subtracted (translations are trivial
-motions, L562-L569). The median is used instead of the mean so that a large rattling cluster
+motions, sec. 4.3.2). The median is used instead of the mean so that a large rattling cluster
 does not make the whole backbone look displaced. In the strict test the measured displacement
 is the non-affine part dr_i - eps x_i (gauge independent: a different choice of the periodic
 image of particle i shifts both terms by eps Lambda m). A strain with

@@ -1,7 +1,8 @@
 """The rigidity matrix A of a periodic contact network, as a scipy.sparse matrix.
 
-Donev dissertation sec. 4.4.3 (seeds/000_chapters/ch04-05.txt L415-L493, PBC L871-L897,
-strain L944-L1126). A has one column per contact and one row per degree of freedom:
+Donev 2006, dissertation sec. 4.4.3 (the rigidity matrix of sec. 4.3.1, periodic boundaries in
+sec. 4.4.3, the strain in secs. 4.4.5.1-4.4.5.2). A has one column per contact and one row per
+degree of freedom:
 
 - particle rows (d per particle, row ``i*d + k``): column {i, j} holds ``-u_ij`` in block i and
   ``+u_ij`` in block j, with u_ij the unit vector from i to (the image of) j. The text writes

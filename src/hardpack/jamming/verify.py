@@ -1,6 +1,6 @@
 """verify(packing): the full jamming verdict of a periodic sphere packing.
 
-Steps (Donev dissertation ch. 4, seeds/000_chapters/ch04-05.txt):
+Steps (Donev 2006, dissertation ch. 4):
 1. contact network within the relative gap ``delta`` (Eq. 4.5; sequential method:
    ``contact_delta``), all periodic images;
 2. local test and iterative rattler removal (LP 4.15, Alg. 13 step 4) -- always run, since
@@ -11,7 +11,7 @@ Steps (Donev dissertation ch. 4, seeds/000_chapters/ch04-05.txt):
    finite-rate packings with gaps; the verdict thresholds the mean displacement). The
    strict test starts from the collectively jammed backbone when there is one; with the ideal
    method, a packing without one is not strictly jammed either (strict implies collective,
-   L165-L166) and no strict LP is solved;
+   sec. 4.2.2) and no strict LP is solved;
 4. self-stress forces, contact number, isostaticity and pressure of the backbone
    (:mod:`hardpack.jamming.forces`); a backbone without a self-stress gets the forces of the
    nearest jamming point (near contacts within ``force_delta`` that close there carry force).
@@ -47,7 +47,7 @@ METHODS = ("ideal", "sequential")
 #: contact tolerance of the ideal test (LS packings at high pressure: contacts ~1e-12, the next
 #: neighbours ~1e-6 and beyond) and of the contacts counted for Z, isostaticity and forces
 DEFAULT_DELTA = 1e-6
-#: neighbour-list tolerance of the sequential test: Donev's 0.1-1 D (L1729-L1738), the first
+#: neighbour-list tolerance of the sequential test: Donev's 0.1-1 D (Donev 2006, sec. 4.6.2.1), the first
 #: coordination shell; each LP may then move a particle by up to delta D_min / 2 = 0.05 D
 SEQUENTIAL_DELTA = 0.1
 
@@ -141,7 +141,7 @@ def verify(
         free-volume pressure from the forces.
     contact_delta : gap tolerance of the contacts that define the rattlers (the local test),
         Z, isostaticity and forces with ``method="sequential"``, whose ``delta`` (0.1-1, Donev
-        L1729-L1738) includes near neighbours on purpose; default min(delta, 1e-6). The ideal
+        2006, sec. 4.6.2.1) includes near neighbours on purpose; default min(delta, 1e-6). The ideal
         method uses ``delta``. Rattlers stay fixed obstacles in the sequential LPs.
     force_delta : when the backbone has no self-stress at the contact tolerance (a hypostatic
         finite-pressure packing), the forces are those of the nearest jamming point, found on
@@ -239,7 +239,7 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
             collective = ideal_test(net, local_active, strict=False, dr_large=dr_large, **common)
             seconds["collective"] = collective.seconds
         if "strict" in tests and collective is not None and not collective.jammed:
-            # strict jamming implies collective jamming (L165-L166): no LP needed
+            # strict jamming implies collective jamming (Donev 2006, sec. 4.2.2): no LP needed
             strict = replace(collective, test="strict", method="implied by the collective test",
                              n_lp=0, seconds=0.0, loads=[])
             seconds["strict"] = 0.0

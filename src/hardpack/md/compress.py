@@ -1,6 +1,6 @@
 """Lubachevsky-Stillinger (LS) compression: event-driven MD with growing spheres.
 
-Protocol (Donev dissertation ch. 1, note 000_ch1-3_md.md sec. 2.1; Ogarko sec. 2.5): start from a
+Protocol (Donev 2006, dissertation secs. 1.1-1.2; Ogarko 2014, secs. 3.1.3 and 3.3.1): start from a
 non-overlapping packing, draw Maxwell-Boltzmann velocities (kT = m = 1), grow every radius in
 proportion to its size while running collision-driven MD, rescale velocities to kT = 1 at every
 synchronisation point, and stop at a reduced pressure (default 1e12), a volume fraction, a number
@@ -11,10 +11,10 @@ mean diameter in units of the thermal speed (kT = m = 1). Radii grow linearly in
 a_i(t) = a_i(0) (1 + 2 Gamma t / <D>(0)), so every particle keeps its size relative to the others.
 Conversions to the seeds' conventions:
 
-- Skoge/Donev ``growthrate`` g (PackLSD/"spheres" code, note 000 sec. 1): a RADIUS rate
+- Skoge/Donev ``growthrate`` g (the C++ "spheres" code of Skoge et al. 2006): a RADIUS rate
   dr/dt = g with velocities rescaled to <v^2> = 1, i.e. kT/m = 1/d:  Gamma = 2 sqrt(d) g.
-- Donev's text gamma (L2680, radius rate in units of sqrt(kT/m)): Gamma = 2 gamma; L436 uses a
-  diameter rate, for which Gamma = gamma.
+- Donev's text gamma (Donev 2006, sec. 3.3.1, radius rate in units of sqrt(kT/m)): Gamma = 2 gamma;
+  sec. 1.2.2 uses a diameter rate, for which Gamma = gamma.
 - Ogarko Gamma_O (Eq. 3.32: da_i/dt = Gamma_O (a_i/a_max) v0, v0 = sqrt(2E/(3M)) = sqrt(kT/m)
   in 3D): Gamma = 2 Gamma_O <a>/a_max (= 2 Gamma_O for monodisperse spheres).
 
@@ -52,9 +52,10 @@ of the target (the LS jamming density rises as the growth rate falls). A run sto
 ``backbone_volume_fraction`` and ``jamming_check``, and a warning when it fails).
 
 **Pressure.** Per window Z = pV/(NkT) = 1 + sum_coll r_ij . J_ij / (d N kT dt) with kT the
-window's time-averaged kinetic temperature (note sec. 2.5; Z = 1 + virial / (2 * integral of
-KE dt)); the running jamming-density estimate is phi_J_est = phi / (1 - d/Z), the free-volume form
-p = d / (1 - phi/phi_J) (Eqs. 1.1-1.2, L330-351).
+window's time-averaged kinetic temperature (derived here from the collisional stress of Donev 2006,
+sec. 3.2.4.2, plus the ideal-gas term: Z = 1 + virial / (2 * integral of KE dt)); the running
+jamming-density estimate is phi_J_est = phi / (1 - d/Z), the free-volume form
+p = d / (1 - phi/phi_J) (Donev 2006, Eqs. 1.1-1.2).
 """
 
 from __future__ import annotations

@@ -23,6 +23,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
@@ -46,6 +47,16 @@ class EquilibriumResult:
     wall_time: float
     packing: Packing
     velocities: np.ndarray
+
+    def to_dataset(self, **attrs) -> xr.Dataset:
+        """The block values as a Dataset (``hardpack_kind = "md_eos"``; Z, Z_err, phi, N, d and
+        the run's counts as attributes, plus ``attrs``)."""
+        ds = xr.Dataset({"Z_block": (("block",), self.Z_blocks)},
+                        coords={"block": np.arange(len(self.Z_blocks))})
+        ds.attrs.update(hardpack_kind="md_eos", Z=self.Z, Z_err=self.Z_err, phi=self.phi,
+                        N=self.packing.n_particles, d=self.packing.dim, collisions=self.collisions,
+                        md_time=self.md_time, wall_time=self.wall_time, **attrs)
+        return ds
 
 
 def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int = 20,

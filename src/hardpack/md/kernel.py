@@ -1,6 +1,6 @@
 """Numba kernels of the event-driven (collision-driven) hard-sphere MD engine.
 
-Algorithm (Donev dissertation ch. 3, note 000_ch1-3_md.md sec. 2.2-2.9), in the "one event per
+Algorithm (Donev 2006, dissertation secs. 3.2.2.2, 3.3.2 and 3.4), in the "one event per
 particle, lazy invalidation" form:
 
 - Every particle i carries ONE predicted event (partner ``ep[i]``) in a 4-ary min-heap whose keys
@@ -12,7 +12,7 @@ particle, lazy invalidation" form:
   third-party invalidation, Alg. 5 step 5). Correctness: whenever a particle changes velocity it
   re-predicts against ALL its neighbours, so for every pair the particle that changed last holds a
   prediction no later than the pair's true next collision.
-- Neighbour lists with immobile bounding spheres (Donev's NNL, sec. 2.9): particle i stays inside
+- Neighbour lists with immobile bounding spheres (Donev's NNL, sec. 3.3.2): particle i stays inside
   the sphere ``bs[i]`` (centre bs[i, :d], radius bs[i, d]); particles whose bounding spheres do
   not overlap cannot collide, so collisions are predicted only against the list ``nb[i, :nn[i]]``.
   The extra event "i leaves its bounding sphere" (``ep = EXIT``; the exit time solves
@@ -35,21 +35,22 @@ Particle state is packed in one row per particle, ``P[i] = (x_0..x_{d-1}, v_0..v
 position and velocity at the particle's own last update time t_i (Alg. 2 step 5, asynchronous
 updates), and its radius at window time 0. Masses are all 1.
 
-Pair collision time (note sec. 2.3, derived there; re-derived here): with r = x_j - x_i,
-u = v_j - v_i, sigma(t) = sigma_0 + g t, contact |r + u t|^2 = sigma(t)^2 gives
-A t^2 + 2 B t + C = 0 with A = u.u - g^2, B = r.u - sigma_0 g, C = r.r - sigma_0^2.
-C <= 0 (round-off overlap): collide now if B < 0; if B >= 0 but A < 0 (growth outruns the
+Pair collision time (derived here; Donev 2006, sec. 3.2.2.2, says only "the first positive root of
+a quadratic"): with r = x_j - x_i, u = v_j - v_i, sigma(t) = sigma_0 + g t, contact
+|r + u t|^2 = sigma(t)^2 gives A t^2 + 2 B t + C = 0 with A = u.u - g^2, B = r.u - sigma_0 g,
+C = r.r - sigma_0^2. C <= 0 (round-off overlap): collide now if B < 0; if B >= 0 but A < 0 (growth outruns the
 separation) the later root (B + sqrt(B^2 - AC)) / (-A) is the re-contact. C > 0: a root exists iff
 (B < 0 or A < 0) and B^2 - AC >= 0, and the first one is C / (-B + sqrt(B^2 - AC)) for B < 0 and
 (B + sqrt(B^2 - AC)) / (-A) for B >= 0 (the two stable forms of the same root).
 For shrinking spheres (kappa < 0) the squared equation also has roots with sigma(t) < 0, i.e.
 after t = 1/|kappa|; windows end before 0.5/|kappa| (engine), so such roots are never processed.
 
-Collision law (note sec. 2.4, sign-corrected there): n = r / |r| at contact,
-v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with equal masses the impulse
-on j is J = -v_n n (v_j += J, v_i -= J), which reverses the CONTACT normal velocity v_n -> -v_n.
-Kinetic energy changes by -v_n g (heating when growing). Collisions with v_n >= 0 are skipped
-(mispredicted or grazing, Alg. 12 step 3).
+Collision law (derived here for growing spheres; Donev 2006, Algorithm 12 steps 4-5, as printed,
+with n from A to B, pushes an approaching pair together, so the sign is reversed here):
+n = r / |r| at contact, v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with
+equal masses the impulse on j is J = -v_n n (v_j += J, v_i -= J), which reverses the CONTACT
+normal velocity v_n -> -v_n. Kinetic energy changes by -v_n g (heating when growing). Collisions
+with v_n >= 0 are skipped (mispredicted or grazing, Alg. 12 step 3).
 """
 
 from __future__ import annotations
@@ -60,7 +61,8 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from hardpack.md.heap import heap_set
+from hardpack.events.heap import heap_set
+from hardpack.events.roots import contact_root, exit_root
 
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
@@ -133,87 +135,6 @@ def prefetch_row(typingctx, arr, idx):
     return sig, codegen
 
 
-# --------------------------------------------------------------------------------- root finding
-@njit(cache=True)
-def pair_time(r, u, sig0, g):
-    """First contact time >= 0 of a pair (see module docstring); inf if none. r, u: (d,) arrays."""
-    rr = 0.0
-    ru = 0.0
-    uu = 0.0
-    for k in range(r.shape[0]):
-        rr += r[k] * r[k]
-        ru += r[k] * u[k]
-        uu += u[k] * u[k]
-    return contact_root(rr, ru, uu, sig0, g, np.inf)
-
-
-@njit(cache=True, inline="always")
-def contact_root(rr, ru, uu, sig0, g, tmax):
-    """First contact time in [0, tmax), else inf (module docstring). When A >= 0 the root is at
-    least C / (-2B), which rejects most pairs before the square root."""
-    b = ru - sig0 * g
-    a = uu - g * g
-    if b >= 0.0 and a >= 0.0:
-        return np.inf
-    c = rr - sig0 * sig0
-    if c <= 0.0:
-        if b < 0.0:
-            return 0.0
-        disc = b * b - a * c
-        disc = max(disc, 0.0)
-        return (b + np.sqrt(disc)) / (-a)
-    if a >= 0.0 and c >= -2.0 * b * tmax:
-        return np.inf
-    disc = b * b - a * c
-    if disc < 0.0:
-        return np.inf
-    if b < 0.0:
-        return c / (-b + np.sqrt(disc))
-    return (b + np.sqrt(disc)) / (-a)  # A < 0 here; same root, no cancellation when B >= 0
-
-
-@njit(cache=True)
-def exit_time(dr, v, rrem, adot):
-    """Time for a sphere (centre offset dr from its bounding centre, velocity v, radius growing at
-    adot) to touch its bounding sphere, whose radius exceeds the particle's by rrem now.
-
-    |dr + v t| = rrem - adot t  ->  A t^2 + 2 B t + C = 0 with A = v.v - adot^2,
-    B = dr.v + rrem adot, C = dr.dr - rrem^2 < 0; first root t = -C / (B + sqrt(B^2 - AC))
-    (note 000 sec. 2.9, valid for any sign of A). For shrinking particles (adot < 0) the root is
-    genuine because rrem - adot t stays positive.
-    """
-    dd = 0.0
-    dv = 0.0
-    vv = 0.0
-    for k in range(dr.shape[0]):
-        dd += dr[k] * dr[k]
-        dv += dr[k] * v[k]
-        vv += v[k] * v[k]
-    return _exit_root(dd, dv, vv, rrem, adot)
-
-
-@njit(cache=True, inline="always")
-def _exit_root(dd, dv, vv, rrem, adot):
-    c = dd - rrem * rrem
-    if c >= 0.0:
-        return 0.0
-    a = vv - adot * adot
-    b = dv + rrem * adot
-    disc = b * b - a * c
-    if disc < 0.0:
-        if adot > 0.0:  # round-off: a growing sphere always leaves
-            disc = 0.0
-        else:
-            return np.inf
-    den = b + np.sqrt(disc)
-    if den > 0.0:
-        return -c / den
-    if adot > 0.0:
-        return 0.0
-    return np.inf
-
-
-# --------------------------------------------------------------------------------- event loop
 @njit(cache=True)
 def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
@@ -222,7 +143,8 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
 
     Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
-    out of the hot path; the heap update is :func:`hardpack.md.heap.heap_set`, inlined): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
+    out of the hot path; the heap update is :func:`hardpack.events.heap.heap_set`, inlined):
+    (1) only if ``rebuild_lists``: N complete-update steps, each the partial
     NNL update of one particle (wrap, new bounding sphere, re-bin on its grid level, list every
     overlapping bounding sphere already binned; together a complete update, Alg. 9); the
     bounding radius is
@@ -507,7 +429,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 dd += dx * dx
                 dv += dx * vk
                 vv += vk * vk
-            best = _exit_root(dd, dv, vv, rrem, adot)
+            best = exit_root(dd, dv, vv, rrem, adot)
             partner = EXIT if best < np.inf else NONE
             for m in range(nn[i]):
                 e = nb[i, m]

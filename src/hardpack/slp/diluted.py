@@ -231,7 +231,8 @@ def diluted_summary(packing_paths, verdict_paths) -> xr.Dataset:
             "strict": int(verdict.attrs["strict"]), "collective": int(verdict.attrs["collective"]),
             "n_removed": int(ds.attrs.get("n_removed_total", 0)), "N": packing.n_particles,
             "T": translational_order(packing) if packing.dim == 3 else math.nan,
-            "phi_diluted": float(ds.attrs.get("phi_diluted", math.nan)), "converged": int(ds.attrs.get("converged", -1)),
+            "phi_diluted": float(ds.attrs.get("phi_diluted", math.nan)),
+            "converged": int(ds.attrs.get("converged", -1)),
         }
         for name in ("ensemble", "d", "fraction", "distribution_params"):
             if name in ds.attrs:

@@ -1,24 +1,25 @@
-"""The sequential-LP loop (Torquato & Jiao 2010, sec. III and the SLP note sec. 1.9, 5.2-5.4).
+"""The sequential-LP loop (Torquato & Jiao 2010, Sec. III.B, with the
+overlap handling and termination rule derived here).
 
 Each step solves the LP of :mod:`hardpack.slp.lp` and applies it: M -> (I + eps) M,
 x -> (I + eps)(x + u). The linearisation drops a cross term of first order in both eps and u
-(SLP note sec. 1.4), so an accepted step can create small overlaps. Handling (the "hybrid" rule
-the note found necessary; pure halving stalls):
+(derived here), so an accepted step can create small overlaps. Handling (a "hybrid" rule
+our prototype found necessary; pure halving stalls):
 
 - worst relative overlap above ``reject_overlap`` (1e-4): reject the step and halve the trust
-  region (the paper's rule, L783-792);
+  region (the paper's rule, Torquato & Jiao 2010, Sec. III.B);
 - a smaller overlap: accept and scale the whole packing up just enough to remove it;
 - after an accepted step the trust region doubles again (up to the full bounds), and the cell is
   LLL-reduced so the image search stays small.
 
 Termination: the LP-predicted density gain -tr(eps*) at the full trust region falls below ``tol``.
-The paper stops at a density increase below 1e-8 (L1293-1295); our default is 1e-10, one or two
+The paper stops at a density increase below 1e-8 (Sec. V.A); our default is 1e-10, one or two
 more LPs: at 1e-8 the contact gaps are still ~1e-9 D and the strict LP jamming test of
 :func:`hardpack.jamming.verify` (contacts within 1e-6, unjamming threshold 1e-6 D) failed on 3 of
 4 smoke packings; continued to 1e-10, two of the three passed (the third holds a near-rattler that
 the test moves by 3e-4 D). Below ~1e-12 the predicted gain is at the LP tolerance
 (1e-10 on rows of size D^2) and the loop no longer terminates. Terminating on the observed gain
-would stop falsely after a rescale or a halving (note sec. 5.4).
+would stop falsely after a rescale or a halving.
 
 Checkpoints: with ``checkpoint``, the state after a step (packing, trust region, step count,
 history, elapsed time) is written atomically every ``checkpoint_interval`` seconds
@@ -39,9 +40,9 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
+from hardpack.geometry.reduction import lll_reduce
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt
-from hardpack.geometry.reduction import lll_reduce
 from hardpack.slp.lp import Bounds, solve_step
 
 log = logging.getLogger(__name__)

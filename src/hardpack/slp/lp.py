@@ -4,7 +4,7 @@ Variables (all continuous, box-bounded by the trust region):
 
 - global displacements u_n = M dx_n of every sphere (N x d; the paper uses lattice-coordinate
   displacements dx_n, Eq. 19; the global form is the same LP in better-conditioned variables,
-  SLP note sec. 5.1); u_0 = 0 removes the free global translation;
+  our choice); u_0 = 0 removes the free global translation;
 - the symmetric strain eps of the cell, M -> (I + eps) M (Eqs. 8-10): d(d+1)/2 entries for a
   deforming cell, or one scalar e (eps = e I) for an isotropically shrinking cell.
 
@@ -16,8 +16,8 @@ delta = u_n - u_m,
 
     r^T eps r + delta . r >= (D_mn^2 - r . r) / 2,
 
-the first-order expansion of |(I + eps)(r + delta)|^2 >= D_mn^2 (exact remainder in the SLP
-note sec. 1.4; signs re-derived and tested here). Self-images (m = n, k != 0) constrain the
+the first-order expansion of |(I + eps)(r + delta)|^2 >= D_mn^2 (exact remainder derived
+here; signs derived and tested here). Self-images (m = n, k != 0) constrain the
 strain alone, which is the lattice (N = 1) problem.
 
 Redundant pairs (our addition, exact): with |eps_ab| bounded, ||eps||_2 <= e_max = min(strain +
@@ -29,7 +29,7 @@ trust region. Leaving those rows out does not change the LP's feasible set or op
 solver may pick another point of the degenerate optimal face); it only shortens the LP. With the
 Table II bounds (0.01 / 0.01 / 0.05 D) r_safe is 1.2-1.4 D in d = 2..6, so for the LP an
 influence radius gamma = 3.5 D is the same as gamma = r_safe: beyond r_safe the influence sphere
-is irrelevant (the SLP note's observation, sec. 5.2, here as a bound). With d = 6, N = 729 this is
+is irrelevant (an observation of our prototype, here as a bound). With d = 6, N = 729 this is
 ~60 thousand rows instead of ~16 million (at phi = 0.37). With the Table I
 bounds (0.1 / 0.1 / 0.5 D) r_safe ~ 9 D and gamma = 1.5 D does drop binding pairs.
 

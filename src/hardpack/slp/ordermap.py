@@ -1,6 +1,6 @@
-"""The phi-T order map of SLP packings (Torquato & Jiao 2010, Fig. 6 and sec. VI, L1569-1630).
+"""The phi-T order map of SLP packings (Torquato & Jiao 2010, Fig. 6 and Sec. VI).
 
-One row per packing: density phi (rattlers included, as in Fig. 6, L1753-1757), its number of
+One row per packing: density phi (rattlers included, as in Fig. 6 and Sec. VI), its number of
 spheres N (settings may use different cell sizes: small cells crystallise partly), translational
 order metric T (:func:`hardpack.structure.order.translational_order`, FCC reference at the same
 density, our shell convention: T = 1 for FCC, ~0 for an ideal gas), the SLP settings that made
@@ -9,7 +9,6 @@ it (influence radius alpha = gamma / D, bound widths, LP solver) and its jamming
 """
 
 from __future__ import annotations
-
 
 import numpy as np
 import xarray as xr

@@ -80,7 +80,8 @@ def pair_correlation(packing, r_max: float | None = None, dr: float | None = Non
 
     Defaults: r_max = 5 mean diameters, dr = mean diameter / 200 (Donev's 0.005 D bins for the
     split second peak, ch7-9 L1854-1867). The pair search reaches max(r_max, x_max times the
-    largest contact distance): lower x_max for wide size distributions. Returns a Dataset with coordinates ``r`` and ``x``
+    largest contact distance): lower x_max for wide size distributions. Returns a Dataset with
+    coordinates ``r`` and ``x``
     (bin centres), variables ``g2``, ``pair_count``, ``ideal_count`` on r, the same with suffix
     ``_scaled`` on x, and scalars ``n_contacts`` and ``z_contacts`` (the delta-peak weight).
     """
