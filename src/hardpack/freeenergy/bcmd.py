@@ -99,7 +99,21 @@ def disjoint_dmu(nb: Neighbours) -> float:
 
 @dataclass(frozen=True)
 class BCMDResult:
-    """Outcome of :func:`run_bcmd`; ``dataset`` holds the per-segment series and all numbers."""
+    """Outcome of :func:`run_bcmd`; ``dataset`` holds the per-segment series and all numbers.
+
+    Attributes
+    ----------
+    delta_f : float
+        (d/2) ln(K/K_0) chained = f_c(Delta mu_min) - f.
+    f_c : float
+        Disjoint-cell reference at Delta mu_min (lengths in mean diameters); NaN for a partial run.
+    f : float
+        Free energy per moving particle; NaN for a partial run.
+    excess : float
+        f - f_ideal with f_ideal = -ln(V/N) - 1 (Eq. 6.15).
+    dataset : xarray.Dataset
+        Per-segment series and all parameters and numbers in its attrs.
+    """
 
     delta_f: float  # (d/2) ln(K/K0) chained = f_c(dmu_min) - f
     f_c: float  # disjoint-cell reference at dmu_min (units: mean diameter)
@@ -139,11 +153,60 @@ def run_bcmd(
     """Run BCMD on ``packing`` (cell centres = its positions, radii as given) from Delta mu_max
     down to Delta mu_min (default: the disjoint-cell point, which must be > 0).
 
-    equilibration: run time at fixed Delta mu_max before shrinking, in units of
-    Delta mu_max <R> / v_th (v_th = 1). reset_ratio: if set, velocities are re-drawn (kT back to
-    its initial value) whenever K grew by this factor since the last draw (thermostat of
-    Donev 2006, sec. 6.3.5.1); ln K is chained across draws. partial: allow stopping above the disjoint-cell
-    point (the Delta f(Delta mu) curve only; f_c, f and the excess are then NaN).
+    Conventions and estimator: see the module docstring (Donev 2006, sec. 6.3).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing with at least 2 particles; its positions are the cell centres.
+    dmu_max : float
+        Initial cell size Delta mu_max (> 0), in units of each particle's radius.
+    dmu_min : float, optional
+        Final cell size Delta mu_min, 0 < dmu_min < dmu_max; default the disjoint-cell point
+        min |R_i - R_j| / (R_i + R_j) - 1.
+    gamma0 : float, default 1e-3
+        Shrink rate gamma_0 > 0 at Delta mu_max.
+    theta : float, default 1.0
+        Exponent of gamma = gamma_0 (Delta mu / Delta mu_max)^theta, >= 0.
+    frozen : {"particle", "cm"}, default "particle"
+        Removal of the translations: freeze particle 0, or measure K in the centre-of-mass frame.
+    seed : int, default 0
+        Seed of the initial and re-drawn velocities.
+    equilibration : float, default 50.0
+        Run time at fixed Delta mu_max before shrinking, in units of Delta mu_max <R> / v_th
+        (v_th = 1); >= 0.
+    segment_fraction : float, default 0.01
+        Relative fall of Delta mu per segment (the rate gamma is updated and one row recorded
+        per segment); in (0, 0.5].
+    reset_ratio : float, optional
+        If set (> 1), velocities are re-drawn (kT back to its initial value) whenever K grew by
+        this factor since the last draw (thermostat of Donev 2006, sec. 6.3.5.1); ln K is
+        chained across draws.
+    max_events : int, default 10**10
+        Bound on the collisions of one segment.
+    partial : bool, default False
+        Allow stopping above the disjoint-cell point (the Delta f(Delta mu) curve only; f_c, f
+        and the excess are then NaN).
+
+    Returns
+    -------
+    BCMDResult
+        ``delta_f`` = (d/2) ln(K/K_0) chained, ``f_c`` the disjoint-cell reference at
+        Delta mu_min, ``f`` = f_c - delta_f per moving particle, ``excess`` = f - f_ideal, and
+        ``dataset``: per-segment variables ``dmu``, ``mu``, ``dmu_mid``, ``time``, ``gamma``,
+        ``ln_k``, ``delta_f``, ``p_c`` (reduced cell-wall pressure), ``events``, with the
+        parameters, results and event counts in its attrs (``hardpack_kind`` = "bcmd").
+
+    Raises
+    ------
+    InvalidInputError
+        If ``packing`` is not a periodic sphere Packing with >= 2 particles, ``frozen`` is
+        unknown, a numeric parameter is outside its range, the cells are never disjoint (some
+        centres at contact), dmu_min >= dmu_max, or dmu_min is above the disjoint-cell point
+        without ``partial``.
+    RuntimeError
+        If a segment exceeds ``max_events``, a particle escapes its cell or two spheres overlap
+        at the end (failures of the event-driven dynamics, not of the input).
     """
     clock = time.perf_counter()
     if not isinstance(packing, Packing):

@@ -71,7 +71,27 @@ def backbone_rows(net: ContactNetwork, backbone: np.ndarray, contacts: np.ndarra
 
 
 def self_stress(net: ContactNetwork, backbone: np.ndarray) -> Forces:
-    """Forces of the backbone from the two LPs of the module docstring, polished to round-off."""
+    """Forces of the backbone from the two LPs of the module docstring, polished to round-off.
+
+    Donev 2006, sec. 5.5.1.1 (LP 5.9) after the jamming-gap LP; a rigid backbone with few
+    self-stresses is solved in the self-stress basis.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of the packing.
+    backbone : numpy.ndarray of bool, shape (N,)
+        The rattler-free backbone; only contacts among its particles carry force.
+
+    Returns
+    -------
+    Forces
+        ``forces`` (M,): 0 off the backbone, mean 1 over the backbone contacts; ``min_force``
+        the optimum t of LP 5.9 relative to the mean force (> 0 certifies a strict
+        self-stress); ``jamming_gap`` mu*; ``imbalance`` (N, d) the net contact force on each
+        particle; ``exists`` False (forces 0, NaN numbers) when the backbone has no contacts or
+        admits no non-negative self-stress.
+    """
     n, d = net.n_particles, net.dim
     contacts = net.among(backbone)
     m = int(contacts.sum())
@@ -261,7 +281,33 @@ def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: f
             counted: np.ndarray | None = None) -> Statics:
     """Counts over the backbone contacts in ``counted`` (default all; :func:`verify` leaves out
     the near contacts that only carry the forces of the nearest jamming point), pressures over
-    every contact with a force."""
+    every contact with a force.
+
+    Formulas in the module docstring (Donev 2006, Eqs. 4.8, 4.9, 4.24).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of the packing.
+    backbone : numpy.ndarray of bool, shape (N,)
+        The rattler-free backbone.
+    forces : Forces
+        Its self-stress (:func:`self_stress`), mean 1 over the backbone contacts.
+    volume : float
+        Volume V of the cell.
+    counted : numpy.ndarray of bool, shape (M,), optional
+        The contacts that count for M_b, Z and the isostaticity gaps (default all).
+
+    Returns
+    -------
+    Statics
+        ``n_backbone`` N_b, ``n_contacts`` M_b, ``z_mean`` 2 M_b / N_b, ``n_dof_collective``
+        d (N_b - 1), ``n_dof_strict`` (+ d(d+1)/2 - 1), ``isostaticity_gap`` and
+        ``isostaticity_gap_strict`` (M_b - N_f - 1), ``pressure_virial`` and ``stress`` (d, d)
+        (forces of mean 1; NaN without forces), ``jamming_gap`` mu* and
+        ``pressure_free_volume`` (N_b - 1) / (N mu*) = PV/(NkT) (inf for mu* = 0, NaN without
+        forces). An empty backbone gives zero counts and NaN Z.
+    """
     d, n = net.dim, net.n_particles
     contacts = net.among(backbone)
     nb = int(backbone.sum())

@@ -83,10 +83,34 @@ def remove_rattlers(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Iteratively remove particles that are not locally jammed.
 
-    Returns (active mask after removal, per-particle local escape displacement; NaN where not
-    measured). ``recheck`` restricts the first LP round to these particles (default: all
-    active ones); later rounds test the neighbours of removed particles. With
-    ``use_lp=False`` only the contact-count rule is applied.
+    Donev 2006, sec. 4.4.3.1 (LP 4.15) and Algorithm 13 step 4; see the module docstring. The
+    contact-count rule (fewer than d + 1 contacts) runs before every LP round.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of the packing.
+    active : numpy.ndarray of bool, shape (N,)
+        The particles present; not modified in place.
+    dr_large : float
+        Escape displacement (absolute length) from which a particle is a rattler.
+    box : float
+        Bound on each displacement component in the local LPs.
+    rng : numpy.random.Generator
+        Source of the random loads.
+    use_lp : bool, default True
+        With False only the contact-count rule is applied.
+    recheck : numpy.ndarray of bool, shape (N,), optional
+        Restricts the first LP round to these particles (default: all active ones); later
+        rounds test the neighbours of removed particles.
+
+    Returns
+    -------
+    active : numpy.ndarray of bool, shape (N,)
+        The particles left after removing the rattlers.
+    escape : numpy.ndarray of float, shape (N,)
+        Local escape displacement |dr_i| of each particle tested by an LP (the last one
+        measured); NaN where not measured.
     """
     d = net.dim
     active = active.copy()

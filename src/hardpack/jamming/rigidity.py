@@ -30,7 +30,19 @@ from hardpack.jamming.contacts import ContactNetwork
 
 
 def strain_pairs(d: int) -> list[tuple[int, int]]:
-    """Index pairs (p, q) of the independent strain components: diagonal, then p < q."""
+    """Index pairs (p, q) of the independent strain components: diagonal, then p < q.
+
+    Parameters
+    ----------
+    d : int
+        The dimension.
+
+    Returns
+    -------
+    list of tuple of int
+        The d(d+1)/2 pairs (0, 0), ..., (d-1, d-1), then (p, q) with p < q in row order: the
+        order of the strain rows of :func:`rigidity_matrix`.
+    """
     return [(p, p) for p in range(d)] + [(p, q) for p in range(d) for q in range(p + 1, d)]
 
 
@@ -90,5 +102,22 @@ def anchored_transpose(net: ContactNetwork, backbone: np.ndarray,
 
 
 def rigidity_matrix(net: ContactNetwork, strain: bool = False) -> sp.csc_matrix:
-    """The rigidity matrix A, shape (N d [+ d(d+1)/2], M); see the module docstring."""
+    """The rigidity matrix A, shape (N d [+ d(d+1)/2], M); see the module docstring.
+
+    Donev 2006, sec. 4.4.3 (Eqs. 4.18-4.21 for the strain rows).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of a periodic packing.
+    strain : bool, default False
+        Add the d(d+1)/2 rows of the symmetric strain components (order of
+        :func:`strain_pairs`).
+
+    Returns
+    -------
+    scipy.sparse.csc_matrix, shape (N d [+ d(d+1)/2], M)
+        One column per contact: -u_ij in the rows of particle i, +u_ij in those of j (zero for
+        a self-image contact), and the strain derivatives of the contact length when ``strain``.
+    """
     return rigidity_transpose(net, strain).T.tocsc()

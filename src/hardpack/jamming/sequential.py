@@ -218,6 +218,49 @@ def sequential_test(
     dict of arrays and scalars; passing such a dict back as ``resume`` (same packing, rng seed and
     parameters) continues after that sequence, with the same loads, so the outcome is that of
     an uninterrupted test.
+
+    Parameters
+    ----------
+    packing : Packing
+        The periodic sphere packing to load; every loading sequence starts from it.
+    delta : float
+        Relative gap tolerance of the contact list; also bounds each LP step by delta r_min.
+    strict : bool
+        False: collective test (fixed cell); True: strict test (strain with Tr eps <= 0).
+    rattlers : numpy.ndarray of bool, shape (N,)
+        Particles kept as fixed obstacles, without load.
+    rng : numpy.random.Generator
+        Source of the random loads (all ``n_loads`` drawn first).
+    box : float
+        Bound on each displacement component in the LPs (capped at delta r_min).
+    threshold : float, default 1e-3
+        Mean displacement / D (or strain |eps|_2) from which a sequence unjams the packing.
+    beta : float, default 0.01
+        A sequence stops once no particle moved by more than beta D in its last step.
+    n_loads : int, default 3
+        Random loads; each is applied as B and -B.
+    max_steps : int, default 3
+        Most LPs per loading sequence.
+    resume : dict, optional
+        A state received by ``save`` to continue from.
+    save : callable, optional
+        Called with the test's state (a dict) after each loading sequence.
+    workers : int, default 1
+        Loading sequences run at once in worker processes.
+
+    Returns
+    -------
+    SequentialOutcome
+        ``jammed``, per-sequence ``mean_displacement``, ``strain_norm``, ``max_displacement``
+        and ``steps``, the per-particle largest ``displacement`` / D, the ``motion`` and
+        ``strain`` of the sequence with the largest mean displacement, the ``final`` packing,
+        LP counts, ``seconds``, ``fallbacks`` and ``undetermined`` with the reason when a
+        sequence could not go on (then ``jammed`` is False).
+
+    Raises
+    ------
+    InvalidInputError
+        If ``resume`` is a state of another layout (saved by an older hardpack).
     """
     t0 = time.perf_counter()
     n, d = packing.n_particles, packing.dim

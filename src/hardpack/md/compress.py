@@ -100,6 +100,25 @@ class StopCriteria:
     max_pressure: reduced pressure Z (growing runs only); target_phi: volume fraction (reached
     exactly: the last window ends when phi hits it); max_collisions: total collisions;
     max_wall_time: seconds of wall-clock time in this invocation. None disables a criterion.
+
+    Parameters
+    ----------
+    max_pressure : float or None, default 1e12
+        Stop when the window's reduced pressure Z = pV/(NkT) reaches it (growing runs only);
+        finite and > 1.
+    target_phi : float or None, default None
+        Stop when the volume fraction reaches it exactly, in (0, 1); above the start phi for a
+        positive growth rate, below it for a negative one (then required).
+    max_collisions : int or None, default None
+        Stop after this many collisions in all (a positive integer).
+    max_wall_time : float or None, default None
+        Stop after this many wall-clock seconds in this invocation (> 0).
+
+    Notes
+    -----
+    The values are checked against the growth rate and start phi by :meth:`check`, which
+    :func:`compress` calls and which raises InvalidInputError for impossible or never-ending
+    combinations.
     """
 
     max_pressure: float | None = 1e12
@@ -144,7 +163,27 @@ class StopCriteria:
 @dataclass
 class CompressResult:
     """Final packing, final velocities (m = 1, kT = 1), per-window time series, run stats and
-    optionally the MD contact forces."""
+    optionally the MD contact forces.
+
+    Attributes
+    ----------
+    packing : Packing
+        The final packing.
+    velocities : numpy.ndarray, shape (N, d)
+        Final velocities (m = 1, kT = 1 after the last rescaling).
+    timeseries : xarray.Dataset
+        One row per synchronisation window along ``window`` (``hardpack_kind`` =
+        "md_timeseries"): ``time``, ``phi``, ``Z``, ``phi_J_est``, ``collisions``, ``kT``,
+        ``kT_mean``, event counts, ``max_overlap``, ``shell``, ``neighbours``, ``wall_time``,
+        ``growth_rate``.
+    stats : dict
+        Protocol, ``growth_rate``, ``seed``, ``stop_reason``, final ``Z``, ``phi``,
+        ``phi_J_est``, collision / event / window counts, times, overlap check, and for a
+        two-stage run the final stage's rate and collisions; for a run stopped at max_pressure
+        also ``backbone_volume_fraction`` and ``jamming_check``.
+    contacts : xarray.Dataset or None
+        The time-averaged MD contact forces (``md_contact_*`` variables) when asked for.
+    """
 
     packing: Packing
     velocities: np.ndarray
@@ -173,6 +212,18 @@ def default_window(growth_rate: float, d: int) -> float:
     collision per particle is about 2 Gamma sqrt(pi) / d (mean |v_n| of colliding pairs sqrt(pi kT)
     and g / sigma = Gamma / <D>). HEATING * d / Gamma collisions per particle keep the heating
     between rescalings near 10 %, capped at MAX_WINDOW (Skoge-Donev use ~20 events per particle).
+
+    Parameters
+    ----------
+    growth_rate : float
+        The dimensionless growth rate Gamma (module docstring); its sign is ignored.
+    d : int
+        The dimension.
+
+    Returns
+    -------
+    float
+        HEATING * d / |Gamma| clipped to [1, MAX_WINDOW]; MAX_WINDOW for Gamma = 0.
     """
     if growth_rate == 0:
         return MAX_WINDOW
@@ -332,6 +383,64 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     contact_forces: accumulate the per-pair collision impulses over the last ``contact_windows``
     windows (:mod:`hardpack.md.contacts`); ``result.contacts`` then holds the time-averaged
     contact forces and :meth:`CompressResult.save` stores them with the packing.
+
+    Parameters
+    ----------
+    packing : Packing
+        Start configuration: a periodic sphere packing in an orthorhombic cell, N >= 2, without
+        overlaps.
+    growth_rate : float
+        Gamma = (d<D>/dt) / sqrt(kT/m), finite; negative shrinks the particles (needs a
+        ``target_phi`` below the start), 0 runs at fixed phi (needs a collision or time limit).
+    seed : int
+        Non-negative seed of the initial Maxwell-Boltzmann velocities (the only randomness).
+    stop : StopCriteria, optional
+        Default: reduced pressure 1e12.
+    checkpoint : str or os.PathLike, optional
+        Path of the resumable checkpoint described above.
+    progress : callable, optional
+        Receives each window's record (a dict).
+    window : float, optional
+        Collisions per particle between synchronisations (> 0); default :func:`default_window`
+        of the current stage's rate.
+    checkpoint_interval : float, default 300.0
+        Seconds between checkpoint writes.
+    progress_interval : float, default 10.0
+        Seconds between progress log lines.
+    overlap_tol : float, default DEFAULT_OVERLAP_TOL
+        Relative overlap tolerance checked at every synchronisation and at the end.
+    final_growth_rate : float, optional
+        Growth rate (finite, > 0) of the slow second stage; needs growth_rate > 0.
+    switch_pressure : float, default 1e3
+        Reduced pressure (finite, > 1, below ``stop.max_pressure``) that starts the slow stage.
+    contact_forces : bool, default False
+        Accumulate the MD contact forces.
+    contact_windows : int, default 10
+        Windows over which they are averaged (a positive integer).
+    keep_checkpoint : bool, default False
+        Leave the checkpoint for the caller to remove.
+
+    Returns
+    -------
+    CompressResult
+        The final packing and velocities, the per-window ``timeseries`` Dataset, the run
+        ``stats`` (stop reason, final Z, phi, phi_J_est, counts, end-state checks) and the MD
+        ``contacts`` when asked for.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing cannot be run (not periodic spheres, sheared cell, fewer than 2
+        particles, overlaps); ``growth_rate``, ``seed``, ``window``, ``contact_windows`` or the
+        two-stage parameters are invalid; the stop criteria are impossible or never end
+        (:meth:`StopCriteria.check`); or a run towards ``target_phi`` without a pressure cap
+        jammed short of it (reduced pressure above JAMMED_PRESSURE with phi_J_est below the
+        target).
+    OverlapError
+        If particles overlap beyond ``overlap_tol`` at a synchronisation point (an engine
+        failure).
+    hardpack.io.interrupt.Interrupted
+        On SIGINT or SIGTERM, after the checkpoint is written.
     """
     check_packing(packing)
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \

@@ -164,6 +164,102 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     and log_val[c] = (impulse J on j from i (d components), r_ij . J) (contact forces,
     :mod:`hardpack.md.contacts`); pass (0, 2) / (0, d + 1) arrays to log nothing.
     Returns a status code (module constants).
+
+    Every array is modified in place unless marked read-only; the caller
+    (:meth:`hardpack.md.engine.Engine.run_window`) allocates them once and keeps them between
+    windows. N particles, d dimensions, n_lev grid levels, n_cells cells over all levels,
+    ccap slots per cell, cap entries per neighbour list.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, 2 d + 2)
+        Particle state: row i = (x_0..x_{d-1}, v_0..v_{d-1}, t_i, a_i), position and velocity
+        at the particle's own last update time t_i (window time) and its radius at window
+        time 0 (module docstring). Masses are 1.
+    dims : tuple of int
+        ``tuple(range(d))``; only its length is used (a compile-time constant for numba).
+    L : numpy.ndarray of float64, shape (d,), read-only
+        Side lengths of the orthorhombic periodic box.
+    kappa : float
+        Relative growth rate of the radii, a_i(t) = a_i (1 + kappa t) (< 0 shrinks).
+    skin : float
+        Bounding-sphere skin of the coming rebuilds (bounding radius a_i(t) + skin sfac_i,
+        capped at rcap of the particle's level).
+    sfac : numpy.ndarray of float64, shape (N,), read-only
+        Relative skin of every particle (:meth:`hardpack.md.engine.Engine.skin_factors`).
+    imgvec : numpy.ndarray of float64, shape (4**d, d), read-only
+        Periodic shift L n of each image code, code = sum_k (n_k + 1) 4^k.
+
+    lvl : numpy.ndarray of int32, shape (N,), read-only
+        Grid / cells: the grid level h of every particle.
+    rcap : numpy.ndarray of float64, shape (n_lev,), read-only
+        Grid / cells: cap on the bounding radius of the particles of each level.
+    ncl : numpy.ndarray of int64, shape (n_lev, d), read-only
+        Grid / cells: cells per side of each level (cell width >= 2 rcap[h] unless coarsened).
+    coff : numpy.ndarray of int64, shape (n_lev + 1,), read-only
+        Grid / cells: offset of each level's first cell in the flat cell index (coff[-1] =
+        n_cells).
+    ccount : numpy.ndarray of int32, shape (n_cells,)
+        Grid / cells: bounding spheres in each cell (reset on a rebuild).
+    cid : numpy.ndarray of int32, shape (n_cells * ccap,)
+        Grid / cells: particle of each slot; slot s of cell c is c * ccap + s.
+    cbs : numpy.ndarray of float64, shape (n_cells * ccap, d + 1)
+        Grid / cells: copy of the bounding sphere (centre, radius) of each slot's particle.
+    slot_of : numpy.ndarray of int32, shape (N,)
+        Grid / cells: slot of each particle's bounding sphere (-1: not binned; reset on a
+        rebuild).
+
+    bs : numpy.ndarray of float64, shape (N, d + 1)
+        Neighbour lists: bounding sphere of every particle, centre then radius.
+    nb : numpy.ndarray of int32 or int64, shape (N, cap)
+        Neighbour lists: entries j << 2d | image code of the bounding spheres that overlap
+        particle i's.
+    nn : numpy.ndarray of int32, shape (N,)
+        Neighbour lists: length of each list (reset on a rebuild).
+    mark : numpy.ndarray of int8, shape (N,)
+        Neighbour lists: scratch flags of a partial update (reset at entry).
+
+    cnt : numpy.ndarray of int32, shape (N,)
+        Heap / events: collision counter of every particle (lazy invalidation).
+    ep : numpy.ndarray of int32, shape (N,)
+        Heap / events: partner of each particle's predicted event (EXIT: leaves its bounding
+        sphere; NONE: nothing predicted).
+    ec : numpy.ndarray of int32, shape (N,)
+        Heap / events: the partner's collision counter at prediction time (``cnt[ep[i]]``).
+    hkey : numpy.ndarray of float64, shape (N,)
+        Heap / events: key (predicted event time) of heap slot k, in heap order.
+    heap : numpy.ndarray of int32, shape (N,)
+        Heap / events: particle in heap slot k (4-ary min-heap, :mod:`hardpack.md.heap`).
+    hpos : numpy.ndarray of int32, shape (N,)
+        Heap / events: heap slot of every particle (reset to -1 at entry).
+
+    acc : numpy.ndarray of float64, shape (5,)
+        Outputs: float accumulators A_T (time reached), A_VIRIAL, A_KEINT, A_KE (enter the
+        current kinetic energy), A_TKE (enter 0).
+    iacc : numpy.ndarray of int64, shape (N_COUNTERS,)
+        Outputs: counters I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE (enter zeros).
+
+    coll_target : int
+        Window controls: stop after this many collisions (at the last one's time).
+    t_cap : float
+        Window controls: stop before the first event later than this window time.
+    rebuild_lists : bool
+        Window controls: start with a complete rebuild of grid and neighbour lists (stage 1);
+        otherwise the previous window's are kept.
+
+    log_pair : numpy.ndarray of int, shape (n_log, 2)
+        Outputs: (i, j) of the window's first n_log collisions; n_log = 0 logs nothing.
+    log_val : numpy.ndarray of float64, shape (n_log, d + 1)
+        Outputs: the impulse J on j from i (d components) and r_ij . J of those collisions.
+
+    Returns
+    -------
+    int
+        Status: DONE_COLLISIONS (``coll_target`` reached; acc[A_T] is the last collision time),
+        DONE_TIME (the next event is later than ``t_cap``; acc[A_T] = t_cap), or, for the
+        caller to enlarge and redo the window, OVERFLOW (a neighbour list is full),
+        CELL_OVERFLOW (a grid cell is full), BOUND_TOO_SMALL (a particle grew to its level's
+        bounding-radius cap); STUCK when no event can ever happen.
     """
     d = len(dims)
     n = P.shape[0]

@@ -51,7 +51,22 @@ class OverlapError(RuntimeError):
 
 def maxwell_boltzmann(n: int, d: int, seed) -> np.ndarray:
     """Velocities from numpy.random.default_rng(seed): Gaussian, zero total momentum, and scaled so
-    that kT = 2 KE / (d N) = 1 exactly (m = 1)."""
+    that kT = 2 KE / (d N) = 1 exactly (m = 1).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles (>= 2 for a non-zero velocity after removing the mean).
+    d : int
+        The dimension.
+    seed : int, numpy.random.SeedSequence or None
+        Anything :func:`numpy.random.default_rng` accepts.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, d)
+        The velocities.
+    """
     rng = np.random.default_rng(seed)
     v = rng.standard_normal((n, d))
     v -= v.mean(axis=0)

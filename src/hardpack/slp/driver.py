@@ -58,6 +58,23 @@ class SLPResult:
     density, and whether it is collectively or strictly jammed is decided by the LP jamming tests
     (:func:`hardpack.jamming.verify`, ``hardpack verify``), as Torquato & Jiao (2010, Sec. III.C)
     test their packings.
+
+    Attributes
+    ----------
+    packing : Packing
+        The last accepted packing (lattice LLL-reduced, positions wrapped).
+    history : xarray.Dataset
+        One row per LP along ``lp`` (``hardpack_kind`` = "slp_history"): coordinate ``step``,
+        ``phi``, ``predicted_gain``, ``n_constraints``, ``lp_seconds``, ``trust_scale``,
+        ``worst_overlap``, ``accepted``.
+    converged : bool
+        The predicted density gain at full trust region fell below ``tol``.
+    n_steps : int
+        Rows of the history (accepted and rejected LPs, and the final one).
+    n_rejected : int
+        LP steps rejected for overlaps above ``reject_overlap``.
+    wall_seconds, cpu_seconds : float
+        Wall-clock and CPU time, summed over resumed invocations.
     """
 
     packing: Packing
@@ -94,6 +111,51 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
     (module docstring), removed when the run ends unless ``keep_checkpoint`` (then the caller
     removes it once the result is written). On SIGINT or SIGTERM the run writes its checkpoint
     before the next LP and raises :class:`hardpack.io.interrupt.Interrupted`.
+
+    Torquato & Jiao 2010, Sec. III; the step acceptance and trust-region rules are in the
+    module docstring.
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing (the start).
+    alpha : float
+        Influence-sphere radius over the pair's mean diameter (gamma_mn = alpha D_mn).
+    bounds : Bounds
+        Full trust-region widths (strain, shear, displacement).
+    deforming : bool, default True
+        Symmetric strain (the paper's deforming cell) or isotropic shrink only.
+    tol : float, default 1e-10
+        Convergence: predicted density gain (-Tr eps) below which the run stops, in (0, 1).
+    max_steps : int, default 2000
+        Most LPs (a positive integer); the result says whether it converged.
+    reject_overlap : float, default 1e-4
+        Largest relative overlap of an accepted step, in (0, 0.5); above it the step is
+        rejected and the trust region halved.
+    progress_every : int, default 10
+        Log a progress line every this many steps (0: never).
+    method : str, default "highs-ipm"
+        HiGHS solver of :func:`hardpack.slp.lp.solve_step`.
+    checkpoint : str or os.PathLike, optional
+        Path of the resumable checkpoint.
+    checkpoint_interval : float, default 300.0
+        Seconds between checkpoint writes.
+    keep_checkpoint : bool, default False
+        Leave the checkpoint for the caller to remove.
+
+    Returns
+    -------
+    SLPResult
+        The end packing, the per-LP ``history`` Dataset, ``converged``, step counts and times.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``packing`` is not a periodic sphere packing, ``tol`` or ``reject_overlap`` is out of
+        range, ``max_steps`` is not a positive integer, or the trust region shrank below
+        MIN_TRUST_SCALE of ``bounds`` without an acceptable step (lower the bounds).
+    hardpack.io.interrupt.Interrupted
+        On SIGINT or SIGTERM, after the checkpoint is written.
     """
     packing.require_periodic_spheres("SLP")
     if not (0 < tol < 1):

@@ -140,6 +140,29 @@ def channel_radii(packing, neighbours="delaunay", eps: float = ACUTE_EPS) -> xr.
     ``neighbours``: "delaunay" (weighted regular triangulation, the source's choice), a cutoff
     in contact distances, or a NeighbourList. Returns a Dataset on dim ``channel`` with
     ``ratio`` and ``particle``, plus scalar counts ``n_obtuse`` and ``n_failed``.
+
+    Ogarko 2014, ch. 4.
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing, d >= 2.
+    neighbours : "delaunay", float or NeighbourList, default "delaunay"
+        Neighbour specification (:func:`hardpack.structure.tessellation.neighbour_list`).
+    eps : float, default 1 - 1e-12
+        Acute-triangle tolerance, in (0, 1]: a^2 + b^2 > eps c^2 for every ordering.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``ratio`` R / r_i and the central ``particle`` i of every channel (dim ``channel``),
+        scalar counts ``n_obtuse`` (triangles not acute) and ``n_failed`` (no positive root);
+        attributes ``eps`` and ``definition``.
+
+    Raises
+    ------
+    InvalidInputError
+        If d < 2, ``eps`` is not in (0, 1], or ``neighbours`` is not a valid specification.
     """
     if packing.dim < 2:
         raise InvalidInputError("channel analysis needs d >= 2")
@@ -159,7 +182,28 @@ def channel_radii(packing, neighbours="delaunay", eps: float = ACUTE_EPS) -> xr.
 
 def channel_histogram(channels: xr.Dataset, bin_width: float = 0.01,
                       ratio_max: float | None = None) -> xr.Dataset:
-    """Normalised histogram (probability density) of R / r with the source's bin 0.01."""
+    """Normalised histogram (probability density) of R / r with the source's bin 0.01.
+
+    Parameters
+    ----------
+    channels : xarray.Dataset
+        Output of :func:`channel_radii` (its ``ratio`` variable is used).
+    bin_width : float, default 0.01
+        Width of the bins, starting at 0.
+    ratio_max : float, optional
+        Upper end of the bins; default the largest ratio.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``density`` (integrates to 1) on the bin centres ``ratio_bin``; attributes
+        ``bin_width`` and ``n_channels``.
+
+    Raises
+    ------
+    InvalidInputError
+        If there are no channels.
+    """
     ratio = channels["ratio"].values
     if ratio.size == 0:
         raise InvalidInputError("no channels to histogram (no acute neighbour triangles)")
