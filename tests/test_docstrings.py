@@ -18,7 +18,6 @@ SECTIONS = ("Parameters\n----------", "Returns\n-------")
 # Functions defined in files under restructuring by another branch; their docstrings are in the
 # numpydoc branch's report. TEMPORARY: the lead empties this set after the merge.
 ALLOWED = {
-    "hardpack.geometry.neighbours.pairs_within",
     "hardpack.jamming.contacts.contact_network",
     "hardpack.slp.lp.solve_step",
     "hardpack.structure.pair.cumulative_coordination",

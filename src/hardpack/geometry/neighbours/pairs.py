@@ -122,10 +122,30 @@ def pairs_within(packing, rel_gap: float = 0.0, cutoff: float | None = None, *, 
     along the periodic axes of ``packing.boundary``; r the bounding radii of ``packing.shape`` (module
     docstring).
 
-    ``rel_gap`` is the relative gap tolerance (Donev's contact tolerance, e.g. 1e-9 for contacts
-    of an LS packing); ``cutoff`` an absolute centre-distance range (e.g. for g2 or the SLP
-    influence sphere). ``levels``: the grid levels (:func:`hardpack.geometry.neighbours.build_grid`;
-    default: Ogarko's optimal number; the pairs never depend on it).
+    Parameters
+    ----------
+    packing : hardpack.geometry.Packing
+        The particles, their cell and boundary.
+    rel_gap : float, default 0.0
+        Relative gap tolerance, >= -1 (Donev's contact tolerance, e.g. 1e-9 for the contacts of an LS
+        packing).
+    cutoff : float, optional
+        Absolute centre-distance range instead of the contact criterion (e.g. for g2 or the SLP
+        influence sphere).
+    levels : None, int or LevelAssignment, optional
+        Grid levels (:func:`hardpack.geometry.neighbours.build_grid`; default Ogarko's optimal number).
+        The pairs never depend on it.
+
+    Returns
+    -------
+    PairList
+        Each pair once (i < j, or i == j with a lexicographically positive image), sorted by
+        (i, j, shift).
+
+    Raises
+    ------
+    InvalidInputError
+        If rel_gap is not finite or below -1, or the cutoff is not positive and finite.
     """
     if not np.isfinite(rel_gap) or rel_gap < -1:
         raise InvalidInputError(f"rel_gap must be a finite number >= -1, got {rel_gap}")
