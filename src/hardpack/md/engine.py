@@ -24,6 +24,7 @@ import numpy as np
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.neighbours import cell_counts, geometric_levels
 from hardpack.md import kernel
+from hardpack.md.kernel import WindowStatus
 
 #: cells per particle of a level above which its grid is coarsened (dilute systems)
 MAX_CELLS_PER_PARTICLE = 2.0
@@ -272,23 +273,23 @@ class Engine:
             self.cnt[:] = 0
             acc = np.array([0.0, 0.0, 0.0, self.kinetic_energy(), 0.0])
             iacc = np.zeros(kernel.N_COUNTERS, dtype=np.int64)
-            status = kernel.run_events(
+            status = WindowStatus(kernel.run_events(
                 self.P, self.dims, self.box, kappa, eff_skin, self.sfac, self.imgvec, self.lvl, self.rcap,
                 self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
                 self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
-                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild, *log)
-            if status in (kernel.OVERFLOW, kernel.CELL_OVERFLOW, kernel.BOUND_TOO_SMALL):
+                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild, *log))
+            if status in (WindowStatus.OVERFLOW, WindowStatus.CELL_OVERFLOW, WindowStatus.BOUND_TOO_SMALL):
                 self.P[:] = start  # redo the window after a full rebuild
-                if status == kernel.OVERFLOW:
+                if status == WindowStatus.OVERFLOW:
                     self.alloc_lists(2 * self.capacity)
-                elif status == kernel.CELL_OVERFLOW:
+                elif status == WindowStatus.CELL_OVERFLOW:
                     self.cell_floor = 2 * self.cell_capacity
                     self.alloc_cells(self.cell_floor)
                 else:
                     self._new_bounds(skin)
                 rebuild = True
                 continue
-            if status == kernel.STUCK:
+            if status == WindowStatus.STUCK:
                 raise RuntimeError("no event can ever happen: no particle moves and none grows")
             break
         self.lists_valid = True

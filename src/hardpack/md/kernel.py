@@ -55,6 +55,8 @@ with v_n >= 0 are skipped (mispredicted or grazing, Alg. 12 step 3).
 
 from __future__ import annotations
 
+import enum
+
 import numpy as np
 from llvmlite import ir
 from numba import njit, types
@@ -67,13 +69,18 @@ from hardpack.events.roots import contact_root, exit_root
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
 
-# status codes of run_events
-DONE_COLLISIONS = 0  # the window's collision budget is used up (sync at the last collision time)
-DONE_TIME = 1  # the next event is later than t_cap (sync at t_cap)
-OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
-STUCK = 3  # no event can ever happen (nothing moves)
-BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
-CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
+
+
+class WindowStatus(enum.IntEnum):
+    """How :func:`run_events` ended a window."""
+
+    DONE_COLLISIONS = 0  # the window's collision budget is used up (sync at the last collision time)
+    DONE_TIME = 1  # the next event is later than t_cap (sync at t_cap)
+    OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
+    STUCK = 3  # no event can ever happen (nothing moves)
+    BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
+    CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
+
 
 # float accumulators, acc[...]
 A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE = 0, 1, 2, 3, 4
@@ -308,9 +315,9 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 acc[A_T] = t_cap
                 acc[A_KEINT] += acc[A_KE] * (t_cap - acc[A_TKE])
                 acc[A_TKE] = t_cap
-                return DONE_TIME
+                return WindowStatus.DONE_TIME
             if t == np.inf:
-                return STUCK
+                return WindowStatus.STUCK
             iacc[I_EVENTS] += 1
             p = ep[i]
             if p < 0:  # leaves its bounding sphere
@@ -404,13 +411,13 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 ri = rcap[h]
                 if a + 0.25 * skin * sfac[i] >= rcap[h]:
                     acc[A_T] = t
-                    return BOUND_TOO_SMALL
+                    return WindowStatus.BOUND_TOO_SMALL
             bs[i, d] = ri
             slot = slot_of[i]  # move i's bounding sphere into cell c's slots
             if slot < 0 or slot // ccap != c:
                 if ccount[c] >= ccap:
                     acc[A_T] = t
-                    return CELL_OVERFLOW
+                    return WindowStatus.CELL_OVERFLOW
                 if slot >= 0:  # leave the old cell: its last entry fills the hole
                     old = slot // ccap
                     last = old * ccap + ccount[old] - 1
@@ -481,7 +488,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                             if d2 < s * s:
                                 if nn[i] >= cap or nn[j] >= cap:
                                     acc[A_T] = t
-                                    return OVERFLOW
+                                    return WindowStatus.OVERFLOW
                                 nb[i, nn[i]] = (j << cbits) | code
                                 nn[i] += 1
                                 back = (i << cbits) | (cback - code)
@@ -574,7 +581,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
             acc[A_T] = t
             acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
             acc[A_TKE] = t
-            return DONE_COLLISIONS
+            return WindowStatus.DONE_COLLISIONS
 
 
 # --------------------------------------------------------------------------------- sync
