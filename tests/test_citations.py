@@ -16,27 +16,6 @@ FORBIDDEN = re.compile(
     r"|\[[CJ]:[0-9]"  # [C:123] / [J:123], lines of the chapter-6 and journal dumps
 )
 
-# TEMPORARY: files that another helper is restructuring while their citations were fixed elsewhere.
-# The lead empties this list after the merge; do not add to it.
-ALLOWED = {
-    "src/hardpack/structure/sk.py",
-    "src/hardpack/structure/order.py",
-    "src/hardpack/structure/channels.py",
-    "src/hardpack/structure/tessellation.py",
-    "src/hardpack/structure/pair.py",
-    "src/hardpack/structure/analysis.py",
-    "src/hardpack/hgrid/search.py",
-    "src/hardpack/hgrid/levels.py",
-    "src/hardpack/hgrid/cost_model.py",
-    "src/hardpack/md/simulation.py",
-    "benchmarks/bench_hgrid.py",
-    "tests/test_hgrid_search.py",
-    "tests/test_hgrid_cost_model.py",
-    "tests/test_hgrid_levels.py",
-    "tests/test_structure_channels.py",
-    "tests/test_structure_jammed.py",
-}
-
 
 def _files():
     for entry in SCANNED:
@@ -65,7 +44,7 @@ def test_no_references_to_the_text_dumps():
     found = {}
     for path in _files():
         rel = path.relative_to(ROOT).as_posix()
-        if path.resolve() == this or rel in ALLOWED:
+        if path.resolve() == this:
             continue
         offences = _offences(path.read_text(encoding="utf-8", errors="replace"))
         if offences:

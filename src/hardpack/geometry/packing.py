@@ -114,6 +114,37 @@ class Packing:
     Overlaps (between particles, or of a particle with a wall) beyond ``overlap_tol`` are refused
     unless ``allow_overlap=True`` (e.g. for an intermediate SLP step or a deliberately overlapping
     test configuration). The arrays are stored read-only; engines work on copies.
+
+    Parameters
+    ----------
+    positions : array_like, shape (N, d)
+        Cartesian centres; N >= 1, d = 1..12.
+    radii : array_like, shape (N,), optional
+        Sphere radii (positive). Give either ``radii`` or ``shape``.
+    lattice : array_like, shape (d, d)
+        The cell: lattice vectors as columns; must be non-singular.
+    species : array_like of int, shape (N,), optional
+        An integer label per particle.
+    boundary : "periodic", HardWalls or SphericalContainer, default "periodic"
+        The boundary (:mod:`hardpack.geometry.boundaries`).
+    allow_overlap : bool, default False
+        Accept overlaps and wall crossings beyond ``overlap_tol``.
+    overlap_tol : float, default 1e-9
+        Relative overlap tolerance, 0 <= overlap_tol < 1 (module docstring).
+    shape : Spheres or Ellipsoids, optional (keyword only)
+        The particle shapes (:mod:`hardpack.geometry.shapes`), instead of ``radii``.
+
+    Raises
+    ------
+    InvalidInputError
+        If positions, radii, lattice or species have the wrong shape, type or non-finite entries;
+        neither or both of radii and shape are given, or shape is not Spheres or Ellipsoids; d is
+        outside 1..12; the lattice is missing or singular; the boundary is not one of the above or
+        does not fit the lattice; overlap_tol is outside [0, 1); or, unless ``allow_overlap``,
+        particles overlap or cross the boundary beyond ``overlap_tol``.
+    NotImplementedError
+        Unless ``allow_overlap``, when ellipsoids' bounding spheres overlap or cross the boundary
+        (the ellipsoid contact function is not implemented yet).
     """
 
     positions: np.ndarray

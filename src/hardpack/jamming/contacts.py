@@ -112,7 +112,27 @@ class ContactNetwork:
 
 
 def contact_network(packing: Packing, delta: float) -> ContactNetwork:
-    """All potential contacts with relative gap <= delta (Eq. 4.5), with every periodic image."""
+    """All potential contacts with relative gap <= delta (Eq. 4.5), with every periodic image.
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell, without overlaps beyond its overlap tolerance.
+    delta : float
+        Relative gap tolerance, 0 < delta < 1: pairs with |r_ij| <= (1 + delta) D_ij are contacts.
+
+    Returns
+    -------
+    ContactNetwork
+        The contacts (i, j, image shift n) with their separations, distances and contact
+        distances, the wrapped positions and the lattice.
+
+    Raises
+    ------
+    InvalidInputError
+        If packing is not a :class:`Packing` of hard spheres in a periodic cell, delta is not a
+        number with 0 < delta < 1, or the packing overlaps beyond its overlap tolerance.
+    """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
             f"expected a hardpack Packing, got {type(packing).__name__}; build one with "

@@ -5,7 +5,7 @@ Units and conventions (used throughout :mod:`hardpack.md`):
 - all masses are equal, m = 1 (the Skoge-Donev convention; equilibrium properties such as the
   equation of state do not depend on the masses);
 - kT = 1: velocities start Maxwell-Boltzmann and are rescaled to kT = 2 KE / (d N) = 1 at every
-  synchronisation point when the particles grow (Donev sec. 3.3.1, L2582-2587), so the thermal
+  synchronisation point when the particles grow (Donev 2006, sec. 3.2.4.1), so the thermal
   speed is sqrt(kT/m) = 1;
 - radii grow linearly in time in proportion to their size, a_i(t) = a_i(0) (1 + kappa t); the
   relative rate of a window is kappa = Gamma / (2 <a>) with <a> the mean radius at the window

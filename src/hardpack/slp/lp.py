@@ -54,7 +54,22 @@ from hardpack.geometry.neighbours import pairs_within
 
 @dataclass(frozen=True)
 class Bounds:
-    """Trust-region widths: |eps_aa| <= strain, |eps_ab| <= shear (a != b), |u_n,a| <= displacement * <D>."""
+    """Trust-region widths: |eps_aa| <= strain, |eps_ab| <= shear (a != b), |u_n,a| <= displacement * <D>.
+
+    Parameters
+    ----------
+    strain : float
+        Bound on the diagonal strain entries (on e for an isotropically shrinking cell); > 0.
+    shear : float
+        Bound on the off-diagonal strain entries; >= 0.
+    displacement : float
+        Bound on each displacement component, in units of the mean diameter <D>; >= 0.
+
+    Raises
+    ------
+    InvalidInputError
+        If a bound is negative or not finite, or the strain bound is 0 (the cell could not shrink).
+    """
 
     strain: float
     shear: float
@@ -129,7 +144,37 @@ METHODS = ("highs-ipm", "highs-ds", "highs")
 
 def solve_step(packing, alpha: float, bounds: Bounds, deforming: bool = True,
                feasibility_tol: float = 1e-10, method: str = "highs-ipm") -> StepSolution:
-    """Build and solve one SLP linear program for ``packing`` (see the module docstring)."""
+    """Build and solve one SLP linear program for ``packing`` (see the module docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell (the start configuration of the step).
+    alpha : float
+        Influence-sphere factor gamma_mn / D_mn, >= 1: pairs closer than alpha D_mn get a row,
+        unless the row cannot bind inside the trust region (:func:`redundancy_radius`).
+    bounds : Bounds
+        The trust region.
+    deforming : bool, default True
+        Symmetric strain of a deforming cell; if False, one isotropic strain eps = e I.
+    feasibility_tol : float, default 1e-10
+        Primal and dual feasibility tolerance of HiGHS.
+    method : {"highs-ipm", "highs-ds", "highs"}, default "highs-ipm"
+        The scipy ``linprog`` method.
+
+    Returns
+    -------
+    StepSolution
+        The optimal strain (d x d) and displacements (N x d), the predicted tr(eps), the number
+        of rows, the LP time, the duals of the rows and the pairs behind them.
+
+    Raises
+    ------
+    InvalidInputError
+        If alpha is not finite or below 1, method is not one of the above, the packing is not hard
+        spheres in a periodic cell, or the linear program fails (e.g. an overlapping start
+        configuration or degenerate bounds).
+    """
     if not (np.isfinite(alpha) and alpha >= 1):
         raise InvalidInputError(f"influence-sphere factor alpha = gamma / D must be >= 1, got {alpha}")
     if method not in METHODS:

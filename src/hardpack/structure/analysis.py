@@ -1,8 +1,8 @@
 """One call for the standard structure analysis of a packing (what ``hardpack structure`` writes).
 
 Merges g2 (absolute and scaled), Z(l) (with and without rattlers when a mask is given), the
-shell-averaged S(k) with the linear S(0) fit over kD < 2 pi 0.4 (Donev ch. 10, ch10-14
-L178-181; D = mean diameter), and the order metrics of the dimension: Q6 (bond-averaged), mean
+shell-averaged S(k) with the linear S(0) fit over kD < 2 pi 0.4 (Donev 2006, sec. 10.3,
+Fig. 10.2; D = mean diameter), and the order metrics of the dimension: Q6 (bond-averaged), mean
 q6, T and the q6 crystallinity in 3D; psi6 and T in 2D; T in d >= 4.
 """
 

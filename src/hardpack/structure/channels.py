@@ -1,23 +1,23 @@
-"""Channel-size ("four-point") analysis of Ogarko's dissertation ch. 4 (seed 002, L7085-7200).
+"""Channel-size ("four-point") analysis of Ogarko 2014, sec. 4.2.
 
 For every particle i and every combination of three of its neighbours (all C(n_i, 3) triples
 of its regular-triangulation neighbours, not only Delaunay faces; periodic images as seen
 from i), keep the triangle of the three neighbour centres only if it is acute with the
 tolerance eps = 1 - 1e-12: a^2 + b^2 > eps c^2 for all three edge orderings, so exact right
-angles (square arrangements) are kept (L7243-7246). In the plane of the triangle the three
-spheres are circles of their full radii; the channel is the circle externally tangent to all
-three (Apollonius problem, centre p and radius R with |p - c_k| = R + r_k). Subtracting the
+angles (square arrangements) are kept (Ogarko 2014, sec. 4.3, footnote on the acute test). In the
+plane of the triangle the three spheres are circles of their full radii; the channel is the circle
+externally tangent to all three (Apollonius problem, centre p and radius R with |p - c_k| = R + r_k). Subtracting the
 k = 1 equation from the others gives p linear in R, and the k = 1 equation then a quadratic in
 R. The channel is the smallest positive root whose centre lies inside the triangle, else the
 smallest positive root (no centre lies in the circle since |p - c_k| = R + r_k > R; for acute
 triangles of equal spheres the root is unique and inside). Triangles without a positive root
 are skipped and counted. The statistic is the histogram of R / r_i (central radius,
-L7449-7453), bin 0.01.
+Ogarko 2014, sec. 4.4.3), bin 0.01.
 
 Exact values: three mutually touching equal spheres 2/sqrt(3) - 1 = 0.1547; a square of
 touching equal spheres (a right isosceles triangle of neighbours) sqrt(2) - 1 = 0.4142;
-three neighbours coplanar with and touching the central sphere at 120 degrees, 1 (L7290-7330).
-Ideal gas at phi = 0.0014, acute triangles only: roughly Gaussian, mean ~15.9, sigma ~4 (L7166).
+three neighbours coplanar with and touching the central sphere at 120 degrees, 1 (Ogarko 2014, sec. 4.4.1).
+Ideal gas at phi = 0.0014, acute triangles only: roughly Gaussian, mean ~15.9, sigma ~4 (Ogarko 2014, Fig. 4.2).
 """
 
 from __future__ import annotations

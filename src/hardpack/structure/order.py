@@ -13,7 +13,7 @@ neighbours), SC 0.3536.
 and the mean local |psi_6(i)|; both are 1 for the triangular lattice.
 
 **Translational order T** (Torquato, Truskett & Debenedetti 2000, as used by Torquato & Jiao 2010,
-seed 003 Eq. 22, L1640-1697): T = |sum_i (n_i - n_i^ideal)| / sum_i (n_i^ref - n_i^ideal) over the
+Sec. VI, Eq. 22): T = |sum_i (n_i - n_i^ideal)| / sum_i (n_i^ref - n_i^ideal) over the
 first N_s neighbour shells of the reference crystal at the packing's number density (FCC in 3D;
 triangular in 2D, D_d in d >= 4). n_i = mean number of neighbours (all periodic images,
 including a particle's own images) in the shell [a_i - w/2, a_i + w/2], n_i^ideal = rho times the
@@ -25,7 +25,7 @@ not digit by digit with the published order map.
 T = 1 exactly for the reference crystal; for N ideal-gas points E[T numerator] = -sum n_i^ideal/N
 (the O(1/N) finite-size bias of counting N - 1 partners against rho = N/V).
 
-**Crystallinity** (Ogarko dissertation ch. 3.3, L6728-6815): normalised q6 vectors
+**Crystallinity** (Ogarko 2014, sec. 3.3.3, Eqs. 3.56-3.57): normalised q6 vectors
 q~_6m(i) = q_6m(i) / |q_6(i)|, bond order d6(i, j) = Re sum_m q~_6m(i) q~*_6m(j); a bond is
 connected if d6 > 0.65 and a particle is solid-like with >= 6 connected bonds; p_c = fraction of
 solid-like particles. Neighbours from the weighted Delaunay (regular) triangulation as in the

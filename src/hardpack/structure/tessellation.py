@@ -2,7 +2,7 @@
 
 The regular triangulation of spheres (centres x_i, weights r_i^2) is the dual of the power
 (Laguerre) diagram; it is the lower convex hull of the lifted points (x_i, |x_i|^2 - r_i^2) in
-d + 1 dimensions (Ogarko dissertation ch. 4, L7085-7200, and ch. 3.3 crystallinity L6728-6815
+d + 1 dimensions (Ogarko 2014, sec. 4.2, and the crystallinity of sec. 3.3.3
 use it through CGAL; this is the same construction through scipy's ConvexHull / Qhull). With
 equal radii it is the ordinary Delaunay triangulation.
 
@@ -76,7 +76,7 @@ def cutoff_neighbours(packing, cutoff: float = 1.2) -> NeighbourList:
 
     The default 1.2 includes the second BCC shell (2/sqrt(3) = 1.155) and excludes the second
     FCC/HCP/SC shell (sqrt 2), as in Steinhardt's lattice values; in jammed packings it sits
-    near the first minimum of g2 at 1.25 D (Donev ch. 9, ch7-9 L1788).
+    near the first minimum of g2 at 1.25 D (Donev 2006, sec. 9.3.1.2).
 
     Parameters
     ----------
