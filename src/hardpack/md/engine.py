@@ -307,6 +307,6 @@ class Engine:
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:
-        """Scale all velocities so that kT = 2 KE / (d N) equals ``kt`` (Donev sec. 3.3.1)."""
+        """Scale all velocities so that kT = 2 KE / (d N) equals ``kt`` (Donev 2006, sec. 3.2.4.1)."""
         ke = self.kinetic_energy()
         self.P[:, self.d: 2 * self.d] *= np.sqrt(self.d * self.n * kt / (2.0 * ke))
