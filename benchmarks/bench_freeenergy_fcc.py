@@ -1,5 +1,5 @@
-"""FCC validation sweeps of BCMD against the published numbers (note bcmd_free_energy.md
-sec. 3.1-3.2): the excess free energy at phi = 0.545 (5.91916) and the jamming-limit constant
+"""FCC validation sweeps of BCMD against the published numbers (Donev 2006,
+dissertation sec. 6.4.1): the excess free energy at phi = 0.545 (5.91916) and the jamming-limit constant
 f_J - f_c^J (2.160), over N and gamma0, one frozen particle, lattice-centred cells.
 
     python benchmarks/bench_freeenergy_fcc.py --reps 3 4 5 --gamma0 1e-3 3e-3 --seeds 1 2
@@ -20,10 +20,10 @@ PUBLISHED = {"melting": 5.91916, "jamming": 2.160}
 
 def fcc_case(case: str, reps: int):
     p = lattice_packing("fcc", (reps,) * 3)
-    if case == "melting":  # phi = 0.545, dmu_max = 1, theta = 1 ([C:1010-1011])
+    if case == "melting":  # phi = 0.545, dmu_max = 1, theta = 1 (Donev 2006, sec. 6.4.1)
         p = p.replace(radii=p.radii * (0.545 / p.phi) ** (1 / 3))
         return p, {"dmu_max": 1.0, "theta": 1.0}
-    delta = 1e-6  # delta = 1e-6, dmu_max = 10 delta, theta = 0.5 ([C:1017-1025])
+    delta = 1e-6  # delta = 1e-6, dmu_max = 10 delta, theta = 0.5 (Donev 2006, sec. 6.4.1)
     return p.replace(radii=p.radii * (1 - delta)), {"dmu_max": 10 * delta, "theta": 0.5}
 
 

@@ -3,16 +3,17 @@
     python benchmarks/bench_hgrid.py            # UV omega = 50, N = 125001, phi = 0.6 (ch. 2.1 setup)
     python benchmarks/bench_hgrid.py --quick    # UV omega = 20, N = 30000, phi = 0.5
 
-Ogarko ch. 2.1 (L764, L1364-1366) reports the optimal HGrid ~220x faster than linked cells for UV
+Ogarko (dissertation, Sec. 2.1.4) reports the optimal HGrid ~220x faster than linked cells for UV
 radii (f ~ a^-3) with omega = 50, N = 125001 at phi = 0.62 (DEM, contact detection per time step).
 
 Configuration: N radii by systematic sampling of UV(omega), placed by largest-first random sequential
-addition directly at the target phi in a periodic cube (hardpack.hgrid.rsa; RSA of such wide
+addition directly at the target phi in a periodic cube (hardpack.geometry.neighbours.rsa; RSA of such wide
 distributions reaches phi = 0.6, no compression needed). It has RSA's pair correlations, not those of a
 jammed packing; the search cost depends mainly on the radii and phi.
 
-Timed: one complete search, :func:`hardpack.hgrid.search.neighbour_pairs` with a precomputed level plan
-(wrap, sort by cell, fill the cell lists, Top-Down search, sort the pair list), for skin = 0 (contact
+Timed: one complete search of the neighbour layer with a precomputed level assignment,
+:func:`hardpack.geometry.neighbours.build_grid` and :func:`~hardpack.geometry.neighbours.grid_pairs` (sort
+by cell, fill the cell lists, Top-Down search, sort the pair list), for skin = 0 (contact
 detection; RSA leaves no contacts) and skin = 0.1 <a> (a neighbour list). The HGrid uses the optimal
 number of levels (min L (m + K), K = 0.3, Eq. 2.7); the single-level grid is the same code with L = 1.
 CPU time (process_time) and wall time are medians over repeats; the machine may be shared. Both methods
@@ -30,9 +31,8 @@ import numpy as np
 
 from hardpack.distributions import uniform_volume
 from hardpack.geometry.balls import ball_volume
+from hardpack.geometry.neighbours import build_grid, grid_pairs, optimal_levels, random_sequential_addition
 from hardpack.hgrid.cost_model import PowerLawSystem, best_levels
-from hardpack.hgrid.rsa import random_sequential_addition
-from hardpack.hgrid.search import neighbour_pairs, plan
 
 
 def timed(fn, repeats):
@@ -66,21 +66,26 @@ def main(argv=None) -> int:
           f"{t_model:.2f} at L = {L_model} -> predicted work ratio {model.linked_cell_cost() / t_model:.0f}")
 
     rows = []
+    frac, lattice = x / box, np.diag(box)
+
+    def search(reach, levels):
+        return grid_pairs(build_grid(frac, lattice, reach, levels=levels))
+
     for skin in (0.0, 0.1):
+        reach = radii + 0.5 * skin
         c0 = time.process_time()
-        grid = plan(radii, box, skin=skin)
+        levels = optimal_levels(reach, float(np.prod(box)), 3)
         t_plan = time.process_time() - c0
-        single = plan(radii, box, skin=skin, n_levels=1)
-        neighbour_pairs(x, radii, box, skin=skin, grid=grid)  # compile outside the timing
-        hg = timed(lambda: neighbour_pairs(x, radii, box, skin=skin, grid=grid), args.repeats)
-        lc = timed(lambda: neighbour_pairs(x, radii, box, skin=skin, grid=single), args.single_repeats)
-        same = np.array_equal(hg[2].i, lc[2].i) and np.array_equal(hg[2].j, lc[2].j)
-        rows.append((skin, grid, t_plan, hg, lc, same))
+        search(reach, levels)  # compile outside the timing
+        hg = timed(lambda: search(reach, levels), args.repeats)
+        lc = timed(lambda: search(reach, 1), args.single_repeats)
+        same = all(np.array_equal(getattr(hg[2], k), getattr(lc[2], k)) for k in ("i", "j", "shift"))
+        rows.append((skin, levels, t_plan, hg, lc, same))
 
     print(f"\n{'skin':>5} {'method':>14} {'L':>3} {'pairs':>9} {'tests/N':>9} {'visits/N':>9} "
           f"{'CPU s':>9} {'wall s':>9} {'speed-up (CPU)':>15}")
-    for skin, grid, t_plan, hg, lc, same in rows:
-        for name, res, L in (("HGrid (ONL)", hg, grid.n_levels), ("single level", lc, 1)):
+    for skin, levels, t_plan, hg, lc, same in rows:
+        for name, res, L in (("HGrid (ONL)", hg, levels.n_levels), ("single level", lc, 1)):
             r = res[2]
             ratio = lc[0] / hg[0] if name.startswith("HGrid") else 1.0
             print(f"{skin:5.2f} {name:>14} {L:3d} {len(r):9d} {r.distance_tests / n:9.1f} {r.cell_visits / n:9.1f} "

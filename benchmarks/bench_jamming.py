@@ -1,7 +1,7 @@
 """Benchmark of hardpack.jamming.verify on 3D LS packings (collective + strict tests).
 
-Targets (project issue 4): N = 1000 in < 10 s (the dissertation's LOQO run took 1822 s for the
-collective test alone, Table 4.3, seeds/000_chapters/ch04-05.txt L2166-L2215) and N = 1e4 in
+Targets: N = 1000 in < 10 s (the dissertation's LOQO run took 1822 s for the
+collective test alone, Donev 2006, Table 4.3) and N = 1e4 in
 < 5 min. The machine has 2 shared cores, so each case is repeated and the median is quoted.
 
 Packings: given files (``--packing``), or made with hardpack.md.compress (RSA at phi = 0.3,

@@ -9,7 +9,7 @@ For every (d, N) and seed, one RSA start at phi0(d) (the LS ensembles' starts: 0
 
 - SLP with the Table I (MRJ) settings: gamma = 1.5 D, bounds 0.1 / 0.1 / 0.5 D, deforming cell,
   stop when the predicted density gain is below run_slp's default 1e-10 (the paper stops at 1e-8,
-  Torquato & Jiao 2010, L1285-1295; why 1e-10: hardpack.slp.driver);
+  Torquato & Jiao 2010, Sec. V.A; why 1e-10: hardpack.slp.driver);
 - LS, two stages: Gamma = 0.02 to reduced pressure 1e3, then Gamma = 1e-4 to 1e12;
 - LS, one fast stage: Gamma = 0.02 to 1e12.
 

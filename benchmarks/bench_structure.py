@@ -1,6 +1,6 @@
 """Timing of the structure analysis (not a test): medians over repeats after a warm-up call.
 
-Targets (project issue 5): g2 of N = 1e5 in < 10 s; S(k) of N = 1e4 up to kD = 40 in < 30 s.
+Targets: g2 of N = 1e5 in < 10 s; S(k) of N = 1e4 up to kD = 40 in < 30 s.
 The configurations are uniform random points at the number density of a monodisperse packing
 at phi = 0.64 (D = 1): the cost of both computations depends only on N, the number density and
 the range, not on the positions being a real packing.

@@ -19,13 +19,6 @@ from hardpack.io import load_dataset, load_packing, save_packing, write_dataset
 from hardpack.md import StopCriteria, compress
 
 
-@pytest.fixture(scope="module")
-def start(tmp_path_factory):
-    path = tmp_path_factory.mktemp("start") / "init.nc"
-    save_packing(random_packing(100, 3, monodisperse(0.5), 0.3, seed=2), path, attrs={"seed": 2})
-    return path
-
-
 def _error(capsys) -> str:
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1, err  # one line, no traceback
@@ -87,8 +80,8 @@ def test_os_errors_at_write_end_in_one_line(tmp_path, capsys, monkeypatch):
     assert _error(capsys) == f"hardpack init: error: No space left on device: {tmp_path / 'x.nc'}"
 
 
-def test_closed_stdout_ends_quietly(start):
-    proc = subprocess.Popen([sys.executable, "-m", "hardpack.cli", "info", str(start)],
+def test_closed_stdout_ends_quietly(rsa_file):
+    proc = subprocess.Popen([sys.executable, "-m", "hardpack.cli", "info", str(rsa_file)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     proc.stdout.close()  # like `hardpack info FILE | head -0`: nothing will be read
     err = proc.stderr.read().decode()
@@ -98,10 +91,10 @@ def test_closed_stdout_ends_quietly(start):
 
 # ---------------------------------------------------------------- long runs: check first, write safely
 @pytest.mark.parametrize("option", ["--out", "--timeseries", "--checkpoint"])
-def test_compress_checks_outputs_before_running(tmp_path, capsys, start, option):
+def test_compress_checks_outputs_before_running(tmp_path, capsys, rsa_file, option):
     paths = {"--out": tmp_path / "p.nc", "--timeseries": tmp_path / "ts.nc", "--checkpoint": tmp_path / "c.npz"}
     paths[option] = tmp_path  # a folder
-    args = ["compress", "--init", str(start), "--growth-rate", "0.1", "--seed", "1",
+    args = ["compress", "--init", str(rsa_file), "--growth-rate", "0.1", "--seed", "1",
             "--max-collisions", "5000000"] + [x for k, v in paths.items() for x in (k, str(v))]
     started = time.perf_counter()
     assert main(args) == 2
@@ -109,17 +102,17 @@ def test_compress_checks_outputs_before_running(tmp_path, capsys, start, option)
     assert _error(capsys).startswith(f"hardpack compress: error: {option} {tmp_path} is a folder")
 
 
-def test_every_long_command_checks_its_outputs(tmp_path, capsys, start):
+def test_every_long_command_checks_its_outputs(tmp_path, capsys, rsa_file):
     folder = str(tmp_path)
     commands = [
-        ["eos", "--init", str(start), "--out", folder, "--seed", "1", "--collisions", "10000000"],
-        ["eos-jam", "--distribution", '{"kind": "monodisperse"}', "--seed", "1", "--systems", "poly",
+        ["eos", "--init", str(rsa_file), "--out", folder, "--seed", "1", "--collisions", "10000000"],
+        ["poly-jam", "--distribution", '{"kind": "monodisperse"}', "--seed", "1", "--systems", "poly",
          "--out", folder],
-        ["slp", "--init", str(start), "--out", folder],
-        ["verify", str(start), "--out", folder, "--method", "sequential"],
-        ["bcmd", str(start), "--out", folder, "--dmu-max", "1"],
-        ["structure", str(start), "--out", folder],
-        ["eos-fluid", "--distribution", '{"kind": "monodisperse"}', "--phi", "0.3", "--seed", "1",
+        ["slp", "--init", str(rsa_file), "--out", folder],
+        ["verify", str(rsa_file), "--out", folder, "--method", "sequential"],
+        ["bcmd", str(rsa_file), "--out", folder, "--dmu-max", "1"],
+        ["structure", str(rsa_file), "--out", folder],
+        ["poly-fluid", "--distribution", '{"kind": "monodisperse"}', "--phi", "0.3", "--seed", "1",
          "--out", folder],
     ]
     for args in commands:
@@ -128,12 +121,12 @@ def test_every_long_command_checks_its_outputs(tmp_path, capsys, start):
                                   f"path such as {tmp_path / 'result.nc'}")
 
 
-def test_checkpoint_is_kept_until_the_output_is_written(tmp_path, capsys, start, monkeypatch):
+def test_checkpoint_is_kept_until_the_output_is_written(tmp_path, capsys, rsa_file, monkeypatch):
     import hardpack.io
 
-    reference = compress(load_packing(start), 0.05, 1, stop=StopCriteria(max_pressure=1e8)).packing
+    reference = compress(load_packing(rsa_file), 0.05, 1, stop=StopCriteria(max_pressure=1e8)).packing
     out, ckpt = tmp_path / "out.nc", tmp_path / "run.ckpt.npz"
-    args = ["compress", "--init", str(start), "--out", str(out), "--growth-rate", "0.05", "--seed", "1",
+    args = ["compress", "--init", str(rsa_file), "--out", str(out), "--growth-rate", "0.05", "--seed", "1",
             "--max-pressure", "1e8", "--checkpoint", str(ckpt), "--checkpoint-interval", "0"]
     saved = hardpack.io.save_packing
 
@@ -252,7 +245,7 @@ def test_info_shows_overlaps_and_says_it_is_a_diagnosis(capsys, overlapping):
 
 
 # ---------------------------------------------------------------- signals outside a polling run
-def test_a_signal_during_any_command_ends_in_one_line(tmp_path, capsys, start, monkeypatch):
+def test_a_signal_during_any_command_ends_in_one_line(tmp_path, capsys, rsa_file, monkeypatch):
     """SIGTERM while a command without its own polling runs (here: the sequential jamming test,
     which checkpoints after every loading sequence) ends in one line with status 143, says where
     the checkpoint is, and leaves the caller's signal handlers as they were."""
@@ -268,7 +261,7 @@ def test_a_signal_during_any_command_ends_in_one_line(tmp_path, capsys, start, m
     monkeypatch.setattr(hardpack.jamming.cli, "verify", killed)
     before = signal.getsignal(signal.SIGTERM)
     ckpt = tmp_path / "v.ckpt"
-    assert main(["verify", str(start), "--out", str(tmp_path / "v.nc"), "--method", "sequential",
+    assert main(["verify", str(rsa_file), "--out", str(tmp_path / "v.nc"), "--method", "sequential",
                  "--checkpoint", str(ckpt)]) == 143
     assert _error(capsys) == (f"hardpack verify: interrupted: stopped by SIGTERM; a checkpoint written "
                               f"before is kept in {ckpt}: start the same command again to resume from it")

@@ -7,7 +7,14 @@ import pytest
 
 from hardpack import InvalidInputError
 from hardpack.distributions import (
-    Discrete, LogNormal, PowerLaw, bidisperse, from_spec, monodisperse, uniform_size, uniform_volume,
+    Discrete,
+    LogNormal,
+    PowerLaw,
+    bidisperse,
+    from_spec,
+    monodisperse,
+    uniform_size,
+    uniform_volume,
 )
 
 

@@ -1,4 +1,4 @@
-"""`hardpack eos-equivalents` writes Tables 3.1 / 3.3 as a netCDF dataset."""
+"""`hardpack poly-equivalents` writes Tables 3.1 / 3.3 as a netCDF dataset."""
 
 import argparse
 
@@ -19,7 +19,7 @@ def run(argv):
 
 def test_uniform_volume_table(tmp_path):
     out = tmp_path / "uv.nc"
-    assert run(["eos-equivalents", "--kind", "uniform_volume", "--values", "2", "10", "--out", str(out)]) == 0
+    assert run(["poly-equivalents", "--kind", "uniform_volume", "--values", "2", "10", "--out", str(out)]) == 0
     ds = load_dataset(out, kind="eos_equivalents")
     # Table 3.1 (R_bi, n1_bi) and Table 3.3 (n1, delta2) at omega = 2 and 10
     assert ds["bi_R"].values == pytest.approx([1.49, 3.90], abs=0.005)
@@ -32,6 +32,6 @@ def test_uniform_volume_table(tmp_path):
 
 def test_bad_family_arguments(tmp_path):
     with pytest.raises(SystemExit):  # argparse refuses an unknown family
-        run(["eos-equivalents", "--kind", "gaussian", "--values", "1", "--out", str(tmp_path / "x.nc")])
+        run(["poly-equivalents", "--kind", "gaussian", "--values", "1", "--out", str(tmp_path / "x.nc")])
     with pytest.raises(InvalidInputError, match="alpha"):
-        run(["eos-equivalents", "--kind", "power_law", "--values", "3", "--out", str(tmp_path / "x.nc")])
+        run(["poly-equivalents", "--kind", "power_law", "--values", "3", "--out", str(tmp_path / "x.nc")])

@@ -1,4 +1,4 @@
-"""phi_J from Z(phi): free-volume fit and plateau test (Ogarko Eq. 3.14, L4561-4575, L5003-5040)."""
+"""phi_J from Z(phi): free-volume fit and plateau test (Ogarko 2014, Eq. 3.14, sec. 3.1.3, Fig. 3.8)."""
 
 import numpy as np
 import pytest

@@ -1,9 +1,9 @@
-"""EOS-vs-moments study (Ogarko ch. 3, issue 6): equivalent systems, fluid Z against BMCSL, jamming of
+"""EOS-vs-moments study (Ogarko 2014, ch. 3): equivalent systems, fluid Z against BMCSL, jamming of
 poly vs tridisperse systems, summaries, validation rows and the CLI.
 
-Physics tolerances: BMCSL (Eq. 3.9) is within 1 % of simulations for phi < 0.54 (L4494-4502,
-L5707-5710); maximally equivalent tridisperse systems jam within 1 % of the polydisperse ones
-(L5753-5757). Slow tests use N = 1000 (fluid) and N = 500 (jamming).
+Physics tolerances: BMCSL (Eq. 3.9) is within 1 % of simulations for phi < 0.54 (Ogarko 2014,
+Fig. 3.1, sec. 3.2); maximally equivalent tridisperse systems jam within 1 % of the polydisperse ones
+(sec. 3.2 and Fig. 3.9(a)). Slow tests use N = 1000 (fluid) and N = 500 (jamming).
 """
 
 import argparse
@@ -53,7 +53,7 @@ def test_refuses_bad_systems():
 )
 def test_fluid_pressure_within_one_percent_of_bmcsl(spec, system):
     """Equilibrium Z at phi = 0.45, N = 1000, 300k collisions (standard error ~0.25 %): within 1 % of
-    BMCSL for the realised radii (L5707-5710)."""
+    BMCSL for the realised radii (Ogarko 2014, sec. 3.2)."""
     row = study.fluid_pressure(spec, system, 0.45, seed=4, n=1000, collisions=300_000)
     assert row["phi"] == pytest.approx(0.45, rel=1e-12)
     assert row["Z_err"] < 0.004 * row["Z"]
@@ -88,7 +88,7 @@ def test_wide_tridisperse_equivalents_run(spec):
 
 
 def _jam_packing(width, system, seed, phi, family="uniform_size"):
-    """A fake eos-jam output: only the attributes the summary reads."""
+    """A fake poly-jam output: only the attributes the summary reads."""
     ds = xr.Dataset({"radius": ("particle", np.ones(1000))})  # N = 1000: the targets' smallest N
     ds.attrs.update(family=family, width=width, system=system, seed=seed, phi=phi, Z=1e12, collisions=1e6,
                     cpu_time=1.0, crystallinity=0.0, crystallinity_large=0.0, O1=0.9, O2=0.8,
@@ -189,7 +189,7 @@ def test_cli_jam_and_summary(tmp_path):
     parser = argparse.ArgumentParser()
     register(parser.add_subparsers())
     outs = [str(tmp_path / f"{s}.nc") for s in ("poly", "tri")]
-    args = parser.parse_args(["eos-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}', "--systems",
+    args = parser.parse_args(["poly-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}', "--systems",
                               "poly", "tri", "--seed", "3", "--n", "60", "--final-growth-rate", "0.02",
                               "--out", *outs])
     assert args.func(args) == 0
@@ -198,17 +198,17 @@ def test_cli_jam_and_summary(tmp_path):
         assert ds.attrs["system"] == system and ds.attrs["Z"] >= 1e12
         assert 0.6 < ds.attrs["phi"] < 0.7  # a jammed packing of mildly polydisperse spheres
     summary_path = str(tmp_path / "s.nc")
-    args = parser.parse_args(["eos-summary", "--kind", "jam", *outs, "--out", summary_path])
+    args = parser.parse_args(["poly-summary", "--kind", "jam", *outs, "--out", summary_path])
     assert args.func(args) == 0
     assert load_dataset(summary_path, kind="eos_jam_summary")["phi_J"].shape == (1, 2, 1)
     with pytest.raises(InvalidInputError, match="one --out"):
-        args = parser.parse_args(["eos-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}', "--seed",
+        args = parser.parse_args(["poly-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}', "--seed",
                                   "1", "--out", outs[0]])
         args.func(args)
 
 
 def test_cli_jam_resumes_a_killed_compression(tmp_path, monkeypatch, caplog):
-    """eos-jam --checkpoint: a run killed after its checkpoint was written (an exception from the
+    """poly-jam --checkpoint: a run killed after its checkpoint was written (an exception from the
     progress callback, as in the engine's own resume test) resumes there when started again and ends
     identical to an uninterrupted run; the checkpoint is removed at the end. It holds one system."""
     import hardpack.md as md
@@ -218,7 +218,7 @@ def test_cli_jam_resumes_a_killed_compression(tmp_path, monkeypatch, caplog):
     ckpt = tmp_path / "tri.ckpt"
 
     def run(out, *extra):
-        args = parser.parse_args(["eos-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}',
+        args = parser.parse_args(["poly-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}',
                                   "--systems", "tri", "--seed", "3", "--n", "60", "--final-growth-rate", "0.02",
                                   "--out", str(tmp_path / out), *extra])
         return args.func(args)
@@ -249,13 +249,13 @@ def test_cli_jam_resumes_a_killed_compression(tmp_path, monkeypatch, caplog):
     reference, resumed = (load_dataset(tmp_path / f, kind="packing") for f in ("reference.nc", "resumed.nc"))
     np.testing.assert_array_equal(resumed["position"].values, reference["position"].values)
     with pytest.raises(InvalidInputError, match="one system"):
-        args = parser.parse_args(["eos-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}', "--seed",
+        args = parser.parse_args(["poly-jam", "--distribution", '{"kind": "uniform_size", "omega": 2}', "--seed",
                                   "1", "--systems", "poly", "tri", "--out", "a.nc", "b.nc", "--checkpoint", str(ckpt)])
         args.func(args)
 
 
 def test_uniform_size_equivalent_is_gauss_legendre():
-    """Sanity link to the closed forms (note sec. 2.4): TUS radii <a>(1 +- omega0 sqrt(3/5)), 5:8:5."""
+    """Sanity link to the closed forms (Ogarko 2014, Eqs. 3.39-40): TUS radii <a>(1 +- omega0 sqrt(3/5)), 5:8:5."""
     tri = study.system_distribution({"kind": "uniform_size", "omega": 3}, "tri")
     w0 = (3 - 1) / (3 + 1)
     assert np.array(tri.radii) == pytest.approx([1 - w0 * np.sqrt(0.6), 1.0, 1 + w0 * np.sqrt(0.6)], rel=1e-9)

@@ -1,4 +1,4 @@
-"""Fluid EOS identities and values (Ogarko ch. 3.1, Eqs. 3.1-3.16, 3.52, 3.55; note 002 sec. 2.2, 2.7)."""
+"""Fluid EOS identities and values (Ogarko 2014, ch. 3, Eqs. 3.1-3.16, 3.52, 3.55)."""
 
 import math
 
@@ -14,7 +14,7 @@ PHI = np.linspace(0.0, 0.64, 65)
 
 
 def test_monodisperse_reductions():
-    """O1 = O2 = 1: BMCSL = SCS = CS and SCSK = BCSK = CSK (L4195-4200, note sec. 2.2)."""
+    """O1 = O2 = 1: BMCSL = SCS = CS and SCSK = BCSK = CSK (Ogarko 2014, Eqs. 3.9-3.12)."""
     cs, k = th.carnahan_starling(PHI), th.csk(PHI)
     for f in (th.bmcsl, th.scs):
         assert f(PHI, 1.0, 1.0) == pytest.approx(cs, rel=1e-14)
@@ -75,9 +75,9 @@ def test_exact_second_virial_coefficient_of_mixtures(dist):
     ids=["US5", "US100", "UV4", "UV10", "LN0.5"],
 )
 def test_bidisperse_equivalent_has_same_eos(dist):
-    """Z_bi = Z_poly exactly (L5295-5340): the binary Jenkins-Mancini pressure with BMCSL contact values
-    (Eqs. 3.1-3.5, an independent formula) for (n1, R) of the equivalent equals BMCSL with the
-    polydisperse (O1, O2)."""
+    """Z_bi = Z_poly exactly (Ogarko 2014, Eqs. 3.20-3.21): the binary Jenkins-Mancini pressure with
+    BMCSL contact values (Eqs. 3.1-3.5, an independent formula) for (n1, R) of the equivalent equals
+    BMCSL with the polydisperse (O1, O2)."""
     eq = equivalent_bidisperse(dist)
     O1, O2 = dimensionless_moments(dist)
     assert th.binary_contact_z(PHI, eq.n1, eq.R) == pytest.approx(th.bmcsl(PHI, O1, O2), rel=1e-11)
@@ -114,10 +114,10 @@ def test_free_volume_and_running_estimate():
 
 def test_empirical_fits():
     """Eqs. 3.15, 3.16 (natural log), 3.52, 3.55 at their published anchors."""
-    assert th.phij_fit_uniform_size(np.inf) == pytest.approx(0.6828)  # nu_inf (L4880-4883)
+    assert th.phij_fit_uniform_size(np.inf) == pytest.approx(0.6828)  # nu_inf (Ogarko 2014, sec. 3.1.3)
     assert th.phij_fit_uniform_size(1.2 + 1e-12) < th.phij_fit_uniform_size(2.0) < 0.6828
-    assert th.phij_fit_lognormal(0.0) == pytest.approx(0.6373)  # phi_RCP = nu_max(0) from data (L6666)
-    # evaluated references of note 002 sec. 2.7
+    assert th.phij_fit_lognormal(0.0) == pytest.approx(0.6373)  # phi_RCP = nu_max(0) from data (below Eq. 3.52)
+    # the printed fits evaluated here (not printed values)
     assert th.phij_fit_uniform_size([2, 4, 10]) == pytest.approx([0.6664, 0.6777, 0.6819], abs=5e-5)
     assert th.phij_fit_uniform_volume([2, 4, 10]) == pytest.approx([0.6693, 0.6965, 0.7509], abs=5e-5)
     assert th.phij_fit_lognormal([0.2, 0.5, 1.0]) == pytest.approx([0.6497, 0.7009, 0.7771], abs=5e-5)
@@ -128,9 +128,9 @@ def test_empirical_fits():
 
 @pytest.mark.filterwarnings("ignore:.*fitted range")  # omega < 1.2 lies outside the fitted data
 def test_fit_slopes_vanish_at_omega_one():
-    """The fits enforce d nu_max / d(1/omega) = 0 at omega = 1 (L4900, L4919); for Eq. 3.16 this holds
-    only with the natural log: with log10 the shape factor F(x = 1/omega) would have dF/dx = 2 - 2/ln 10
-    = 1.13 at x = 1 instead of 2 - 2 = 0 (note sec. 2.7)."""
+    """The fits enforce d nu_max / d(1/omega) = 0 at omega = 1 (Ogarko 2014, below Eqs. 3.15 and
+    3.16); for Eq. 3.16 this holds only with the natural log: with log10 the shape factor
+    F(x = 1/omega) would have dF/dx = 2 - 2/ln 10 = 1.13 at x = 1 instead of 2 - 2 = 0 (derived here)."""
     eps = 1e-6
     for f in (th.phij_fit_uniform_size, th.phij_fit_uniform_volume):
         slope = (f(1 / (1 - eps)) - f(1.0)) / eps

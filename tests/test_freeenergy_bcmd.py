@@ -17,7 +17,7 @@ FCC_JAMMING = 2.160  # [f_J - f_c^J]_FCC, N -> infinity (Donev 2006, Sec. 6.4.1)
 def test_disjoint_cells_reference(name, reps, frozen):
     # Half-size spheres: the cells (radius (1 + dmu) R) stay disjoint for dmu <= 1, so every
     # sphere is an independent billiard in a shrinking ball and (d/2) ln(K/K0) = d ln(dmu0/dmu1)
-    # exactly up to the adiabatic error O(wall speed / v) ~ 1e-4 (note sec. 5.2 item 1); the
+    # exactly up to the adiabatic error O(wall speed / v) ~ 1e-4 (derived here); the
     # CM-frame K differs from the total K by O(1/N) fluctuations of the CM momentum, hence the
     # looser tolerance there. The reference f_c = -d ln dmu - ln V_p (Eq. 6.10).
     res, exact = disjoint_cells(name, reps, frozen)
@@ -27,8 +27,8 @@ def test_disjoint_cells_reference(name, reps, frozen):
     vp = np.pi / 6 if d == 3 else np.pi / 4  # unit-diameter particle (length unit = diameter)
     assert res.f_c == pytest.approx(-d * np.log(0.05) - np.log(vp), rel=1e-12)
     ds = res.dataset
-    # cell pressure p_c = mu / dmu for disjoint cells (note sec. 1.5); per-segment noise is a few
-    # per cent, so compare the mean ratio (1 %)
+    # cell pressure p_c = mu / dmu for disjoint cells (derived here; Fig. 6.4's asymptote);
+    # per-segment noise is a few per cent, so compare the mean ratio (1 %)
     ratio = ds.p_c / ((1 + ds.dmu_mid) / ds.dmu_mid)
     assert float(ratio.mean()) == pytest.approx(1.0, abs=0.01)
     assert ds.attrs["final_min_gap"] > 0
@@ -91,7 +91,7 @@ def test_fcc_jamming_limit():
 
 
 def test_velocity_redraws_are_chained():
-    # thermostat of [C:918-923]: velocities re-drawn whenever K doubled; the chained
+    # thermostat of Donev 2006, sec. 6.3.5.1: velocities re-drawn whenever K doubled; the chained
     # sum of ln(K_end/K_start) must still give the exact disjoint-cell d ln(dmu0/dmu1)
     # (measured within 2e-4 over three seeds; tolerance as in the test above)
     p = lattice_packing("fcc", (2, 2, 2))

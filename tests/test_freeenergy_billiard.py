@@ -1,4 +1,4 @@
-"""Point billiard in a simplex intersected with a shrinking ball (note sec. 5.2 item 2): the
+"""Point billiard in a simplex intersected with a shrinking ball (Donev 2006, sec. 6.3.3): the
 identity ln(V/V_min) = (n/2) ln(K/K0) recovers the exact simplex volume."""
 
 import numpy as np
@@ -15,7 +15,7 @@ from hardpack.freeenergy.ladder import billiard_simplex
 )
 def test_simplex_volume_recovered(n, wall_ratio):
     # exact volume from Eq. 6.5; ball centred at the centroid, from containing the simplex to
-    # inscribed in it (the note's target is 1 %). Measured over seeds 1-6 at wall speed 1e-5 v:
+    # inscribed in it (target 1 %). Measured over seeds 1-6 at wall speed 1e-5 v:
     # scatter 0.4 %, means +0.5 % (n = 2) and -0.35 % (n = 3); the elongated n = 4 simplex
     # (xi_max / xi_min = 15) scatters by ~1.5 % at 1e-5 and ~0.5 % at 3e-6, hence the slower
     # wall there.

@@ -5,6 +5,7 @@ import argparse
 import numpy as np
 import pytest
 
+from hardpack.cli import main
 from hardpack.freeenergy import cli
 from hardpack.geometry.lattices import lattice_packing
 from hardpack.io import load_dataset, save_packing
@@ -51,11 +52,9 @@ def test_bcmd_cli_disjoint(tmp_path):
 def test_bcmd_cli_refuses(tmp_path, capsys):
     src = tmp_path / "fcc.nc"
     save_packing(lattice_packing("fcc", (2, 2, 2)), src)
-    args = parse(
-        ["bcmd", str(src), "--out", str(tmp_path / "r.nc"), "--dmu-max", "0.1"]
-    )
-    assert args.func(args) == 2  # touching spheres: cells never disjoint
-    assert "never disjoint" in capsys.readouterr().err
+    status = main(["bcmd", str(src), "--out", str(tmp_path / "r.nc"), "--dmu-max", "0.1"])
+    assert status == 2  # touching spheres: cells never disjoint
+    assert "hardpack bcmd: error: the cells are never disjoint" in capsys.readouterr().err
 
 
 def test_bcmd_simplex_cli_not_isostatic(tmp_path, capsys):

@@ -1,5 +1,5 @@
-"""Reference curves of the FCC free energy (hardpack.freeenergy.crystal) against the note's
-derived numbers and exact integrals."""
+"""Reference curves of the FCC free energy (hardpack.freeenergy.crystal) against numbers
+derived here from Donev 2006, sec. 6.4.1, and exact integrals."""
 
 import numpy as np
 import pytest
@@ -16,11 +16,11 @@ from hardpack.freeenergy.crystal import (
 
 
 def test_note_numbers():
-    # note sec. 2 step 1 and 3.1: Delta mu_min = 0.10757 at phi = 0.545, f_c = 7.3358 and the
-    # expected (3/2) ln(K/K0) = 5.91916... -> 2.3766 (the note rounds f to 4.9592)
+    # derived here from the melting value of Donev 2006, sec. 6.4.1: Delta mu_min = 0.10757 at
+    # phi = 0.545, f_c = 7.3358 and the expected (3/2) ln(K/K0) = 5.91916... -> 2.3766 (f = 4.9592)
     assert disjoint_dmu(0.545) == pytest.approx(0.10757, abs=1e-5)
     assert cell_offset(0.545) - 5.91916 == pytest.approx(2.3766, abs=2e-4)
-    # note sec. 3.2: excess -> -3 ln(1 - phi/phi_cp) + 2.436 as phi -> phi_cp
+    # derived here from [f_J - f_c^J]_FCC = 2.160: excess -> -3 ln(1 - phi/phi_cp) + 2.436 as phi -> phi_cp
     phi = PHI_CP * (1 - 1e-7)
     assert cell_limit_excess(phi) == pytest.approx(-3 * np.log(1e-7) + 2.436, abs=2e-3)
 

@@ -1,5 +1,5 @@
-"""BCMD on isostatic packings against their exact jamming simplex (Donev Table 6.1 test, note
-sec. 5.2 items 6-7) at reduced size: 62 backbone disks (64 bidisperse, 2 rattlers removed), and
+"""BCMD on isostatic packings against their exact jamming simplex (Donev 2006, Table 6.1
+and sec. 6.4.2) at reduced size: 62 backbone disks (64 bidisperse, 2 rattlers removed), and
 an engine-made 3D sphere packing (two-stage LS compression, stored below), one particle frozen or the centre
 of mass fixed."""
 

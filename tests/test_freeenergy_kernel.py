@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from hardpack.freeenergy._kernel import heap_set, wall_time
+from hardpack.events.heap import heap_set
+from hardpack.freeenergy._kernel import wall_time
 
 
 def test_heap_set_keeps_a_min_heap():

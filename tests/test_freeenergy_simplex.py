@@ -12,7 +12,7 @@ from hardpack.freeenergy.simplex import jamming_simplex, log_simplex_volume
 
 
 def test_note_one_dimensional_example():
-    # note sec. 1.3: A = (1, -1)^T, b = (1, 1) -> the segment [-1, 1], V = 2 exactly
+    # A = (1, -1)^T, b = (1, 1) -> the segment [-1, 1], V = 2 exactly
     assert np.exp(log_simplex_volume([[1.0], [-1.0]], [1.0, 1.0])) == pytest.approx(
         2.0, rel=1e-14
     )

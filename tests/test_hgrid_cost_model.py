@@ -1,4 +1,4 @@
-"""Analytic HGrid cost model vs Ogarko ch. 2.2 (Eqs. 2.14-2.47, Figs. 2.9-2.15; note 002 sec. 1.4-1.5, 4.1)."""
+"""Analytic HGrid cost model vs Ogarko 2014, sec. 2.2 (Eqs. 2.14-2.47, Figs. 2.9-2.15)."""
 
 import math
 
@@ -9,7 +9,7 @@ from scipy.integrate import quad
 from hardpack.errors import InvalidInputError
 from hardpack.hgrid import cost_model as cm
 
-FIG_215 = cm.PowerLawSystem(alpha=-3.0, omega=100.0, nu=0.7, d=3)  # K = 0.2, Top-Down (L3080-3114)
+FIG_215 = cm.PowerLawSystem(alpha=-3.0, omega=100.0, nu=0.7, d=3)  # K = 0.2, Top-Down (Ogarko 2014, Fig. 2.15)
 
 
 def brute_force_cost(system, s, K, method):
@@ -56,7 +56,8 @@ def test_cost_matches_literal_equations(system, cells, method):
 
 def test_linked_cell_values():
     """Single level (Eqs. 2.39-2.40): alpha = -3, omega = 100 -> 91146; monodisperse nu = 0.7 -> 20.85;
-    alpha = 0, omega -> infinity -> 75.0 (note sec. 4.1)."""
+    alpha = 0, omega -> infinity -> 75.0 (values of an independent re-implementation of the model; not
+    printed in Ogarko 2014)."""
     assert FIG_215.linked_cell_cost(0.2) == pytest.approx(91146, abs=0.5)
     assert FIG_215.cost([2.0, 200.0]) == pytest.approx(FIG_215.linked_cell_cost(0.2), rel=1e-12)
     assert cm.PowerLawSystem(0.0, 1.0).linked_cell_cost(0.2) == pytest.approx(20.85, abs=5e-3)
@@ -84,7 +85,7 @@ def test_linked_cell_asymptotics(alpha, power):
 
 
 def test_figure_2_15_minima():
-    """alpha = -3, omega = 100, nu = 0.7, d = 3, K = 0.2, Top-Down (L3090-3114): linear 12.40 at L* = 43,
+    """alpha = -3, omega = 100, nu = 0.7, d = 3, K = 0.2, Top-Down (Ogarko 2014, sec. 2.2.5, Fig. 2.15): linear 12.40 at L* = 43,
     constant-m 11.60 at L* = 12 (our 12.398 and 11.595), optimal 11.58; L = 8 and 19 cost 10 % more than
     the constant-m optimum; exponential L* = 4 with L = 6 24 % worse.
 
@@ -159,15 +160,16 @@ def test_q_between_one_and_two():
     ],
 )
 def test_constant_m_optima_below_30(alpha, omega, expected):
-    """T <= 30 N in 3D (L3311) at the constant-m optimum; values of note sec. 4.1. The alpha = 0 optimum
-    for large omega is ~60 % below the linked-cell 75.0 (L2861-2864)."""
+    """T <= 30 N in 3D (Ogarko 2014, sec. 2.2.6) at the constant-m optimum; the values are those of an
+    independent re-implementation of the model (not printed in the work). The alpha = 0 optimum for large
+    omega is ~60 % below the linked-cell 75.0 (sec. 2.2.5, text on Figs. 2.9-2.10)."""
     _, t, _ = cm.best_levels(cm.PowerLawSystem(alpha, omega), "constant-m", L_max=30)
     assert t == pytest.approx(expected, abs=0.05) and t <= 30
 
 
 def test_top_down_vs_bottom_up():
     """Top-Down is preferred for alpha < 0 and always with constant m; Bottom-Up wins for alpha >= 0 with
-    linear and exponential cells (L2866-2870, L2911-2918, L3013-3016)."""
+    linear and exponential cells (Ogarko 2014, sec. 2.2.5, text on Figs. 2.10, 2.11 and 2.13)."""
     for alpha in (-2.0, -3.0):
         sys = cm.PowerLawSystem(alpha, 100.0)
         for rule in ("exponential", "constant-m"):

@@ -2,20 +2,16 @@
 
 from __future__ import annotations
 
-import argparse
-
 import pytest
 
+from hardpack.cli import main
 from hardpack.geometry.lattices import lattice_packing
 from hardpack.io import load_dataset, save_packing
-from hardpack.jamming import cli
 
 
 def _main(argv) -> int:
-    parser = argparse.ArgumentParser(prog="hardpack")
-    cli.register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    return args.func(args)
+    """The whole command line (its one error path included)."""
+    return main(argv)
 
 
 def test_verify_writes_verdict(tmp_path, capsys):

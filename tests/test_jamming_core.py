@@ -17,7 +17,7 @@ from hardpack.jamming.rigidity import strain_pairs
 # ---------------------------------------------------------------------------- contacts
 @pytest.mark.parametrize("name, m, z", [("triangular", 3, 6), ("fcc", 6, 12), ("square", 2, 4)])
 def test_one_particle_cells_touch_their_own_images(name, m, z):
-    """With one particle per cell every contact is with the particle's own image (L887-L894);
+    """With one particle per cell every contact is with the particle's own image (Donev 2006, sec. 4.4.3);
     each is stored once (n lexicographically positive) and counts twice for the particle."""
     net = contact_network(primitive_cell(name), delta=1e-6)
     assert net.n_contacts == m
@@ -76,7 +76,7 @@ def _positively_spanning(normals: np.ndarray) -> bool:
 
 def test_rattler_removal_cascades_through_a_honeycomb():
     """Honeycomb disks have exactly d + 1 = 3 contacts. One vacancy leaves its 3 neighbours with
-    2 contacts; removing them frees their neighbours, and so on (L922-L927): iterative removal
+    2 contacts; removing them frees their neighbours, and so on (Donev 2006, sec. 4.4.3.1): iterative removal
     must strip the whole packing, a single pass would remove only 3 disks."""
     p = lattice_packing("honeycomb", (4, 4))
     p = p.replace(positions=p.positions[1:], radii=p.radii[1:])

@@ -20,14 +20,14 @@ order). So the collective test asks whether the bar framework of the contacts ha
 infinitesimal mechanism periodic in the cell, the strict test whether it has one with a
 traceless strain. A motion periodic in a cell is a sum of Bloch waves exp(i q.R) with q in the
 cell's reciprocal lattice; q = 0 (modulo the primitive reciprocal lattice) is the only wave of a
-primitive cell, and the strain couples to q = 0 only (Donev: the strain is the same for every
-supercell, L1216-L1303; any motion of a cell is one of its supercells, L1352-L1403).
+primitive cell, and the strain couples to q = 0 only (Donev 2006: the strain is the same for
+every supercell, secs. 4.4.5.4-4.4.6; any motion of a cell is one of its supercells, sec. 4.4.6.3).
 
 - Bravais lattices (one particle per primitive cell; neighbour vectors r): a wave q != 0 is a
   mechanism iff a displacement v is perpendicular to every r with q.r not in 2 pi Z.
   * triangular: any two of its three directions generate the lattice, so q != 0 leaves two of
     them out of phase and no v is perpendicular to both; strain: u^T eps u = 0 on three
-    directions 60 degrees apart forces eps = 0. Strictly jammed in every cell (Donev L852-L853).
+    directions 60 degrees apart forces eps = 0. Strictly jammed in every cell (Donev 2006, sec. 4.4.2.1).
   * FCC (conventional and primitive cells): of the six directions <110>, any three
     independent ones generate the lattice, and at most three lie in a plane (the {111}), so
     q != 0 leaves a spanning set out of phase; strain: u^T eps u = 0 on the six <110> gives
@@ -152,7 +152,7 @@ def _contacts(packing: Packing):
     """Every contact (i, j, lattice n, r_ij) once (|x_j + lattice n - x_i| = 1 to 1e-9), from
     the geometry alone: for each pair the images around the nearest one, up to 1 / height + 1/2
     cells away along each lattice vector (|r| <= 1 needs that)."""
-    d, lat, n = packing.dim, packing.lattice, packing.n_particles
+    lat, n = packing.lattice, packing.n_particles
     frac = packing.fractional()
     i, j = np.triu_indices(n)  # i <= j
     nearest = -np.rint(frac[j] - frac[i])  # frac_j - frac_i + nearest in [-1/2, 1/2]

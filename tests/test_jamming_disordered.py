@@ -1,10 +1,10 @@
 """Disordered packings from the LS engine (hardpack.md): jamming, contact number, forces.
 
-Published targets (Donev dissertation, seeds/000_chapters/ch04-05.txt): LS packings of
+Published targets (Donev 2006, dissertation chs. 4-5): LS packings of
 monodisperse spheres (phi ~ 0.64) and equimolar binary disks (size ratio 1.4, phi ~ 0.84) are
-collectively jammed but, from a fixed cell, not strictly jammed (L2012-L2017, L1808-L1810), with
-Z = 2d after rattler removal for generic (isostatic) packings (L2039-L2046, Ch. 5 L2794-L2795)
-and rattler fractions up to ~2.5 % in 3D and ~5 % in 2D (L2643-L2644). The free-volume
+collectively jammed but, from a fixed cell, not strictly jammed (secs. 4.7.2.1 and 4.6.2.5), with
+Z = 2d after rattler removal for generic (isostatic) packings (sec. 4.7.2.1; Eq. 5.1)
+and rattler fractions up to ~2.5 % in 3D and ~5 % in 2D (sec. 5.2). The free-volume
 pressure p = d / (1 - phi/phi_J) (Eq. 5.24, "verified numerically for disordered isostatic hard
 sphere packings") ties the jamming gap of the force network to the MD pressure.
 
@@ -21,10 +21,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-md = pytest.importorskip("hardpack.md", reason="hardpack.md (the LS engine) is not available")
-if not hasattr(md, "compress"):  # pragma: no cover - engine present but without its driver
-    pytest.skip("hardpack.md.compress is not available yet", allow_module_level=True)
-
+from hardpack import md
 from hardpack.distributions import bidisperse, monodisperse
 from hardpack.initial import random_packing
 from hardpack.jamming import verify
@@ -68,7 +65,7 @@ def test_ls_spheres(spheres):
     packing, pressure = spheres
     r = verify(packing, delta=1e-6, seed=0, md_pressure=pressure)
     _common_checks(r, 3)
-    # Donev: up to ~2.5 % in 3D (L2643). One N = 250 sample scatters by about +-1.2 % (binomial;
+    # Donev: up to ~2.5 % in 3D (Donev 2006, sec. 5.2). One N = 250 sample scatters by about +-1.2 % (binomial;
     # we measured 1.2-4.4 % over 7 LS packings, mean 2.4 %, and 1.7 % at N = 1000), so a single
     # sample is held to 5 % (2 sigma above 2.5 %)
     assert r.rattler_fraction <= 0.05
@@ -79,7 +76,7 @@ def test_ls_binary_disks(disks):
     packing, pressure = disks
     r = verify(packing, delta=1e-6, seed=0, md_pressure=pressure)
     _common_checks(r, 2)
-    # Donev: "as many as 5 %" in 2D (L2643); our LS disks at N = 250 have 5-7 % (seeds 1-2)
+    # Donev: "as many as 5 %" in 2D (sec. 5.2); our LS disks at N = 250 have 5-7 % (seeds 1-2)
     assert r.rattler_fraction <= 0.08
     assert 0.83 < packing.phi < 0.86
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_jamming_support import jammed_disks
 
 from hardpack.geometry.lattices import lattice_packing
 from hardpack.geometry.packing import Packing
@@ -39,11 +38,11 @@ def test_crystal_forces_uniform_and_balanced(name, reps):
     np.testing.assert_allclose(_boundary_stress(r), r.statics.stress, atol=1e-12)
 
 
-def test_disordered_forces_positive_balanced_isostatic():
+def test_disordered_forces_positive_balanced_isostatic(jammed_disks):
     """Exactly jammed binary disks: unique strictly positive self-stress, balanced to round-off
     on every backbone disk, isostatic backbone (Eq. 4.8: M = 2 N_b - 1) and the boundary stress
     (4.23) equal to the virial stress (4.24)."""
-    r = verify(jammed_disks(), delta=1e-6)
+    r = verify(jammed_disks, delta=1e-6)
     assert r.collective
     s, f = r.statics, r.forces
     assert s.isostaticity_gap == 0 and s.n_contacts == 2 * (s.n_backbone - 1) + 1
@@ -58,13 +57,13 @@ def test_disordered_forces_positive_balanced_isostatic():
     assert np.abs(af[~r.rattler]).max() < 1e-12
 
 
-def test_jamming_gap_of_uniformly_shrunk_packing():
+def test_jamming_gap_of_uniformly_shrunk_packing(jammed_disks):
     """Shrinking every radius by (1 - s) opens every contact by s D: the jamming gap mu* (the
     relative growth that closes them again) is s / (1 - s) exactly."""
     s = 1e-9
-    disks = jammed_disks()
+    disks = jammed_disks
     shrunk = disks.replace(radii=disks.radii * (1 - s))
-    # the cage extends to ~ M s D / f_min (elongated corners, L580-L583): dr_large = 1e-3 D
+    # the cage extends to ~ M s D / f_min (elongated corners, Donev 2006, sec. 4.3.2): dr_large = 1e-3 D
     r = verify(shrunk, delta=1e-6, dr_large=1e-3)
     assert r.collective
     assert r.statics.jamming_gap == pytest.approx(s / (1 - s), rel=1e-6)

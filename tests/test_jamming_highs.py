@@ -1,8 +1,7 @@
 """HiGHS wrapper (hardpack.jamming.highs): a presolve 'infeasible' verdict is confirmed."""
 
-from pathlib import Path
-
 import math
+from pathlib import Path
 
 import pytest
 

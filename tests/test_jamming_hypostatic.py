@@ -2,8 +2,8 @@
 nearest jamming point; the working-set LP solver against HiGHS.
 
 References: a contact network with fewer than d(N-1) + 1 contacts cannot be jammed (Donev
-L534, Eq. 4.8); the honeycomb lattice (Z = 3 < 4) is not collectively jammed (Table 4.1). An
-isostatic network has a unique self-stress (Ch. 5, L2894-L2899), so when one of its contacts is
+2006, Eq. 4.8); the honeycomb lattice (Z = 3 < 4) is not collectively jammed (Table 4.1). An
+isostatic network has a unique self-stress (Donev 2006, sec. 5.4.1.2), so when one of its contacts is
 opened by 1e-7 D the self-stress of the nearest jamming point must be exactly that one.
 """
 
@@ -14,7 +14,6 @@ import logging
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from test_jamming_support import jammed_disks
 
 from hardpack.geometry.lattices import lattice_packing
 from hardpack.geometry.packing import Packing
@@ -47,11 +46,11 @@ def _opened(p: Packing, gap: float) -> tuple[Packing, int]:
     return Packing(net.positions + change[: n * d].reshape(n, d), radii, p.lattice), int(backbone.sum())
 
 
-def test_forces_of_the_nearest_jamming_point_restore_the_open_contact():
+def test_forces_of_the_nearest_jamming_point_restore_the_open_contact(jammed_disks):
     """One contact of an isostatic disk packing opened by ~3e-7: at the contact tolerance 1e-8
     the backbone is one contact short (no self-stress); the forces of the nearest jamming point
     close exactly that contact and equal the unique self-stress of the full network to round-off."""
-    q, n_backbone = _opened(jammed_disks(), 1e-6)
+    q, n_backbone = _opened(jammed_disks, 1e-6)
     full = verify(q, delta=1e-5, tests=("local",))
     short = verify(q, delta=1e-8, tests=("local",))
     assert full.statics.isostaticity_gap == 0 and short.statics.isostaticity_gap == -1
@@ -75,22 +74,22 @@ def test_hypostatic_honeycomb_unjams_under_sequential_loading():
     assert not r.collective and max(r.collective_test.mean_displacement) > 0.01
 
 
-def test_jammed_disks_stay_within_their_gaps():
+def test_jammed_disks_stay_within_their_gaps(jammed_disks):
     """The exactly jammed isostatic disks: no load moves the backbone by more than round-off in
     the collective test (threshold 1e-3), while the fixed cell lets the strict test shear them
-    (Donev L2012-L2017: fixed-cell packings are not strictly jammed)."""
-    r = verify(jammed_disks(), method="sequential", seed=1)
+    (Donev 2006, sec. 4.7.2.1: fixed-cell packings are not strictly jammed)."""
+    r = verify(jammed_disks, method="sequential", seed=1)
     assert r.collective and max(r.collective_test.mean_displacement) < 1e-8
     assert not r.strict and r.strict_test.n_lp <= 3
 
 
-def test_tiled_isostatic_packing_is_hypostatic_and_not_collectively_jammed():
+def test_tiled_isostatic_packing_is_hypostatic_and_not_collectively_jammed(jammed_disks):
     """Four periodic copies of the isostatic disks keep every contact (4 M_b = 4 (2 N_b - 1))
     but gain degrees of freedom (2 (4 N_b - 1)): three contacts short of d(N-1) + 1 (Eq. 4.8),
     so the copies can move against each other and the ideal test (Algorithm 13) must unjam the
     tiled packing, while the original is collectively jammed. The counting is exact; it is why
     benchmarks of jamming tests may tile a packing for scaling but not for a jammed verdict."""
-    p = jammed_disks()
+    p = jammed_disks
     one = verify(p, tests=("local", "collective"), seed=2)
     tiled = verify(p.tiled(2), tests=("local", "collective"), seed=2)
     assert one.collective and one.statics.isostaticity_gap == 0
@@ -101,12 +100,12 @@ def test_tiled_isostatic_packing_is_hypostatic_and_not_collectively_jammed():
 
 
 @pytest.mark.parametrize("strict", [False, True])
-def test_working_set_matches_highs(strict):
+def test_working_set_matches_highs(strict, jammed_disks):
     """The sparse-LU working-set solver (cold -- for the strict LP through the strain
     continuation -- and warm-started for the reversed load) returns the optimum HiGHS finds for
     LP 4.10 on the first coordination shell of slightly opened jammed disks (two independent
     solvers; the tolerance is HiGHS's 1e-10)."""
-    q, _ = _opened(jammed_disks(), 1e-3)
+    q, _ = _opened(jammed_disks, 1e-3)
     net = contact_network(q, 0.1)
     rng = np.random.default_rng(5)
     moving = np.ones(q.n_particles, bool)
@@ -125,7 +124,7 @@ def test_working_set_matches_highs(strict):
         np.testing.assert_allclose(mine.displacement, exact.displacement, atol=1e-8)
 
 
-def test_strain_continuation_stops_at_an_interior_strain(monkeypatch):
+def test_strain_continuation_stops_at_an_interior_strain(monkeypatch, jammed_disks):
     """The strain continuation ends at the first stage whose optimal strain is inside its
     bound (lp._strain_continuation): that optimum must be the optimum HiGHS finds with the full
     bound. With a box of 5 D the contacts bound the strain at ~0.035 of the box (measured), so
@@ -133,7 +132,7 @@ def test_strain_continuation_stops_at_an_interior_strain(monkeypatch):
     the test exercises the shortcut); tolerance as in test_working_set_matches_highs."""
     import hardpack.jamming.lp as lp
 
-    q, _ = _opened(jammed_disks(), 1e-3)
+    q, _ = _opened(jammed_disks, 1e-3)
     net = contact_network(q, 0.1)
     moving = np.ones(q.n_particles, bool)
     length = cell_length(q.lattice)
@@ -157,7 +156,7 @@ def test_strain_continuation_stops_at_an_interior_strain(monkeypatch):
 
 
 @pytest.mark.parametrize("strict", [False, True])
-def test_working_set_returns_a_regular_basis_of_active_columns(monkeypatch, strict):
+def test_working_set_returns_a_regular_basis_of_active_columns(monkeypatch, strict, jammed_disks):
     """The basis a working-set LP hands to the next one (workingset._KLP.optimal_basis, read
     off the simplex pivots of the K-LP) is a vertex basis of the optimum: its columns are
     linearly independent (numerical rank = their number) and all of them are active at the
@@ -165,7 +164,7 @@ def test_working_set_returns_a_regular_basis_of_active_columns(monkeypatch, stri
     takes zero-load columns at a degenerate optimum, which need not be either."""
     import hardpack.jamming.lp as lp
 
-    q, _ = _opened(jammed_disks(), 1e-3)
+    q, _ = _opened(jammed_disks, 1e-3)
     net = contact_network(q, 0.1)
     moving = np.ones(q.n_particles, bool)
     length = cell_length(q.lattice)
@@ -191,11 +190,11 @@ def test_working_set_returns_a_regular_basis_of_active_columns(monkeypatch, stri
         assert np.abs(cols.slacks(sol.x)[sol.basis]).max() <= 1e-10 * 0.05
 
 
-def test_long_working_set_lps_log_their_rounds(monkeypatch, caplog):
+def test_long_working_set_lps_log_their_rounds(monkeypatch, caplog, jammed_disks):
     """A working-set LP logs each round once it has run PROGRESS_AFTER seconds (progress of
     the > 1 h LPs at N = 1e4); set to -1 s here so that every round is long, and to 1 h so
     that none is."""
-    q, _ = _opened(jammed_disks(), 1e-3)
+    q, _ = _opened(jammed_disks, 1e-3)
     net = contact_network(q, 0.1)
     moving = np.ones(q.n_particles, bool)
     load = random_load(np.random.default_rng(5), moving, 2)

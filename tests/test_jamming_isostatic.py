@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_jamming_support import jammed_disks
 
 from hardpack.jamming import contact_network, remove_rattlers, rigidity_matrix
 from hardpack.jamming.isostatic import RigidBackbone
@@ -12,11 +11,11 @@ from hardpack.jamming.lp import solve_motion
 
 
 @pytest.fixture(scope="module")
-def backbone():
+def backbone(jammed_disks):
     """The jammed disks with random gaps ~1e-7 D (radii shrunk unevenly), so that the LP
     vertex is unique and the cage has a finite size."""
     rng = np.random.default_rng(0)
-    disks = jammed_disks()
+    disks = jammed_disks
     p = disks.replace(radii=disks.radii * (1 - rng.uniform(0, 2e-7, 64)))
     net = contact_network(p, 1e-5)
     active, _ = remove_rattlers(net, np.ones(64, bool), dr_large=1e-3, box=3.0, rng=rng)
@@ -49,7 +48,7 @@ def test_strain_mode_is_a_floppy_motion(backbone):
     assert np.abs(stretch[iso.contacts]).max() < 1e-10 * np.abs(eps).max()
 
 
-def test_hyperstatic_backbone_matches_highs():
+def test_hyperstatic_backbone_matches_highs(jammed_disks):
     """With the next near contacts inside delta the backbone has K >= 3 self-stresses: the
     K-variable LPs (vertex of LP 4.10, jamming gap mu*) still agree with HiGHS on the full LPs."""
     import scipy.sparse as sp
@@ -59,7 +58,7 @@ def test_hyperstatic_backbone_matches_highs():
     from hardpack.jamming.lp import solve_lp
 
     rng = np.random.default_rng(3)
-    disks = jammed_disks()
+    disks = jammed_disks
     p = disks.replace(radii=disks.radii * (1 - rng.uniform(0, 2e-7, 64)))
     gaps = np.sort(pairs_within(p, rel_gap=0.05).gap)
     n_tight = int((gaps < 1e-6).sum())

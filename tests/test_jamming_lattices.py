@@ -1,7 +1,7 @@
 """Table 4.1 of Donev's dissertation and the strictly jammed 2D packings of Fig. 4.11.
 
-Source: seeds/000_chapters/ch04-05.txt L1880-L1963 (Table 4.1, periodic boundary conditions)
-and L1968-L1981 (Fig. 4.11, Eq. 4.26). The text chose "the smallest unit cells for which an
+Source: Donev 2006, dissertation sec. 4.7.1 (Table 4.1, periodic boundary conditions)
+and sec. 4.7.1.1 (Fig. 4.11, Eq. 4.26). The text chose "the smallest unit cells for which an
 unjamming motion exists", with N_s particles per cell. The cells used here are index-k
 supercells of the primitive cell (matrix columns = new lattice vectors in primitive units): the
 first doubling along the third (2D: second) primitive vector gives the N_s of the table and an
@@ -30,11 +30,11 @@ from hardpack.jamming import rigidity_matrix, verify
 D2, D3 = [[1, 0], [0, 2]], [[1, 0, 0], [0, 1, 0], [0, 0, 2]]
 I2, I3 = np.eye(2, dtype=int), np.eye(3, dtype=int)
 
-# name, cell matrix, printed phi, Z, printed N_s, L, C, S   (Table 4.1, L1921-L1956)
+# name, cell matrix, printed phi, Z, printed N_s, L, C, S   (Donev 2006, Table 4.1)
 TABLE_4_1 = [
     ("honeycomb", D2, 0.605, 3, 4, True, False, False),
-    # printed Z = 6 for Kagome is a misprint: every Kagome disk touches 4 others (the note,
-    # 000_ch4-5_jamming.md sec. 3.1, flags it); we assert the true value.
+    # printed Z = 6 for Kagome is a misprint: every Kagome disk touches 4 others (Donev 2006,
+    # Table 4.1); we assert the true value.
     ("kagome", I2, 0.680, 4, 3, True, False, False),
     ("square", D2, 0.785, 4, 2, True, False, False),
     ("triangular", I2, 0.907, 6, 1, True, True, True),
@@ -57,7 +57,7 @@ def test_table_4_1(name, cell, phi, z, ns, local, collective, strict):
     assert r.network.n_contacts * 2 / p.n_particles == z
     assert (r.local, r.collective, r.strict) == (local, collective, strict)
     assert not r.rattler.any() if collective else True
-    # Donev L165-L166: strict => collective => local, reflected in the category string
+    # Donev 2006, sec. 4.2.2: strict => collective => local, reflected in the category string
     expected = "strictly jammed" if strict else "collectively jammed" if collective else "locally jammed"
     assert r.category == expected
 
@@ -73,7 +73,7 @@ def test_table_cells_are_the_smallest_with_a_mechanism(name):
 @pytest.mark.parametrize("name, reps", [("triangular", (3, 4)), ("triangular", (5, 5)),
                                         ("fcc", (2, 2, 2)), ("hcp", (2, 2, 2))])
 def test_dense_lattices_strictly_jammed_in_larger_cells(name, reps):
-    """Triangular is strictly jammed for every N_c (L852-L853); FCC and HCP too."""
+    """Triangular is strictly jammed for every N_c (Donev 2006, sec. 4.4.2.1); FCC and HCP too."""
     r = verify(lattice_packing(name, reps), delta=1e-6, seed=3)
     assert r.strict and r.collective and r.local
     assert r.unjamming("collective")["max"] == 0.0 and r.unjamming("strict")["max"] == 0.0
@@ -108,7 +108,7 @@ def test_kagome_pattern_without_reinforcement_unjams():
 
 
 def test_divacancy_unjams_triangular_lattice():
-    """L1974-L1976: a compact divacancy unjams the (strictly jammed) triangular packing."""
+    """Donev 2006, sec. 4.7.1.1: a compact divacancy unjams the (strictly jammed) triangular packing."""
     p = triangular_with_vacancies(6, [(0, 0), (1, 0)])
     r = verify(p, delta=1e-6, seed=7)
     assert not r.strict

@@ -1,4 +1,4 @@
-"""LP contact forces vs the MD's time-averaged collision forces (issue 4, 'forces' must-show).
+"""LP contact forces vs the MD's time-averaged collision forces.
 
 An isostatic backbone has a unique self-stress, so the LP forces and the MD forces must agree
 contact by contact after one fitted factor, and the virial of the scaled LP forces must equal the
@@ -43,8 +43,9 @@ def test_lp_forces_match_md_forces_of_an_isostatic_ls_packing():
 
 def test_a_wrong_force_network_is_detected():
     """Same contacts, forces permuted: the fitted virial no longer matches the MD pressure."""
-    from hardpack.geometry.lattices import lattice_packing
     import xarray as xr
+
+    from hardpack.geometry.lattices import lattice_packing
 
     p = lattice_packing("fcc", (2, 2, 2))
     result = verify(p)

@@ -29,6 +29,36 @@ def init_file(tmp_path_factory):
     return path
 
 
+def _killed_after_first_checkpoint(base, ckpt, progress) -> int:
+    """Run ``base`` with a checkpoint after every window, SIGKILL it once ``progress(ckpt)`` >= 1
+    (a checkpoint of the run proper was written); return that progress."""
+    first = subprocess.Popen([*base, "--checkpoint-interval", "0"], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    while progress(ckpt) < 1:
+        assert first.poll() is None and time.time() < deadline
+        time.sleep(0.01)
+    os.kill(first.pid, signal.SIGKILL)
+    first.wait()
+    return progress(ckpt)
+
+
+def _resumed_and_signalled(base, ckpt, sig) -> str:
+    """Start ``base`` again (no timed checkpoints), send ``sig`` once it has resumed from
+    ``ckpt``, check the exit status 128 + sig and return its standard error."""
+    run = subprocess.Popen([*base, "--checkpoint-interval", "1e9"], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.PIPE, text=True)
+    for line in run.stderr:
+        if "resumed from" in line and str(ckpt) + " " in line:
+            break
+    time.sleep(0.3)
+    assert run.poll() is None, "the run ended before the signal"
+    os.kill(run.pid, sig)
+    err = run.stderr.read()
+    assert run.wait(timeout=120) == 128 + sig
+    return err
+
+
 def _windows(path):
     try:
         with np.load(path) as data:
@@ -65,15 +95,8 @@ def test_sigkill_and_resume_is_bit_identical(tmp_path, init_file):
 def test_checkpoint_of_another_run_is_refused(tmp_path, init_file):
     ckpt = tmp_path / "c.npz"
     cmd = _cli("compress", "--init", str(init_file), "--out", str(tmp_path / "o.nc"), "--growth-rate",
-               "0.05", "--seed", "1", "--max-collisions", "20000", "--checkpoint", str(ckpt),
-               "--checkpoint-interval", "0", "--window", "1")
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.time() + 120
-    while _windows(ckpt) < 1:
-        assert proc.poll() is None and time.time() < deadline
-        time.sleep(0.01)
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
+               "0.05", "--seed", "1", "--max-collisions", "20000", "--checkpoint", str(ckpt), "--window", "1")
+    _killed_after_first_checkpoint(cmd, ckpt, _windows)
     other = subprocess.run(
         _cli("compress", "--init", str(init_file), "--out", str(tmp_path / "o.nc"), "--growth-rate",
              "0.05", "--seed", "2", "--max-collisions", "20000", "--checkpoint", str(ckpt),
@@ -115,27 +138,9 @@ def test_signal_writes_a_checkpoint_and_resume_is_bit_identical(tmp_path, init_f
     reference = compress(load_packing(init_file), 0.05, 1, stop=StopCriteria(max_pressure=1e10)).packing
     out, ckpt = tmp_path / "out.nc", tmp_path / "run.ckpt.npz"
     base = _cli("compress", "--init", str(init_file), "--out", str(out), *ARGS, "--checkpoint", str(ckpt))
-    # a first run killed hard leaves an early checkpoint
-    first = subprocess.Popen([*base, "--checkpoint-interval", "0"], stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)
-    deadline = time.time() + 120
-    while _windows(ckpt) < 1:
-        assert first.poll() is None and time.time() < deadline
-        time.sleep(0.01)
-    os.kill(first.pid, signal.SIGKILL)
-    first.wait()
-    early = _windows(ckpt)
+    early = _killed_after_first_checkpoint(base, ckpt, _windows)
     # the second run writes no timed checkpoint: only the signal makes it write one
-    second = subprocess.Popen([*base, "--checkpoint-interval", "1e9"], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True)
-    for line in second.stderr:
-        if "resumed from" in line:
-            break
-    time.sleep(0.3)
-    assert second.poll() is None, "the run ended before the signal"
-    os.kill(second.pid, sig)
-    err = second.stderr.read()
-    assert second.wait(timeout=120) == 128 + sig
+    err = _resumed_and_signalled(base, ckpt, sig)
     assert not out.exists() and _windows(ckpt) > early
     last = err.strip().splitlines()[-1]
     assert last.startswith(f"hardpack compress: interrupted: stopped by {signal.Signals(sig).name} at phi = ")
@@ -169,25 +174,8 @@ def test_eos_sigterm_and_resume_is_bit_identical(tmp_path, init_file):
     assert run.returncode == 0, run.stderr
     out, ckpt = tmp_path / "eos.nc", tmp_path / "eos.ckpt"
     base = _cli(*args, "--out", str(out), "--checkpoint", str(ckpt))
-    first = subprocess.Popen([*base, "--checkpoint-interval", "0"], stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)
-    deadline = time.time() + 120
-    while _collisions(ckpt) < 1:  # the equilibrium run has saved its state
-        assert first.poll() is None and time.time() < deadline
-        time.sleep(0.01)
-    os.kill(first.pid, signal.SIGKILL)
-    first.wait()
-    early = _collisions(ckpt)
-    second = subprocess.Popen([*base, "--checkpoint-interval", "1e9"], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True)
-    for line in second.stderr:
-        if "resumed from" in line and str(ckpt) + " " in line:
-            break
-    time.sleep(0.3)
-    assert second.poll() is None, "the run ended before the signal"
-    os.kill(second.pid, signal.SIGTERM)
-    err = second.stderr.read()
-    assert second.wait(timeout=120) == 128 + signal.SIGTERM
+    early = _killed_after_first_checkpoint(base, ckpt, _collisions)  # the equilibrium run's state
+    err = _resumed_and_signalled(base, ckpt, signal.SIGTERM)
     assert _collisions(ckpt) > early and not out.exists()
     assert err.strip().splitlines()[-1].startswith("hardpack eos: interrupted: stopped by SIGTERM at ")
 

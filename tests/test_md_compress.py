@@ -2,10 +2,10 @@
 free-volume law near jamming, conservation laws at zero growth, stop criteria, outputs, and
 refusal of impossible inputs.
 
-Published targets (note 000_ch1-3_md.md sec. 4): 3D monodisperse LS packings from a liquid jam
-at phi_J = 0.635-0.655 for a wide range of rates (Donev L378-380; Skoge et al. 2006: 0.64);
-2D equimolar binary disks with diameter ratio 1.4 jam near 0.84 (L540-541); 4D monodisperse
-near 0.46 (Skoge et al. 2006, Table I). Near jamming p = d / (1 - phi/phi_J) (Eq. 1.1, L330-342).
+Published targets: 3D monodisperse LS packings from a liquid jam
+at phi_J = 0.635-0.655 for a wide range of rates (Donev 2006, sec. 1.2 and Fig. 1.3; Skoge et al. 2006: 0.64);
+2D equimolar binary disks with diameter ratio 1.4 jam near 0.84 (Donev 2006, sec. 1.3.2.1); 4D monodisperse
+near 0.46 (Skoge et al. 2006, Table I). Near jamming p = d / (1 - phi/phi_J) (Donev 2006, Eq. 1.1).
 """
 
 import numpy as np

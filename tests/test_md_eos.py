@@ -4,7 +4,7 @@
   few 0.1 % up to freezing (phi = 0.494);
 - 2D disks: Henderson Z = (1 + phi^2/8) / (1 - phi)^2, accurate to < 0.5 % for phi <= 0.5;
 - 3D polydisperse: BMCSL Z = 1/(1-phi) + 3 O1 phi/(1-phi)^2 + O2 phi^2 (3-phi)/(1-phi)^3 with
-  O1 = <a><a^2>/<a^3>, O2 = <a^2>^3/<a^3>^2 (Ogarko Eq. 3.9, note 002 sec. 2.2).
+  O1 = <a><a^2>/<a^3>, O2 = <a^2>^3/<a^3>^2 (Ogarko 2014, Eqs. 3.6 and 3.9).
 
 Each run has N = 500 and enough collisions for a standard error below 0.25 % of Z, so the 1 %
 tolerance (which also absorbs O(1/N) finite-size effects) is meaningful.

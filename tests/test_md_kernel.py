@@ -1,5 +1,6 @@
 """Two-body analytics of the event-driven MD kernel: collision times with growth, neighbourhood
-exit times, and post-collision velocities (the growth-corrected elastic law of note 000 sec. 2.4).
+exit times, and post-collision velocities (the growth-corrected elastic law derived in
+hardpack.md.kernel).
 
 Every expected number below is derived by hand from straight-line motion and linearly growing
 radii, independently of the kernel's quadratic formulas.
@@ -8,8 +9,8 @@ radii, independently of the kernel's quadratic formulas.
 import numpy as np
 import pytest
 
+from hardpack.events.roots import exit_time, pair_time
 from hardpack.md.engine import Engine
-from hardpack.md.kernel import exit_time, pair_time
 
 
 def pt(r, u, sig0, g):

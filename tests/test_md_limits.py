@@ -15,20 +15,13 @@ from hardpack.io import load_dataset, save_packing
 from hardpack.md import StopCriteria, compress
 
 
-@pytest.fixture(scope="module")
-def start3d(tmp_path_factory):
-    path = tmp_path_factory.mktemp("limits") / "init3d.nc"
-    save_packing(random_packing(100, 3, monodisperse(0.5), 0.3, seed=2), path)
-    return path
-
-
 @pytest.mark.parametrize("command", [
     ["compress", "--target-phi", "0.9", "--max-pressure", "none", "--growth-rate", "0.1"],
     ["eos", "--phi", "0.9", "--collisions", "10000"],
 ])
-def test_target_above_jamming_is_refused(tmp_path, start3d, command):
+def test_target_above_jamming_is_refused(tmp_path, rsa_file, command):
     # without the check both runs grow towards phi = 0.9 forever (the timeout fails the test)
-    run = subprocess.run([sys.executable, "-m", "hardpack.cli", command[0], "--init", str(start3d), "--out",
+    run = subprocess.run([sys.executable, "-m", "hardpack.cli", command[0], "--init", str(rsa_file), "--out",
                           str(tmp_path / "out.nc"), "--seed", "1", *command[1:]],
                          capture_output=True, text=True, timeout=120, check=False)
     assert run.returncode == 2
@@ -48,10 +41,10 @@ def test_target_below_jamming_is_still_reached():
     assert res.stats["Z"] < 1e9
 
 
-def test_end_state_far_from_jammed_is_flagged(tmp_path, start3d, caplog):
+def test_end_state_far_from_jammed_is_flagged(tmp_path, rsa_file, caplog):
     out = tmp_path / "fast.nc"
     with caplog.at_level(logging.WARNING, logger="hardpack.md"):
-        assert main(["compress", "--init", str(start3d), "--out", str(out), "--growth-rate", "1e6",
+        assert main(["compress", "--init", str(rsa_file), "--out", str(out), "--growth-rate", "1e6",
                      "--seed", "1"]) == 0
     attrs = load_dataset(out).attrs
     assert attrs["stop_reason"] == "max_pressure" and attrs["phi"] < 0.5
@@ -59,10 +52,10 @@ def test_end_state_far_from_jammed_is_flagged(tmp_path, start3d, caplog):
     assert "the end state is far from jammed" in caplog.text and "too fast" in caplog.text
 
 
-def test_jammed_end_state_passes(start3d):
+def test_jammed_end_state_passes(rsa_file):
     from hardpack.io import load_packing
 
-    res = compress(load_packing(start3d), 0.02, 1)
+    res = compress(load_packing(rsa_file), 0.02, 1)
     assert res.stats["jamming_check"] == "passed"
     assert res.stats["backbone_volume_fraction"] > 0.9  # a few percent rattlers
 

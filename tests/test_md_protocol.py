@@ -2,7 +2,7 @@
 forces (per-pair impulse sums over the final windows).
 
 Physics asserted: the collision virial of the stored pair forces reproduces the window pressure
-Z = pV/(NkT) (note 000 sec. 2.5; Donev L102-105: per-pair exchanged momentum = contact forces),
+Z = pV/(NkT) (Donev 2006, sec. 3.2.4.2; sec. 1.1: per-pair exchanged momentum = contact forces),
 the time-averaged forces are repulsive central forces along the contact normals, each particle's
 net time-averaged force is its momentum change over the window (Newton's third law / momentum
 conservation), and the forces of a collectively jammed two-stage packing match the unique

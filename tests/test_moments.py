@@ -2,15 +2,14 @@
 
 import math
 
+import mpmath
 import numpy as np
 import pytest
 
 from hardpack.distributions import Discrete, LogNormal, bidisperse, monodisperse, uniform_size, uniform_volume
 from hardpack.eos import moments as mo
-from hardpack.validation.analytic import moment_table_rows
-from hardpack.validation.targets import load_targets
 from hardpack.errors import InvalidInputError
-
+from hardpack.validation.analytic import moment_table_rows
 
 OMEGAS_31 = (1.2, 1.4, 2, 4, 5, 7, 8, 10, 20, 50, 100)
 #: the printed cells our values do not round to (Table 3.3 omega = 4 n2 and delta1; Table 3.4
@@ -40,7 +39,6 @@ def test_uniform_size_bidisperse_equivalent_is_equimolar():
 def test_independent_high_precision_tridisperse_solve_agrees():
     """The five misprinted cells, recomputed with 50-digit Gauss quadrature from the exact moments
     (an independent route to the 3-node equivalent), agree with ours to 1e-10."""
-    mpmath = pytest.importorskip("mpmath")
     mpmath.mp.dps = 50
     for family, x, name in (("UV", 4, "n2"), ("UV", 4, "delta1"), ("LN", 0.15, "n1"), ("LN", 0.5, "delta2"),
                             ("LN", 1.0, "n2")):
@@ -138,7 +136,7 @@ def test_lognormal_dimensionless_moments(sigma):
 
 @pytest.mark.parametrize("omega", [1.2, 2.0, 3.0, 10.0, 100.0])
 def test_uniform_size_tridisperse_is_585(omega):
-    """US: 5:8:5 with radii <a>(1 +- omega0 sqrt(3/5)) and <a> (Eqs. 3.39-3.40, L5922); the generic
+    """US: 5:8:5 with radii <a>(1 +- omega0 sqrt(3/5)) and <a> (Ogarko 2014, Eqs. 3.39-3.40, sec. 3.2); the generic
     quadrature, the printed formula and the kurtosis family at beta2 = 1.8 coincide."""
     w0 = (omega - 1) / (omega + 1)
     dist = uniform_size(omega)
@@ -174,7 +172,7 @@ def test_kurtosis_family_omega_3(beta2):
 
 def test_kurtosis_family_bounds():
     with pytest.raises(InvalidInputError):
-        mo.kurtosis_family(3.0, 12.0)  # smallest radius reaches 0 (L5818-5830)
+        mo.kurtosis_family(3.0, 12.0)  # smallest radius reaches 0 (Ogarko 2014, sec. 3.2)
     with pytest.raises(InvalidInputError):
         mo.kurtosis_family(3.0, 1.0)  # no middle species: that is a bidisperse system
 
@@ -199,7 +197,7 @@ def test_bidisperse_source_is_its_own_equivalent():
     ids=["US4", "UV10", "LN0.5", "bi1.4"],
 )
 def test_moment_relations(dist):
-    """delta = (O2/O1^2 - 1)^(1/2) (L5462-5467); 0 < O1 <= 1, O1^2 <= O2 <= O1 (L4339-4342);
+    """delta = (O2/O1^2 - 1)^(1/2) (Ogarko 2014, appendix of sec. 3.1); 0 < O1 <= 1, O1^2 <= O2 <= O1 (sec. 3.1.2);
     kurtosis >= 1; M^c_k from raw moments vs direct definitions."""
     O1, O2 = mo.dimensionless_moments(dist)
     assert 0 < O1 < 1 and O1**2 < O2 < O1
@@ -217,7 +215,7 @@ def test_moment_relations(dist):
     ids=["US4", "UV10", "LN0.5"],
 )
 def test_sampled_moments_converge(dist, tol):
-    """Systematic samples (L1121-1126) converge to the analytic moments: O(1/N^2) for bounded supports
+    """Systematic samples (Ogarko 2014, sec. 2.1.3) converge to the analytic moments: O(1/N^2) for bounded supports
     (midpoint rule on the quantile function), slower for the log-normal (the tail beyond the quantile
     1 - 1/2N is missing: 1.2 % in <a^5> for sigma = 0.5). Tolerances are for N = 10^5 and k <= 5."""
     exact = mo.raw_moments(dist, 5)

@@ -207,7 +207,9 @@ def test_quaternions_near_unit_are_normalised_once(q, excess):
     assume(np.linalg.norm(q) > 0.1)
     w = q / np.linalg.norm(q) * (1 + excess)
     once = Ellipsoids(np.ones((1, 3)), w[None]).orientations
-    assert abs(np.linalg.norm(once) - 1) < 1e-15
+    # unit to round-off: quaternions within 8 eps of unit norm are kept as given (so that a
+    # second construction changes nothing), the others divided by their norm
+    assert abs(np.linalg.norm(once) - 1) <= 8 * np.finfo(float).eps
     assert np.array_equal(Ellipsoids(np.ones((1, 3)), once).orientations, once)
 
 

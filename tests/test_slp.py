@@ -13,11 +13,11 @@ from hardpack.geometry import ball_volume, pairs_within
 from hardpack.initial import random_packing
 from hardpack.slp import Bounds, run_slp, solve_step
 from hardpack.slp.driver import _apply
-from hardpack.slp.lp import influence_pairs, redundancy_radius
+from hardpack.slp.lp import redundancy_radius
 
-SMALL = Bounds(strain=0.01, shear=0.01, displacement=0.05)  # Table II settings (L1493-1495)
+SMALL = Bounds(strain=0.01, shear=0.01, displacement=0.05)  # Torquato & Jiao 2010, Sec. V.B
 
-# exact densest-packing densities (SLP note sec. 3.3)
+# exact densest-packing densities (Torquato & Jiao 2010, Sec. V.B)
 TRIANGULAR = math.pi / math.sqrt(12)
 FCC = math.pi / math.sqrt(18)
 D4 = math.pi**2 / 16
@@ -67,7 +67,7 @@ def test_lp_predicts_a_density_gain_and_respects_bounds():
 
 @pytest.mark.parametrize("d, expected", [(2, TRIANGULAR), (3, FCC)])
 def test_single_sphere_lattice_reaches_the_densest_lattice(d, expected):
-    """N = 1 reduces SLP to lattice optimisation (L1462-1470); 3 random starts each."""
+    """N = 1 reduces SLP to lattice optimisation (Torquato & Jiao 2010, Sec. V.B); 3 random starts each."""
     for seed in range(3):
         result = run_slp(random_lattice(d, 0.1, seed), alpha=3.5, bounds=SMALL)
         assert result.converged
@@ -130,7 +130,7 @@ def test_interior_point_and_simplex_agree_on_the_optimum():
 
 
 def test_table_ii_d2_nine_disks_reach_the_triangular_lattice():
-    """Table II (L1428-1454): N = 3^2 from phi = 0.45, gamma = 3.5 D; all four seeds succeed here."""
+    """Torquato & Jiao 2010, Table II: N = 3^2 from phi = 0.45, gamma = 3.5 D; all four seeds succeed here."""
     for seed in range(4):
         p = random_packing(9, 2, monodisperse(), 0.45, seed=seed)
         result = run_slp(p, alpha=3.5, bounds=SMALL)
@@ -141,7 +141,7 @@ def test_table_ii_d2_nine_disks_reach_the_triangular_lattice():
 
 @pytest.mark.slow
 def test_table_ii_d3_27_spheres_best_of_six_seeds_is_fcc():
-    """Table II d = 3: best of seeds 0..5 is FCC (the note's prototype hit it in 1 of 4 trials).
+    """Table II d = 3: best of seeds 0..5 is FCC (an earlier prototype hit it in 1 of 4 trials).
 
     phi0 = 0.3 instead of the paper's 0.4, which RSA cannot reach (saturation ~0.384).
     """
@@ -196,7 +196,15 @@ def test_table_i_3d_mrj_protocol_gives_a_strictly_jammed_isostatic_packing():
     assert verdict.statics.isostaticity_gap_strict == 0
 
 
-def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path, monkeypatch):
+@pytest.fixture(scope="module")
+def uninterrupted():
+    """An SLP run of 30 spheres (3D, MRJ-like settings) without checkpoints: its arguments and
+    result, the reference of the resume tests."""
+    args = (random_packing(30, 3, monodisperse(), 0.3, seed=4), 1.5, Bounds(0.1, 0.1, 0.5))
+    return args, run_slp(*args)
+
+
+def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path, monkeypatch, uninterrupted):
     """A run interrupted after 20 LPs (checkpoint after every step) and started again with the
     same arguments continues from its checkpoint (20 LPs fewer) and ends with the packing and
     history of the uninterrupted run, bit for bit (every step is a deterministic function of
@@ -204,9 +212,8 @@ def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path,
     refused."""
     import hardpack.slp.driver as driver
 
-    start = random_packing(30, 3, monodisperse(), 0.3, seed=4)
-    args = (start, 1.5, Bounds(0.1, 0.1, 0.5))
-    whole = run_slp(*args)
+    args, whole = uninterrupted
+    start = args[0]
     ckpt = tmp_path / "slp.ckpt"
     solve = driver.solve_step
     calls = []
@@ -236,16 +243,15 @@ def test_a_killed_run_resumes_from_its_checkpoint_and_ends_identically(tmp_path,
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
-def test_a_signal_writes_the_checkpoint_and_the_run_resumes_identically(tmp_path, monkeypatch, sig):
+def test_a_signal_writes_the_checkpoint_and_the_run_resumes_identically(tmp_path, monkeypatch, sig,
+                                                                         uninterrupted):
     """SIGTERM or SIGINT during LP 20 (no timed checkpoint): the run writes its checkpoint before
     LP 21 and raises Interrupted; started again it does only the remaining LPs and ends with the
     uninterrupted run's packing, bit for bit."""
     import hardpack.slp.driver as driver
     from hardpack.io.interrupt import Interrupted
 
-    start = random_packing(30, 3, monodisperse(), 0.3, seed=4)
-    args = (start, 1.5, Bounds(0.1, 0.1, 0.5))
-    whole = run_slp(*args)
+    args, whole = uninterrupted
     ckpt = tmp_path / "slp.ckpt"
     solve = driver.solve_step
     calls = []

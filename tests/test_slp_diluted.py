@@ -7,9 +7,9 @@ from hardpack import InvalidInputError
 from hardpack.distributions import monodisperse
 from hardpack.initial import random_packing
 from hardpack.slp import Bounds, diluted_summary, run_diluted, run_slp
-from hardpack.slp.diluted import remove_random, removal_count
+from hardpack.slp.diluted import removal_count, remove_random
 
-MRJ = Bounds(0.1, 0.1, 0.5)  # Table I settings (L1285-1289), gamma = 1.5 D
+MRJ = Bounds(0.1, 0.1, 0.5)  # Table I settings (Torquato & Jiao 2010, Sec. V.A), gamma = 1.5 D
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,6 @@
 
 import math
 
-import numpy as np
 import pytest
 import xarray as xr
 
@@ -45,8 +44,9 @@ def order_map(tmp_path_factory):
 
 
 def test_order_map_puts_fcc_at_t_one_and_the_glass_below(order_map):
-    """T = 1 for FCC by construction of the metric (seed 003 L1695-1697); the jammed disordered
-    packing is less dense and less ordered; both pass the strict jamming test."""
+    """T = 1 for FCC by construction of the metric (Torquato & Jiao 2010, Sec. VI, below
+    Eq. 22); the jammed disordered packing is less dense and less ordered; both pass the strict
+    jamming test."""
     summary = order_map_summary([p for p, _ in order_map], [v for _, v in order_map])
     assert summary["phi"].values[0] == pytest.approx(FCC, abs=1e-12)
     assert summary["T"].values[0] == pytest.approx(1.0, abs=1e-9)

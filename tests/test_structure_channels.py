@@ -134,7 +134,7 @@ def test_fcc_channels_show_the_triangle_square_and_ring_values():
 
 
 def test_gas_channel_distribution_matches_ogarko():
-    """Ogarko ch. 4 Fig. 4.2 (L7166-7175): ideal gas at nu = 0.0014, acute triangles only:
+    """Ogarko 2014, Fig. 4.2: ideal gas at nu = 0.0014, acute triangles only:
     roughly Gaussian with mean ~15.9 and sigma ~4 (read off a figure: we allow 5 % on the
     mean and 15 % on sigma); non-acute triangles are excluded."""
     n, r, nu = 2000, 1.0, 0.0014

@@ -12,6 +12,7 @@ Conventions (freud 3.x):
   which is our ``particle_weighted=True`` (our default averages over bonds, as Steinhardt).
 """
 
+import freud
 import numpy as np
 import pytest
 
@@ -20,8 +21,6 @@ from hardpack.initial import random_packing
 from hardpack.structure.order import steinhardt
 from hardpack.structure.pair import pair_correlation
 from hardpack.structure.sk import structure_factor_vectors
-
-freud = pytest.importorskip("freud")
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,7 @@
 
 N = 2000 monodisperse spheres from RSA at phi = 0.3, compressed with hardpack.md at the fast
 rate Gamma = 1e-2 to reduced pressure 1e10 (about 15 s; phi ~ 0.645, amorphous). Published
-targets (Donev dissertation ch. 9, ch7-9 L1788-1789, L1830, L1857-1861; ch. 10 L173-181):
+targets (Donev 2006, secs. 9.3.1.2 and 9.3.1.3, Figs. 9.6-9.7; sec. 10.3, Fig. 10.2):
 - backbone (rattlers removed) Z(l) - Z_c ~ 11 l^0.6: we accept alpha = 0.6 +- 0.1;
 - with rattlers kept the exponent is smaller ("closer to 0.5");
 - split second peak of g2: maxima at sqrt(3) D and at 2 D with a sharp drop at 2 D+;

@@ -14,7 +14,8 @@ Subpackages, one concern each:
 - :mod:`hardpack.plots`         figures
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
 try:
     __version__ = _version("hardpack")

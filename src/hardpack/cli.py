@@ -17,7 +17,10 @@ import numpy as np
 from hardpack import __version__
 from hardpack.errors import InvalidInputError
 
-SUBCOMMAND_MODULES: tuple[str, ...] = ("hardpack.md.cli", "hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli", "hardpack.structure.cli", "hardpack.jamming.cli", "hardpack.freeenergy.cli")
+SUBCOMMAND_MODULES: tuple[str, ...] = (
+    "hardpack.md.cli", "hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli",
+    "hardpack.structure.cli", "hardpack.jamming.cli", "hardpack.freeenergy.cli",
+)
 
 
 def _json_arg(text: str):
@@ -145,7 +148,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_init)
 
     p = sub.add_parser("lattice", help=cmd_lattice.__doc__)
-    p.add_argument("--name", required=True, help="fcc, hcp, bcc, sc, diamond, triangular, square, honeycomb, kagome, D<d>, hypercubic<d>")
+    p.add_argument("--name", required=True,
+                   help="fcc, hcp, bcc, sc, diamond, triangular, square, honeycomb, kagome, D<d>, hypercubic<d>")
     p.add_argument("--reps", type=int, nargs="+", default=[1], help="unit cells along each lattice vector")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_lattice)

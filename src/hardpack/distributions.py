@@ -1,7 +1,7 @@
-"""Particle-size distributions, parameterised as in Ogarko's dissertation (seed 002, ch. 2-3).
+"""Particle-size distributions, parameterised as in Ogarko's dissertation (Ogarko 2014, ch. 2-3).
 
 Every distribution is a number pdf f(a) of sphere radii a. Widths follow Ogarko: omega is always
-the ratio of radii a_max / a_min (note 002_ogarko.md sec. 1.1). Scale: every continuous
+the ratio of radii a_max / a_min (Ogarko 2014, secs. 2.1.2 and 3.1.3). Scale: every continuous
 distribution is normalised to mean radius <a> = ``mean_radius`` (default 1), which is the unit of
 length of ch. 3 (Table 3.2); packings are rescaled to the target density afterwards, so only the
 shape of the distribution matters.
@@ -11,7 +11,7 @@ shape of the distribution matters.
   :func:`bidisperse` (size ratio R = a_large / a_small, number fraction x of the large species)
 - :class:`PowerLaw` f(a) ~ a^alpha on [a_min, omega a_min] (ch. 2.2, Eq. 2.37); alpha = 0 is
   uniform in size (US), alpha = -3 the "uniform volume" (UV) distribution f ~ a^-3 of ch. 3
-  (Eq. 3.43; strictly uniform in a^-2, see the note's remark on the wording)
+  (Eq. 3.43; strictly uniform in a^-2, as Ogarko 2014, Eq. 3.45, notes)
 - :func:`uniform_size` (US) and :func:`uniform_volume` (UV)
 - :class:`LogNormal` f(a) = exp(-(ln(a/a0))^2 / (2 sigma^2)) / (sigma sqrt(2 pi) a) (Eq. 3.46),
   with <a^k> = a0^k exp(k^2 sigma^2 / 2) (Eq. 3.47)
@@ -19,7 +19,7 @@ shape of the distribution matters.
 Each has analytic raw moments <a^k> (any real k >= 0 for the continuous ones), a quantile
 function, and ``sample(n, rng)`` with systematic (stratified-quantile) sampling: radius i is
 F^-1((i + u) / n) with one uniform offset u (u = 1/2 when no generator is given). This is the
-"systematic sampling" of L1121-1126 / L4469-4474, which guarantees that the rare largest sizes
+"systematic sampling" of Ogarko 2014, secs. 2.1.3 and 3.1.3, which guarantees that the rare largest sizes
 are present even in small systems.
 """
 

@@ -272,7 +272,7 @@ def simplex_files(ensemble):
 
 
 #: jam protocols of the polydisperse study by study name: the equivalence runs and the slow
-#: crystallisation runs, and their `hardpack eos-summary --kind`
+#: crystallisation runs, and their `hardpack poly-summary --kind`
 POLY_PROTOCOLS = {"phij": POLY.get("jam", {}), "crystallisation": POLY.get("crystallisation", {})}
 POLY_SUMMARY_KIND = {"phij": "jam", "crystallisation": "crystallisation"}
 POLY_FLUID = POLY.get("fluid", {})
@@ -303,7 +303,7 @@ def poly_jam_files(protocol, family):
 
 # ---------------------------------------------------------------------------------------------
 # Summaries: results/{key}_summary.nc. COMBINED are written by `hardpack combine` (the per-seed
-# files as one Dataset indexed by their attributes), EOS_SUMMARIES by `hardpack eos-summary`.
+# files as one Dataset indexed by their attributes), EOS_SUMMARIES by `hardpack poly-summary`.
 
 JAMMING_VARIABLES = ("z_mean", "rattler_fraction", "isostaticity_gap", "local", "collective", "strict",
                      "fallback_lp_default_tolerances", "fallback_lp_working_set_to_highs",

@@ -4,7 +4,7 @@
 # resume: the slow runs take up to ~20 CPU min each); one job per (family, width) measures the
 # fluid Z(phi) of the three against BMCSL. The same jobs with a slow final stage
 # (study poly_crystallisation) look for the large-species crystallisation of the bidisperse
-# equivalents (Ogarko L4851-4865). Summaries, figures and validation rows follow.
+# equivalents (Ogarko 2014, sec. 3.1.3). Summaries, figures and validation rows follow.
 
 
 rule poly_jam:
@@ -36,7 +36,7 @@ rule poly_jam:
     benchmark:
         "results/benchmarks/poly_jam/{protocol}/{family}_w{width}/{system}/seed{seed}.tsv"
     shell:
-        "hardpack eos-jam --distribution '{params.spec}' --systems {wildcards.system} --seed {wildcards.seed}"
+        "hardpack poly-jam --distribution '{params.spec}' --systems {wildcards.system} --seed {wildcards.seed}"
         " --n {params.n} --init-phi {params.init_phi} --growth-rate {params.growth_rate}"
         " --switch-pressure {params.switch_pressure} --final-growth-rate {params.final_growth_rate}"
         " --max-pressure {params.max_pressure} --out {output} --checkpoint {params.checkpoint} > {log} 2>&1"
@@ -66,11 +66,11 @@ rule poly_fluid:
     benchmark:
         "results/benchmarks/poly_fluid/{family}_w{width}.tsv"
     shell:
-        "hardpack eos-fluid --distribution '{params.spec}' --systems poly bi tri --phi {params.phi}"
+        "hardpack poly-fluid --distribution '{params.spec}' --systems poly bi tri --phi {params.phi}"
         " --n {params.n} --collisions {params.collisions} --seed {params.seed} --out {output} > {log} 2>&1"
 
 
-rule eos_summary:
+rule poly_summary:
     """phi_J (and large-species crystallinity) over (width, system, seed) for one family, or all
     fluid cases in one Dataset (case, system, phi): EOS_SUMMARIES in common.smk."""
     input:
@@ -90,11 +90,11 @@ rule eos_summary:
     conda:
         "../envs/hardpack.yaml"
     log:
-        "results/logs/eos_summary/{key}.log",
+        "results/logs/poly_summary/{key}.log",
     benchmark:
-        "results/benchmarks/eos_summary/{key}.tsv"
+        "results/benchmarks/poly_summary/{key}.tsv"
     shell:
-        "hardpack eos-summary --kind {params.kind} {input} --out {output} > {log} 2>&1"
+        "hardpack poly-summary --kind {params.kind} {input} --out {output} > {log} 2>&1"
 
 
 rule fig_phij_vs_omega:

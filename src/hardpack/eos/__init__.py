@@ -5,5 +5,5 @@
 - :mod:`hardpack.eos.theory`   CS, CSK, PY, Henderson (2D), BMCSL, SCS, SCSK, BCSK, Z_OL, free volume,
   running phi_J estimate, empirical jamming-density fits (Eqs. 3.15, 3.16, 3.52, 3.55)
 - :mod:`hardpack.eos.phij`     phi_J from the free-volume law fitted to the last decades of Z
-- :mod:`hardpack.eos.study`    poly / bi / tri systems: jamming runs, fluid Z vs BMCSL, summaries (issue 6)
+- :mod:`hardpack.eos.study`    poly / bi / tri systems: jamming runs, fluid Z vs BMCSL, summaries
 """

@@ -1,8 +1,8 @@
-"""``hardpack eos-equivalents``: moments and bi-/tridisperse equivalents of a distribution family;
-``hardpack eos-jam`` / ``eos-fluid`` / ``eos-summary``: the runs of the EOS-vs-moments study
+"""``hardpack poly-equivalents``: moments and bi-/tridisperse equivalents of a distribution family;
+``hardpack poly-jam`` / ``poly-fluid`` / ``poly-summary``: the runs of the EOS-vs-moments study
 (:mod:`hardpack.eos.study`).
 
-eos-equivalents:
+poly-equivalents:
 Writes one netCDF Dataset (``hardpack_kind = "eos_equivalents"``) over the family parameter
 (omega for uniform_size / uniform_volume / power_law, sigma for lognormal): O1, O2, delta,
 skewness, kurtosis, the bidisperse equivalent (n1, R; Table 3.1) and the maximally equivalent
@@ -76,7 +76,7 @@ def equivalents_dataset(kind: str, values, alpha: float | None = None) -> xr.Dat
     return ds
 
 
-def cmd_equivalents(args) -> int:
+def cmd_poly_equivalents(args) -> int:
     """Moments, O1/O2 and bi-/tridisperse equivalents of a distribution family (Ogarko Tables 3.1-3.4)."""
     from hardpack.io import write_dataset
 
@@ -102,7 +102,7 @@ def _check_outputs(systems, outputs, checkpoint=None):
                                 "(run the others as separate commands, each with its own checkpoint)")
 
 
-def cmd_jam(args) -> int:
+def cmd_poly_jam(args) -> int:
     """Jam a distribution and/or its bi- and tridisperse equivalents (two-stage LS compression)."""
     from hardpack.eos.study import JamProtocol, jam
     from hardpack.io import checkpoint as ckpt
@@ -125,7 +125,7 @@ def cmd_jam(args) -> int:
     return 0
 
 
-def cmd_fluid(args) -> int:
+def cmd_poly_fluid(args) -> int:
     """Equilibrium Z(phi) of a distribution and its equivalents against BMCSL (one netCDF file)."""
     from hardpack.eos.study import fluid_dataset, fluid_pressure
     from hardpack.io import write_dataset
@@ -144,7 +144,7 @@ def cmd_fluid(args) -> int:
     return 0
 
 
-def cmd_summary(args) -> int:
+def cmd_poly_summary(args) -> int:
     """Combine the study's jammed packings (one family; ``jam``: the equivalence runs,
     ``crystallisation``: the slow runs) or fluid files into one summary Dataset."""
     from hardpack.eos.study import fluid_summary, jam_summary
@@ -158,7 +158,7 @@ def cmd_summary(args) -> int:
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("eos-jam", help=cmd_jam.__doc__)
+    p = subparsers.add_parser("poly-jam", help=cmd_poly_jam.__doc__)
     p.add_argument("--distribution", required=True,
                    help='size distribution as JSON, e.g. \'{"kind": "uniform_volume", "omega": 4}\'')
     p.add_argument("--systems", nargs="+", default=["poly", "bi", "tri"], choices=["poly", "bi", "tri"])
@@ -172,9 +172,9 @@ def register(subparsers) -> None:
     p.add_argument("--out", nargs="+", required=True, help="one packing netCDF per system")
     p.add_argument("--checkpoint", help="checkpoint file of the compression (one system only): written "
                    "every 5 min, resumed if present, removed at the end")
-    p.set_defaults(func=cmd_jam)
+    p.set_defaults(func=cmd_poly_jam)
 
-    p = subparsers.add_parser("eos-fluid", help=cmd_fluid.__doc__)
+    p = subparsers.add_parser("poly-fluid", help=cmd_poly_fluid.__doc__)
     p.add_argument("--distribution", required=True, help="size distribution as JSON")
     p.add_argument("--systems", nargs="+", default=["poly", "bi", "tri"], choices=["poly", "bi", "tri"])
     p.add_argument("--phi", type=float, nargs="+", required=True, help="volume fractions (< 0.6)")
@@ -182,18 +182,18 @@ def register(subparsers) -> None:
     p.add_argument("--n", type=int, default=500, help="number of particles (default 500)")
     p.add_argument("--collisions", type=int, default=400_000, help="collisions averaged per run")
     p.add_argument("--out", required=True, help="output netCDF (system x phi)")
-    p.set_defaults(func=cmd_fluid)
+    p.set_defaults(func=cmd_poly_fluid)
 
-    p = subparsers.add_parser("eos-summary", help=cmd_summary.__doc__)
+    p = subparsers.add_parser("poly-summary", help=cmd_poly_summary.__doc__)
     p.add_argument("--kind", choices=["jam", "crystallisation", "fluid"], required=True,
-                   help="jam: equivalence runs; crystallisation: slow runs (same files); fluid: eos-fluid files")
-    p.add_argument("files", nargs="+", help="eos-jam packings of one family, or eos-fluid files")
+                   help="jam: equivalence runs; crystallisation: slow runs (same files); fluid: poly-fluid files")
+    p.add_argument("files", nargs="+", help="poly-jam packings of one family, or poly-fluid files")
     p.add_argument("--out", required=True, help="summary netCDF")
-    p.set_defaults(func=cmd_summary)
+    p.set_defaults(func=cmd_poly_summary)
 
-    p = subparsers.add_parser("eos-equivalents", help=cmd_equivalents.__doc__)
+    p = subparsers.add_parser("poly-equivalents", help=cmd_poly_equivalents.__doc__)
     p.add_argument("--kind", required=True, choices=sorted(FAMILIES), help="distribution family")
     p.add_argument("--values", type=float, nargs="+", required=True, help="omega (or sigma for lognormal) values")
     p.add_argument("--alpha", type=float, help="exponent of the power_law family")
     p.add_argument("--out", required=True, help="output netCDF file")
-    p.set_defaults(func=cmd_equivalents)
+    p.set_defaults(func=cmd_poly_equivalents)

@@ -1,19 +1,20 @@
-"""Moments of radius distributions and moment-matched (equivalent) mixtures (Ogarko, seed 002 ch. 3).
+"""Moments of radius distributions and moment-matched (equivalent) mixtures (Ogarko 2014, ch. 3).
 
-Notation follows note 002_ogarko.md sec. 2.1 (dissertation L4339-4352, L5462-5467, Eq. 3.38):
+Notation follows Ogarko 2014 (sec. 3.1.2, the appendix of sec. 3.1, sec. 3.2 and Eq. 3.38):
 
 - raw moments <a^k> of the number pdf f(a) of radii;
 - scaled moments M_k = <a^k> / <a>^k and central scaled moments M^c_k = <(a - <a>)^k> / <a>^k;
 - O1 = <a><a^2>/<a^3> and O2 = <a^2>^3/<a^3>^2 (Eq. 3.6), the only PSD input of every fluid EOS;
 - polydispersity delta = std(a)/<a> = (O2/O1^2 - 1)^(1/2), skewness, kurtosis beta2 = M^c_4/(M^c_2)^2;
-- mean diameters D_pq = 2 (<a^p>/<a^q>)^(1/(p-q)) (L4345-4352).
+- mean diameters D_pq = 2 (<a^p>/<a^q>)^(1/(p-q)) (sec. 3.1.2).
 
 A *source* is either a :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array
 of radii (sample moments, e.g. ``Packing.radii`` or ``distribution.sample(n)``).
 
 Equivalent mixtures. The bidisperse system that matches <a^0>..<a^3> (Eqs. 3.20-3.21, ch. 3.1) and
 the "maximally equivalent" tridisperse system that matches <a^0>..<a^5> (ch. 3.2, Tables 3.2-3.4)
-are exactly the 2- and 3-node Gauss quadratures of f(a) (note sec. 2.3-2.4). They are computed here
+are exactly the 2- and 3-node Gauss quadratures of f(a) (derived here: an s-node Gauss quadrature
+matches <a^0>..<a^(2s-1)>, as many moments as an s-disperse mixture has free parameters). They are computed here
 by the Chebyshev algorithm (Gautschi, "On generating orthogonal polynomials", SIAM J. Sci. Stat.
 Comput. 3, 289 (1982)) applied to the central scaled moments, followed by Golub-Welsch (eigen-
 decomposition of the symmetric tridiagonal Jacobi matrix). Working in the scaled, centred variable
@@ -76,7 +77,7 @@ def raw_moments(source, kmax: int = 5) -> np.ndarray:
 
 
 def scaled_moments(source, kmax: int = 5) -> np.ndarray:
-    """M_k = <a^k>/<a>^k for k = 0..kmax (ch. 3.2, L5632-5650)."""
+    """M_k = <a^k>/<a>^k for k = 0..kmax (Ogarko 2014, sec. 3.2)."""
     mu = raw_moments(source, kmax)
     return mu / raw_moment(source, 1) ** np.arange(kmax + 1)
 
@@ -123,7 +124,7 @@ def dimensionless_moments(source) -> tuple[float, float]:
 
 
 def polydispersity(source) -> float:
-    """delta = std(a)/<a> (L5462-5467)."""
+    """delta = std(a)/<a> (Ogarko 2014, appendix of sec. 3.1)."""
     return math.sqrt(max(central_scaled_moments(source, 2)[2], 0.0))
 
 
@@ -134,13 +135,13 @@ def skewness(source) -> float:
 
 
 def kurtosis(source) -> float:
-    """beta2 = M^c_4/(M^c_2)^2 >= 1 (L5802, L6344); 1.8 for uniform size; NaN if monodisperse."""
+    """beta2 = M^c_4/(M^c_2)^2 >= 1 (sec. 3.2, Eq. 3.41); 1.8 for uniform size; NaN if monodisperse."""
     c = central_scaled_moments(source, 4)
     return c[4] / c[2] ** 2 if c[2] > 0 else math.nan
 
 
 def mean_diameter(source, p: float, q: float) -> float:
-    """D_pq = 2 (<a^p>/<a^q>)^(1/(p-q)) (L4345-4352); e.g. D_10 = 2<a>, D_32 = Sauter diameter."""
+    """D_pq = 2 (<a^p>/<a^q>)^(1/(p-q)) (Ogarko 2014, sec. 3.1.2); e.g. D_10 = 2<a>, D_32 = Sauter diameter."""
     if p == q:
         raise InvalidInputError(f"D_pq needs p != q, got p = q = {p}")
     return 2.0 * (raw_moment(source, p) / raw_moment(source, q)) ** (1.0 / (p - q))
@@ -217,7 +218,7 @@ class BidisperseEquivalent:
 class TridisperseEquivalent:
     """Maximally equivalent tridisperse system (ch. 3.2): same <a^0>..<a^5>.
 
-    Ogarko's parametrisation (Table 3.2, L6200-6245) with a1 >= a2 >= a3: number fractions n1, n2
+    Ogarko's parametrisation (Ogarko 2014, Table 3.2) with a1 >= a2 >= a3: number fractions n1, n2
     (n3 = 1 - n1 - n2) and delta_i = n_i a_i/<a> (so a_i = <a> delta_i / n_i).
     """
 
@@ -235,7 +236,7 @@ class TridisperseEquivalent:
 
 
 def equivalent_bidisperse(source) -> BidisperseEquivalent:
-    """Bidisperse equivalent = 2-node Gauss quadrature (note sec. 2.3).
+    """Bidisperse equivalent = 2-node Gauss quadrature (derived here, see the module docstring).
 
     For a monodisperse source it returns R = 1, n1 = 1/2 (Table 3.1, row omega = 1), the narrow
     limit of every smooth distribution (its skewness vanishes).
@@ -248,7 +249,7 @@ def equivalent_bidisperse(source) -> BidisperseEquivalent:
 
 
 def equivalent_tridisperse(source) -> TridisperseEquivalent:
-    """Maximally equivalent tridisperse system = 3-node Gauss quadrature (note sec. 2.4).
+    """Maximally equivalent tridisperse system = 3-node Gauss quadrature (derived here, see the module docstring).
 
     Reproduces Tables 3.3 (UV) and 3.4 (log-normal) and the 5:8:5 US solution (Eqs. 3.39-3.40).
     """
@@ -261,7 +262,7 @@ def equivalent_tridisperse(source) -> TridisperseEquivalent:
 
 
 def bidisperse_from_O(O1: float, O2: float) -> tuple[float, float]:
-    """Closed form (n1, R) of the bidisperse equivalent from (O1, O2), Eqs. 3.20-3.21 (L5295-5340).
+    """Closed form (n1, R) of the bidisperse equivalent from (O1, O2), Ogarko 2014, Eqs. 3.20-3.21.
 
     lambda = sqrt(O2) sqrt(4 O1^3 + O2 - 3 O1 (2 + O1) O2 + 4 O2^2),
     n1 = 1/2 + (3 O1 O2 - O2 - 2 O1^3)/(2 lambda),
@@ -270,7 +271,8 @@ def bidisperse_from_O(O1: float, O2: float) -> tuple[float, float]:
     """
     if not (0 < O1 <= 1 + 1e-12 and O1**2 * (1 - 1e-12) <= O2 <= O1 * (1 + 1e-12)):
         raise InvalidInputError(
-            f"(O1, O2) = ({O1}, {O2}) is not realisable: need 0 < O1 <= 1 and O1^2 <= O2 <= O1 (L4339-4342)"
+            f"(O1, O2) = ({O1}, {O2}) is not realisable: need 0 < O1 <= 1 and O1^2 <= O2 <= O1 "
+            "(Ogarko 2014, sec. 3.1.2)"
         )
     if abs(O1 - 1) < 1e-12 and abs(O2 - 1) < 1e-12:  # monodisperse up to round-off
         return 0.5, 1.0
@@ -294,7 +296,7 @@ def _omega0(omega: float) -> float:
 
 
 def tridisperse_uniform_size(omega: float, mean_radius: float = 1.0) -> TridisperseEquivalent:
-    """Analytic maximal equivalent of the US distribution, Eqs. 3.39-3.40 (L6300-6334):
+    """Analytic maximal equivalent of the US distribution, Ogarko 2014, Eqs. 3.39-3.40:
 
     n1 = 5/18, n2 = 8/18, delta1 = (5 + sqrt(15) omega0)/18, delta2 = 8/18 with
     omega0 = (omega - 1)/(omega + 1), i.e. radii <a>(1 + sqrt(3/5) omega0), <a>, <a>(1 - sqrt(3/5) omega0)
@@ -308,12 +310,12 @@ def kurtosis_family(omega: float, beta2: float, mean_radius: float = 1.0) -> Tri
     """Symmetric tridisperse system with the central moments M^c_2, M^c_3, M^c_5 of US(omega) and
     kurtosis beta2 = M^c_4/(M^c_2)^2.
 
-    Generalises Eqs. 3.41-3.42 (printed for omega = 3, L6340-6375) to any omega:
+    Generalises Eqs. 3.41-3.42 (printed for omega = 3, Ogarko 2014, sec. 3.3.2) to any omega:
     n1 = n3 = 1/(2 beta2), n2 = (beta2 - 1)/beta2, delta1 = (1 + omega0 sqrt(beta2/3))/(2 beta2),
     delta2 = n2, i.e. radii <a>(1 +- omega0 sqrt(beta2/3)) and <a>. For omega = 3 (omega0 = 1/2)
     delta1 = (6 + sqrt(3 beta2))/(12 beta2) as printed. beta2 = 1.8 is the maximally equivalent
     system (Eqs. 3.39-3.40). Allowed: 1 < beta2 < 3/omega0^2 (beta2 = 1 is bidisperse; at the upper
-    end the smallest radius reaches 0, beta2 = 12 for omega = 3, L5818-5830).
+    end the smallest radius reaches 0, beta2 = 12 for omega = 3, sec. 3.2).
     """
     w0 = _omega0(omega)
     if not (1 < beta2 < 3 / w0**2):

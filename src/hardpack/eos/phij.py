@@ -1,8 +1,8 @@
-"""Jamming density phi_J from compressibility data Z(phi) near jamming (Ogarko ch. 3.1, note sec. 2.6).
+"""Jamming density phi_J from compressibility data Z(phi) near jamming (Ogarko 2014, sec. 3.1.3).
 
 Near jamming the pressure follows the free-volume law Z = d/(1 - phi/phi_J) (Eq. 3.14), so every
 point gives a running estimate phi_J^est = phi/(1 - d/Z) (:func:`hardpack.eos.theory.phij_estimate`,
-L4561-4575). Where the free-volume law holds these estimates are constant; :func:`fit_free_volume`
+Ogarko 2014, Eq. 3.14). Where the free-volume law holds these estimates are constant; :func:`fit_free_volume`
 takes their weighted mean over the last decades of Z (a one-parameter weighted least-squares fit of
 the linearised law) and tests for the plateau with a weighted linear trend in ln Z. A fluid EOS such
 as BMCSL gives a drifting estimate (no plateau) and is flagged.
@@ -12,8 +12,8 @@ error (windowed virial pressures), whose size is then estimated from the scatter
 as in scipy.optimize.curve_fit with absolute_sigma=False. By the delta method the estimate from
 point i has error phi_i d sigma_Z,i/(Z_i - d)^2, so the highest pressures dominate.
 
-Caveat (L5003-5040): the law holds for phi_J - phi <~ 1e-8, i.e. Z >~ 3e8; fits at moderate Z are
-biased high, which the plateau test detects when the data are precise enough.
+Caveat (Ogarko 2014, sec. 3.1.3 and Fig. 3.8): the law holds for phi_J - phi <~ 1e-8, i.e. Z >~ 3e8;
+fits at moderate Z are biased high, which the plateau test detects when the data are precise enough.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 A *system* is a size distribution (spec as in :func:`hardpack.distributions.from_spec`) in one of
 three forms (:data:`SYSTEMS`):
 
-- ``poly``: the distribution itself (systematic sampling, L4469-4474);
+- ``poly``: the distribution itself (systematic sampling, Ogarko 2014, sec. 3.1.3);
 - ``bi``: its equivalent bidisperse mixture, same <a^0>..<a^3> (Eqs. 3.20-3.21, Table 3.1);
 - ``tri``: its maximally equivalent tridisperse mixture, same <a^0>..<a^5> (ch. 3.2, Tables 3.3-3.4).
 
@@ -56,8 +56,8 @@ class JamProtocol:
     pressure reaches ``switch_pressure``, then ``final_growth_rate`` until ``max_pressure``
     (hardpack.md.compress's two-stage protocol; Gamma as defined there).
 
-    Ogarko grows at one constant rate (L4395-4430); the jamming density depends on the rate (it rises
-    by <= 1 % as Gamma decreases, L4961-4970), so poly and equivalent systems are compared at the
+    Ogarko grows at one constant rate (Ogarko 2014, sec. 3.1.3); the jamming density depends on the rate (it rises
+    by <= 1 % as Gamma decreases, inset of Fig. 3.7(a)), so poly and equivalent systems are compared at the
     same protocol and N only.
     """
 
@@ -82,7 +82,7 @@ class JamProtocol:
 
 def large_species_crystallinity(packing, solid: np.ndarray) -> float:
     """Fraction of solid-like particles among those larger than the mean radius (the large species of
-    a bidisperse mixture; crystallisation of that species breaks the bidisperse equivalence, L4862-4865)."""
+    a bidisperse mixture; crystallisation of that species breaks the bidisperse equivalence, sec. 3.1.3)."""
     large = packing.radii > packing.radii.mean()
     return float(solid[large].mean()) if large.any() else math.nan
 
@@ -127,7 +127,7 @@ def fluid_pressure(spec: dict, system: str, phi: float, seed: int, n: int = 500,
     RSA start at min(phi, 0.2), LS growth at ``prep_rate`` exactly to phi, then
     :func:`hardpack.md.equilibrate` over ``collisions`` collisions (a quarter more are discarded first).
     BMCSL (Eq. 3.9) uses O1, O2 of the realised radii, so the comparison is free of sampling error;
-    Ogarko finds Z within 1 % of BMCSL for phi < 0.54 (L4494-4502, L5707-5710).
+    Ogarko finds Z within 1 % of BMCSL for phi < 0.54 (Ogarko 2014, sec. 3.1.3 and Fig. 3.1; sec. 3.2).
     """
     from hardpack.initial import random_packing
     from hardpack.md import StopCriteria, compress, equilibrate
@@ -159,11 +159,11 @@ JAM_STUDIES = ("jam", "crystallisation")
 
 
 def jam_summary(packings, study: str = "jam") -> xr.Dataset:
-    """Jammed packings of one family (Datasets written by ``hardpack eos-jam``) as one Dataset over
+    """Jammed packings of one family (Datasets written by ``hardpack poly-jam``) as one Dataset over
     (width, system, seed): phi_J (the final phi; phi_J - phi ~ 3 phi / Z <= 1e-11 at Z = 1e12) and
     the run statistics. Missing combinations are NaN. ``study`` (attribute) tells the validation
     what the runs test: "jam", the equivalence of the mixtures at one protocol, or
-    "crystallisation", the slow runs for the large-species crystallisation of Ogarko L4862-4865."""
+    "crystallisation", the slow runs for the large-species crystallisation of Ogarko 2014, sec. 3.1.3."""
     if study not in JAM_STUDIES:
         raise InvalidInputError(f"study must be one of {JAM_STUDIES}, got {study!r}")
     packings = list(packings)

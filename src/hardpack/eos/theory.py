@@ -1,17 +1,17 @@
 """Equations of state of hard-sphere (and hard-disk) fluids and empirical jamming densities.
 
-Compressibility factor Z = PV/(N k_B T) as a function of the volume fraction phi (Ogarko ch. 3.1,
-note 002_ogarko.md sec. 2.2, 2.6, 2.7). All functions are vectorised over phi and refuse
+Compressibility factor Z = PV/(N k_B T) as a function of the volume fraction phi (Ogarko 2014,
+secs. 3.1.2-3.1.3, 3.2 and 3.3.2). All functions are vectorised over phi and refuse
 phi outside [0, 1) (or outside [0, phi_J) for the free-volume form) and unrealisable moments.
 
 Polydisperse theories depend on the size distribution only through O1 = <a><a^2>/<a^3> and
 O2 = <a^2>^3/<a^3>^2 (Eq. 3.6; :func:`hardpack.eos.moments.dimensionless_moments`), with
-0 < O1 <= 1 and O1^2 <= O2 <= O1 (L4339-4342). O1 = O2 = 1 is the monodisperse case, where
+0 < O1 <= 1 and O1^2 <= O2 <= O1 (Ogarko 2014, sec. 3.1.2). O1 = O2 = 1 is the monodisperse case, where
 BMCSL = SCS = CS and SCSK = BCSK = CSK.
 
 Fluid theories (CS, CSK, BMCSL, SCS, SCSK, BCSK, Z_OL, PY, Henderson) describe the equilibrium
 fluid: for monodisperse spheres up to freezing/melting (phi ~ 0.49-0.55), for polydisperse spheres
-to phi ~ 0.56-0.60 (ch. 3.1 tested them to phi <= 0.60, L4494-4531). They stay finite up to phi = 1
+to phi ~ 0.56-0.60 (tested to phi <= 0.60, Ogarko 2014, Fig. 3.1). They stay finite up to phi = 1
 and do not know about jamming; beyond their range compare with :func:`free_volume`.
 """
 
@@ -40,20 +40,20 @@ def _omoments(O1, O2) -> tuple[np.ndarray, np.ndarray]:
     if not np.all(ok):
         raise InvalidInputError(
             f"(O1, O2) = ({O1}, {O2}) is not a size distribution: need 0 < O1 <= 1 and O1^2 <= O2 <= O1 "
-            "(Ogarko L4339-4342); compute them with hardpack.eos.moments.dimensionless_moments"
+            "(Ogarko 2014, sec. 3.1.2); compute them with hardpack.eos.moments.dimensionless_moments"
         )
     return o1, o2
 
 
 def carnahan_starling(phi):
     """Carnahan-Starling Z_CS = (1 + phi + phi^2 - phi^3)/(1 - phi)^3 = 1 + 4 phi g_CS, with
-    g_CS = (1 - phi/2)/(1 - phi)^3 (L4240-4250). Monodisperse 3D fluid, phi <~ 0.55."""
+    g_CS = (1 - phi/2)/(1 - phi)^3 (Ogarko 2014, below Eq. 3.8). Monodisperse 3D fluid, phi <~ 0.55."""
     x = _phi(phi)
     return (1 + x + x**2 - x**3) / (1 - x) ** 3
 
 
 def csk(phi):
-    """Carnahan-Starling-Kolafa Z_CSK = [1 + phi + phi^2 - 2 phi^3 (1 + phi)/3]/(1 - phi)^3 (L4305-4310).
+    """Carnahan-Starling-Kolafa Z_CSK = [1 + phi + phi^2 - 2 phi^3 (1 + phi)/3]/(1 - phi)^3 (sec. 3.1.2).
     Monodisperse 3D fluid, slightly more accurate than CS near freezing (phi <~ 0.55)."""
     x = _phi(phi)
     return (1 + x + x**2 - 2 * x**3 * (1 + x) / 3) / (1 - x) ** 3
@@ -61,7 +61,7 @@ def csk(phi):
 
 def percus_yevick(phi):
     """Percus-Yevick (compressibility route) Z = (1 + phi + phi^2)/(1 - phi)^3, monodisperse 3D fluid.
-    Overestimates Z; use CS/CSK for accuracy. Not from seed 002 (standard liquid-state theory)."""
+    Overestimates Z; use CS/CSK for accuracy. Not in Ogarko 2014 (standard liquid-state theory)."""
     x = _phi(phi)
     return (1 + x + x**2) / (1 - x) ** 3
 
@@ -74,9 +74,9 @@ def henderson(phi):
 
 
 def bmcsl(phi, O1=1.0, O2=1.0):
-    """Boublik-Mansoori-Carnahan-Starling-Leland, Eq. 3.9 (L4275-4289):
+    """Boublik-Mansoori-Carnahan-Starling-Leland, Ogarko 2014, Eq. 3.9:
     Z = 1/(1 - phi) + 3 O1 phi/(1 - phi)^2 + O2 phi^2 (3 - phi)/(1 - phi)^3 = 1 + 4 phi g_eff (Eqs. 3.7-3.8).
-    Polydisperse 3D fluid; within 1 % of simulations for phi < 0.54-0.60 (L4497-4502, L5707-5710)."""
+    Polydisperse 3D fluid; within 1 % of simulations for phi < 0.54-0.60 (Fig. 3.1, sec. 3.2)."""
     x = _phi(phi)
     o1, o2 = _omoments(O1, O2)
     return 1 / (1 - x) + 3 * o1 * x / (1 - x) ** 2 + o2 * x**2 * (3 - x) / (1 - x) ** 3
@@ -104,20 +104,20 @@ def bcsk(phi, O1=1.0, O2=1.0):
 
 
 def z_ol(phi, O1=1.0, O2=1.0):
-    """Ogarko-Luding Z_OL = (Z_SCS + Z_BCSK)/2, Eq. 3.13 (L4519-4531): better than 0.2 % for
+    """Ogarko-Luding Z_OL = (Z_SCS + Z_BCSK)/2, Ogarko 2014, Eq. 3.13: better than 0.2 % for
     0.20 <= phi <= 0.60 in polydisperse fluids (not monodisperse above phi = 0.54)."""
     return 0.5 * (scs(phi, O1, O2) + bcsk(phi, O1, O2))
 
 
 def binary_contact_z(phi, n1, R):
     """Z of a binary mixture from the Jenkins-Mancini pressure with BMCSL contact values,
-    Eqs. 3.1-3.5 (L4080-4200): species 1 (radius a1 = R a2, number fraction n1) and 2,
+    Ogarko 2014, Eqs. 3.1-3.5: species 1 (radius a1 = R a2, number fraction n1) and 2,
     A_k = n1 + (1 - n1) R^-k, and
 
     Z = 1 + phi/(2 <a^3>) sum_ij n_i n_j g_ij (a_i + a_j)^3.
 
     Equal to BMCSL with the mixture's (O1, O2) (Eq. 3.8); written out independently so that the
-    equivalence Z_bi = Z_poly of the bidisperse equivalent (L5295-5340) can be checked.
+    equivalence Z_bi = Z_poly of the bidisperse equivalent (Eqs. 3.20-3.21) can be checked.
     """
     x = _phi(phi)
     if not (0 <= n1 <= 1 and R >= 1):
@@ -139,7 +139,7 @@ def free_volume(phi, phi_j, d: int = 3):
     """Free-volume (Salsburg-Wood) EOS near jamming, Eq. 3.14: Z_fv = d/(1 - phi/phi_J).
 
     Valid asymptotically as phi -> phi_J; in ED compressions the data collapse onto it for
-    phi_J - phi <~ 1e-8 (L5003-5040). Refuses phi >= phi_J."""
+    phi_J - phi <~ 1e-8 (Ogarko 2014, sec. 3.1.3 and Fig. 3.8). Refuses phi >= phi_J."""
     if not (0 < phi_j <= 1):
         raise InvalidInputError(f"phi_J must lie in (0, 1], got {phi_j}")
     x = _phi(phi, upper=phi_j)
@@ -147,7 +147,7 @@ def free_volume(phi, phi_j, d: int = 3):
 
 
 def phij_estimate(phi, Z, d: int = 3):
-    """Running jamming-density estimate phi_J^est = phi/(1 - d/Z) (L4561-4575, L5737-5741).
+    """Running jamming-density estimate phi_J^est = phi/(1 - d/Z) (Ogarko 2014, Eq. 3.14, sec. 3.1.3; sec. 3.2).
 
     The inverse of :func:`free_volume` at each point; phi_J^est -> phi as Z -> infinity, and it is
     constant (a plateau) only where Z follows the free-volume law. Undefined (NaN) where Z <= d.
@@ -180,23 +180,23 @@ def _omega(omega):
 
 
 def phij_fit_uniform_size(omega, nu_inf: float = 0.6828, phi_rcp: float = 0.65):
-    """nu_max(omega) for US, Eq. 3.15 (L4886-4902): nu_inf - (nu_inf - phi_RCP)(3 omega^-2 - 2 omega^-3).
+    """nu_max(omega) for US, Ogarko 2014, Eq. 3.15: nu_inf - (nu_inf - phi_RCP)(3 omega^-2 - 2 omega^-3).
 
     Fitted (within +-0.5 %) for omega >~ 1.2 (no crystallisation) at growth rates 8-16e-6; omega = inf
-    allowed (nu_inf = 0.6828 +- 0.0004, L4880-4883). Warns for omega < 1.2. Fig. 3.10 uses
-    nu_inf = 0.679, phi_RCP = 0.647 instead (L5876-5881)."""
+    allowed (nu_inf = 0.6828 +- 0.0004, sec. 3.1.3). Warns for omega < 1.2. Fig. 3.10 uses
+    nu_inf = 0.679, phi_RCP = 0.647 instead (Fig. 3.10 caption)."""
     w = _omega(omega)
     _warn_range("phij_fit_uniform_size", w, 1.2, np.inf)
     return nu_inf - (nu_inf - phi_rcp) * (3 / w**2 - 2 / w**3)
 
 
 def phij_fit_uniform_volume(omega, nu_inf: float = 0.859, phi_rcp: float = 0.647):
-    """nu_max(omega) for UV, Eq. 3.16 (L4906-4925):
+    """nu_max(omega) for UV, Ogarko 2014, Eq. 3.16:
     nu_inf - (nu_inf - phi_RCP)(omega^-1 - omega^-2 + omega^-3)(1 - ln omega^-2).
 
     The printed "log" is the natural log: only ln gives d nu/d(1/omega) = 0 at omega = 1 as the text
-    requires (note sec. 2.7). Fitted (+-1 %) for 1.2 <= omega <= 10 (rates 8-16e-6); warns outside.
-    Bidisperse equivalents with omega > 10 follow it with phi_RCP and nu_inf swapped (L4925-4930)."""
+    requires (derived here). Fitted (+-1 %) for 1.2 <= omega <= 10 (rates 8-16e-6); warns outside.
+    Bidisperse equivalents with omega > 10 follow it with phi_RCP and nu_inf swapped (Fig. 3.7(b))."""
     w = _omega(omega)
     _warn_range("phij_fit_uniform_volume", w, 1.2, 10.0)
     return nu_inf - (nu_inf - phi_rcp) * (1 / w - 1 / w**2 + 1 / w**3) * (1 + 2 * np.log(w))
@@ -211,7 +211,7 @@ def _sigma(sigma):
 
 
 def phij_fit_lognormal(sigma, nu_inf: float = 0.7990, phi_rcp: float = 0.6373):
-    """nu_max(sigma) for log-normal radii, Eq. 3.52 (L6660-6705): nu_inf - (nu_inf - phi_RCP) exp(-2 sigma^2).
+    """nu_max(sigma) for log-normal radii, Ogarko 2014, Eq. 3.52: nu_inf - (nu_inf - phi_RCP) exp(-2 sigma^2).
     Fitted (+-0.7 %) for 0 <= sigma <= 1 at the fast rate Gamma = 16e-3 (random close packing);
     warns outside. exp(-2 sigma^2) = (D32/D43)^2 (Eq. 3.54)."""
     s = _sigma(sigma)
@@ -219,7 +219,7 @@ def phij_fit_lognormal(sigma, nu_inf: float = 0.7990, phi_rcp: float = 0.6373):
 
 
 def phij_fit_lognormal_alt(sigma, nu_inf: float = 0.8583, c1: float = -0.3516, c2: float = 0.1332):
-    """Alternative log-normal fit, Eq. 3.55 (L6711-6719): nu_inf + c1 exp(-sigma^2) + c2 exp(-sigma^3).
+    """Alternative log-normal fit, Ogarko 2014, Eq. 3.55: nu_inf + c1 exp(-sigma^2) + c2 exp(-sigma^3).
     +-0.4 % for 0 <= sigma <= 1 (Gamma = 16e-3); departs from Eq. 3.52 for sigma > 1; warns outside."""
     s = _sigma(sigma)
     return nu_inf + c1 * np.exp(-(s**2)) + c2 * np.exp(-(s**3))

@@ -10,7 +10,8 @@
   jamming simplex (Table 6.1), frozen particle or frozen centre of mass.
 - :mod:`hardpack.freeenergy.crystal`: reference curves of the FCC free energy vs density (EOS
   integration from the published melting value, cell limit with the jamming constant).
-- :mod:`hardpack.freeenergy.ladder`: the cheap checks against exact values (note sec. 5.2).
+- :mod:`hardpack.freeenergy.ladder`: the cheap checks against exact values (disjoint cells,
+  a billiard in a simplex).
 """
 
 from hardpack.freeenergy.bcmd import BCMDResult, run_bcmd

@@ -1,6 +1,6 @@
 """Numba event loop of bounding-cell MD (BCMD) for one schedule segment.
 
-Model (note ``bcmd_free_energy.md`` sec. 2 steps 3-4): sphere i has a fixed cell centre; its
+Model (Donev 2006, dissertation sec. 6.3.1, for spheres): sphere i has a fixed cell centre; its
 displacement ``dr_i`` from that centre is stored separately (precision at small Delta mu) and
 must satisfy |dr_i| <= rho_i(s) = R_i (dmu0 - gamma s), a spherical hard wall whose radius
 shrinks at speed gamma R_i (s: time since the segment start). Pairs (i, j) of the static
@@ -14,11 +14,11 @@ v_0..v_{d-1}, s_i)``, displacement and velocity at the particle's own last updat
 
 Events follow the md engine's scheme (one predicted event per particle in a 4-ary min-heap with
 the keys stored in heap order, lazy invalidation by the partner's collision counter); the
-contact-time roots are the md kernel's: pairs use ``contact_root`` (constant radii, g = 0, with its
+contact-time roots are :mod:`hardpack.events.roots`': pairs use ``contact_root`` (constant radii, g = 0, with its
 early rejection against the best time so far); the cell wall solves the md bounding-sphere exit
 equation |dr + v s| = rho - adot s (adot = gamma R_i) in a form stable right after a bounce
 (:func:`_wall_root`).
-Moving-wall law (Donev [C:589-613]): v_n' = 2 w - v_n along the outward normal, w = -gamma R_i.
+Moving-wall law (Donev 2006, sec. 6.3.3): v_n' = 2 w - v_n along the outward normal, w = -gamma R_i.
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hardpack.md.heap import heap_set
-from hardpack.md.kernel import contact_root
+from hardpack.events.heap import heap_set
+from hardpack.events.roots import contact_root
 
 WALL = -1  # event: the particle hits its cell wall
 NONE = -2  # nothing predicted

@@ -1,8 +1,8 @@
 """Bounding-cell molecular dynamics (BCMD): free energy of a hard-sphere solid from the kinetic
 energy gained while its single-occupancy cells shrink.
 
-Donev dissertation ch. 6 sec. 6.3 (seeds/000_chapters/ch06.txt [C:451-726]); step list of the
-note ``bcmd_free_energy.md`` sec. 2. Conventions (note sec. 1.4, 2 step 3):
+Donev 2006, dissertation sec. 6.3 (the journal version is Donev et al. 2007, Sec. 3). Conventions
+(secs. 6.3.1 and 6.3.4; where the text is silent, our choices are stated below):
 
 - Each moving sphere i (radius R_i, mass 1) lives in a hard spherical cell of radius mu R_i with
   mu = 1 + Delta mu, centred on its initial position R_i^0, so its centre obeys
@@ -13,22 +13,23 @@ note ``bcmd_free_energy.md`` sec. 2. Conventions (note sec. 1.4, 2 step 3):
   ratio, and every segment uses only the prefix of pairs whose cells can still overlap (FCC at
   melting: 42 neighbours at Delta mu = 1, 12 below 0.566).
 - The cells shrink at d(Delta mu)/dt = -gamma(Delta mu), gamma = gamma_0 (Delta mu /
-  Delta mu_max)^theta ([C:693-705]), updated each time Delta mu has fallen by the fraction
-  ``segment_fraction``; wall collisions use v_n' = 2 w - v_n, w = -gamma R_i ([C:589-613]).
+  Delta mu_max)^theta (sec. 6.3.4), updated each time Delta mu has fallen by the fraction
+  ``segment_fraction``; wall collisions use v_n' = 2 w - v_n, w = -gamma R_i (sec. 6.3.3).
 - Translations: ``frozen="particle"`` freezes particle 0 (infinite mass), N_eff = N - 1;
-  ``frozen="cm"`` measures K in the centre-of-mass frame, N_f = d (N - 1). Per the note sec. 1.7
+  ``frozen="cm"`` measures K in the centre-of-mass frame, N_f = d (N - 1). Per sec. 6.3.4.1
   the two free energies differ by d ln N / N; in both modes the reference f_c below is the mean
   over the moving particles, so the CM-mode number is f_c - (d/2) ln(K_cm/K_0) as in Donev's
-  frozen-CM row of Table 6.1 (its exact finite-N normalisation, App. B, is not reproduced here).
-- Estimator (Eq. 6.12-6.13, [C:550-661]): ln(V / V_min) = (N_f / 2) ln(K / K_0), chained over
+  frozen-CM row of Table 6.1 (its exact finite-N normalisation, sec. 6.3.4.1, is not reproduced here).
+- Estimator (Eqs. 6.12-6.13, secs. 6.3.2-6.3.3): ln(V / V_min) = (N_f / 2) ln(K / K_0), chained over
   velocity re-draws; per particle Delta f = ln(V/V_min) / N_eff = (d/2) ln(K/K_0).
 - Result: f = f_c(Delta mu_min) - Delta f with the disjoint-cell reference
   f_c = -<ln(|B_d| (Delta mu_min R_i)^d)>_moving (Eq. 6.10; = -d ln Delta mu - ln V_p for
   unit-diameter spheres); lengths are in units of the mean diameter 2<R>. The excess over the
   ideal gas uses f_ideal = -ln(V/N) - 1 (Eq. 6.15). At Delta mu_min = delta of a jammed packing
   shrunk by (1 - delta), Delta f = f_J - f_c^J (Eq. 6.18).
-- Diagnostic: cell pressure p_c = <F_wall> mu R / (d kT) per segment (note sec. 1.5), which
-  tends to mu / Delta mu for disjoint cells.
+- Diagnostic: cell pressure p_c = <F_wall> mu R / (d kT) per segment (derived here:
+  V_c/S_c = mu R / d for a spherical cell; the integrand of Eq. 6.9), which tends to mu / Delta mu
+  for disjoint cells (the asymptote of Fig. 6.4).
 """
 
 from __future__ import annotations
@@ -98,7 +99,21 @@ def disjoint_dmu(nb: Neighbours) -> float:
 
 @dataclass(frozen=True)
 class BCMDResult:
-    """Outcome of :func:`run_bcmd`; ``dataset`` holds the per-segment series and all numbers."""
+    """Outcome of :func:`run_bcmd`; ``dataset`` holds the per-segment series and all numbers.
+
+    Attributes
+    ----------
+    delta_f : float
+        (d/2) ln(K/K_0) chained = f_c(Delta mu_min) - f.
+    f_c : float
+        Disjoint-cell reference at Delta mu_min (lengths in mean diameters); NaN for a partial run.
+    f : float
+        Free energy per moving particle; NaN for a partial run.
+    excess : float
+        f - f_ideal with f_ideal = -ln(V/N) - 1 (Eq. 6.15).
+    dataset : xarray.Dataset
+        Per-segment series and all parameters and numbers in its attrs.
+    """
 
     delta_f: float  # (d/2) ln(K/K0) chained = f_c(dmu_min) - f
     f_c: float  # disjoint-cell reference at dmu_min (units: mean diameter)
@@ -138,11 +153,60 @@ def run_bcmd(
     """Run BCMD on ``packing`` (cell centres = its positions, radii as given) from Delta mu_max
     down to Delta mu_min (default: the disjoint-cell point, which must be > 0).
 
-    equilibration: run time at fixed Delta mu_max before shrinking, in units of
-    Delta mu_max <R> / v_th (v_th = 1). reset_ratio: if set, velocities are re-drawn (kT back to
-    its initial value) whenever K grew by this factor since the last draw (thermostat of
-    [C:918-923]); ln K is chained across draws. partial: allow stopping above the disjoint-cell
-    point (the Delta f(Delta mu) curve only; f_c, f and the excess are then NaN).
+    Conventions and estimator: see the module docstring (Donev 2006, sec. 6.3).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing with at least 2 particles; its positions are the cell centres.
+    dmu_max : float
+        Initial cell size Delta mu_max (> 0), in units of each particle's radius.
+    dmu_min : float, optional
+        Final cell size Delta mu_min, 0 < dmu_min < dmu_max; default the disjoint-cell point
+        min |R_i - R_j| / (R_i + R_j) - 1.
+    gamma0 : float, default 1e-3
+        Shrink rate gamma_0 > 0 at Delta mu_max.
+    theta : float, default 1.0
+        Exponent of gamma = gamma_0 (Delta mu / Delta mu_max)^theta, >= 0.
+    frozen : {"particle", "cm"}, default "particle"
+        Removal of the translations: freeze particle 0, or measure K in the centre-of-mass frame.
+    seed : int, default 0
+        Seed of the initial and re-drawn velocities.
+    equilibration : float, default 50.0
+        Run time at fixed Delta mu_max before shrinking, in units of Delta mu_max <R> / v_th
+        (v_th = 1); >= 0.
+    segment_fraction : float, default 0.01
+        Relative fall of Delta mu per segment (the rate gamma is updated and one row recorded
+        per segment); in (0, 0.5].
+    reset_ratio : float, optional
+        If set (> 1), velocities are re-drawn (kT back to its initial value) whenever K grew by
+        this factor since the last draw (thermostat of Donev 2006, sec. 6.3.5.1); ln K is
+        chained across draws.
+    max_events : int, default 10**10
+        Bound on the collisions of one segment.
+    partial : bool, default False
+        Allow stopping above the disjoint-cell point (the Delta f(Delta mu) curve only; f_c, f
+        and the excess are then NaN).
+
+    Returns
+    -------
+    BCMDResult
+        ``delta_f`` = (d/2) ln(K/K_0) chained, ``f_c`` the disjoint-cell reference at
+        Delta mu_min, ``f`` = f_c - delta_f per moving particle, ``excess`` = f - f_ideal, and
+        ``dataset``: per-segment variables ``dmu``, ``mu``, ``dmu_mid``, ``time``, ``gamma``,
+        ``ln_k``, ``delta_f``, ``p_c`` (reduced cell-wall pressure), ``events``, with the
+        parameters, results and event counts in its attrs (``hardpack_kind`` = "bcmd").
+
+    Raises
+    ------
+    InvalidInputError
+        If ``packing`` is not a periodic sphere Packing with >= 2 particles, ``frozen`` is
+        unknown, a numeric parameter is outside its range, the cells are never disjoint (some
+        centres at contact), dmu_min >= dmu_max, or dmu_min is above the disjoint-cell point
+        without ``partial``.
+    RuntimeError
+        If a segment exceeds ``max_events``, a particle escapes its cell or two spheres overlap
+        at the end (failures of the event-driven dynamics, not of the input).
     """
     clock = time.perf_counter()
     if not isinstance(packing, Packing):

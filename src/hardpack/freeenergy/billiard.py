@@ -1,5 +1,5 @@
 """Point billiard in a polytope intersected with a shrinking ball: the BCMD volume identity in
-its barest form (Donev ch. 6 sec. 6.3.3 / App. A, Fig. 6.1, [C:579-661]; note sec. 5.2 item 2).
+its barest form (Donev 2006, dissertation sec. 6.3.3 and Fig. 6.1; Donev et al. 2007, Appendix A).
 
 A point moves freely inside P = {x : A x <= b} intersected with the ball |x - c| <= xi(t),
 reflecting elastically off the planes and with v_n' = 2 w - v_n off the ball wall moving at
@@ -25,7 +25,7 @@ from hardpack.geometry.balls import ball_volume
 
 @njit(cache=True)
 def _shrink(x, v, a, b, c, xi_max, xi_min, wall_ratio, fraction, redraw_every, seed):
-    np.random.seed(seed)
+    np.random.seed(seed)  # noqa: NPY002 (numba kernels have only the legacy generator)
     n = x.shape[0]
     m = a.shape[0]
     xi = xi_max
@@ -65,7 +65,7 @@ def _shrink(x, v, a, b, c, xi_max, xi_min, wall_ratio, fraction, redraw_every, s
                 t_redraw += tau
                 speed = np.sqrt(np.sum(v * v))
                 for k in range(n):
-                    v[k] = np.random.normal()
+                    v[k] = np.random.normal()  # noqa: NPY002
                 v *= speed / np.sqrt(np.sum(v * v))
                 continue
             x += v * best
@@ -105,8 +105,42 @@ def volume_estimate(
     """BCMD estimate of |P|, P = {x : a x <= b}, from a point billiard started at ``centre``.
 
     Requires the ball B(centre, xi_max) to contain P and B(centre, xi_min) to lie inside P (the
-    caller checks; the estimate is meaningless otherwise). wall_ratio: wall speed / particle
-    speed (adiabaticity, note sec. 2 step 6). Returns (estimate, number of bounces).
+    caller checks; the estimate is meaningless otherwise). Eq. 6.13 (Donev 2006, sec. 6.3.3):
+    |P| = |B(xi_min)| (K/K_0)^{n/2}.
+
+    Parameters
+    ----------
+    a : array_like, shape (m, n)
+        Facet normals of the polytope.
+    b : array_like, shape (m,)
+        Right-hand sides of a x <= b.
+    centre : array_like, shape (n,)
+        Centre of the ball and start of the point; strictly inside P.
+    xi_max : float
+        Initial ball radius (the ball contains P).
+    xi_min : float
+        Final ball radius (the ball lies inside P), 0 < xi_min < xi_max.
+    wall_ratio : float, default 1e-3
+        Wall speed / particle speed (adiabaticity of the shrink).
+    fraction : float, default 0.01
+        Relative fall of xi per shrink segment.
+    redraw_every : float, default 2.0
+        The velocity direction is re-drawn uniformly every ``redraw_every`` xi / speed of time.
+    seed : int, default 0
+        Seed of the initial and re-drawn directions.
+
+    Returns
+    -------
+    estimate : float
+        The estimate of the volume |P|.
+    bounces : int
+        Number of bounces off the planes and the ball.
+
+    Raises
+    ------
+    InvalidInputError
+        If the shapes of ``a``, ``b`` and ``centre`` disagree, the centre is not strictly
+        inside P, or not 0 < xi_min < xi_max.
     """
     a = np.ascontiguousarray(a, dtype=float)
     b = np.ascontiguousarray(b, dtype=float)

@@ -11,8 +11,6 @@ excess over the ideal gas; writes the per-segment series (hardpack.freeenergy.bc
 
 from __future__ import annotations
 
-import sys
-
 from hardpack.errors import InvalidInputError
 from hardpack.freeenergy.bcmd import FROZEN_MODES, run_bcmd
 
@@ -20,7 +18,7 @@ from hardpack.freeenergy.bcmd import FROZEN_MODES, run_bcmd
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "bcmd",
-        help="bounding-cell MD free energy of a packing (Donev ch. 6)",
+        help="Bounding-cell MD free energy of a packing (Donev ch. 6).",
         description=__doc__.splitlines()[0],
     )
     p.add_argument("packing", help="packing netCDF file (hardpack.io.save_packing)")
@@ -69,11 +67,11 @@ def register(subparsers) -> None:
         default=None,
         help="re-draw velocities when K grew by this factor (rattlers; default off)",
     )
-    p.set_defaults(func=run)
+    p.set_defaults(func=cmd_bcmd)
 
     p = subparsers.add_parser(
         "bcmd-simplex",
-        help="BCMD of a jammed packing's rattler-free backbone vs its exact simplex (Table 6.1)",
+        help="BCMD of a jammed packing's rattler-free backbone vs its exact simplex (Donev ch. 6, Table 6.1).",
         description=__doc__.splitlines()[2],
     )
     p.add_argument("packing", help="jammed packing netCDF file")
@@ -91,17 +89,17 @@ def register(subparsers) -> None:
     p.add_argument("--frozen", choices=FROZEN_MODES, default="particle",
                    help="freeze particle 0 (default) or measure K in the CM frame")
     p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
-    p.set_defaults(func=run_simplex)
+    p.set_defaults(func=cmd_bcmd_simplex)
 
     p = subparsers.add_parser(
         "bcmd-ladder",
-        help="the cheap BCMD checks against exact values (disjoint cells, billiard, simplex)",
+        help="The cheap BCMD checks against exact values (disjoint cells, billiard, simplex).",
     )
     p.add_argument("--out", required=True, help="output netCDF file")
-    p.set_defaults(func=run_ladder)
+    p.set_defaults(func=cmd_bcmd_ladder)
 
 
-def run_ladder(args) -> int:
+def cmd_bcmd_ladder(args) -> int:
     from hardpack.freeenergy.ladder import ladder_dataset
     from hardpack.io import write_dataset
 
@@ -114,24 +112,20 @@ def run_ladder(args) -> int:
     return 0
 
 
-def run_simplex(args) -> int:
+def cmd_bcmd_simplex(args) -> int:
     from hardpack.freeenergy.isostatic import simplex_test
     from hardpack.io import load_dataset, load_packing, write_dataset
 
-    try:
-        packing = load_packing(args.packing)
-        verdict = load_dataset(args.jamming, kind="jamming")
-        tol = args.contact_tol
-        if tol is None:
-            tol = min(float(verdict.attrs["delta"]), args.delta / 10)
-        ds = simplex_test(
-            packing, verdict["rattler"].values.astype(bool), delta=args.delta, contact_tol=tol,
-            dmu_max_ratio=args.dmu_max_ratio, gamma0=args.gamma0, theta=args.theta,
-            frozen=args.frozen, seed=args.seed,
-        )
-    except InvalidInputError as exc:
-        print(f"hardpack bcmd-simplex: error: {exc}", file=sys.stderr)
-        return 2
+    packing = load_packing(args.packing)
+    verdict = load_dataset(args.jamming, kind="jamming")
+    tol = args.contact_tol
+    if tol is None:
+        tol = min(float(verdict.attrs["delta"]), args.delta / 10)
+    ds = simplex_test(
+        packing, verdict["rattler"].values.astype(bool), delta=args.delta, contact_tol=tol,
+        dmu_max_ratio=args.dmu_max_ratio, gamma0=args.gamma0, theta=args.theta,
+        frozen=args.frozen, seed=args.seed,
+    )
     ds.attrs.update(source=str(args.packing), verdict=str(args.jamming), seed=args.seed)
     write_dataset(ds, args.out, seed=args.seed)
     a = ds.attrs
@@ -158,24 +152,20 @@ def _sized(packing, phi, delta):
     return packing
 
 
-def run(args) -> int:
+def cmd_bcmd(args) -> int:
     from hardpack.io import load_packing, write_dataset
 
-    try:
-        packing = _sized(load_packing(args.packing), args.phi, args.delta)
-        res = run_bcmd(
-            packing,
-            dmu_max=args.dmu_max,
-            dmu_min=args.dmu_min,
-            gamma0=args.gamma0,
-            theta=args.theta,
-            frozen=args.frozen,
-            seed=args.seed,
-            reset_ratio=args.reset_ratio,
-        )
-    except InvalidInputError as exc:
-        print(f"hardpack bcmd: error: {exc}", file=sys.stderr)
-        return 2
+    packing = _sized(load_packing(args.packing), args.phi, args.delta)
+    res = run_bcmd(
+        packing,
+        dmu_max=args.dmu_max,
+        dmu_min=args.dmu_min,
+        gamma0=args.gamma0,
+        theta=args.theta,
+        frozen=args.frozen,
+        seed=args.seed,
+        reset_ratio=args.reset_ratio,
+    )
     ds = res.dataset
     ds.attrs["source"] = str(args.packing)
     if args.delta is not None:

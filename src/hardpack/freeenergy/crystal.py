@@ -1,9 +1,9 @@
 """Reference curves for the free energy of the FCC hard-sphere crystal vs density.
 
 Units: the sphere diameter D = 1, kT = 1, per particle. phi_cp = pi / sqrt(18) is close packing.
-Two published numbers anchor the curves (note ``bcmd_free_energy.md`` sec. 3.1-3.2):
-the excess free energy over the ideal gas at melting, 5.91916 at phi = 0.545 ([C:1008-1010]),
-and the jamming-limit constant [f_J - f_c^J]_FCC = 2.160 ([C:1012-1018]).
+Two published numbers anchor the curves (Donev 2006, dissertation sec. 6.4.1): the excess free
+energy over the ideal gas at melting, 5.91916 at phi = 0.545, and the jamming-limit constant
+[f_J - f_c^J]_FCC = 2.160.
 
 - BCMD's quantity. A run from large cells down to the disjoint-cell point Delta mu_d(phi) =
   (phi_cp / phi)^(1/3) - 1 of lattice-centred cells measures Delta f = f_c(Delta mu_d) - f, with
@@ -12,7 +12,7 @@ and the jamming-limit constant [f_J - f_c^J]_FCC = 2.160 ([C:1012-1018]).
   Delta mu_d (:func:`cell_offset`). At close packing Delta f -> f_J - f_c^J (Eq. 6.18).
 - Cell (free-volume) limit: Delta f = 2.160 for all phi, i.e. excess = c(phi) - 2.160, exact to
   first order in Delta mu_d (:func:`cell_limit_excess`; e.g. -3 ln(1 - phi/phi_cp) + 2.436 as
-  phi -> phi_cp, note sec. 3.2).
+  phi -> phi_cp, derived here).
 - Thermodynamic integration of the crystal's equation of state Z(phi) = pV/(NkT) from the
   melting value (:func:`eos_excess`): excess(phi) = excess(phi_0) + int_{phi_0}^{phi} (Z - 1)
   dphi'/phi'. The free-volume part Z_fv = 1 / (1 - x), x = (phi/phi_cp)^(1/3) (the cell model's
@@ -30,8 +30,8 @@ from hardpack.errors import InvalidInputError
 
 PHI_CP = np.pi / np.sqrt(18.0)
 MELTING_PHI = 0.545
-MELTING_EXCESS = 5.91916  # [C:1008-1010]
-JAMMING_CONSTANT = 2.160  # [C:1012-1018]
+MELTING_EXCESS = 5.91916  # Donev 2006, sec. 6.4.1
+JAMMING_CONSTANT = 2.160  # Donev 2006, sec. 6.4.1
 
 
 def disjoint_dmu(phi):

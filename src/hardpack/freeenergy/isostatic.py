@@ -1,9 +1,9 @@
 """BCMD against the exact jamming simplex of a rattler-free isostatic packing.
 
-Donev dissertation ch. 6 sec. 6.4.2 and Table 6.1 ([C:1062-1146]; note ``bcmd_free_energy.md``
-sec. 3.3 and 5.2 items 6-7): remove the rattlers, freeze one particle, shrink the spheres by
-(1 - delta) around their jammed positions and compare BCMD's Delta f = (d/2) ln(K/K_0), run from
-Delta mu_max down to the disjoint-cell point Delta mu_min, with the exact
+Donev 2006, dissertation sec. 6.4.2 and Table 6.1 (Donev et al. 2007, Sec. 4.3): remove the
+rattlers, freeze one particle, shrink the spheres by (1 - delta) around their jammed positions
+and compare BCMD's Delta f = (d/2) ln(K/K_0), run from Delta mu_max down to the disjoint-cell
+point Delta mu_min, with the exact
 
     Delta f_exact = [ln|P| - sum_{i moving} ln |B_d(Delta mu_min R_i)|] / N_eff,
 
@@ -13,9 +13,10 @@ are the final disjoint cells. For unit-diameter spheres and exact contacts this 
 f_J - f_c^J (Eq. 6.18); using the actual gaps removes the O(gap / delta) error of a packing
 jammed at finite pressure, leaving only the O(delta) linearisation error.
 
-Frozen centre of mass instead of a frozen particle (note sec. 1.7, App. B [C:745-784]): the
-coordinate Jacobian N^d shifts the per-particle value by d ln N / N, so the CM-frame BCMD run is
-compared with Delta f_exact + d ln N / N (Donev: 4.9690 - 4.9479 = 3 ln 978 / 978).
+Frozen centre of mass instead of a frozen particle (Donev 2006, sec. 6.3.4.1; Donev et al. 2007,
+Appendix B): the coordinate Jacobian N^d shifts the per-particle value by d ln N / N, so the
+CM-frame BCMD run is compared with Delta f_exact + d ln N / N (Donev 2006, sec. 6.4.2:
+4.9690 - 4.9479 = 3 ln 978 / 978).
 """
 
 from __future__ import annotations
@@ -57,11 +58,26 @@ def remove_rattlers(packing: Packing, rattler) -> Packing:
 class SimplexReference:
     """Exact jamming-simplex numbers of a backbone shrunk by (1 - delta), particle 0 frozen.
 
-    isostaticity_gap: M - (N_f + 1) (0 for an isostatic backbone; the other fields are NaN
-    otherwise); delta_f: the exact Delta f above; f_j: ln|P_x| / N_eff of the unit-gap simplex
-    (Eq. 6.3); min_force: smallest normalised contact force (unit sum); dmu_min: the
-    disjoint-cell point; next_gap: the smallest relative gap of a non-contact (inf if none below
-    1e-3), which must be >> delta for the linearised simplex to bound the motion.
+    Attributes
+    ----------
+    n_particles : int
+        Particles of the backbone.
+    n_contacts : int
+        M, the contacts within ``contact_tol``.
+    isostaticity_gap : int
+        M - (N_f + 1); 0 for an isostatic backbone, otherwise ``delta_f``, ``f_j`` and
+        ``min_force`` are NaN.
+    delta_f : float
+        The exact Delta f of the module docstring.
+    f_j : float
+        ln|P_x| / N_eff of the unit-gap simplex (Eq. 6.3).
+    min_force : float
+        Smallest normalised contact force (unit sum).
+    dmu_min : float
+        The disjoint-cell point of the shrunk backbone.
+    next_gap : float
+        The smallest relative gap of a non-contact (inf if none below 1e-3), which must be
+        >> delta for the linearised simplex to bound the motion.
     """
 
     n_particles: int
@@ -80,6 +96,29 @@ def simplex_reference(backbone: Packing, delta: float, contact_tol: float) -> Si
     Contacts are the pairs with relative gap <= contact_tol in the unshrunk backbone (e.g. the
     jamming verifier's tolerance); contact_tol must be well below delta so that shrinking by
     (1 - delta) opens every contact to a gap of about delta.
+
+    Parameters
+    ----------
+    backbone : Packing
+        A rattler-free periodic sphere packing; particle 0 is frozen.
+    delta : float
+        Relative shrink of the radii, 0 < delta < 0.01 (the simplex is a linearisation).
+    contact_tol : float
+        Relative gap below which a pair of the unshrunk backbone is a contact,
+        0 < contact_tol < delta.
+
+    Returns
+    -------
+    SimplexReference
+        The exact Delta f, f_J, the smallest force, the disjoint-cell point and the next gap;
+        a backbone that is not isostatic gets ``isostaticity_gap`` != 0 and NaN values.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``backbone`` is not a periodic sphere packing, ``delta`` is outside (0, 0.01),
+        ``contact_tol`` is outside (0, delta), or the simplex is degenerate (see
+        :func:`jamming_simplex` and :func:`log_simplex_volume`).
     """
     backbone.require_periodic_spheres("the exact simplex free energy")
     delta = float(delta)
@@ -125,10 +164,38 @@ def simplex_test(
 ) -> xr.Dataset:
     """BCMD of the rattler-free, (1 - delta)-shrunk packing vs its exact simplex value.
 
-    Returns the BCMD dataset (per-segment series) with attributes ``exact`` (Delta f_exact, plus
-    d ln N / N for frozen="cm"), ``bcmd`` (BCMD's Delta f), ``rel_diff``, ``isostatic`` (0/1),
-    ``isostaticity_gap`` and the costs ``seconds_simplex``, ``seconds_bcmd``, ``n_events``. A
-    backbone that is not isostatic gets no BCMD run (a summary with NaNs and isostatic = 0).
+    Donev 2006, sec. 6.4.2 and Table 6.1; see the module docstring.
+
+    Parameters
+    ----------
+    packing : Packing
+        A jammed periodic sphere packing.
+    rattler : array_like of bool, shape (N,)
+        The rattlers of this very packing (e.g. from its jamming verdict); they are removed.
+    delta : float, default 1e-8
+        Relative shrink of the radii, in (0, 0.01).
+    contact_tol : float, default 1e-9
+        Relative gap of the contacts in the unshrunk backbone, in (0, delta).
+    dmu_max_ratio : float, default 100.0
+        BCMD starts at Delta mu_max = dmu_max_ratio times the disjoint-cell point.
+    gamma0, theta, frozen, seed
+        Passed to :func:`hardpack.freeenergy.bcmd.run_bcmd`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The BCMD dataset (per-segment series) with attributes ``exact`` (Delta f_exact, plus
+        d ln N / N for frozen="cm"), ``bcmd`` (BCMD's Delta f), ``rel_diff``, ``isostatic``
+        (0/1), ``isostaticity_gap``, ``f_j``, ``min_force``, ``next_gap`` and the costs
+        ``seconds_simplex``, ``seconds_bcmd``, ``n_events``. A backbone that is not isostatic
+        gets no BCMD run (attributes only, with NaNs and isostatic = 0).
+
+    Raises
+    ------
+    InvalidInputError
+        If ``packing`` is not a periodic sphere packing, the rattler mask does not match it,
+        fewer than 2 particles are left, or ``delta`` / ``contact_tol`` or the BCMD parameters
+        are out of range (see :func:`simplex_reference` and :func:`run_bcmd`).
     """
     t0 = time.perf_counter()
     packing.require_periodic_spheres("the exact simplex free energy")

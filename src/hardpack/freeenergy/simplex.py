@@ -1,13 +1,13 @@
 """Exact volume of a simplex and the jamming-simplex constant f_J of an isostatic packing.
 
-Donev dissertation ch. 6 (seeds/000_chapters/ch06.txt), note ``bcmd_free_energy.md`` sec. 1.3:
+Donev 2006, dissertation sec. 6.2.2:
 
-- H-representation (Eq. 6.5, [C:289-308]): for the simplex {x in R^n : A x <= b}, A of shape
+- H-representation (Eq. 6.5, sec. 6.2.2.2): for the simplex {x in R^n : A x <= b}, A of shape
   (n+1, n), set the square matrix At = [A b] and a = At^{-T} e_{n+1} (the last row of At^{-1}).
   Then V^{-1} = n! |det At| prod_i a_i. Derivation (checked here): y = b - A x >= 0 satisfies
   [x; -1] = -At^{-1} y, whose last component gives a^T y = 1, so the simplex is bounded exactly
   when every a_i > 0; the function refuses anything else.
-- Jamming simplex (Eqs. 6.3-6.4, [C:164-189]): P_x = {x : A^T x <= e} with A the N_f x M
+- Jamming simplex (Eqs. 6.3-6.4, sec. 6.2.2): P_x = {x : A^T x <= e} with A the N_f x M
   rigidity matrix (journal sign convention; the chapter's A^T x >= -e is its mirror image and has
   the same volume). With M = N_f + 1 the augmented matrix is At = [A; e^T] and the contact forces
   f~ = At^{-1} e_{M} (force balance A f~ = 0, unit sum) are the a_i above, so
@@ -51,8 +51,27 @@ def _log_det_and_last_solve(mat: sp.spmatrix) -> tuple[float, np.ndarray]:
 def log_simplex_volume(a, b) -> float:
     """ln V of the simplex {x in R^n : a @ x <= b}, a of shape (n+1, n), b > 0 (Eq. 6.5).
 
-    Refuses (InvalidInputError) shapes that are not (n+1, n), b <= 0 (the origin must be interior)
-    and constraint sets that do not bound a simplex (some a_i <= 0 or a singular [A b]).
+    Donev 2006, sec. 6.2.2.2: V^{-1} = n! |det [A b]| prod_i a_i with a the last row of
+    [A b]^{-1}; the log-determinant comes from one sparse LU.
+
+    Parameters
+    ----------
+    a : array_like or scipy.sparse matrix, shape (n+1, n)
+        The constraint normals A, one row per facet.
+    b : array_like, shape (n+1,)
+        The right-hand sides; all > 0, i.e. the origin is interior.
+
+    Returns
+    -------
+    float
+        ln V, the natural logarithm of the simplex volume.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``a`` is not of shape (n+1, n) or ``b`` not of length n+1; if ``b`` is not finite or
+        some b_i <= 0 (the origin must be interior); if the constraints do not bound a simplex
+        (a singular [A b] or some weight a_i <= 0).
     """
     a_mat = (
         sp.csc_matrix(a, dtype=float) if sp.issparse(a) else np.asarray(a, dtype=float)
@@ -85,10 +104,22 @@ def log_simplex_volume(a, b) -> float:
 
 @dataclass(frozen=True)
 class JammingSimplex:
-    """Result of :func:`jamming_simplex` (note sec. 1.3).
+    """Result of :func:`jamming_simplex` (Donev 2006, sec. 6.2.2).
 
-    log_volume: ln|P_x|; forces: f~ (unit sum, length M); f_j: ln|P_x| / n_eff;
-    f_j_minus_fcj: f_J - f_c^J with f_c^J = ln V_p, the quantity BCMD measures (Eq. 6.18).
+    Attributes
+    ----------
+    log_volume : float
+        ln|P_x|, the log-volume of the jamming simplex.
+    forces : numpy.ndarray, shape (M,)
+        The contact forces f~ = [A; e^T]^{-1} e_M, normalised to unit sum.
+    n_dof : int
+        N_f, the number of degrees of freedom (rows of the rigidity matrix).
+    n_eff : int
+        The number of moving particles used in f_J.
+    f_j : float
+        f_J = ln|P_x| / n_eff.
+    f_j_minus_fcj : float
+        f_J - f_c^J with f_c^J = ln V_p, the quantity BCMD measures (Eq. 6.18).
     """
 
     log_volume: float
@@ -104,14 +135,34 @@ def jamming_simplex(
 ) -> JammingSimplex:
     """Volume of the jamming polytope P_x = {x : A^T x <= e} of an isostatic packing (Eq. 6.3).
 
-    rigidity: the N_f x M rigidity matrix A (rows of frozen particles already removed; for spheres
-    of unit diameter shrunk by (1 - delta) the gaps are delta e, so x = dR / delta).
-    n_eff: the number of moving particles (N - 1 with one frozen particle) used in
-    f_J = ln|P_x| / n_eff. log_vp: ln V_p of the particle (ln(pi/6) for unit-diameter spheres,
-    ln(pi/4) for unit disks); it only shifts ``f_j_minus_fcj``.
+    Donev 2006, sec. 6.2.2 (Eqs. 6.3-6.5): with At = [A; e^T], |P_x|^{-1} = N_f! |det At|
+    prod f~ where f~ = At^{-1} e_M are the contact forces.
 
-    Refuses a packing that is not isostatic (M != N_f + 1) or whose contact forces
-    f~ = [A; e^T]^{-1} e_M are not all > force_tol (then P_x is not a bounded simplex).
+    Parameters
+    ----------
+    rigidity : array_like or scipy.sparse matrix, shape (N_f, M)
+        The rigidity matrix A, rows of frozen particles already removed. For spheres of unit
+        diameter shrunk by (1 - delta) the gaps are delta e, so x = dR / delta.
+    n_eff : int
+        The number of moving particles (N - 1 with one frozen particle) used in
+        f_J = ln|P_x| / n_eff; >= 1.
+    log_vp : float, default 0.0
+        ln V_p of the particle (ln(pi/6) for unit-diameter spheres, ln(pi/4) for unit disks);
+        it only shifts ``f_j_minus_fcj``.
+    force_tol : float, default 0.0
+        Every contact force f~ must exceed this value.
+
+    Returns
+    -------
+    JammingSimplex
+        ln|P_x|, the forces f~, N_f, n_eff, f_J and f_J - ln V_p.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not isostatic (M != N_f + 1), if ``n_eff`` < 1, if the augmented
+        matrix is singular, or if some contact force f~ <= ``force_tol`` (then P_x is not a
+        bounded simplex).
     """
     a = sp.csc_matrix(rigidity, dtype=float)
     n_f, m = a.shape

@@ -1,5 +1,5 @@
-"""Geometry: the packing model (particle shapes, boundaries), d-ball volumes, periodic neighbour
-search and crystal lattices."""
+"""Geometry: the packing model (particle shapes, boundaries), d-ball volumes, the neighbour layer
+(:mod:`.neighbours`) and crystal lattices."""
 
 from hardpack.geometry.balls import ball_volume, unit_ball_volume
 from hardpack.geometry.boundaries import (

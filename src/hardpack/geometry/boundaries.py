@@ -38,6 +38,17 @@ class ContainmentReport:
 
     ``overlap`` = 1 - h / r of the worst particle (positive means it crosses ``wall``); ``worst``
     is -1 when no particle is named (a periodic cell has no walls; ``wall`` then says why).
+
+    Parameters
+    ----------
+    n_outside : int
+        Particles whose relative overlap with a wall exceeds the tolerance.
+    worst : int
+        Index of the particle with the largest relative overlap, or -1.
+    wall : str
+        The wall of the worst particle, in words (or why there is none).
+    overlap : float
+        1 - h / r of the worst particle (-inf without walls).
     """
 
     n_outside: int
@@ -92,7 +103,19 @@ class Periodic:
 
 @dataclass(frozen=True)
 class HardWalls:
-    """Hard walls at x_k = 0 and x_k = L_k for every axis k in ``axes``; periodic along the others."""
+    """Hard walls at x_k = 0 and x_k = L_k for every axis k in ``axes``; periodic along the others.
+
+    Parameters
+    ----------
+    axes : int or sequence of int
+        The distinct walled axes (0 = x, 1 = y, ...); stored sorted as a tuple. The packing's
+        lattice must be orthorhombic along them (:meth:`check`).
+
+    Raises
+    ------
+    InvalidInputError
+        If ``axes`` is empty, not integers, negative or repeated.
+    """
 
     axes: tuple
     kind: ClassVar[str] = "hard_walls"
@@ -152,7 +175,21 @@ class HardWalls:
 
 @dataclass(frozen=True)
 class SphericalContainer:
-    """A hard spherical wall of ``radius`` about ``centre``, inside the orthorhombic lattice box."""
+    """A hard spherical wall of ``radius`` about ``centre``, inside the orthorhombic lattice box.
+
+    Parameters
+    ----------
+    centre : sequence of float, shape (d,)
+        Centre of the container, in the coordinates of the packing.
+    radius : float
+        Radius R > 0 of the container; the volume fraction is over V_d(R).
+
+    Raises
+    ------
+    InvalidInputError
+        If ``centre`` is not d finite numbers or ``radius`` is not one positive finite number.
+        The fit into the packing's lattice box is checked by :meth:`check`.
+    """
 
     centre: tuple
     radius: float

@@ -75,6 +75,27 @@ def lattice_packing(name: str, reps=1) -> Packing:
     ``reps`` is a positive integer or a sequence of d of them (whole-valued floats such as 2.0
     are taken as integers; 2.5, 0, -1, True or a sequence of the wrong length are refused).
     Spheres have radius 1/2 and touch their nearest neighbours exactly.
+
+    Parameters
+    ----------
+    name : str
+        One of "square", "triangular", "honeycomb", "kagome" (2D), "sc", "bcc", "fcc", "hcp",
+        "diamond" (3D), "hypercubic<d>" or "D<d>" (the checkerboard lattice D_d) in any d.
+        Cells are conventional cubic (SC, BCC, FCC, diamond, D_d) or primitive hexagonal
+        (triangular, honeycomb, Kagome, HCP); see the module docstring.
+    reps : int or sequence of int, default 1
+        Repetitions of the unit cell along each lattice vector (one count for all, or d).
+
+    Returns
+    -------
+    Packing
+        A periodic packing of spheres of radius 1/2 (nearest-neighbour distance 1) whose
+        lattice is the unit cell scaled by ``reps``.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``name`` is not a known lattice or ``reps`` is not one or d positive whole numbers.
     """
     lat, basis, radius = _cell(name)
     d = lat.shape[0]

@@ -114,6 +114,37 @@ class Packing:
     Overlaps (between particles, or of a particle with a wall) beyond ``overlap_tol`` are refused
     unless ``allow_overlap=True`` (e.g. for an intermediate SLP step or a deliberately overlapping
     test configuration). The arrays are stored read-only; engines work on copies.
+
+    Parameters
+    ----------
+    positions : array_like, shape (N, d)
+        Cartesian centres; N >= 1, d = 1..12.
+    radii : array_like, shape (N,), optional
+        Sphere radii (positive). Give either ``radii`` or ``shape``.
+    lattice : array_like, shape (d, d)
+        The cell: lattice vectors as columns; must be non-singular.
+    species : array_like of int, shape (N,), optional
+        An integer label per particle.
+    boundary : "periodic", HardWalls or SphericalContainer, default "periodic"
+        The boundary (:mod:`hardpack.geometry.boundaries`).
+    allow_overlap : bool, default False
+        Accept overlaps and wall crossings beyond ``overlap_tol``.
+    overlap_tol : float, default 1e-9
+        Relative overlap tolerance, 0 <= overlap_tol < 1 (module docstring).
+    shape : Spheres or Ellipsoids, optional (keyword only)
+        The particle shapes (:mod:`hardpack.geometry.shapes`), instead of ``radii``.
+
+    Raises
+    ------
+    InvalidInputError
+        If positions, radii, lattice or species have the wrong shape, type or non-finite entries;
+        neither or both of radii and shape are given, or shape is not Spheres or Ellipsoids; d is
+        outside 1..12; the lattice is missing or singular; the boundary is not one of the above or
+        does not fit the lattice; overlap_tol is outside [0, 1); or, unless ``allow_overlap``,
+        particles overlap or cross the boundary beyond ``overlap_tol``.
+    NotImplementedError
+        Unless ``allow_overlap``, when ellipsoids' bounding spheres overlap or cross the boundary
+        (the ellipsoid contact function is not implemented yet).
     """
 
     positions: np.ndarray
@@ -331,24 +362,6 @@ class Packing:
         return self.minimum_image(self.positions[j] - self.positions[i])
 
     # ------------------------------------------------------------------ overlaps
-    def _search_spheres(self) -> "Packing":
-        """A periodic sphere packing whose pairs within contact are the candidate pairs of this one:
-        the packing itself for spheres in a periodic cell; otherwise the bounding spheres, with the
-        walled lattice vectors stretched so that no image across a wall comes within range
-        (centres inside the walls keep their coordinates bit for bit)."""
-        if self.shape.kind == "sphere" and self.boundary.kind == "periodic":
-            return self
-        radii = self.shape.bounding_radii
-        x, lat = self.positions, self.lattice
-        walled = np.flatnonzero(~self.boundary.periodic_axes(self.dim))
-        if len(walled):
-            x, lat = x.copy(), lat.copy()
-            reach = 4.0 * radii.max()  # > the pair search range 2 r_max
-            for k in walled:
-                x[:, k] -= min(0.0, x[:, k].min())
-                lat[k, k] = max(lat[k, k], x[:, k].max()) + reach
-        return Packing(x, radii, lat, allow_overlap=True)
-
     def overlap_report(self, tol: float = DEFAULT_OVERLAP_TOL) -> OverlapReport:
         """Count pairs with distance < (r_i + r_j)(1 - tol), with every periodic image.
 
@@ -359,7 +372,7 @@ class Packing:
         """
         from hardpack.geometry.neighbours import pairs_within
 
-        pairs = pairs_within(self._search_spheres(), rel_gap=0.0)
+        pairs = pairs_within(self, rel_gap=0.0)  # bounding spheres, images along periodic axes only
         if self.shape.kind != "sphere":
             undecided = np.flatnonzero(pairs.distance < pairs.contact)
             if len(undecided):
@@ -406,4 +419,5 @@ class Packing:
             sizes = f"radii=[{self.radii.min():.4g}, {self.radii.max():.4g}]"
         else:
             sizes = f"{self.shape.kind}s, semiaxes=[{self.shape.semiaxes.min():.4g}, {self.shape.semiaxes.max():.4g}]"
-        return f"Packing(N={self.n_particles}, d={self.dim}, phi={self.phi:.6f}, {sizes}, boundary={str(self.boundary)!r})"
+        return (f"Packing(N={self.n_particles}, d={self.dim}, phi={self.phi:.6f}, {sizes}, "
+                f"boundary={str(self.boundary)!r})")

@@ -70,7 +70,18 @@ def _freeze(obj, **arrays) -> None:
 
 @dataclass(frozen=True, eq=False)
 class Spheres:
-    """Hard spheres: ``radii`` of shape (N,), positive and finite."""
+    """Hard spheres: ``radii`` of shape (N,), positive and finite.
+
+    Parameters
+    ----------
+    radii : array_like, shape (N,)
+        One positive finite radius per particle; stored as a read-only float array.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``radii`` is not numeric, not finite, not of shape (N,) or not positive.
+    """
 
     radii: np.ndarray
     kind: ClassVar[str] = "sphere"
@@ -114,6 +125,21 @@ class Ellipsoids:
 
     ``semiaxes`` (N, d): positive body-frame semiaxes. ``orientations``: (N, 4) unit quaternions
     (s, p_1, p_2, p_3) in 3D, (N,) angles in radians in 2D.
+
+    Parameters
+    ----------
+    semiaxes : array_like, shape (N, d), d in (2, 3)
+        Positive finite body-frame semiaxes of each particle.
+    orientations : array_like, shape (N, 4) in 3D or (N,) in 2D
+        Unit quaternions (s, p_1, p_2, p_3) (Donev 2006, Eq. 1.7) or angles in radians of the
+        first semiaxis with the x axis. A quaternion within 8 machine epsilons of unit norm is
+        kept as given, one within ``QUATERNION_TOL`` is normalised.
+
+    Raises
+    ------
+    InvalidInputError
+        If the arrays are not numeric and finite, have the wrong shapes, a semiaxis is not
+        positive, or a quaternion's norm is off 1 by more than ``QUATERNION_TOL``.
     """
 
     semiaxes: np.ndarray

@@ -1,7 +1,7 @@
-"""Hierarchical grid (HGrid) for contact detection of polydisperse spheres (Ogarko ch. 2).
+"""The analytic cost model of hierarchical-grid (HGrid) contact detection (Ogarko ch. 2.2) and its Fig. 2.15
+study (``hardpack hgrid-cost``).
 
 - :mod:`hardpack.hgrid.cost_model`  analytic cost T/N of an HGrid for power-law radii (ch. 2.2)
-- :mod:`hardpack.hgrid.levels`      "equal particles per cell" level assignment for actual radii (ch. 2.1)
-- :mod:`hardpack.hgrid.search`      Top-Down HGrid neighbour search in a periodic box (ch. 2.1)
-- :mod:`hardpack.hgrid.rsa`         largest-first random sequential addition with HGrid overlap tests
+
+The HGrid itself (level assignment, search, RSA) is the neighbour layer, :mod:`hardpack.geometry.neighbours`.
 """

@@ -1,10 +1,11 @@
-"""Analytic cost model of hierarchical-grid (HGrid) contact detection (Ogarko ch. 2.2, Eqs. 2.14-2.47;
-Krijgsman, Ogarko & Luding, Comp. Part. Mech. 2014; note 002_ogarko.md sec. 1.4-1.5).
+"""Analytic cost model of hierarchical-grid (HGrid) contact detection (Ogarko 2014, sec. 2.2,
+Eqs. 2.14-2.47; the section is based on Krijgsman, Ogarko & Luding, Comp. Part. Mech. 2014).
 
 Model: N spheres in d dimensions at volume fraction nu, random positions without excluded volume,
 radii i.i.d. from f(r) = C r^alpha on [r_min, omega r_min] (Eq. 2.37). Lengths are in units of r_min.
 An HGrid has levels h = 1..L with cell sizes s_1 < ... < s_L and boundaries s_0 = 2 r_min,
-s_L = 2 r_max (diameters: L2217 and Eq. 2.44; the text's "s_0 = r_min" at L2895/L2969/L3024 is a typo).
+s_L = 2 r_max (diameters: below Eq. 2.18 and Eq. 2.44; the text's "s_0 = r_min" below Eqs. 2.43 and
+2.47 and in the optimal cell-size paragraph of sec. 2.2.5 is a typo).
 A particle of radius r lives on level h if s_{h-1} < 2r <= s_h. Per level (Eqs. 2.17-2.19):
 
     p_h = int_{s_{h-1}/2}^{s_h/2} f dr,     m_h = nu s_h^d p_h / V_p,     V_p = V_d <r^d>   (2.14).
@@ -15,18 +16,19 @@ a level-h particle, b = <(2r/s_j + 2)^d>_h (Eq. 2.24):
     T/N = sum_h p_h [(1/2 + n_c) m_h + sum_j m_j b(j,h) + K (1 + n_c + sum_j b(j,h))]   (2.31-2.35)
 
 with j < h for Top-Down and j > h for Bottom-Up. The unit of time is one sphere-sphere overlap
-test; K = (cell access time)/(overlap test time) ~ 0.2 (L2569-2573; the text words the ratio the other
-way round, and ch. 2.1 uses K = 0.3). All integrals of the power law are done in closed form.
+test; K = (cell access time)/(overlap test time) ~ 0.2 (sec. 2.2.3, before Eq. 2.35; the text words the
+ratio the other way round, and sec. 2.1 uses K = 0.3 with Eq. 2.7). All integrals of the power law are
+done in closed form.
 
 Cell-size distributions (ch. 2.2.5): linear (2.42), exponential (2.43-2.44), constant ratio q of
 particles per cell (2.45-2.47; q = 1 recommended) and the numerical optimum over the s_h
 (the text used MATLAB fmincon; here BFGS on an unconstrained parametrisation of the log-increments).
 
-Fig. 2.15 check (alpha = -3, omega = 100, nu = 0.7, d = 3, K = 0.2, Top-Down; L3090-3114): printed
+Fig. 2.15 check (alpha = -3, omega = 100, nu = 0.7, d = 3, K = 0.2, Top-Down; sec. 2.2.5): printed
 linear 12.40 at L* = 43, constant-m 11.60 at L* = 12, optimal 11.58; this model gives 12.398, 11.595 and
 11.574. The text also prints 11.57 for the exponential minimum, which cannot be (it would undercut the
-optimum); the model gives 12.13 at L* = 4 (L* as printed), so that printed value is a misattribution
-(note sec. 4.1). The text's "L = 3 is 43 % worse" is 47 % here; "L = 6 is 24 % worse" agrees.
+optimum); the model gives 12.13 at L* = 4 (L* as printed), so that printed value is a misattribution. The
+text's "L = 3 is 43 % worse" is 47 % here; "L = 6 is 24 % worse" agrees.
 """
 
 from __future__ import annotations
@@ -45,7 +47,8 @@ METHODS = ("top-down", "bottom-up")
 
 
 def n_neighbour_cells(d: int) -> int:
-    """n_c = (3^d - 1)/2 neighbour cells visited per cell with the half stencil (L2334-2337)."""
+    """n_c = (3^d - 1)/2 neighbour cells visited per cell with the half stencil (Ogarko 2014, sec. 2.2.3,
+    below Eq. 2.23)."""
     return (3**d - 1) // 2
 
 

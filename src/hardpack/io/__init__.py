@@ -4,8 +4,8 @@ from hardpack.io.provenance import provenance
 from hardpack.io.store import (
     combine_ensemble,
     dataset_to_packing,
-    load_judged_packing,
     load_dataset,
+    load_judged_packing,
     load_packing,
     packing_to_dataset,
     save_packing,

@@ -47,7 +47,22 @@ def _version(name: str) -> str:
 
 
 def provenance(config=None, seed: int | None = None) -> dict:
-    """Attributes describing how a result was made (see the module docstring)."""
+    """Attributes describing how a result was made (see the module docstring).
+
+    Parameters
+    ----------
+    config : object, optional
+        The parameters used; stored as sorted JSON in ``config`` (non-JSON values via ``str``).
+    seed : int, optional
+        The random seed; stored as ``seed``.
+
+    Returns
+    -------
+    dict
+        ``hardpack_version``, ``git_commit``, ``created`` (UTC ISO 8601), ``python_version``,
+        ``<package>_version`` for numpy, scipy, numba, xarray and netCDF4 ("not installed" if
+        absent), and ``config`` and ``seed`` when given.
+    """
     attrs = {
         "hardpack_version": _version("hardpack"),
         "git_commit": git_commit(),

@@ -94,7 +94,30 @@ def _boundary_variables(boundary, d: int) -> dict:
 
 
 def packing_to_dataset(packing: Packing, attrs: dict | None = None, extra: dict | None = None) -> xr.Dataset:
-    """Dataset of a packing (layout in the module docstring); ``extra`` adds data variables."""
+    """Dataset of a packing (layout in the module docstring); ``extra`` adds data variables.
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing (spheres or ellipsoids, any boundary).
+    attrs : dict, optional
+        Extra attributes; ``None`` values are dropped, booleans become ints, and other values
+        that netCDF cannot store become JSON strings. They override the standard attributes.
+    extra : dict, optional
+        Data variables to add, name -> anything ``Dataset.__setitem__`` accepts.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``position(particle, dim)``, ``lattice(dim, vector)``, the shape and boundary variables,
+        ``species`` if set, and the attributes ``hardpack_kind`` = "packing",
+        ``hardpack_format``, ``N``, ``d``, ``phi``, ``shape_kind``, ``boundary``.
+
+    Raises
+    ------
+    InvalidInputError
+        If the particle shape has no storage layout.
+    """
     data = {
         "position": (("particle", "dim"), np.asarray(packing.positions)),
         **_shape_variables(packing.shape, packing.dim),
@@ -169,7 +192,30 @@ def _boundary_from(ds: xr.Dataset, source: str):
 
 
 def dataset_to_packing(ds: xr.Dataset, source: str = "dataset", **packing_kwargs) -> Packing:
-    """Rebuild (and validate) a packing from its Dataset (format 1 or 2); errors name ``source``."""
+    """Rebuild (and validate) a packing from its Dataset (format 1 or 2); errors name ``source``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A packing dataset in the layout of the module docstring.
+    source : str, default "dataset"
+        Name of the dataset's origin (usually the file path), used in error messages.
+    **packing_kwargs
+        Passed to :class:`Packing` (e.g. ``allow_overlap``, ``overlap_tol``).
+
+    Returns
+    -------
+    Packing
+        The validated packing, bit for bit as stored.
+
+    Raises
+    ------
+    StoreError
+        If variables of the packing, its shape or its boundary are missing or inconsistent with
+        the attributes, the format, shape kind or boundary is unknown (newer than this code), or
+        the data do not make a valid packing (e.g. overlaps; the :class:`InvalidInputError`
+        message is kept). StoreError is an InvalidInputError.
+    """
     _require(ds, source, ["position", "lattice"], "every packing")
     version = ds.attrs.get("hardpack_format", 1)
     if not isinstance(version, (int, np.integer)) or version > FORMAT_VERSION:
@@ -195,6 +241,24 @@ def write_dataset(ds: xr.Dataset, path, *, attrs: dict | None = None, config=Non
 
     Existing attributes of ``ds`` win over the provenance defaults except for the version,
     commit and time stamps, which always describe this write.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The dataset to write; it is not modified (a copy gets the attributes).
+    path : str or os.PathLike
+        Destination netCDF file; replaced atomically (:func:`hardpack.io.atomic.atomic_path`).
+    attrs : dict, optional
+        Attributes that override everything else.
+    config : object, optional
+        Parameters recorded as the JSON attribute ``config`` (:func:`provenance`).
+    seed : int, optional
+        Seed recorded as the attribute ``seed``.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
     """
     path = Path(path)
     out = ds.copy()
@@ -211,7 +275,29 @@ def write_dataset(ds: xr.Dataset, path, *, attrs: dict | None = None, config=Non
 
 def save_packing(packing: Packing, path, *, attrs: dict | None = None, extra: dict | None = None,
                  config=None, seed=None) -> Path:
-    """Atomically write a packing with provenance (see :func:`write_dataset`)."""
+    """Atomically write a packing with provenance (see :func:`write_dataset`).
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing to store.
+    path : str or os.PathLike
+        Destination netCDF file, replaced atomically.
+    attrs, extra
+        Extra attributes and data variables (:func:`packing_to_dataset`).
+    config, seed
+        Provenance of the protocol (:func:`write_dataset`).
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    InvalidInputError
+        If the particle shape has no storage layout.
+    """
     return write_dataset(packing_to_dataset(packing, attrs, extra), path, config=config, seed=seed)
 
 
@@ -219,6 +305,24 @@ def load_dataset(path, kind: str | None = None) -> xr.Dataset:
     """Load a hardpack netCDF file fully into memory; errors name the file.
 
     With ``kind`` the file's ``hardpack_kind`` attribute must match.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The netCDF file.
+    kind : str, optional
+        The expected ``hardpack_kind`` (e.g. "packing", "jamming").
+
+    Returns
+    -------
+    xarray.Dataset
+        The dataset, loaded into memory (the file is closed).
+
+    Raises
+    ------
+    StoreError
+        If the file does not exist, cannot be read as netCDF, or its ``hardpack_kind`` is not
+        ``kind``.
     """
     path = Path(path)
     if not path.is_file():
@@ -235,15 +339,56 @@ def load_dataset(path, kind: str | None = None) -> xr.Dataset:
 
 
 def load_packing(path, **packing_kwargs) -> Packing:
-    """Load and validate a packing written by :func:`save_packing`."""
+    """Load and validate a packing written by :func:`save_packing`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A netCDF file of ``hardpack_kind`` "packing".
+    **packing_kwargs
+        Passed to :class:`Packing` (e.g. ``allow_overlap``, ``overlap_tol``).
+
+    Returns
+    -------
+    Packing
+        The validated packing.
+
+    Raises
+    ------
+    StoreError
+        If the file is missing, unreadable, not a packing, or holds an invalid packing
+        (:func:`load_dataset`, :func:`dataset_to_packing`).
+    """
     ds = load_dataset(path, kind="packing")
     return dataset_to_packing(ds, source=str(path), **packing_kwargs)
 
 
 def load_judged_packing(path, verdict_path) -> tuple[xr.Dataset, Packing, xr.Dataset]:
-    """A packing file with the jamming verdict that judges it (``hardpack verify`` output):
-    (packing dataset, packing, verdict dataset). Refuses a verdict of another packing (its
-    ``source`` attribute names another file)."""
+    """A packing file with the jamming verdict that judges it (``hardpack verify`` output).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The packing file (``hardpack_kind`` "packing").
+    verdict_path : str or os.PathLike
+        The verdict file (``hardpack_kind`` "jamming") of that packing.
+
+    Returns
+    -------
+    packing_dataset : xarray.Dataset
+        The packing file's dataset.
+    packing : Packing
+        The validated packing.
+    verdict : xarray.Dataset
+        The jamming verdict.
+
+    Raises
+    ------
+    InvalidInputError
+        If the verdict's ``source`` attribute names another file than ``path``.
+    StoreError
+        If either file is missing, unreadable or of the wrong kind, or the packing is invalid.
+    """
     ds, verdict = load_dataset(path, kind="packing"), load_dataset(verdict_path, kind="jamming")
     source = verdict.attrs.get("source")
     if source is not None and os.path.normpath(source) != os.path.normpath(str(path)):
@@ -307,6 +452,31 @@ def combine_ensemble(sources, index=("seed",), variables=None) -> xr.Dataset:
     files of different ``hardpack_kind`` (e.g. a jamming verdict among packings) or without one,
     and files of different dimension d, particle shapes (``shape_kind``) or boundaries
     (``boundary``) unless that attribute is an index.
+
+    Parameters
+    ----------
+    sources : iterable of str, os.PathLike or xarray.Dataset
+        The members, files (loaded with :func:`load_dataset`) or datasets.
+    index : sequence of str, default ("seed",)
+        Attributes that label the samples; each becomes a coordinate along ``sample``.
+    variables : sequence of str, optional
+        Further numeric attributes to tabulate as data variables along ``sample``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension ``sample`` with the ``index`` coordinates, the data variables ``N``, ``d``,
+        ``phi`` and ``variables`` (where every member has them), ``radius_min``,
+        ``radius_max``, ``radius_mean`` (sphere members), the stacked ``position``,
+        ``radius``, ``semiaxis``, ``quaternion``, ``angle``, ``lattice`` when all members have
+        the same N and d, and the attributes ``hardpack_kind`` = "ensemble" and ``index``.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``sources`` is empty, or the members do not belong together (as listed above).
+    StoreError
+        If a member is unreadable, has no ``hardpack_kind`` or lacks an ``index`` attribute.
     """
     dsets, names = [], []
     for src in sources:

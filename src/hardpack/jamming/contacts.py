@@ -2,8 +2,8 @@
 
 A pair {i, j} (any periodic image n, including a particle's own image in small cells) is a
 potential contact when ``|r_ij| <= (1 + delta) D_ij`` with ``D_ij = r_i + r_j``
-(Donev dissertation Eq. 4.5, seeds/000_chapters/ch04-05.txt L338-L346; the polydisperse
-D_ij is the note's [rec], 000_ch4-5_jamming.md sec. 2.1). Periodic images follow L887-L894:
+(Donev 2006, dissertation Eq. 4.5, written there for monodisperse D; the polydisperse
+D_ij = (D_i + D_j)/2 is the one of sec. 4.5.1.1). Periodic images follow sec. 4.4.3:
 a contact between i and the image of j shifted by ``lattice @ n`` is stored as (i, j, n).
 
 Convention used throughout :mod:`hardpack.jamming`: positions are the packing's *wrapped*
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hardpack.errors import InvalidInputError
-from hardpack.geometry.neighbours import pairs_within
+from hardpack.geometry.neighbours import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
 
 
@@ -112,7 +112,27 @@ class ContactNetwork:
 
 
 def contact_network(packing: Packing, delta: float) -> ContactNetwork:
-    """All potential contacts with relative gap <= delta (Eq. 4.5), with every periodic image."""
+    """All potential contacts with relative gap <= delta (Eq. 4.5), with every periodic image.
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell, without overlaps beyond its overlap tolerance.
+    delta : float
+        Relative gap tolerance, 0 < delta < 1: pairs with |r_ij| <= (1 + delta) D_ij are contacts.
+
+    Returns
+    -------
+    ContactNetwork
+        The contacts (i, j, image shift n) with their separations, distances and contact
+        distances, the wrapped positions and the lattice.
+
+    Raises
+    ------
+    InvalidInputError
+        If packing is not a :class:`Packing` of hard spheres in a periodic cell, delta is not a
+        number with 0 < delta < 1, or the packing overlaps beyond its overlap tolerance.
+    """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
             f"expected a hardpack Packing, got {type(packing).__name__}; build one with "
@@ -127,10 +147,6 @@ def contact_network(packing: Packing, delta: float) -> ContactNetwork:
             "Finish or repair the packing (e.g. rerun the generator to a higher pressure)"
         )
     pairs = pairs_within(packing, rel_gap=delta)
-    x = packing.fractional() @ packing.lattice.T
-    if packing.is_orthorhombic:  # the same guard as pairs_within's periodic tree
-        box = np.diag(packing.lattice)
-        x = np.where(x >= box, 0.0, x)
     return ContactNetwork(
         i=pairs.i.astype(np.int64),
         j=pairs.j.astype(np.int64),
@@ -138,7 +154,7 @@ def contact_network(packing: Packing, delta: float) -> ContactNetwork:
         separation=pairs.separation,
         distance=pairs.distance,
         contact_distance=pairs.contact,
-        positions=x,
+        positions=wrapped_positions(packing),
         lattice=np.array(packing.lattice, dtype=float),
         delta=delta,
     )

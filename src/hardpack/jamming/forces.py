@@ -5,14 +5,14 @@ Forces: two LPs on the backbone's equilibrium matrix A (particle rows only, fixe
 1. Jamming-gap LP: ``mu* = min h^T f  s.t.  A f = 0, f >= 0, D^T f = 1``. It is the dual of
    "grow every diameter by the largest common factor 1 + mu with linearised contacts",
    ``max mu  s.t.  A^T dR >= mu D - h`` (the growth LP behind SLP/CALiPPSO; Donev's estimate
-   Eq. 5.19, seeds/000_chapters/ch04-05.txt L3527-L3531, up to its normalisation), so f is the
+   Eq. 5.19 in Donev 2006, dissertation sec. 5.5.5.2, up to its normalisation), so f is the
    force network the packing would carry at the jamming point it is closest to. Because
    A f = 0, f^T h does not change when particles move inside their cage, so mu* does not depend
    on where the snapshot sits in the cage.
 2. Among optimal f (h^T f <= mu* (1 + 1e-6) + 1e-14 D), the most uniform one:
-   ``max t  s.t.  f >= t`` -- Donev's self-stress LP (5.9), L3114-L3127. For an isostatic
+   ``max t  s.t.  f >= t`` -- Donev's self-stress LP (5.9), sec. 5.5.1.1. For an isostatic
    backbone both LPs return the unique self-stress; for crystals (h = 0) step 2 picks uniform
-   forces. t > 0 certifies a strict self-stress (L3160-L3165).
+   forces. t > 0 certifies a strict self-stress (sec. 5.5.1.1).
 
 When the backbone is rigid with few self-stresses (K = M - d(N_b - 1) <= 12, one of them
 positive), both LPs are solved in the K coordinates of the self-stress basis from one sparse LU
@@ -25,14 +25,14 @@ over the backbone contacts.
 Statics (each checked by the tests):
 
 - virial ``p V = (1/d) sum_c f_c |r_c|``, stress ``sigma = (1/V) sum_c f_c |r_c| u u^T``
-  (Eq. 4.24, L1325-L1351); with balanced forces this equals the boundary form (4.23).
+  (Eq. 4.24, sec. 4.4.6.2); with balanced forces this equals the boundary form (4.23).
 - free-volume reduced pressure ``p = PV/(NkT) = (N_b - 1) / (N mu*)``: for homogeneous gaps the
   basin {A^T dR >= -h} scales like mu*, its volume like mu*^(d (N_b - 1)), and a relative length
   dilation eps raises mu* by eps, so beta P = d(N_b - 1) / (d V mu*) (derived here; to first order
   it is Salsburg-Wood / Donev Eq. 1.1 and 5.24, p = d / (1 - phi/phi_J) with 1 - phi/phi_J = d mu*).
   It is exact for uniformly shrunk jammed packings; for thermal snapshots with very unequal gaps the
   basin is not a scaled copy of itself and the estimate is only indicative.
-- isostaticity counts (Eqs. 4.8, 4.9, L497-L535): N_f = d(N_b - 1) in a fixed cell and
+- isostaticity counts (Eqs. 4.8, 4.9, sec. 4.3.1.1): N_f = d(N_b - 1) in a fixed cell and
   N_f + d(d+1)/2 - 1 with a deformable cell; an isostatic backbone has M_b = N_f + 1, and
   ``gap = M_b - N_f - 1`` is 0 (isostatic), > 0 (hyperstatic) or < 0 (hypostatic).
 """
@@ -71,7 +71,27 @@ def backbone_rows(net: ContactNetwork, backbone: np.ndarray, contacts: np.ndarra
 
 
 def self_stress(net: ContactNetwork, backbone: np.ndarray) -> Forces:
-    """Forces of the backbone from the two LPs of the module docstring, polished to round-off."""
+    """Forces of the backbone from the two LPs of the module docstring, polished to round-off.
+
+    Donev 2006, sec. 5.5.1.1 (LP 5.9) after the jamming-gap LP; a rigid backbone with few
+    self-stresses is solved in the self-stress basis.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of the packing.
+    backbone : numpy.ndarray of bool, shape (N,)
+        The rattler-free backbone; only contacts among its particles carry force.
+
+    Returns
+    -------
+    Forces
+        ``forces`` (M,): 0 off the backbone, mean 1 over the backbone contacts; ``min_force``
+        the optimum t of LP 5.9 relative to the mean force (> 0 certifies a strict
+        self-stress); ``jamming_gap`` mu*; ``imbalance`` (N, d) the net contact force on each
+        particle; ``exists`` False (forces 0, NaN numbers) when the backbone has no contacts or
+        admits no non-negative self-stress.
+    """
     n, d = net.n_particles, net.dim
     contacts = net.among(backbone)
     m = int(contacts.sum())
@@ -261,7 +281,33 @@ def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: f
             counted: np.ndarray | None = None) -> Statics:
     """Counts over the backbone contacts in ``counted`` (default all; :func:`verify` leaves out
     the near contacts that only carry the forces of the nearest jamming point), pressures over
-    every contact with a force."""
+    every contact with a force.
+
+    Formulas in the module docstring (Donev 2006, Eqs. 4.8, 4.9, 4.24).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of the packing.
+    backbone : numpy.ndarray of bool, shape (N,)
+        The rattler-free backbone.
+    forces : Forces
+        Its self-stress (:func:`self_stress`), mean 1 over the backbone contacts.
+    volume : float
+        Volume V of the cell.
+    counted : numpy.ndarray of bool, shape (M,), optional
+        The contacts that count for M_b, Z and the isostaticity gaps (default all).
+
+    Returns
+    -------
+    Statics
+        ``n_backbone`` N_b, ``n_contacts`` M_b, ``z_mean`` 2 M_b / N_b, ``n_dof_collective``
+        d (N_b - 1), ``n_dof_strict`` (+ d(d+1)/2 - 1), ``isostaticity_gap`` and
+        ``isostaticity_gap_strict`` (M_b - N_f - 1), ``pressure_virial`` and ``stress`` (d, d)
+        (forces of mean 1; NaN without forces), ``jamming_gap`` mu* and
+        ``pressure_free_volume`` (N_b - 1) / (N mu*) = PV/(NkT) (inf for mu* = 0, NaN without
+        forces). An empty backbone gives zero counts and NaN Z.
+    """
     d, n = net.dim, net.n_particles
     contacts = net.among(backbone)
     nb = int(backbone.sum())

@@ -1,6 +1,6 @@
 """Algorithm 13 (randomised LP test for ideal packings): collective or strict jamming.
 
-Donev dissertation sec. 4.6.1, seeds/000_chapters/ch04-05.txt L1649-L1677:
+Donev 2006, dissertation sec. 4.6.1 (Algorithm 13):
 
 1. collective: strain fixed at 0; strict: strain variables and Tr eps <= 0 (LP 4.10 + 4.17);
 3. no particles left -> not jammed;
@@ -14,7 +14,7 @@ Donev dissertation sec. 4.6.1, seeds/000_chapters/ch04-05.txt L1649-L1677:
 
 Displacements are measured *relative to the bulk*: the LP pins the mean displacement, and the
 componentwise median over the tested particles is then subtracted (translations are trivial
-motions, L562-L569). The median is used instead of the mean so that a large rattling cluster
+motions, sec. 4.3.2). The median is used instead of the mean so that a large rattling cluster
 does not make the whole backbone look displaced. In the strict test the measured displacement
 is the non-affine part dr_i - eps x_i (gauge independent: a different choice of the periodic
 image of particle i shifts both terms by eps Lambda m). A strain with
@@ -92,7 +92,39 @@ def ideal_test(
     rng: np.random.Generator,
     max_rounds: int = 100,
 ) -> TestOutcome:
-    """Algorithm 13 on the particles ``start`` (already free of rattlers, or not)."""
+    """Algorithm 13 on the particles ``start`` (already free of rattlers, or not).
+
+    Donev 2006, sec. 4.6.1; the steps and the measure of displacement are in the module
+    docstring.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of the packing (:func:`hardpack.jamming.contacts.contact_network`).
+    start : numpy.ndarray of bool, shape (N,)
+        The particles to test; rattlers among them are removed first (not modified in place).
+    strict : bool
+        False: collective test (fixed cell); True: strict test (strain variables with
+        Tr eps <= 0, LP 4.10 + 4.17).
+    dr_large : float
+        Displacement (absolute length) from which a particle counts as displaced (step 7), and
+        from which a strain with |eps|_2 times the longest lattice vector unjams the cell.
+    box : float
+        Bound on each displacement component in the LPs (absolute length).
+    rng : numpy.random.Generator
+        Source of the random loads.
+    max_rounds : int, default 100
+        Most rounds of loads B, -B (steps 3-9) before giving up with "not jammed".
+
+    Returns
+    -------
+    TestOutcome
+        ``jammed`` and the jammed subpacking ``backbone`` (N,), the largest relative
+        displacement of each particle over all loads ``displacement`` (N,; NaN untested), the
+        first unjamming ``motion`` (N, d) and its ``strain`` (strict test), per-LP ``loads``,
+        ``n_lp``, ``seconds``, and ``undetermined`` with the reason when an LP's strain violates
+        the volume constraint beyond its accuracy (then ``jammed`` is False).
+    """
     t0 = time.perf_counter()
     n, d = net.n_particles, net.dim
     length = cell_length(net.lattice)

@@ -2,7 +2,7 @@
 
 Generic disordered packings from LS / MD have, after rattler removal, a backbone that is rigid
 (rank A' = N_f = d(N_b - 1); A' is A without one "anchor" particle's rows, which fixes the
-translation) with M = N_f + K contacts, K small (K = 1: isostatic, Eq. 4.8, L497-L535; a few
+translation) with M = N_f + K contacts, K small (K = 1: isostatic, Donev 2006, Eq. 4.8; a few
 more with near contacts inside delta). Then every LP the tests need reduces, through one sparse
 LU factorisation, to an LP in K unknowns. Derivations (ours):
 

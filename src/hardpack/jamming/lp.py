@@ -3,15 +3,16 @@
     max  B^T dR + b_eps^T eps        (virtual work of a random load)
     s.t. A^T (dR, eps) >= -h          (linearised impenetrability, Eq. 4.7)
          Tr eps <= 0                  (volume non-increasing, Eq. 4.17/4.19; strict test only)
-         |dR| <= box, |eps| <= box/L  (keeps the LP bounded; footnote 8, L584-L585)
-         dr_a = 0 for one "anchor" particle a   (removes the trivial translation, L562-L569)
+         |dR| <= box, |eps| <= box/L  (keeps the LP bounded; sec. 4.3.2, footnote 8)
+         dr_a = 0 for one "anchor" particle a   (removes the trivial translation, sec. 4.3.2)
 
-(seeds/000_chapters/ch04-05.txt L539-L597, L944-L1037). Only the ``moving`` particles carry
+(Donev 2006, dissertation secs. 4.3.2 and 4.4.5). Only the ``moving`` particles carry
 displacement variables; particles in ``fixed`` stay put but still constrain their moving
-neighbours (Donev L880-L885). One moving particle is anchored (fixed), which removes the
-translations (L562-L569, option b; fixed particles such as rattlers alone would leave them to
-the rattlers' cages); the solution differs from a mean-pinned one only by a translation, which
-the callers remove (componentwise median), and no dense pinning row is needed.
+neighbours (Donev 2006, sec. 4.4.3). One moving particle is anchored (fixed), which removes
+the translations (sec. 4.3.2, the text's alternative of fixing one sphere; fixed particles such as
+rattlers alone would leave them to the rattlers' cages); the solution differs from a mean-pinned
+one only by a translation, which the callers remove (componentwise median), and no dense pinning
+row is needed.
 
 Solvers: :mod:`hardpack.jamming.workingset` (sparse LU of the contact core + a small LP,
 exact; 10-30 times faster than HiGHS on jammed packings, and warm-started from the previous LP
@@ -19,7 +20,7 @@ of a test via ``warm``) first. A strict LP without a warm start goes through a c
 the strain bound (:func:`_strain_continuation`): its optimum shears a fixed-cell packing until
 hundreds of near contacts close, far from the contact core where a cold working set starts.
 HiGHS solves the full LP when the working set gives up, in the dual, force formulation
-(Eq. 4.12, L626-L653) with the box turned into penalised slack loads:
+(Eq. 4.12, sec. 4.3.2.2) with the box turned into penalised slack loads:
 
     min h^T f + box 1^T (z+ + z-)  s.t.  -A f [+ p Tr] + z+ - z- = (B, b_eps),  f, p, z >= 0,
 
@@ -223,7 +224,7 @@ def _highs_motion(g: sp.csc_matrix, h: np.ndarray, c: np.ndarray, upper: np.ndar
 
 
 def random_load(rng: np.random.Generator, mask: np.ndarray, d: int) -> np.ndarray:
-    """Gaussian load on the particles in ``mask`` with zero net force (note sec. 2.4 [rec])."""
+    """Gaussian load on the particles in ``mask`` with zero net force (as Donev 2006, sec. 4.3.2, suggests)."""
     load = np.zeros((mask.size, d))
     k = int(mask.sum())
     if k:

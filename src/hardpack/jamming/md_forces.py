@@ -1,7 +1,7 @@
-"""LP contact forces against the time-averaged contact forces the MD measured (issue 4).
+"""LP contact forces against the time-averaged contact forces the MD measured.
 
 Near jamming the collision impulses a pair exchanges, averaged over time, are the contact force of
-the packing up to one common factor (Donev ch. 1 L102-105, L126-130; hardpack.md.contacts). The LP
+the packing up to one common factor (Donev 2006, sec. 1.1 and Fig. 1.1; hardpack.md.contacts). The LP
 self-stress of an isostatic backbone is unique up to the same factor, so the two force networks
 must agree contact by contact once that factor is fitted:
 

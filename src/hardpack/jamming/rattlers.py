@@ -1,6 +1,6 @@
 """Local jamming and iterative rattler removal (Donev Alg. 13 step 4, LP 4.15).
 
-Source: seeds/000_chapters/ch04-05.txt L906-L931 and L1649-L1662. A particle is locally jammed
+Source: Donev 2006, dissertation secs. 4.4.3.1 (LP 4.15) and 4.6.1 (Algorithm 13). A particle is locally jammed
 when it cannot move while every other particle (including its own periodic images) stays
 fixed. For sphere i with contact normals u_k (towards the neighbours) and gaps h_k the local
 LP (4.15) is
@@ -8,16 +8,16 @@ LP (4.15) is
     max b_i^T dr_i   s.t.  u_k^T dr_i <= h_k for every contact k,   |dr_i| <= box,
 
 and i is a rattler when ``|dr_i| >= dr_large``. We use two random loads of opposite direction
-(the text's option for packings with gaps, L920-L921), which for an ideal packing (h = 0) finds
+(the text's option for packings with gaps, sec. 4.4.3.1), which for an ideal packing (h = 0) finds
 an escape direction with probability one whenever one exists (recession-cone argument,
-L672-L681). The LPs of all tested particles are independent, so they are solved as one
+sec. 4.3.2.3). The LPs of all tested particles are independent, so they are solved as one
 block-separable HiGHS LP per round (both loads in the same LP).
 
 Removing a rattler removes its contacts, which can unjam its neighbours, so the test repeats on
-the neighbours of removed particles until nothing changes (L922-L927). Because removing
+the neighbours of removed particles until nothing changes (sec. 4.4.3.1). Because removing
 particles only relaxes the others' constraints, removing a whole round's rattlers at once
 gives the same final set as the text's one-at-a-time stack. The cheap rule "fewer than d + 1
-contacts" (d vectors cannot positively span R^d, L908-L911) runs first and needs no LP.
+contacts" (d vectors cannot positively span R^d, sec. 4.4.3.1) runs first and needs no LP.
 """
 
 from __future__ import annotations
@@ -83,10 +83,34 @@ def remove_rattlers(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Iteratively remove particles that are not locally jammed.
 
-    Returns (active mask after removal, per-particle local escape displacement; NaN where not
-    measured). ``recheck`` restricts the first LP round to these particles (default: all
-    active ones); later rounds test the neighbours of removed particles. With
-    ``use_lp=False`` only the contact-count rule is applied.
+    Donev 2006, sec. 4.4.3.1 (LP 4.15) and Algorithm 13 step 4; see the module docstring. The
+    contact-count rule (fewer than d + 1 contacts) runs before every LP round.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of the packing.
+    active : numpy.ndarray of bool, shape (N,)
+        The particles present; not modified in place.
+    dr_large : float
+        Escape displacement (absolute length) from which a particle is a rattler.
+    box : float
+        Bound on each displacement component in the local LPs.
+    rng : numpy.random.Generator
+        Source of the random loads.
+    use_lp : bool, default True
+        With False only the contact-count rule is applied.
+    recheck : numpy.ndarray of bool, shape (N,), optional
+        Restricts the first LP round to these particles (default: all active ones); later
+        rounds test the neighbours of removed particles.
+
+    Returns
+    -------
+    active : numpy.ndarray of bool, shape (N,)
+        The particles left after removing the rattlers.
+    escape : numpy.ndarray of float, shape (N,)
+        Local escape displacement |dr_i| of each particle tested by an LP (the last one
+        measured); NaN where not measured.
     """
     d = net.dim
     active = active.copy()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -16,7 +17,22 @@ from hardpack.jamming.sequential import SequentialOutcome
 CATEGORIES = ("local", "collective", "strict")
 ADVERBS = {"local": "locally", "collective": "collectively", "strict": "strictly"}
 #: codes of a test's verdict in the dataset's attributes
-VERDICT_CODES = {True: 1, False: 0, None: -1, "undetermined": -2}
+
+
+class Verdict(enum.IntEnum):
+    """A jamming test's verdict as stored in datasets (netCDF has no booleans with a "not run")."""
+
+    JAMMED = 1
+    NOT_JAMMED = 0
+    NOT_RUN = -1
+    UNDETERMINED = -2  # the test ran but could not decide (the reason is stored beside it)
+
+    @classmethod
+    def of(cls, jammed: bool | None, undetermined: bool = False) -> Verdict:
+        """The code of a verdict (``jammed`` None: the test was not run)."""
+        if undetermined:
+            return cls.UNDETERMINED
+        return cls.NOT_RUN if jammed is None else cls.JAMMED if jammed else cls.NOT_JAMMED
 
 
 @dataclass
@@ -24,7 +40,7 @@ class JammingResult:
     """Everything :func:`verify` measured. ``None`` marks a test that was not run.
 
     - ``local``/``collective``/``strict``: True when a (sub)packing is jammed in that sense
-      (Donev L268-L285: a packing with a jammed backbone counts as jammed).
+      (Donev 2006, sec. 4.2.4.1: a packing with a jammed backbone counts as jammed).
     - ``rattler``: particles outside the backbone (local rattlers, plus rattling clusters the
       collective test removed when it found a jammed backbone).
     - ``network``: all contacts within delta; ``forces.forces`` is the backbone self-stress.
@@ -171,8 +187,8 @@ class JammingResult:
     def to_dataset(self) -> xr.Dataset:
         """Per-particle, per-contact and scalar results (dims 'particle', 'contact', 'dim').
 
-        Verdict attributes ``local``, ``collective``, ``strict``: 1 jammed, 0 not jammed, -1 not
-        run, -2 undetermined (the reason in ``<test>_undetermined``); ``fallback_<name>``: the
+        Verdict attributes ``local``, ``collective``, ``strict``: the codes of :class:`Verdict` (1 jammed,
+        0 not jammed, -1 not run, -2 undetermined, the reason in ``<test>_undetermined``); ``fallback_<name>``: the
         count of each numerical fallback (:data:`FALLBACKS`), 0 when it did not happen."""
         net, d = self.network, self.network.dim
         data = {
@@ -199,7 +215,7 @@ class JammingResult:
         s = self.statics
         attrs = dict(
             hardpack_kind="jamming", verdict=self.category,
-            **{k: VERDICT_CODES["undetermined" if k in self.undetermined else v] for k, v in self.verdicts.items()},
+            **{k: int(Verdict.of(v, k in self.undetermined)) for k, v in self.verdicts.items()},
             **{f"{k}_undetermined": reason for k, reason in self.undetermined.items()},
             **{f"fallback_{k}": int(v) for k, v in self.fallbacks.items()},
             **{k: v for k, v in self.params.items() if v is not None},

@@ -1,7 +1,8 @@
 """The rigidity matrix A of a periodic contact network, as a scipy.sparse matrix.
 
-Donev dissertation sec. 4.4.3 (seeds/000_chapters/ch04-05.txt L415-L493, PBC L871-L897,
-strain L944-L1126). A has one column per contact and one row per degree of freedom:
+Donev 2006, dissertation sec. 4.4.3 (the rigidity matrix of sec. 4.3.1, periodic boundaries in
+sec. 4.4.3, the strain in secs. 4.4.5.1-4.4.5.2). A has one column per contact and one row per
+degree of freedom:
 
 - particle rows (d per particle, row ``i*d + k``): column {i, j} holds ``-u_ij`` in block i and
   ``+u_ij`` in block j, with u_ij the unit vector from i to (the image of) j. The text writes
@@ -29,7 +30,19 @@ from hardpack.jamming.contacts import ContactNetwork
 
 
 def strain_pairs(d: int) -> list[tuple[int, int]]:
-    """Index pairs (p, q) of the independent strain components: diagonal, then p < q."""
+    """Index pairs (p, q) of the independent strain components: diagonal, then p < q.
+
+    Parameters
+    ----------
+    d : int
+        The dimension.
+
+    Returns
+    -------
+    list of tuple of int
+        The d(d+1)/2 pairs (0, 0), ..., (d-1, d-1), then (p, q) with p < q in row order: the
+        order of the strain rows of :func:`rigidity_matrix`.
+    """
     return [(p, p) for p in range(d)] + [(p, q) for p in range(d) for q in range(p + 1, d)]
 
 
@@ -89,5 +102,22 @@ def anchored_transpose(net: ContactNetwork, backbone: np.ndarray,
 
 
 def rigidity_matrix(net: ContactNetwork, strain: bool = False) -> sp.csc_matrix:
-    """The rigidity matrix A, shape (N d [+ d(d+1)/2], M); see the module docstring."""
+    """The rigidity matrix A, shape (N d [+ d(d+1)/2], M); see the module docstring.
+
+    Donev 2006, sec. 4.4.3 (Eqs. 4.18-4.21 for the strain rows).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contacts of a periodic packing.
+    strain : bool, default False
+        Add the d(d+1)/2 rows of the symmetric strain components (order of
+        :func:`strain_pairs`).
+
+    Returns
+    -------
+    scipy.sparse.csc_matrix, shape (N d [+ d(d+1)/2], M)
+        One column per contact: -u_ij in the rows of particle i, +u_ij in those of j (zero for
+        a self-image contact), and the strain derivatives of the contact length when ``strain``.
+    """
     return rigidity_transpose(net, strain).T.tocsc()

@@ -1,22 +1,22 @@
 """Algorithm 14 (sequential random loading) for packings with gaps, e.g. finite-rate LS packings.
 
-Donev dissertation sec. 4.6.2, seeds/000_chapters/ch04-05.txt L1678-L1814:
+Donev 2006, dissertation sec. 4.6.2 (Algorithm 14):
 
 3. rattlers are marked (iterative local test) and kept as fixed obstacles (no load on them;
-   the text keeps them as constraints, L1743-L1753; fixing them avoids the spurious
-   large rattler displacements the text warns about, L1746-L1751);
+   the text keeps them as constraints, sec. 4.6.2.2; fixing them avoids the spurious
+   large rattler displacements the text warns about there);
 4. random load B (zero on rattlers);
 5. solve LP 4.10 (+ 4.17 for the strict test) for a linearised motion (dR, eps);
-   The LP box (|dr| <= box, footnote 8) is at most delta r_min, the trust region of the
+   The LP box (|dr| <= box, sec. 4.3.2, footnote 8) is at most delta r_min, the trust region of the
    linearised neighbour list: a longer LP motion could not be taken in step 6 anyway;
 6. move along it as far as possible: the largest tau such that no pair overlaps for
    t in [0, tau] (quadratic collision times of the straight-line motion, as in LS collision
-   scheduling, L1754-L1774), no pair outside the contact list can collide (every particle
+   scheduling, sec. 4.6.2.3), no pair outside the contact list can collide (every particle
    moves less than the list's gap delta D_min), and det(I + tau eps) <= 1; then
    R <- R + tau dR, Lambda <- (I + tau eps) Lambda, and the contact network is rebuilt;
 7. repeat 5-6 while some particle moved by more than beta D (at most ``max_steps`` LPs);
 9. the same with -B; 10. ``n_loads`` loads in all (the text used 3 loads x 2 directions x 3 LPs,
-   L2074-L2081), and, as step 10 says, stop with "not jammed" as soon as the displacement
+   sec. 4.7.2.2), and, as step 10 says, stop with "not jammed" as soon as the displacement
    accumulated in a sequence exceeds the threshold (a valid packing that far from the start
    certifies the verdict; the remaining loads could only add statistics).
 
@@ -33,7 +33,7 @@ sequences 2-6 took 530-850 s there, against 45-52 s at the given packing (measur
 The contact list must reach beyond the gaps that matter: step 6 moves no particle by more than
 delta D_min / 2 per LP, so a sequence can never displace anything by more than
 max_steps delta D_min / 2 and a small delta makes the test unable to fail (:func:`verify`
-refuses such settings; Donev uses delta = 0.1-1, L1729-L1738). The LPs are solved by
+refuses such settings; Donev uses delta = 0.1-1, sec. 4.6.2.1). The LPs are solved by
 :mod:`hardpack.jamming.workingset`; within a sequence each warm-starts from the previous one's
 basis, and the first starts from the smallest gaps (a strict one through :func:`solve_motion`'s
 strain continuation: its optimum shears the cell and closes hundreds of near contacts).
@@ -41,16 +41,16 @@ strain continuation: its optimum shears the cell and closes hundreds of near con
 The statistic reported (Tables 4.2-4.7) is the displacement |dr_i| accumulated over one loading
 sequence (one load direction), relative to the bulk (componentwise median over the non-rattlers
 subtracted), in units of the mean diameter, averaged over the non-rattlers (rattlers are fixed
-and excluded; Donev's tables include them, L2280-L2290). In the strict test dr_i includes the
+and excluded; Donev's Table 4.5 includes them, sec. 4.7.2.3). In the strict test dr_i includes the
 affine part of a cell deformation, as the LP variables of the text do. The strain accumulated
 over the sequence, |eps|_2 (the largest relative displacement the cell deformation gives two
 touching particles, in units of their distance D), counts as well: with one particle per cell,
 e.g. the square or simple cubic lattice sheared at decreasing volume (Donev Table 4.1: not
 strictly jammed), that particle is its own bulk and no displacement relative to the bulk can
-see the cell deform. The strain does not depend on the supercell (L1216-L1303), where the
+see the cell deform. The strain does not depend on the supercell (secs. 4.4.5.4-4.4.6), where the
 affine part of the mean displacement grows with the cell. The verdict is "jammed" when no
 sequence reaches ``threshold`` with its mean displacement or its strain (a judgement, as the
-text says, L1789-L1814). It is undetermined (reported with the reason) when no sequence
+text says, sec. 4.6.2.5). It is undetermined (reported with the reason) when no sequence
 reached it but one could not go on: a step that keeps overlapping after MAX_HALVINGS halvings,
 or an LP strain that violates Tr eps <= 0 beyond the LP's accuracy (:class:`VolumeIncrease`).
 
@@ -218,6 +218,49 @@ def sequential_test(
     dict of arrays and scalars; passing such a dict back as ``resume`` (same packing, rng seed and
     parameters) continues after that sequence, with the same loads, so the outcome is that of
     an uninterrupted test.
+
+    Parameters
+    ----------
+    packing : Packing
+        The periodic sphere packing to load; every loading sequence starts from it.
+    delta : float
+        Relative gap tolerance of the contact list; also bounds each LP step by delta r_min.
+    strict : bool
+        False: collective test (fixed cell); True: strict test (strain with Tr eps <= 0).
+    rattlers : numpy.ndarray of bool, shape (N,)
+        Particles kept as fixed obstacles, without load.
+    rng : numpy.random.Generator
+        Source of the random loads (all ``n_loads`` drawn first).
+    box : float
+        Bound on each displacement component in the LPs (capped at delta r_min).
+    threshold : float, default 1e-3
+        Mean displacement / D (or strain |eps|_2) from which a sequence unjams the packing.
+    beta : float, default 0.01
+        A sequence stops once no particle moved by more than beta D in its last step.
+    n_loads : int, default 3
+        Random loads; each is applied as B and -B.
+    max_steps : int, default 3
+        Most LPs per loading sequence.
+    resume : dict, optional
+        A state received by ``save`` to continue from.
+    save : callable, optional
+        Called with the test's state (a dict) after each loading sequence.
+    workers : int, default 1
+        Loading sequences run at once in worker processes.
+
+    Returns
+    -------
+    SequentialOutcome
+        ``jammed``, per-sequence ``mean_displacement``, ``strain_norm``, ``max_displacement``
+        and ``steps``, the per-particle largest ``displacement`` / D, the ``motion`` and
+        ``strain`` of the sequence with the largest mean displacement, the ``final`` packing,
+        LP counts, ``seconds``, ``fallbacks`` and ``undetermined`` with the reason when a
+        sequence could not go on (then ``jammed`` is False).
+
+    Raises
+    ------
+    InvalidInputError
+        If ``resume`` is a state of another layout (saved by an older hardpack).
     """
     t0 = time.perf_counter()
     n, d = packing.n_particles, packing.dim

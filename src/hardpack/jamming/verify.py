@@ -1,6 +1,6 @@
 """verify(packing): the full jamming verdict of a periodic sphere packing.
 
-Steps (Donev dissertation ch. 4, seeds/000_chapters/ch04-05.txt):
+Steps (Donev 2006, dissertation ch. 4):
 1. contact network within the relative gap ``delta`` (Eq. 4.5; sequential method:
    ``contact_delta``), all periodic images;
 2. local test and iterative rattler removal (LP 4.15, Alg. 13 step 4) -- always run, since
@@ -11,7 +11,7 @@ Steps (Donev dissertation ch. 4, seeds/000_chapters/ch04-05.txt):
    finite-rate packings with gaps; the verdict thresholds the mean displacement). The
    strict test starts from the collectively jammed backbone when there is one; with the ideal
    method, a packing without one is not strictly jammed either (strict implies collective,
-   L165-L166) and no strict LP is solved;
+   sec. 4.2.2) and no strict LP is solved;
 4. self-stress forces, contact number, isostaticity and pressure of the backbone
    (:mod:`hardpack.jamming.forces`); a backbone without a self-stress gets the forces of the
    nearest jamming point (near contacts within ``force_delta`` that close there carry force).
@@ -47,7 +47,7 @@ METHODS = ("ideal", "sequential")
 #: contact tolerance of the ideal test (LS packings at high pressure: contacts ~1e-12, the next
 #: neighbours ~1e-6 and beyond) and of the contacts counted for Z, isostaticity and forces
 DEFAULT_DELTA = 1e-6
-#: neighbour-list tolerance of the sequential test: Donev's 0.1-1 D (L1729-L1738), the first
+#: neighbour-list tolerance of the sequential test: Donev's 0.1-1 D (Donev 2006, sec. 4.6.2.1), the first
 #: coordination shell; each LP may then move a particle by up to delta D_min / 2 = 0.05 D
 SEQUENTIAL_DELTA = 0.1
 
@@ -124,36 +124,69 @@ def verify(
 
     Parameters
     ----------
-    delta : relative gap tolerance for contacts, 0 < delta < 1; default DEFAULT_DELTA (1e-6)
+    packing : Packing
+        A periodic sphere packing without overlaps.
+    delta : float, optional
+        Relative gap tolerance for contacts, 0 < delta < 1; default DEFAULT_DELTA (1e-6)
         for the ideal method and SEQUENTIAL_DELTA (0.1) for the sequential one, whose
         neighbour list must reach the near contacts a loading sequence can close.
-    tests : any of "local", "collective", "strict" (local always runs: the others need it).
-    seed : seed of the random loads (results are reproducible for a given seed).
-    method : "ideal" (Algorithm 13) or "sequential" (Algorithm 14).
-    dr_large : displacement (absolute length) above which a particle counts as displaced in
+    tests : str or sequence of str, default ("local", "collective", "strict")
+        Any of "local", "collective", "strict" (local always runs: the others need it).
+    seed : int, default 0
+        Non-negative seed of the random loads (results are reproducible for a given seed).
+    method : {"ideal", "sequential"}, default "ideal"
+        "ideal" (Algorithm 13) or "sequential" (Algorithm 14).
+    dr_large : float, optional
+        Displacement (absolute length) above which a particle counts as displaced in
         the ideal test and the local test; default delta (sequential: contact_delta) times the
-        mean diameter (Alg. 13 step 2, "delta D ~ dr_large").
-    box : bound on each displacement component in the LPs; default the mean diameter.
-    threshold, n_loads, max_steps, beta : sequential test only (mean displacement / D above
-        which the packing is called unjammed; loads; LPs per load direction; step size / D
-        below which a loading sequence stops).
-    md_pressure : reduced pressure PV/(NkT) measured by the generator, compared with the
+        mean diameter (Alg. 13 step 2, "delta D ~ dr_large"). Must be below ``box``.
+    box : float, optional
+        Bound on each displacement component in the LPs; default the mean diameter.
+    threshold, n_loads, max_steps, beta : float, int, int, float
+        Sequential test only (mean displacement / D above which the packing is called
+        unjammed, default 1e-3; loads, default 3; LPs per load direction, default 3; step
+        size / D below which a loading sequence stops, default 0.01).
+    md_pressure : float, optional
+        Reduced pressure PV/(NkT) measured by the generator, compared with the
         free-volume pressure from the forces.
-    contact_delta : gap tolerance of the contacts that define the rattlers (the local test),
+    contact_delta : float, optional
+        Gap tolerance of the contacts that define the rattlers (the local test),
         Z, isostaticity and forces with ``method="sequential"``, whose ``delta`` (0.1-1, Donev
-        L1729-L1738) includes near neighbours on purpose; default min(delta, 1e-6). The ideal
+        2006, sec. 4.6.2.1) includes near neighbours on purpose; default min(delta, 1e-6). The ideal
         method uses ``delta``. Rattlers stay fixed obstacles in the sequential LPs.
-    force_delta : when the backbone has no self-stress at the contact tolerance (a hypostatic
+    force_delta : float, optional
+        When the backbone has no self-stress at the contact tolerance (a hypostatic
         finite-pressure packing), the forces are those of the nearest jamming point, found on
         the contacts within this tolerance (default SEQUENTIAL_DELTA, the first shell; see
         :func:`hardpack.jamming.forces.jamming_point_forces`). The result's network then also
         holds the near contacts that carry force; Z and the isostaticity counts leave them out.
-    checkpoint : sequential method only: path of a checkpoint written after every loading
+    checkpoint : str or os.PathLike, optional
+        Sequential method only: path of a checkpoint written after every loading
         sequence (:mod:`hardpack.io.checkpoint`); a killed verification started again with the
         same arguments resumes from it and gives the result of an uninterrupted one. It is
         removed when the verification ends.
-    workers : sequential method only: loading sequences run at once, each in its own process
+    workers : int, default 1
+        Sequential method only: loading sequences run at once, each in its own process
         (they are independent; the result does not depend on this number).
+
+    Returns
+    -------
+    JammingResult
+        The verdicts ``local``, ``collective``, ``strict`` (None: not run or undetermined, with
+        the reason in ``undetermined``), the contact ``network``, the ``rattler`` mask, the
+        backbone ``forces`` and ``statics``, the test outcomes, ``params``, ``seconds`` and the
+        ``fallbacks`` counts; :meth:`JammingResult.to_dataset` stores it.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``packing`` is not a periodic sphere Packing or overlaps; ``method`` or a test name
+        is unknown; ``delta``, ``contact_delta`` or ``force_delta`` is not in (0, 1); ``seed``
+        is not a non-negative integer; ``dr_large``, ``box``, ``threshold``, ``beta`` or
+        ``md_pressure`` is not a positive finite number; ``n_loads``, ``max_steps`` or
+        ``workers`` is not a positive integer; dr_large >= box; the sequential test could never
+        reach ``threshold`` (max_steps * delta * r_min < threshold D); or ``checkpoint`` is
+        given with the ideal method.
     """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
@@ -239,7 +272,7 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
             collective = ideal_test(net, local_active, strict=False, dr_large=dr_large, **common)
             seconds["collective"] = collective.seconds
         if "strict" in tests and collective is not None and not collective.jammed:
-            # strict jamming implies collective jamming (L165-L166): no LP needed
+            # strict jamming implies collective jamming (Donev 2006, sec. 4.2.2): no LP needed
             strict = replace(collective, test="strict", method="implied by the collective test",
                              n_lp=0, seconds=0.0, loads=[])
             seconds["strict"] = 0.0

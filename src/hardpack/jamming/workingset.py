@@ -6,7 +6,7 @@ The LP of :mod:`hardpack.jamming.lp`, written with one list of constraint column
 
 where the columns are the contacts (a_j = column of A restricted to the variables, h_j = gap),
 the volume constraint of the strict test (a = -trace, h = 0) and the box (-e_k and +e_k with
-h = the bound on |x_k|). Its dual is the force LP (Donev Eq. 4.12, L626-L653):
+h = the bound on |x_k|). Its dual is the force LP (Donev 2006, Eq. 4.12, sec. 4.3.2.2):
 
     min h^T f   s.t.  sum_j f_j a_j = -c,  f >= 0.
 

@@ -16,9 +16,6 @@ import argparse
 import logging
 import sys
 
-import numpy as np
-import xarray as xr
-
 log = logging.getLogger(__name__)
 
 
@@ -75,13 +72,7 @@ def cmd_eos(args) -> int:
                            checkpoint_interval=args.checkpoint_interval).packing
     res = equilibrate(packing, args.seed, args.collisions, n_blocks=args.blocks, checkpoint=args.checkpoint,
                       checkpoint_interval=args.checkpoint_interval, keep_checkpoint=True)
-    ds = xr.Dataset({"Z_block": (("block",), res.Z_blocks)},
-                    coords={"block": np.arange(len(res.Z_blocks))})
-    ds.attrs.update(hardpack_kind="md_eos", Z=res.Z, Z_err=res.Z_err, phi=res.phi,
-                    N=packing.n_particles, d=packing.dim, collisions=res.collisions,
-                    md_time=res.md_time, wall_time=res.wall_time, seed=args.seed,
-                    init=str(args.init))
-    write_dataset(ds, args.out, seed=args.seed)
+    write_dataset(res.to_dataset(seed=args.seed, init=str(args.init)), args.out, seed=args.seed)
     for path in checkpoints:  # only now that the result is safely written
         ckpt.remove(path)
     log.info("wrote %s: phi=%.6f Z=%.5f +- %.5f", args.out, res.phi, res.Z, res.Z_err)

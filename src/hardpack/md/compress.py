@@ -1,6 +1,6 @@
 """Lubachevsky-Stillinger (LS) compression: event-driven MD with growing spheres.
 
-Protocol (Donev dissertation ch. 1, note 000_ch1-3_md.md sec. 2.1; Ogarko sec. 2.5): start from a
+Protocol (Donev 2006, dissertation secs. 1.1-1.2; Ogarko 2014, secs. 3.1.3 and 3.3.1): start from a
 non-overlapping packing, draw Maxwell-Boltzmann velocities (kT = m = 1), grow every radius in
 proportion to its size while running collision-driven MD, rescale velocities to kT = 1 at every
 synchronisation point, and stop at a reduced pressure (default 1e12), a volume fraction, a number
@@ -11,10 +11,10 @@ mean diameter in units of the thermal speed (kT = m = 1). Radii grow linearly in
 a_i(t) = a_i(0) (1 + 2 Gamma t / <D>(0)), so every particle keeps its size relative to the others.
 Conversions to the seeds' conventions:
 
-- Skoge/Donev ``growthrate`` g (PackLSD/"spheres" code, note 000 sec. 1): a RADIUS rate
+- Skoge/Donev ``growthrate`` g (the C++ "spheres" code of Skoge et al. 2006): a RADIUS rate
   dr/dt = g with velocities rescaled to <v^2> = 1, i.e. kT/m = 1/d:  Gamma = 2 sqrt(d) g.
-- Donev's text gamma (L2680, radius rate in units of sqrt(kT/m)): Gamma = 2 gamma; L436 uses a
-  diameter rate, for which Gamma = gamma.
+- Donev's text gamma (Donev 2006, sec. 3.3.1, radius rate in units of sqrt(kT/m)): Gamma = 2 gamma;
+  sec. 1.2.2 uses a diameter rate, for which Gamma = gamma.
 - Ogarko Gamma_O (Eq. 3.32: da_i/dt = Gamma_O (a_i/a_max) v0, v0 = sqrt(2E/(3M)) = sqrt(kT/m)
   in 3D): Gamma = 2 Gamma_O <a>/a_max (= 2 Gamma_O for monodisperse spheres).
 
@@ -52,9 +52,10 @@ of the target (the LS jamming density rises as the growth rate falls). A run sto
 ``backbone_volume_fraction`` and ``jamming_check``, and a warning when it fails).
 
 **Pressure.** Per window Z = pV/(NkT) = 1 + sum_coll r_ij . J_ij / (d N kT dt) with kT the
-window's time-averaged kinetic temperature (note sec. 2.5; Z = 1 + virial / (2 * integral of
-KE dt)); the running jamming-density estimate is phi_J_est = phi / (1 - d/Z), the free-volume form
-p = d / (1 - phi/phi_J) (Eqs. 1.1-1.2, L330-351).
+window's time-averaged kinetic temperature (derived here from the collisional stress of Donev 2006,
+sec. 3.2.4.2, plus the ideal-gas term: Z = 1 + virial / (2 * integral of KE dt)); the running
+jamming-density estimate is phi_J_est = phi / (1 - d/Z), the free-volume form
+p = d / (1 - phi/phi_J) (Donev 2006, Eqs. 1.1-1.2).
 """
 
 from __future__ import annotations
@@ -99,6 +100,25 @@ class StopCriteria:
     max_pressure: reduced pressure Z (growing runs only); target_phi: volume fraction (reached
     exactly: the last window ends when phi hits it); max_collisions: total collisions;
     max_wall_time: seconds of wall-clock time in this invocation. None disables a criterion.
+
+    Parameters
+    ----------
+    max_pressure : float or None, default 1e12
+        Stop when the window's reduced pressure Z = pV/(NkT) reaches it (growing runs only);
+        finite and > 1.
+    target_phi : float or None, default None
+        Stop when the volume fraction reaches it exactly, in (0, 1); above the start phi for a
+        positive growth rate, below it for a negative one (then required).
+    max_collisions : int or None, default None
+        Stop after this many collisions in all (a positive integer).
+    max_wall_time : float or None, default None
+        Stop after this many wall-clock seconds in this invocation (> 0).
+
+    Notes
+    -----
+    The values are checked against the growth rate and start phi by :meth:`check`, which
+    :func:`compress` calls and which raises InvalidInputError for impossible or never-ending
+    combinations.
     """
 
     max_pressure: float | None = 1e12
@@ -143,7 +163,27 @@ class StopCriteria:
 @dataclass
 class CompressResult:
     """Final packing, final velocities (m = 1, kT = 1), per-window time series, run stats and
-    optionally the MD contact forces."""
+    optionally the MD contact forces.
+
+    Attributes
+    ----------
+    packing : Packing
+        The final packing.
+    velocities : numpy.ndarray, shape (N, d)
+        Final velocities (m = 1, kT = 1 after the last rescaling).
+    timeseries : xarray.Dataset
+        One row per synchronisation window along ``window`` (``hardpack_kind`` =
+        "md_timeseries"): ``time``, ``phi``, ``Z``, ``phi_J_est``, ``collisions``, ``kT``,
+        ``kT_mean``, event counts, ``max_overlap``, ``shell``, ``neighbours``, ``wall_time``,
+        ``growth_rate``.
+    stats : dict
+        Protocol, ``growth_rate``, ``seed``, ``stop_reason``, final ``Z``, ``phi``,
+        ``phi_J_est``, collision / event / window counts, times, overlap check, and for a
+        two-stage run the final stage's rate and collisions; for a run stopped at max_pressure
+        also ``backbone_volume_fraction`` and ``jamming_check``.
+    contacts : xarray.Dataset or None
+        The time-averaged MD contact forces (``md_contact_*`` variables) when asked for.
+    """
 
     packing: Packing
     velocities: np.ndarray
@@ -172,6 +212,18 @@ def default_window(growth_rate: float, d: int) -> float:
     collision per particle is about 2 Gamma sqrt(pi) / d (mean |v_n| of colliding pairs sqrt(pi kT)
     and g / sigma = Gamma / <D>). HEATING * d / Gamma collisions per particle keep the heating
     between rescalings near 10 %, capped at MAX_WINDOW (Skoge-Donev use ~20 events per particle).
+
+    Parameters
+    ----------
+    growth_rate : float
+        The dimensionless growth rate Gamma (module docstring); its sign is ignored.
+    d : int
+        The dimension.
+
+    Returns
+    -------
+    float
+        HEATING * d / |Gamma| clipped to [1, MAX_WINDOW]; MAX_WINDOW for Gamma = 0.
     """
     if growth_rate == 0:
         return MAX_WINDOW
@@ -331,6 +383,64 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     contact_forces: accumulate the per-pair collision impulses over the last ``contact_windows``
     windows (:mod:`hardpack.md.contacts`); ``result.contacts`` then holds the time-averaged
     contact forces and :meth:`CompressResult.save` stores them with the packing.
+
+    Parameters
+    ----------
+    packing : Packing
+        Start configuration: a periodic sphere packing in an orthorhombic cell, N >= 2, without
+        overlaps.
+    growth_rate : float
+        Gamma = (d<D>/dt) / sqrt(kT/m), finite; negative shrinks the particles (needs a
+        ``target_phi`` below the start), 0 runs at fixed phi (needs a collision or time limit).
+    seed : int
+        Non-negative seed of the initial Maxwell-Boltzmann velocities (the only randomness).
+    stop : StopCriteria, optional
+        Default: reduced pressure 1e12.
+    checkpoint : str or os.PathLike, optional
+        Path of the resumable checkpoint described above.
+    progress : callable, optional
+        Receives each window's record (a dict).
+    window : float, optional
+        Collisions per particle between synchronisations (> 0); default :func:`default_window`
+        of the current stage's rate.
+    checkpoint_interval : float, default 300.0
+        Seconds between checkpoint writes.
+    progress_interval : float, default 10.0
+        Seconds between progress log lines.
+    overlap_tol : float, default DEFAULT_OVERLAP_TOL
+        Relative overlap tolerance checked at every synchronisation and at the end.
+    final_growth_rate : float, optional
+        Growth rate (finite, > 0) of the slow second stage; needs growth_rate > 0.
+    switch_pressure : float, default 1e3
+        Reduced pressure (finite, > 1, below ``stop.max_pressure``) that starts the slow stage.
+    contact_forces : bool, default False
+        Accumulate the MD contact forces.
+    contact_windows : int, default 10
+        Windows over which they are averaged (a positive integer).
+    keep_checkpoint : bool, default False
+        Leave the checkpoint for the caller to remove.
+
+    Returns
+    -------
+    CompressResult
+        The final packing and velocities, the per-window ``timeseries`` Dataset, the run
+        ``stats`` (stop reason, final Z, phi, phi_J_est, counts, end-state checks) and the MD
+        ``contacts`` when asked for.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing cannot be run (not periodic spheres, sheared cell, fewer than 2
+        particles, overlaps); ``growth_rate``, ``seed``, ``window``, ``contact_windows`` or the
+        two-stage parameters are invalid; the stop criteria are impossible or never end
+        (:meth:`StopCriteria.check`); or a run towards ``target_phi`` without a pressure cap
+        jammed short of it (reduced pressure above JAMMED_PRESSURE with phi_J_est below the
+        target).
+    OverlapError
+        If particles overlap beyond ``overlap_tol`` at a synchronisation point (an engine
+        failure).
+    hardpack.io.interrupt.Interrupted
+        On SIGINT or SIGTERM, after the checkpoint is written.
     """
     check_packing(packing)
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \

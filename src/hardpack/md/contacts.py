@@ -1,8 +1,8 @@
 """MD contact forces: per-pair collision impulses summed over the final synchronisation windows.
 
 Near jamming every particle rattles in a cage of near-contacts, and the time-averaged momentum
-exchanged per pair is the contact force of the packing up to a common factor (Donev ch. 1, L102-105,
-L126-130; Alg. 12 step 7; note 000 sec. 2.1 step 8). Over windows of total duration tau with
+exchanged per pair is the contact force of the packing up to a common factor (Donev 2006,
+sec. 1.1 and Fig. 1.1; Algorithm 12 step 7). Over windows of total duration tau with
 kinetic temperatures kT(t) (m = 1), the pair (i, j) collides many times with impulses J on j (from
 i, along the contact normal); we store, in units with kT = 1,
 
@@ -10,7 +10,7 @@ i, along the contact normal); we store, in units with kT = 1,
     W_ij = sum r_ij . J / int kT dt     (its time-averaged virial, r_ij = x_j - x_i at each collision)
 
 with int kT dt = 2 int KE dt / (d N). The collision virial gives the window pressure
-(note 000 sec. 2.5)
+(derived here from the collisional stress of Donev 2006, sec. 3.2.4.2)
 
     Z = p V / (N <kT>) = 1 + sum_pairs W_ij / (d N),    i.e.   p V / <kT> = N + sum_pairs W_ij / d,
 

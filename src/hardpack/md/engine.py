@@ -22,13 +22,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from hardpack.errors import InvalidInputError
+from hardpack.geometry.neighbours import cell_counts, geometric_levels
 from hardpack.md import kernel
+from hardpack.md.kernel import WindowStatus
 
 #: cells per particle of a level above which its grid is coarsened (dilute systems)
 MAX_CELLS_PER_PARTICLE = 2.0
 #: skins scale like (a_i + <a>)^-SKIN_SIZE_EXPONENT (see Engine.skin_factors)
 SKIN_SIZE_EXPONENT = 1.0
-#: ratio of the bounding radii spanned by one grid level (hierarchical grid for wide distributions)
+#: ratio of the bounding radii spanned by one grid level (hierarchical grid for wide distributions;
+#: geometric cell sizes, :func:`hardpack.geometry.neighbours.geometric_levels`)
 LEVEL_RATIO = 2.0
 #: cell width of a level in units of its bounding-radius cap: a rebuild scans the cells within
 #: R_i + rcap of the centre (3^d on its own level; width 1 with up to 5^d cells was 1.6x slower)
@@ -85,18 +88,6 @@ def image_vectors(box: np.ndarray) -> np.ndarray:
     """Table of periodic shifts L * n indexed by the image code (:func:`image_shifts`)."""
     d = len(box)
     return image_shifts(np.arange(4**d), d) * box[None, :]
-
-
-def grid_levels(bound_radii: np.ndarray) -> np.ndarray:
-    """Grid level of every particle: bounding radii in classes of ratio LEVEL_RATIO from the
-    smallest (level 0), so each level's cells fit its largest bounding sphere without holding
-    many much smaller ones (a hierarchical grid, Ogarko ch. 2.1; monodisperse and moderately
-    polydisperse systems get one level). Empty classes are dropped (levels renumbered 0, 1, ...
-    over the occupied ones): a discrete distribution such as a tridisperse equivalent of a wide
-    one leaves gaps between its classes, and a level without particles has no grid."""
-    ratio = bound_radii / bound_radii.min()
-    classes = np.floor(np.log(ratio) / np.log(LEVEL_RATIO) + 1e-12).astype(np.int64)
-    return np.unique(classes, return_inverse=True)[1].astype(np.int64).reshape(classes.shape)
 
 
 class Engine:
@@ -202,8 +193,11 @@ class Engine:
         """Grid levels, their bounding-radius caps and cells for the coming complete rebuild.
 
         Particles are put on levels by their bounding radius R = a + skin s_i (s_i from
-        :meth:`skin_factors`), in classes of ratio LEVEL_RATIO (one level unless the radii differ
-        by more than that). Level h caps the bounding radii of its particles at rcap_h =
+        :meth:`skin_factors`), in classes of ratio LEVEL_RATIO from the smallest (Ogarko's
+        insertion rule with geometric cell sizes, :func:`hardpack.geometry.neighbours.geometric_levels`;
+        one level unless the radii differ by more than that; empty classes are no levels, so a
+        discrete distribution with gaps between its sizes gets one level per occupied class).
+        Level h caps the bounding radii of its particles at rcap_h =
         max_h(a + skin s) GRID_HEADROOM (head room for growth) and has cells of width >= 2 rcap_h
         (at most MAX_CELLS_PER_PARTICLE per particle of the level), so a particle's own level is
         searched in 3^d cells and the other levels in the cells within R_i + rcap_l.
@@ -220,16 +214,11 @@ class Engine:
                 f"{2 * amax:.4g} must stay below half the shortest box side {lmin:.4g} (so that a "
                 "pair touches through one periodic image only); use more particles or a larger box"
             )
-        lvl = grid_levels(bound)
-        nlev = int(lvl.max()) + 1
-        count = np.bincount(lvl, minlength=nlev)
-        self.rcap = np.minimum(np.array([bound[lvl == h].max() for h in range(nlev)]) * GRID_HEADROOM,
-                               0.25 * lmin)
-        ncl = np.maximum(np.floor(self.box[None, :] / (CELL_WIDTH * self.rcap[:, None])), 1).astype(np.int64)
-        for h in range(nlev):  # coarsen levels that would have many empty cells
-            excess = np.prod(ncl[h].astype(float)) / (MAX_CELLS_PER_PARTICLE * count[h])
-            if excess > 1.0:
-                ncl[h] = np.maximum(np.floor(ncl[h] / excess ** (1.0 / self.d)), 1).astype(np.int64)
+        levels = geometric_levels(bound, float(np.prod(self.box)), self.d, LEVEL_RATIO)
+        lvl = levels.level
+        count = np.bincount(lvl, minlength=levels.n_levels)
+        self.rcap = np.minimum(0.5 * levels.cell_sizes * GRID_HEADROOM, 0.25 * lmin)
+        ncl = cell_counts(self.box, CELL_WIDTH * self.rcap, count, MAX_CELLS_PER_PARTICLE)
         self.lvl = lvl.astype(np.int32)
         self.ncl = ncl
         self.coff = np.concatenate([[0], np.cumsum(np.prod(ncl, axis=1))]).astype(np.int64)
@@ -284,23 +273,23 @@ class Engine:
             self.cnt[:] = 0
             acc = np.array([0.0, 0.0, 0.0, self.kinetic_energy(), 0.0])
             iacc = np.zeros(kernel.N_COUNTERS, dtype=np.int64)
-            status = kernel.run_events(
+            status = WindowStatus(kernel.run_events(
                 self.P, self.dims, self.box, kappa, eff_skin, self.sfac, self.imgvec, self.lvl, self.rcap,
                 self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
                 self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
-                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild, *log)
-            if status in (kernel.OVERFLOW, kernel.CELL_OVERFLOW, kernel.BOUND_TOO_SMALL):
+                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild, *log))
+            if status in (WindowStatus.OVERFLOW, WindowStatus.CELL_OVERFLOW, WindowStatus.BOUND_TOO_SMALL):
                 self.P[:] = start  # redo the window after a full rebuild
-                if status == kernel.OVERFLOW:
+                if status == WindowStatus.OVERFLOW:
                     self.alloc_lists(2 * self.capacity)
-                elif status == kernel.CELL_OVERFLOW:
+                elif status == WindowStatus.CELL_OVERFLOW:
                     self.cell_floor = 2 * self.cell_capacity
                     self.alloc_cells(self.cell_floor)
                 else:
                     self._new_bounds(skin)
                 rebuild = True
                 continue
-            if status == kernel.STUCK:
+            if status == WindowStatus.STUCK:
                 raise RuntimeError("no event can ever happen: no particle moves and none grows")
             break
         self.lists_valid = True
@@ -318,6 +307,6 @@ class Engine:
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:
-        """Scale all velocities so that kT = 2 KE / (d N) equals ``kt`` (Donev sec. 3.3.1)."""
+        """Scale all velocities so that kT = 2 KE / (d N) equals ``kt`` (Donev 2006, sec. 3.2.4.1)."""
         ke = self.kinetic_energy()
         self.P[:, self.d: 2 * self.d] *= np.sqrt(self.d * self.n * kt / (2.0 * ke))

@@ -23,6 +23,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
@@ -35,7 +36,29 @@ log = logging.getLogger("hardpack.md")
 
 @dataclass
 class EquilibriumResult:
-    """Mean reduced pressure Z +- Z_err (standard error over blocks) at volume fraction phi."""
+    """Mean reduced pressure Z +- Z_err (standard error over blocks) at volume fraction phi.
+
+    Attributes
+    ----------
+    Z : float
+        Mean of the block values of Z = pV/(NkT).
+    Z_err : float
+        Standard error of the block means, std / sqrt(n_blocks).
+    Z_blocks : numpy.ndarray, shape (n_blocks,)
+        The block values.
+    phi : float
+        Volume fraction.
+    collisions : int
+        Collisions after equilibration.
+    md_time : float
+        MD time after equilibration.
+    wall_time : float
+        Wall-clock seconds of the whole run.
+    packing : Packing
+        The final configuration.
+    velocities : numpy.ndarray, shape (N, d)
+        The final velocities.
+    """
 
     Z: float
     Z_err: float
@@ -47,6 +70,28 @@ class EquilibriumResult:
     packing: Packing
     velocities: np.ndarray
 
+    def to_dataset(self, **attrs) -> xr.Dataset:
+        """The block values as a Dataset (``hardpack_kind = "md_eos"``; Z, Z_err, phi, N, d and
+        the run's counts as attributes, plus ``attrs``).
+
+        Parameters
+        ----------
+        **attrs
+            Further attributes (e.g. the protocol parameters).
+
+        Returns
+        -------
+        xarray.Dataset
+            ``Z_block(block)`` with the attributes ``hardpack_kind``, ``Z``, ``Z_err``, ``phi``,
+            ``N``, ``d``, ``collisions``, ``md_time``, ``wall_time`` and ``attrs``.
+        """
+        ds = xr.Dataset({"Z_block": (("block",), self.Z_blocks)},
+                        coords={"block": np.arange(len(self.Z_blocks))})
+        ds.attrs.update(hardpack_kind="md_eos", Z=self.Z, Z_err=self.Z_err, phi=self.phi,
+                        N=self.packing.n_particles, d=self.packing.dim, collisions=self.collisions,
+                        md_time=self.md_time, wall_time=self.wall_time, **attrs)
+        return ds
+
 
 def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int = 20,
                 n_equilibration: int | None = None,
@@ -57,6 +102,46 @@ def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int
     n_equilibration: collisions discarded first (default n_collisions // 4).
     checkpoint: resumable checkpoint (module docstring), removed at the end unless
     ``keep_checkpoint`` (then the caller removes it once the result is written).
+
+    Parameters
+    ----------
+    packing : Packing
+        Start configuration: a periodic sphere packing in an orthorhombic cell, N >= 2, without
+        overlaps; its phi is kept (Gamma = 0).
+    seed : int
+        Non-negative seed of the initial Maxwell-Boltzmann velocities.
+    n_collisions : int
+        Collisions measured (after equilibration), an integer >= n_blocks.
+    n_blocks : int, default 20
+        Blocks of n_collisions // n_blocks collisions each, an integer >= 2.
+    n_equilibration : int, optional
+        Collisions discarded first (>= 0); default n_collisions // 4.
+    overlap_tol : float, default DEFAULT_OVERLAP_TOL
+        Relative overlap tolerance checked at every synchronisation.
+    checkpoint : str or os.PathLike, optional
+        Path of the resumable checkpoint.
+    checkpoint_interval : float, default 300.0
+        Seconds between checkpoint writes.
+    keep_checkpoint : bool, default False
+        Leave the checkpoint for the caller to remove.
+
+    Returns
+    -------
+    EquilibriumResult
+        Z +- Z_err with the block values, phi, the counts and times of the measured part, the
+        final packing and velocities; :meth:`EquilibriumResult.to_dataset` stores it.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing cannot be run (not periodic spheres, sheared cell, fewer than 2
+        particles, overlaps), ``seed`` is not a non-negative integer, ``n_blocks`` < 2,
+        ``n_collisions`` < n_blocks, or ``n_equilibration`` < 0.
+    OverlapError
+        If particles overlap beyond ``overlap_tol`` at a synchronisation point (an engine
+        failure).
+    hardpack.io.interrupt.Interrupted
+        On SIGINT or SIGTERM (after the checkpoint is written, when there is one).
     """
     check_packing(packing)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:

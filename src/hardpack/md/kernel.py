@@ -1,6 +1,6 @@
 """Numba kernels of the event-driven (collision-driven) hard-sphere MD engine.
 
-Algorithm (Donev dissertation ch. 3, note 000_ch1-3_md.md sec. 2.2-2.9), in the "one event per
+Algorithm (Donev 2006, dissertation secs. 3.2.2.2, 3.3.2 and 3.4), in the "one event per
 particle, lazy invalidation" form:
 
 - Every particle i carries ONE predicted event (partner ``ep[i]``) in a 4-ary min-heap whose keys
@@ -12,7 +12,7 @@ particle, lazy invalidation" form:
   third-party invalidation, Alg. 5 step 5). Correctness: whenever a particle changes velocity it
   re-predicts against ALL its neighbours, so for every pair the particle that changed last holds a
   prediction no later than the pair's true next collision.
-- Neighbour lists with immobile bounding spheres (Donev's NNL, sec. 2.9): particle i stays inside
+- Neighbour lists with immobile bounding spheres (Donev's NNL, sec. 3.3.2): particle i stays inside
   the sphere ``bs[i]`` (centre bs[i, :d], radius bs[i, d]); particles whose bounding spheres do
   not overlap cannot collide, so collisions are predicted only against the list ``nb[i, :nn[i]]``.
   The extra event "i leaves its bounding sphere" (``ep = EXIT``; the exit time solves
@@ -35,24 +35,27 @@ Particle state is packed in one row per particle, ``P[i] = (x_0..x_{d-1}, v_0..v
 position and velocity at the particle's own last update time t_i (Alg. 2 step 5, asynchronous
 updates), and its radius at window time 0. Masses are all 1.
 
-Pair collision time (note sec. 2.3, derived there; re-derived here): with r = x_j - x_i,
-u = v_j - v_i, sigma(t) = sigma_0 + g t, contact |r + u t|^2 = sigma(t)^2 gives
-A t^2 + 2 B t + C = 0 with A = u.u - g^2, B = r.u - sigma_0 g, C = r.r - sigma_0^2.
-C <= 0 (round-off overlap): collide now if B < 0; if B >= 0 but A < 0 (growth outruns the
+Pair collision time (derived here; Donev 2006, sec. 3.2.2.2, says only "the first positive root of
+a quadratic"): with r = x_j - x_i, u = v_j - v_i, sigma(t) = sigma_0 + g t, contact
+|r + u t|^2 = sigma(t)^2 gives A t^2 + 2 B t + C = 0 with A = u.u - g^2, B = r.u - sigma_0 g,
+C = r.r - sigma_0^2. C <= 0 (round-off overlap): collide now if B < 0; if B >= 0 but A < 0 (growth outruns the
 separation) the later root (B + sqrt(B^2 - AC)) / (-A) is the re-contact. C > 0: a root exists iff
 (B < 0 or A < 0) and B^2 - AC >= 0, and the first one is C / (-B + sqrt(B^2 - AC)) for B < 0 and
 (B + sqrt(B^2 - AC)) / (-A) for B >= 0 (the two stable forms of the same root).
 For shrinking spheres (kappa < 0) the squared equation also has roots with sigma(t) < 0, i.e.
 after t = 1/|kappa|; windows end before 0.5/|kappa| (engine), so such roots are never processed.
 
-Collision law (note sec. 2.4, sign-corrected there): n = r / |r| at contact,
-v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with equal masses the impulse
-on j is J = -v_n n (v_j += J, v_i -= J), which reverses the CONTACT normal velocity v_n -> -v_n.
-Kinetic energy changes by -v_n g (heating when growing). Collisions with v_n >= 0 are skipped
-(mispredicted or grazing, Alg. 12 step 3).
+Collision law (derived here for growing spheres; Donev 2006, Algorithm 12 steps 4-5, as printed,
+with n from A to B, pushes an approaching pair together, so the sign is reversed here):
+n = r / |r| at contact, v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with
+equal masses the impulse on j is J = -v_n n (v_j += J, v_i -= J), which reverses the CONTACT
+normal velocity v_n -> -v_n. Kinetic energy changes by -v_n g (heating when growing). Collisions
+with v_n >= 0 are skipped (mispredicted or grazing, Alg. 12 step 3).
 """
 
 from __future__ import annotations
+
+import enum
 
 import numpy as np
 from llvmlite import ir
@@ -60,18 +63,24 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from hardpack.md.heap import heap_set
+from hardpack.events.heap import heap_set
+from hardpack.events.roots import contact_root, exit_root
 
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
 
-# status codes of run_events
-DONE_COLLISIONS = 0  # the window's collision budget is used up (sync at the last collision time)
-DONE_TIME = 1  # the next event is later than t_cap (sync at t_cap)
-OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
-STUCK = 3  # no event can ever happen (nothing moves)
-BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
-CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
+
+
+class WindowStatus(enum.IntEnum):
+    """How :func:`run_events` ended a window."""
+
+    DONE_COLLISIONS = 0  # the window's collision budget is used up (sync at the last collision time)
+    DONE_TIME = 1  # the next event is later than t_cap (sync at t_cap)
+    OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
+    STUCK = 3  # no event can ever happen (nothing moves)
+    BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
+    CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
+
 
 # float accumulators, acc[...]
 A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE = 0, 1, 2, 3, 4
@@ -133,87 +142,6 @@ def prefetch_row(typingctx, arr, idx):
     return sig, codegen
 
 
-# --------------------------------------------------------------------------------- root finding
-@njit(cache=True)
-def pair_time(r, u, sig0, g):
-    """First contact time >= 0 of a pair (see module docstring); inf if none. r, u: (d,) arrays."""
-    rr = 0.0
-    ru = 0.0
-    uu = 0.0
-    for k in range(r.shape[0]):
-        rr += r[k] * r[k]
-        ru += r[k] * u[k]
-        uu += u[k] * u[k]
-    return contact_root(rr, ru, uu, sig0, g, np.inf)
-
-
-@njit(cache=True, inline="always")
-def contact_root(rr, ru, uu, sig0, g, tmax):
-    """First contact time in [0, tmax), else inf (module docstring). When A >= 0 the root is at
-    least C / (-2B), which rejects most pairs before the square root."""
-    b = ru - sig0 * g
-    a = uu - g * g
-    if b >= 0.0 and a >= 0.0:
-        return np.inf
-    c = rr - sig0 * sig0
-    if c <= 0.0:
-        if b < 0.0:
-            return 0.0
-        disc = b * b - a * c
-        disc = max(disc, 0.0)
-        return (b + np.sqrt(disc)) / (-a)
-    if a >= 0.0 and c >= -2.0 * b * tmax:
-        return np.inf
-    disc = b * b - a * c
-    if disc < 0.0:
-        return np.inf
-    if b < 0.0:
-        return c / (-b + np.sqrt(disc))
-    return (b + np.sqrt(disc)) / (-a)  # A < 0 here; same root, no cancellation when B >= 0
-
-
-@njit(cache=True)
-def exit_time(dr, v, rrem, adot):
-    """Time for a sphere (centre offset dr from its bounding centre, velocity v, radius growing at
-    adot) to touch its bounding sphere, whose radius exceeds the particle's by rrem now.
-
-    |dr + v t| = rrem - adot t  ->  A t^2 + 2 B t + C = 0 with A = v.v - adot^2,
-    B = dr.v + rrem adot, C = dr.dr - rrem^2 < 0; first root t = -C / (B + sqrt(B^2 - AC))
-    (note 000 sec. 2.9, valid for any sign of A). For shrinking particles (adot < 0) the root is
-    genuine because rrem - adot t stays positive.
-    """
-    dd = 0.0
-    dv = 0.0
-    vv = 0.0
-    for k in range(dr.shape[0]):
-        dd += dr[k] * dr[k]
-        dv += dr[k] * v[k]
-        vv += v[k] * v[k]
-    return _exit_root(dd, dv, vv, rrem, adot)
-
-
-@njit(cache=True, inline="always")
-def _exit_root(dd, dv, vv, rrem, adot):
-    c = dd - rrem * rrem
-    if c >= 0.0:
-        return 0.0
-    a = vv - adot * adot
-    b = dv + rrem * adot
-    disc = b * b - a * c
-    if disc < 0.0:
-        if adot > 0.0:  # round-off: a growing sphere always leaves
-            disc = 0.0
-        else:
-            return np.inf
-    den = b + np.sqrt(disc)
-    if den > 0.0:
-        return -c / den
-    if adot > 0.0:
-        return 0.0
-    return np.inf
-
-
-# --------------------------------------------------------------------------------- event loop
 @njit(cache=True)
 def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
@@ -222,7 +150,8 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
 
     Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
-    out of the hot path; the heap update is :func:`hardpack.md.heap.heap_set`, inlined): (1) only if ``rebuild_lists``: N complete-update steps, each the partial
+    out of the hot path; the heap update is :func:`hardpack.events.heap.heap_set`, inlined):
+    (1) only if ``rebuild_lists``: N complete-update steps, each the partial
     NNL update of one particle (wrap, new bounding sphere, re-bin on its grid level, list every
     overlapping bounding sphere already binned; together a complete update, Alg. 9); the
     bounding radius is
@@ -242,6 +171,102 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     and log_val[c] = (impulse J on j from i (d components), r_ij . J) (contact forces,
     :mod:`hardpack.md.contacts`); pass (0, 2) / (0, d + 1) arrays to log nothing.
     Returns a status code (module constants).
+
+    Every array is modified in place unless marked read-only; the caller
+    (:meth:`hardpack.md.engine.Engine.run_window`) allocates them once and keeps them between
+    windows. N particles, d dimensions, n_lev grid levels, n_cells cells over all levels,
+    ccap slots per cell, cap entries per neighbour list.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, 2 d + 2)
+        Particle state: row i = (x_0..x_{d-1}, v_0..v_{d-1}, t_i, a_i), position and velocity
+        at the particle's own last update time t_i (window time) and its radius at window
+        time 0 (module docstring). Masses are 1.
+    dims : tuple of int
+        ``tuple(range(d))``; only its length is used (a compile-time constant for numba).
+    L : numpy.ndarray of float64, shape (d,), read-only
+        Side lengths of the orthorhombic periodic box.
+    kappa : float
+        Relative growth rate of the radii, a_i(t) = a_i (1 + kappa t) (< 0 shrinks).
+    skin : float
+        Bounding-sphere skin of the coming rebuilds (bounding radius a_i(t) + skin sfac_i,
+        capped at rcap of the particle's level).
+    sfac : numpy.ndarray of float64, shape (N,), read-only
+        Relative skin of every particle (:meth:`hardpack.md.engine.Engine.skin_factors`).
+    imgvec : numpy.ndarray of float64, shape (4**d, d), read-only
+        Periodic shift L n of each image code, code = sum_k (n_k + 1) 4^k.
+
+    lvl : numpy.ndarray of int32, shape (N,), read-only
+        Grid / cells: the grid level h of every particle.
+    rcap : numpy.ndarray of float64, shape (n_lev,), read-only
+        Grid / cells: cap on the bounding radius of the particles of each level.
+    ncl : numpy.ndarray of int64, shape (n_lev, d), read-only
+        Grid / cells: cells per side of each level (cell width >= 2 rcap[h] unless coarsened).
+    coff : numpy.ndarray of int64, shape (n_lev + 1,), read-only
+        Grid / cells: offset of each level's first cell in the flat cell index (coff[-1] =
+        n_cells).
+    ccount : numpy.ndarray of int32, shape (n_cells,)
+        Grid / cells: bounding spheres in each cell (reset on a rebuild).
+    cid : numpy.ndarray of int32, shape (n_cells * ccap,)
+        Grid / cells: particle of each slot; slot s of cell c is c * ccap + s.
+    cbs : numpy.ndarray of float64, shape (n_cells * ccap, d + 1)
+        Grid / cells: copy of the bounding sphere (centre, radius) of each slot's particle.
+    slot_of : numpy.ndarray of int32, shape (N,)
+        Grid / cells: slot of each particle's bounding sphere (-1: not binned; reset on a
+        rebuild).
+
+    bs : numpy.ndarray of float64, shape (N, d + 1)
+        Neighbour lists: bounding sphere of every particle, centre then radius.
+    nb : numpy.ndarray of int32 or int64, shape (N, cap)
+        Neighbour lists: entries j << 2d | image code of the bounding spheres that overlap
+        particle i's.
+    nn : numpy.ndarray of int32, shape (N,)
+        Neighbour lists: length of each list (reset on a rebuild).
+    mark : numpy.ndarray of int8, shape (N,)
+        Neighbour lists: scratch flags of a partial update (reset at entry).
+
+    cnt : numpy.ndarray of int32, shape (N,)
+        Heap / events: collision counter of every particle (lazy invalidation).
+    ep : numpy.ndarray of int32, shape (N,)
+        Heap / events: partner of each particle's predicted event (EXIT: leaves its bounding
+        sphere; NONE: nothing predicted).
+    ec : numpy.ndarray of int32, shape (N,)
+        Heap / events: the partner's collision counter at prediction time (``cnt[ep[i]]``).
+    hkey : numpy.ndarray of float64, shape (N,)
+        Heap / events: key (predicted event time) of heap slot k, in heap order.
+    heap : numpy.ndarray of int32, shape (N,)
+        Heap / events: particle in heap slot k (4-ary min-heap, :mod:`hardpack.md.heap`).
+    hpos : numpy.ndarray of int32, shape (N,)
+        Heap / events: heap slot of every particle (reset to -1 at entry).
+
+    acc : numpy.ndarray of float64, shape (5,)
+        Outputs: float accumulators A_T (time reached), A_VIRIAL, A_KEINT, A_KE (enter the
+        current kinetic energy), A_TKE (enter 0).
+    iacc : numpy.ndarray of int64, shape (N_COUNTERS,)
+        Outputs: counters I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE (enter zeros).
+
+    coll_target : int
+        Window controls: stop after this many collisions (at the last one's time).
+    t_cap : float
+        Window controls: stop before the first event later than this window time.
+    rebuild_lists : bool
+        Window controls: start with a complete rebuild of grid and neighbour lists (stage 1);
+        otherwise the previous window's are kept.
+
+    log_pair : numpy.ndarray of int, shape (n_log, 2)
+        Outputs: (i, j) of the window's first n_log collisions; n_log = 0 logs nothing.
+    log_val : numpy.ndarray of float64, shape (n_log, d + 1)
+        Outputs: the impulse J on j from i (d components) and r_ij . J of those collisions.
+
+    Returns
+    -------
+    int
+        Status: DONE_COLLISIONS (``coll_target`` reached; acc[A_T] is the last collision time),
+        DONE_TIME (the next event is later than ``t_cap``; acc[A_T] = t_cap), or, for the
+        caller to enlarge and redo the window, OVERFLOW (a neighbour list is full),
+        CELL_OVERFLOW (a grid cell is full), BOUND_TOO_SMALL (a particle grew to its level's
+        bounding-radius cap); STUCK when no event can ever happen.
     """
     d = len(dims)
     n = P.shape[0]
@@ -290,9 +315,9 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 acc[A_T] = t_cap
                 acc[A_KEINT] += acc[A_KE] * (t_cap - acc[A_TKE])
                 acc[A_TKE] = t_cap
-                return DONE_TIME
+                return WindowStatus.DONE_TIME
             if t == np.inf:
-                return STUCK
+                return WindowStatus.STUCK
             iacc[I_EVENTS] += 1
             p = ep[i]
             if p < 0:  # leaves its bounding sphere
@@ -386,13 +411,13 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 ri = rcap[h]
                 if a + 0.25 * skin * sfac[i] >= rcap[h]:
                     acc[A_T] = t
-                    return BOUND_TOO_SMALL
+                    return WindowStatus.BOUND_TOO_SMALL
             bs[i, d] = ri
             slot = slot_of[i]  # move i's bounding sphere into cell c's slots
             if slot < 0 or slot // ccap != c:
                 if ccount[c] >= ccap:
                     acc[A_T] = t
-                    return CELL_OVERFLOW
+                    return WindowStatus.CELL_OVERFLOW
                 if slot >= 0:  # leave the old cell: its last entry fills the hole
                     old = slot // ccap
                     last = old * ccap + ccount[old] - 1
@@ -463,7 +488,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                             if d2 < s * s:
                                 if nn[i] >= cap or nn[j] >= cap:
                                     acc[A_T] = t
-                                    return OVERFLOW
+                                    return WindowStatus.OVERFLOW
                                 nb[i, nn[i]] = (j << cbits) | code
                                 nn[i] += 1
                                 back = (i << cbits) | (cback - code)
@@ -507,7 +532,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 dd += dx * dx
                 dv += dx * vk
                 vv += vk * vk
-            best = _exit_root(dd, dv, vv, rrem, adot)
+            best = exit_root(dd, dv, vv, rrem, adot)
             partner = EXIT if best < np.inf else NONE
             for m in range(nn[i]):
                 e = nb[i, m]
@@ -556,7 +581,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
             acc[A_T] = t
             acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
             acc[A_TKE] = t
-            return DONE_COLLISIONS
+            return WindowStatus.DONE_COLLISIONS
 
 
 # --------------------------------------------------------------------------------- sync

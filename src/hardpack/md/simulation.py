@@ -5,7 +5,7 @@ Units and conventions (used throughout :mod:`hardpack.md`):
 - all masses are equal, m = 1 (the Skoge-Donev convention; equilibrium properties such as the
   equation of state do not depend on the masses);
 - kT = 1: velocities start Maxwell-Boltzmann and are rescaled to kT = 2 KE / (d N) = 1 at every
-  synchronisation point when the particles grow (Donev sec. 3.3.1, L2582-2587), so the thermal
+  synchronisation point when the particles grow (Donev 2006, sec. 3.2.4.1), so the thermal
   speed is sqrt(kT/m) = 1;
 - radii grow linearly in time in proportion to their size, a_i(t) = a_i(0) (1 + kappa t); the
   relative rate of a window is kappa = Gamma / (2 <a>) with <a> the mean radius at the window
@@ -51,7 +51,22 @@ class OverlapError(RuntimeError):
 
 def maxwell_boltzmann(n: int, d: int, seed) -> np.ndarray:
     """Velocities from numpy.random.default_rng(seed): Gaussian, zero total momentum, and scaled so
-    that kT = 2 KE / (d N) = 1 exactly (m = 1)."""
+    that kT = 2 KE / (d N) = 1 exactly (m = 1).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles (>= 2 for a non-zero velocity after removing the mean).
+    d : int
+        The dimension.
+    seed : int, numpy.random.SeedSequence or None
+        Anything :func:`numpy.random.default_rng` accepts.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, d)
+        The velocities.
+    """
     rng = np.random.default_rng(seed)
     v = rng.standard_normal((n, d))
     v -= v.mean(axis=0)

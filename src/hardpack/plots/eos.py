@@ -62,7 +62,8 @@ def plot_phij_vs_width(summaries):
             top.set_xscale("log")
             top.xaxis.set_major_formatter(ScalarFormatter())
             top.xaxis.set_minor_formatter(NullFormatter())
-            top.set_xticks([t for t in (1, 1.2, 1.5, 2, 3, 4, 5, 8, 10, 20, 50, 100) if widths.min() <= t <= widths.max()])
+            ticks = (1, 1.2, 1.5, 2, 3, 4, 5, 8, 10, 20, 50, 100)
+            top.set_xticks([t for t in ticks if widths.min() <= t <= widths.max()])
             bottom.set_xlabel(r"$\omega = a_{\max}/a_{\min}$")
         else:
             bottom.set_xlabel(r"$\sigma$ (log-normal)")
@@ -75,7 +76,7 @@ def plot_phij_vs_width(summaries):
 
 
 def plot_crystallisation(summary, threshold: float):
-    """Slow runs (Ogarko L4851-4865): left, phi_J vs omega of poly / bi / tri with the published fit;
+    """Slow runs (Ogarko 2014, sec. 3.1.3): left, phi_J vs omega of poly / bi / tri with the published fit;
     right, the q6 crystallinity of the large particles (mean over seeds, each seed a small marker)
     with the ``threshold`` the validation counts as partial crystallisation."""
     stats = seed_statistics(summary)

@@ -50,9 +50,9 @@ def plot_fcc_finite_size(summaries: dict):
 def plot_fcc_density(bcmd, eos):
     """FCC free energy vs density: (a) excess over the ideal gas vs phi, (b) BCMD's Delta f =
     f_c(Delta mu_d) - f vs the distance to jamming delta (log scale; f = -3 ln delta - f_J
-    + ..., so Delta f tends to the jamming constant as delta -> 0), with the EOS integration of the engine's pressure from the published
-    melting value and the cell limit with the published jamming constant
-    (hardpack.freeenergy.crystal)."""
+    + ..., so Delta f tends to the jamming constant as delta -> 0), with the EOS integration of
+    the engine's pressure from the published melting value and the cell limit with the published
+    jamming constant (hardpack.freeenergy.crystal)."""
     fig, (ax1, ax2) = figure(1, 2, figsize=(9.0, 3.6))
     phi_b, ex_b = bcmd["phi"].values, bcmd["excess"].values
     phi_e, z = eos["phi"].values, eos["Z"].values
@@ -67,7 +67,7 @@ def plot_fcc_density(bcmd, eos):
              label=f"published 5.91916 + EOS integral (MD, N = {n_md})")
     ax1.plot(phi_b, ex_b, "o", color="C0", ms=4, label=f"hardpack BCMD, N = {n}")
     ax1.plot([MELTING_PHI], [MELTING_EXCESS], "*", color="C3", ms=9,
-             label="published at melting (ch. 6 L1008)")
+             label="published at melting (Donev 2006, sec. 6.4.1)")
     ax1.set_xlabel(r"$\phi$")
     ax1.set_ylabel(r"excess free energy $f - f_{ideal}$ [$k_BT$]")
     ax1.set_ylim(top=1.1 * max(ex_b.max(), ex_e.max()))
@@ -77,7 +77,7 @@ def plot_fcc_density(bcmd, eos):
     ax2.plot([distance_to_jamming(MELTING_PHI)], [cell_offset(MELTING_PHI) - MELTING_EXCESS], "*", color="C3", ms=9,
              label="published melting value")
     ax2.axhline(JAMMING_CONSTANT, color="C2", ls=":",
-                label=f"published jamming limit {JAMMING_CONSTANT} (ch. 6 L1012)")
+                label=f"published jamming limit {JAMMING_CONSTANT} (Donev 2006, sec. 6.4.1)")
     ax2.set_xscale("log")
     ax2.set_xlabel(r"distance to jamming $\delta = (\phi_{cp}/\phi)^{1/3} - 1$")
     ax2.set_ylabel(r"$\Delta f = f_c(\Delta\mu_d) - f$ [$k_BT$]")

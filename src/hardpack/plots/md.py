@@ -1,4 +1,4 @@
-"""Figures of the LS engine: the growth-rate scan of Donev's Fig. 1.3 (ch. 1, L366-380, L415-421)."""
+"""Figures of the LS engine: the growth-rate scan of Donev's Fig. 1.3 (Donev 2006, secs. 1.2-1.2.1)."""
 
 from __future__ import annotations
 

@@ -85,7 +85,7 @@ def plot_order_map(summary, diluted=None):
     One colour and marker per SLP setting (alpha = gamma / D, bounds strain / shear / displacement,
     LP solver); filled when the packing passed the strict jamming test. Coinciding packings (e.g.
     several seeds ending in the same crystal) are labelled with their count. FCC (phi = 0.74048,
-    T = 1) and the paper's MRJ density 0.64 (L1620-1624) are marked for reference.
+    T = 1) and the paper's MRJ density 0.64 (Torquato & Jiao 2010, Sec. VI) are marked for reference.
 
     ``diluted`` (:func:`hardpack.slp.diluted.diluted_summary`, optional) adds the diluted-MRJ
     packings of the paper's Sec. VI on the left as red squares (its Fig. 6 symbol), each seed's

@@ -61,6 +61,19 @@ class DilutedRound:
     in this round; ``phi_diluted``: density right after the removal (before re-jamming);
     ``converged``, ``n_steps``, ``n_rejected``, ``wall_seconds``, ``cpu_seconds``: the SLP run's
     (:class:`hardpack.slp.driver.SLPResult`).
+
+    Attributes
+    ----------
+    packing : Packing
+        The re-jammed packing of this round.
+    start_index : numpy.ndarray of int, shape (N,)
+        Index of each sphere in the MRJ start packing.
+    n_removed : int
+        Spheres removed in this round.
+    phi_diluted : float
+        Density right after the removal (before re-jamming).
+    converged, n_steps, n_rejected, wall_seconds, cpu_seconds
+        The SLP run's (:class:`hardpack.slp.driver.SLPResult`).
     """
 
     packing: Packing
@@ -127,11 +140,23 @@ def run_diluted(packing: Packing, fraction: float, rounds: int, seed: int, alpha
         ``keep_checkpoint`` (the caller removes it once the rounds are written).
     checkpoint_interval : float
         Seconds between the SLP checkpoints within a round.
+    keep_checkpoint : bool, default False
+        Leave the checkpoint for the caller to remove.
 
     Returns
     -------
     list of DilutedRound
         Rounds 1..``rounds`` in order.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``packing`` is not a periodic sphere packing, ``seed`` is not a non-negative
+        integer, ``fraction`` is not in (0, 1), ``rounds`` is not a positive integer, the
+        fraction removes no sphere per round or the rounds leave fewer than two, or an SLP
+        re-jamming refuses its settings (:func:`hardpack.slp.driver.run_slp`).
+    hardpack.io.interrupt.Interrupted
+        On SIGINT or SIGTERM, after the checkpoint is written.
     """
     packing.require_periodic_spheres("the diluted-MRJ protocol")
     if int(seed) != seed or seed < 0:
@@ -207,6 +232,30 @@ def diluted_summary(packing_paths, verdict_paths) -> xr.Dataset:
     (spheres removed since round 0), ``N``, ``T`` (translational order metric of
     :func:`hardpack.structure.order.translational_order`, NaN unless d = 3), ``phi_diluted``
     (density right after the round's removal, NaN in round 0), ``converged`` (the SLP run's).
+
+    Parameters
+    ----------
+    packing_paths : sequence of str or os.PathLike
+        Packing files (the MRJ starts and the ``hardpack slp-dilute`` rounds), each with a
+        ``seed`` attribute.
+    verdict_paths : sequence of str or os.PathLike
+        Their jamming verdicts, in the same order.
+
+    Returns
+    -------
+    xarray.Dataset
+        The variables above over the dimensions ``seed`` and ``round``; attributes
+        ``hardpack_kind`` = "slp_diluted", ``T_convention`` and, when the packings have them,
+        ``ensemble``, ``d``, ``fraction``, ``distribution``.
+
+    Raises
+    ------
+    InvalidInputError
+        If there are no packings or not one verdict per packing, a verdict judges another
+        packing or has another number of spheres, a (seed, round) is given twice, or some seed
+        lacks a round the others have.
+    StoreError
+        If a file is missing, unreadable or of the wrong kind.
     """
     from hardpack.structure.order import translational_order
 
@@ -231,7 +280,8 @@ def diluted_summary(packing_paths, verdict_paths) -> xr.Dataset:
             "strict": int(verdict.attrs["strict"]), "collective": int(verdict.attrs["collective"]),
             "n_removed": int(ds.attrs.get("n_removed_total", 0)), "N": packing.n_particles,
             "T": translational_order(packing) if packing.dim == 3 else math.nan,
-            "phi_diluted": float(ds.attrs.get("phi_diluted", math.nan)), "converged": int(ds.attrs.get("converged", -1)),
+            "phi_diluted": float(ds.attrs.get("phi_diluted", math.nan)),
+            "converged": int(ds.attrs.get("converged", -1)),
         }
         for name in ("ensemble", "d", "fraction", "distribution_params"):
             if name in ds.attrs:

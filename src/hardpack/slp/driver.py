@@ -1,24 +1,25 @@
-"""The sequential-LP loop (Torquato & Jiao 2010, sec. III and the SLP note sec. 1.9, 5.2-5.4).
+"""The sequential-LP loop (Torquato & Jiao 2010, Sec. III.B, with the
+overlap handling and termination rule derived here).
 
 Each step solves the LP of :mod:`hardpack.slp.lp` and applies it: M -> (I + eps) M,
 x -> (I + eps)(x + u). The linearisation drops a cross term of first order in both eps and u
-(SLP note sec. 1.4), so an accepted step can create small overlaps. Handling (the "hybrid" rule
-the note found necessary; pure halving stalls):
+(derived here), so an accepted step can create small overlaps. Handling (a "hybrid" rule
+our prototype found necessary; pure halving stalls):
 
 - worst relative overlap above ``reject_overlap`` (1e-4): reject the step and halve the trust
-  region (the paper's rule, L783-792);
+  region (the paper's rule, Torquato & Jiao 2010, Sec. III.B);
 - a smaller overlap: accept and scale the whole packing up just enough to remove it;
 - after an accepted step the trust region doubles again (up to the full bounds), and the cell is
   LLL-reduced so the image search stays small.
 
 Termination: the LP-predicted density gain -tr(eps*) at the full trust region falls below ``tol``.
-The paper stops at a density increase below 1e-8 (L1293-1295); our default is 1e-10, one or two
+The paper stops at a density increase below 1e-8 (Sec. V.A); our default is 1e-10, one or two
 more LPs: at 1e-8 the contact gaps are still ~1e-9 D and the strict LP jamming test of
 :func:`hardpack.jamming.verify` (contacts within 1e-6, unjamming threshold 1e-6 D) failed on 3 of
 4 smoke packings; continued to 1e-10, two of the three passed (the third holds a near-rattler that
 the test moves by 3e-4 D). Below ~1e-12 the predicted gain is at the LP tolerance
 (1e-10 on rows of size D^2) and the loop no longer terminates. Terminating on the observed gain
-would stop falsely after a rescale or a halving (note sec. 5.4).
+would stop falsely after a rescale or a halving.
 
 Checkpoints: with ``checkpoint``, the state after a step (packing, trust region, step count,
 history, elapsed time) is written atomically every ``checkpoint_interval`` seconds
@@ -39,9 +40,9 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
+from hardpack.geometry.reduction import lll_reduce
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt
-from hardpack.geometry.reduction import lll_reduce
 from hardpack.slp.lp import Bounds, solve_step
 
 log = logging.getLogger(__name__)
@@ -57,6 +58,23 @@ class SLPResult:
     density, and whether it is collectively or strictly jammed is decided by the LP jamming tests
     (:func:`hardpack.jamming.verify`, ``hardpack verify``), as Torquato & Jiao (2010, Sec. III.C)
     test their packings.
+
+    Attributes
+    ----------
+    packing : Packing
+        The last accepted packing (lattice LLL-reduced, positions wrapped).
+    history : xarray.Dataset
+        One row per LP along ``lp`` (``hardpack_kind`` = "slp_history"): coordinate ``step``,
+        ``phi``, ``predicted_gain``, ``n_constraints``, ``lp_seconds``, ``trust_scale``,
+        ``worst_overlap``, ``accepted``.
+    converged : bool
+        The predicted density gain at full trust region fell below ``tol``.
+    n_steps : int
+        Rows of the history (accepted and rejected LPs, and the final one).
+    n_rejected : int
+        LP steps rejected for overlaps above ``reject_overlap``.
+    wall_seconds, cpu_seconds : float
+        Wall-clock and CPU time, summed over resumed invocations.
     """
 
     packing: Packing
@@ -93,6 +111,51 @@ def run_slp(packing: Packing, alpha: float, bounds: Bounds, deforming: bool = Tr
     (module docstring), removed when the run ends unless ``keep_checkpoint`` (then the caller
     removes it once the result is written). On SIGINT or SIGTERM the run writes its checkpoint
     before the next LP and raises :class:`hardpack.io.interrupt.Interrupted`.
+
+    Torquato & Jiao 2010, Sec. III; the step acceptance and trust-region rules are in the
+    module docstring.
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing (the start).
+    alpha : float
+        Influence-sphere radius over the pair's mean diameter (gamma_mn = alpha D_mn).
+    bounds : Bounds
+        Full trust-region widths (strain, shear, displacement).
+    deforming : bool, default True
+        Symmetric strain (the paper's deforming cell) or isotropic shrink only.
+    tol : float, default 1e-10
+        Convergence: predicted density gain (-Tr eps) below which the run stops, in (0, 1).
+    max_steps : int, default 2000
+        Most LPs (a positive integer); the result says whether it converged.
+    reject_overlap : float, default 1e-4
+        Largest relative overlap of an accepted step, in (0, 0.5); above it the step is
+        rejected and the trust region halved.
+    progress_every : int, default 10
+        Log a progress line every this many steps (0: never).
+    method : str, default "highs-ipm"
+        HiGHS solver of :func:`hardpack.slp.lp.solve_step`.
+    checkpoint : str or os.PathLike, optional
+        Path of the resumable checkpoint.
+    checkpoint_interval : float, default 300.0
+        Seconds between checkpoint writes.
+    keep_checkpoint : bool, default False
+        Leave the checkpoint for the caller to remove.
+
+    Returns
+    -------
+    SLPResult
+        The end packing, the per-LP ``history`` Dataset, ``converged``, step counts and times.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``packing`` is not a periodic sphere packing, ``tol`` or ``reject_overlap`` is out of
+        range, ``max_steps`` is not a positive integer, or the trust region shrank below
+        MIN_TRUST_SCALE of ``bounds`` without an acceptable step (lower the bounds).
+    hardpack.io.interrupt.Interrupted
+        On SIGINT or SIGTERM, after the checkpoint is written.
     """
     packing.require_periodic_spheres("SLP")
     if not (0 < tol < 1):

@@ -4,7 +4,7 @@ Variables (all continuous, box-bounded by the trust region):
 
 - global displacements u_n = M dx_n of every sphere (N x d; the paper uses lattice-coordinate
   displacements dx_n, Eq. 19; the global form is the same LP in better-conditioned variables,
-  SLP note sec. 5.1); u_0 = 0 removes the free global translation;
+  our choice); u_0 = 0 removes the free global translation;
 - the symmetric strain eps of the cell, M -> (I + eps) M (Eqs. 8-10): d(d+1)/2 entries for a
   deforming cell, or one scalar e (eps = e I) for an isotropically shrinking cell.
 
@@ -16,8 +16,8 @@ delta = u_n - u_m,
 
     r^T eps r + delta . r >= (D_mn^2 - r . r) / 2,
 
-the first-order expansion of |(I + eps)(r + delta)|^2 >= D_mn^2 (exact remainder in the SLP
-note sec. 1.4; signs re-derived and tested here). Self-images (m = n, k != 0) constrain the
+the first-order expansion of |(I + eps)(r + delta)|^2 >= D_mn^2 (exact remainder derived
+here; signs derived and tested here). Self-images (m = n, k != 0) constrain the
 strain alone, which is the lattice (N = 1) problem.
 
 Redundant pairs (our addition, exact): with |eps_ab| bounded, ||eps||_2 <= e_max = min(strain +
@@ -29,7 +29,7 @@ trust region. Leaving those rows out does not change the LP's feasible set or op
 solver may pick another point of the degenerate optimal face); it only shortens the LP. With the
 Table II bounds (0.01 / 0.01 / 0.05 D) r_safe is 1.2-1.4 D in d = 2..6, so for the LP an
 influence radius gamma = 3.5 D is the same as gamma = r_safe: beyond r_safe the influence sphere
-is irrelevant (the SLP note's observation, sec. 5.2, here as a bound). With d = 6, N = 729 this is
+is irrelevant (an observation of our prototype, here as a bound). With d = 6, N = 729 this is
 ~60 thousand rows instead of ~16 million (at phi = 0.37). With the Table I
 bounds (0.1 / 0.1 / 0.5 D) r_safe ~ 9 D and gamma = 1.5 D does drop binding pairs.
 
@@ -54,7 +54,22 @@ from hardpack.geometry.neighbours import pairs_within
 
 @dataclass(frozen=True)
 class Bounds:
-    """Trust-region widths: |eps_aa| <= strain, |eps_ab| <= shear (a != b), |u_n,a| <= displacement * <D>."""
+    """Trust-region widths: |eps_aa| <= strain, |eps_ab| <= shear (a != b), |u_n,a| <= displacement * <D>.
+
+    Parameters
+    ----------
+    strain : float
+        Bound on the diagonal strain entries (on e for an isotropically shrinking cell); > 0.
+    shear : float
+        Bound on the off-diagonal strain entries; >= 0.
+    displacement : float
+        Bound on each displacement component, in units of the mean diameter <D>; >= 0.
+
+    Raises
+    ------
+    InvalidInputError
+        If a bound is negative or not finite, or the strain bound is 0 (the cell could not shrink).
+    """
 
     strain: float
     shear: float
@@ -121,8 +136,7 @@ def influence_pairs(packing, alpha: float, bounds: Bounds, deforming: bool = Tru
     keep = pairs.distance < limit
     if keep.all():
         return pairs
-    return type(pairs)(pairs.i[keep], pairs.j[keep], pairs.shift[keep], pairs.separation[keep],
-                       pairs.distance[keep], pairs.contact[keep])
+    return pairs.subset(keep)
 
 
 METHODS = ("highs-ipm", "highs-ds", "highs")
@@ -130,7 +144,37 @@ METHODS = ("highs-ipm", "highs-ds", "highs")
 
 def solve_step(packing, alpha: float, bounds: Bounds, deforming: bool = True,
                feasibility_tol: float = 1e-10, method: str = "highs-ipm") -> StepSolution:
-    """Build and solve one SLP linear program for ``packing`` (see the module docstring)."""
+    """Build and solve one SLP linear program for ``packing`` (see the module docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell (the start configuration of the step).
+    alpha : float
+        Influence-sphere factor gamma_mn / D_mn, >= 1: pairs closer than alpha D_mn get a row,
+        unless the row cannot bind inside the trust region (:func:`redundancy_radius`).
+    bounds : Bounds
+        The trust region.
+    deforming : bool, default True
+        Symmetric strain of a deforming cell; if False, one isotropic strain eps = e I.
+    feasibility_tol : float, default 1e-10
+        Primal and dual feasibility tolerance of HiGHS.
+    method : {"highs-ipm", "highs-ds", "highs"}, default "highs-ipm"
+        The scipy ``linprog`` method.
+
+    Returns
+    -------
+    StepSolution
+        The optimal strain (d x d) and displacements (N x d), the predicted tr(eps), the number
+        of rows, the LP time, the duals of the rows and the pairs behind them.
+
+    Raises
+    ------
+    InvalidInputError
+        If alpha is not finite or below 1, method is not one of the above, the packing is not hard
+        spheres in a periodic cell, or the linear program fails (e.g. an overlapping start
+        configuration or degenerate bounds).
+    """
     if not (np.isfinite(alpha) and alpha >= 1):
         raise InvalidInputError(f"influence-sphere factor alpha = gamma / D must be >= 1, got {alpha}")
     if method not in METHODS:

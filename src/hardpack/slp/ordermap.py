@@ -1,6 +1,6 @@
-"""The phi-T order map of SLP packings (Torquato & Jiao 2010, Fig. 6 and sec. VI, L1569-1630).
+"""The phi-T order map of SLP packings (Torquato & Jiao 2010, Fig. 6 and Sec. VI).
 
-One row per packing: density phi (rattlers included, as in Fig. 6, L1753-1757), its number of
+One row per packing: density phi (rattlers included, as in Fig. 6 and Sec. VI), its number of
 spheres N (settings may use different cell sizes: small cells crystallise partly), translational
 order metric T (:func:`hardpack.structure.order.translational_order`, FCC reference at the same
 density, our shell convention: T = 1 for FCC, ~0 for an ideal gas), the SLP settings that made
@@ -9,7 +9,6 @@ it (influence radius alpha = gamma / D, bound widths, LP solver) and its jamming
 """
 
 from __future__ import annotations
-
 
 import numpy as np
 import xarray as xr
@@ -23,7 +22,33 @@ VERDICT = ("strict", "collective", "z_mean", "rattler_fraction")
 
 
 def order_map_summary(packing_paths, verdict_paths) -> xr.Dataset:
-    """phi, T, settings and verdict of each packing; ``verdict_paths[k]`` judges ``packing_paths[k]``."""
+    """phi, T, settings and verdict of each packing; ``verdict_paths[k]`` judges ``packing_paths[k]``.
+
+    Torquato & Jiao 2010, Fig. 6; columns described in the module docstring.
+
+    Parameters
+    ----------
+    packing_paths : sequence of str or os.PathLike
+        3D SLP packing files; each must carry the attributes ``alpha``, ``strain_bound``,
+        ``shear_bound``, ``displacement_bound``, ``lp_method`` and ``seed``.
+    verdict_paths : sequence of str or os.PathLike
+        Their jamming verdicts (``hardpack verify`` output), in the same order.
+
+    Returns
+    -------
+    xarray.Dataset
+        One row per packing along ``packing``: ``phi``, ``N``, ``T``, the settings above and
+        the verdict ``strict``, ``collective``, ``z_mean``, ``rattler_fraction``; attributes
+        ``hardpack_kind`` = "slp_order_map" and ``T_convention``.
+
+    Raises
+    ------
+    InvalidInputError
+        If there are no packings or not one verdict per packing, a verdict judges another
+        packing, or a packing is not 3D.
+    StoreError
+        If a file is missing, unreadable or of the wrong kind.
+    """
     packing_paths, verdict_paths = list(packing_paths), list(verdict_paths)
     if not packing_paths or len(packing_paths) != len(verdict_paths):
         raise InvalidInputError(

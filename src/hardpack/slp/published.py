@@ -11,7 +11,7 @@ import math
 # Table II: densest packings from N = 3^d random starts
 TABLE_II = {
     # d: (N, LS phi, SLP phi, exact target, name of the densest known packing)
-    # printed "0.9068..." (truncated pi/sqrt(12)) and "0.7408..." (misprint of 0.74048; note sec. 0)
+    # printed "0.9068..." (truncated pi/sqrt(12)) and "0.7408..." (misprint of 0.74048)
     2: (9, math.pi / math.sqrt(12), math.pi / math.sqrt(12), math.pi / math.sqrt(12), "triangular"),
     3: (27, math.pi / math.sqrt(18), math.pi / math.sqrt(18), math.pi / math.sqrt(18), "FCC"),
     4: (81, 0.5608, 0.6168, math.pi**2 / 16, "D4"),

@@ -1,8 +1,8 @@
 """One call for the standard structure analysis of a packing (what ``hardpack structure`` writes).
 
 Merges g2 (absolute and scaled), Z(l) (with and without rattlers when a mask is given), the
-shell-averaged S(k) with the linear S(0) fit over kD < 2 pi 0.4 (Donev ch. 10, ch10-14
-L178-181; D = mean diameter), and the order metrics of the dimension: Q6 (bond-averaged), mean
+shell-averaged S(k) with the linear S(0) fit over kD < 2 pi 0.4 (Donev 2006, sec. 10.3,
+Fig. 10.2; D = mean diameter), and the order metrics of the dimension: Q6 (bond-averaged), mean
 q6, T and the q6 crystallinity in 3D; psi6 and T in 2D; T in d >= 4.
 """
 
@@ -39,6 +39,41 @@ def analyse(packing, r_max: float | None = None, k_max: float | None = None, rat
     Also the near-contact power law Z(l) - Z_c = a l^alpha fitted over :data:`NEAR_CONTACT_FIT`
     (rattler-free backbone when a rattler mask is given; NaN when the window holds no gaps) and,
     with ``channels`` in d = 2, 3, the histogram of channel radii R / r (Ogarko ch. 4, bin 0.01).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing.
+    r_max, dr : float, optional
+        Range and bin width of g2 (:func:`hardpack.structure.pair.pair_correlation` defaults).
+    k_max : float, optional
+        Largest wavenumber of S(k); default 20 / mean diameter.
+    rattlers : array_like of bool, shape (N,), optional
+        Rattler mask; Z(l) and the near-contact fit are then also given without rattlers.
+    contact_tol : float, default DEFAULT_CONTACT_TOL
+        Relative gap below which a pair is a contact in g2 and Z(l).
+    gap_max : float, default 0.5
+        Largest relative gap l of Z(l).
+    order : bool, default True
+        Add the order metrics of the dimension.
+    channels : bool, default True
+        Add the channel-radius histogram (d = 2, 3).
+
+    Returns
+    -------
+    xarray.Dataset
+        The merged variables of g2, Z(l), S(k), ``channel_density``, per-particle ``q6`` and
+        ``solid`` (3D), and the scalars ``S0``, ``S0_err``, ``S0_slope`` (NaN with too few
+        k-shells), ``alpha``, ``alpha_err``, ``alpha_amplitude`` (NaN without gaps in the
+        window), ``n_channels``, ``T``, ``Q6``, ``q6_mean``, ``crystallinity`` (3D),
+        ``psi6_global``, ``psi6_local_mean`` (2D); attributes ``hardpack_kind`` = "structure",
+        ``n_particles``, ``dim``, ``phi``, ``mean_diameter`` and the conventions used.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not a periodic sphere packing, or a parameter is refused by the
+        underlying functions.
     """
     packing.require_periodic_spheres("the structure analysis")
     diameter = 2.0 * float(np.mean(packing.radii))

@@ -1,23 +1,23 @@
-"""Channel-size ("four-point") analysis of Ogarko's dissertation ch. 4 (seed 002, L7085-7200).
+"""Channel-size ("four-point") analysis of Ogarko 2014, sec. 4.2.
 
 For every particle i and every combination of three of its neighbours (all C(n_i, 3) triples
 of its regular-triangulation neighbours, not only Delaunay faces; periodic images as seen
 from i), keep the triangle of the three neighbour centres only if it is acute with the
 tolerance eps = 1 - 1e-12: a^2 + b^2 > eps c^2 for all three edge orderings, so exact right
-angles (square arrangements) are kept (L7243-7246). In the plane of the triangle the three
-spheres are circles of their full radii; the channel is the circle externally tangent to all
-three (Apollonius problem, centre p and radius R with |p - c_k| = R + r_k). Subtracting the
+angles (square arrangements) are kept (Ogarko 2014, sec. 4.3, footnote on the acute test). In the
+plane of the triangle the three spheres are circles of their full radii; the channel is the circle
+externally tangent to all three (Apollonius problem, centre p and radius R with |p - c_k| = R + r_k). Subtracting the
 k = 1 equation from the others gives p linear in R, and the k = 1 equation then a quadratic in
 R. The channel is the smallest positive root whose centre lies inside the triangle, else the
 smallest positive root (no centre lies in the circle since |p - c_k| = R + r_k > R; for acute
 triangles of equal spheres the root is unique and inside). Triangles without a positive root
 are skipped and counted. The statistic is the histogram of R / r_i (central radius,
-L7449-7453), bin 0.01.
+Ogarko 2014, sec. 4.4.3), bin 0.01.
 
 Exact values: three mutually touching equal spheres 2/sqrt(3) - 1 = 0.1547; a square of
 touching equal spheres (a right isosceles triangle of neighbours) sqrt(2) - 1 = 0.4142;
-three neighbours coplanar with and touching the central sphere at 120 degrees, 1 (L7290-7330).
-Ideal gas at phi = 0.0014, acute triangles only: roughly Gaussian, mean ~15.9, sigma ~4 (L7166).
+three neighbours coplanar with and touching the central sphere at 120 degrees, 1 (Ogarko 2014, sec. 4.4.1).
+Ideal gas at phi = 0.0014, acute triangles only: roughly Gaussian, mean ~15.9, sigma ~4 (Ogarko 2014, Fig. 4.2).
 """
 
 from __future__ import annotations
@@ -140,6 +140,29 @@ def channel_radii(packing, neighbours="delaunay", eps: float = ACUTE_EPS) -> xr.
     ``neighbours``: "delaunay" (weighted regular triangulation, the source's choice), a cutoff
     in contact distances, or a NeighbourList. Returns a Dataset on dim ``channel`` with
     ``ratio`` and ``particle``, plus scalar counts ``n_obtuse`` and ``n_failed``.
+
+    Ogarko 2014, ch. 4.
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing, d >= 2.
+    neighbours : "delaunay", float or NeighbourList, default "delaunay"
+        Neighbour specification (:func:`hardpack.structure.tessellation.neighbour_list`).
+    eps : float, default 1 - 1e-12
+        Acute-triangle tolerance, in (0, 1]: a^2 + b^2 > eps c^2 for every ordering.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``ratio`` R / r_i and the central ``particle`` i of every channel (dim ``channel``),
+        scalar counts ``n_obtuse`` (triangles not acute) and ``n_failed`` (no positive root);
+        attributes ``eps`` and ``definition``.
+
+    Raises
+    ------
+    InvalidInputError
+        If d < 2, ``eps`` is not in (0, 1], or ``neighbours`` is not a valid specification.
     """
     if packing.dim < 2:
         raise InvalidInputError("channel analysis needs d >= 2")
@@ -159,7 +182,28 @@ def channel_radii(packing, neighbours="delaunay", eps: float = ACUTE_EPS) -> xr.
 
 def channel_histogram(channels: xr.Dataset, bin_width: float = 0.01,
                       ratio_max: float | None = None) -> xr.Dataset:
-    """Normalised histogram (probability density) of R / r with the source's bin 0.01."""
+    """Normalised histogram (probability density) of R / r with the source's bin 0.01.
+
+    Parameters
+    ----------
+    channels : xarray.Dataset
+        Output of :func:`channel_radii` (its ``ratio`` variable is used).
+    bin_width : float, default 0.01
+        Width of the bins, starting at 0.
+    ratio_max : float, optional
+        Upper end of the bins; default the largest ratio.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``density`` (integrates to 1) on the bin centres ``ratio_bin``; attributes
+        ``bin_width`` and ``n_channels``.
+
+    Raises
+    ------
+    InvalidInputError
+        If there are no channels.
+    """
     ratio = channels["ratio"].values
     if ratio.size == 0:
         raise InvalidInputError("no channels to histogram (no acute neighbour triangles)")

@@ -13,7 +13,7 @@ neighbours), SC 0.3536.
 and the mean local |psi_6(i)|; both are 1 for the triangular lattice.
 
 **Translational order T** (Torquato, Truskett & Debenedetti 2000, as used by Torquato & Jiao 2010,
-seed 003 Eq. 22, L1640-1697): T = |sum_i (n_i - n_i^ideal)| / sum_i (n_i^ref - n_i^ideal) over the
+Sec. VI, Eq. 22): T = |sum_i (n_i - n_i^ideal)| / sum_i (n_i^ref - n_i^ideal) over the
 first N_s neighbour shells of the reference crystal at the packing's number density (FCC in 3D;
 triangular in 2D, D_d in d >= 4). n_i = mean number of neighbours (all periodic images,
 including a particle's own images) in the shell [a_i - w/2, a_i + w/2], n_i^ideal = rho times the
@@ -25,7 +25,7 @@ not digit by digit with the published order map.
 T = 1 exactly for the reference crystal; for N ideal-gas points E[T numerator] = -sum n_i^ideal/N
 (the O(1/N) finite-size bias of counting N - 1 partners against rho = N/V).
 
-**Crystallinity** (Ogarko dissertation ch. 3.3, L6728-6815): normalised q6 vectors
+**Crystallinity** (Ogarko 2014, sec. 3.3.3, Eqs. 3.56-3.57): normalised q6 vectors
 q~_6m(i) = q_6m(i) / |q_6(i)|, bond order d6(i, j) = Re sum_m q~_6m(i) q~*_6m(j); a bond is
 connected if d6 > 0.65 and a particle is solid-like with >= 6 connected bonds; p_c = fraction of
 solid-like particles. Neighbours from the weighted Delaunay (regular) triangulation as in the
@@ -51,7 +51,20 @@ def _require_dim(packing, dims, what):
 
 
 def bond_harmonics(separation: np.ndarray, l: int) -> np.ndarray:
-    """Y_lm of the bond directions, shape (n_bonds, 2l + 1) for m = -l..l (3D bonds)."""
+    """Y_lm of the bond directions, shape (n_bonds, 2l + 1) for m = -l..l (3D bonds).
+
+    Parameters
+    ----------
+    separation : numpy.ndarray, shape (n_bonds, 3)
+        Bond vectors (non-zero); only their directions matter.
+    l : int
+        Degree of the spherical harmonics, >= 0.
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (n_bonds, 2l + 1)
+        Y_lm(theta, phi) (scipy's ``sph_harm_y`` convention) for m = -l..l.
+    """
     r = np.linalg.norm(separation, axis=1)
     theta = np.arccos(np.clip(separation[:, 2] / r, -1.0, 1.0))
     phi = np.mod(np.arctan2(separation[:, 1], separation[:, 0]), 2 * np.pi)
@@ -68,7 +81,31 @@ def _per_particle_mean(values, nl: NeighbourList, n: int):
 
 
 def local_qlm(packing, l: int = 6, neighbours=1.2):
-    """q_lm(i) (N, 2l + 1) and the neighbour list used (NaN rows for particles without bonds)."""
+    """q_lm(i) (N, 2l + 1) and the neighbour list used (NaN rows for particles without bonds).
+
+    Parameters
+    ----------
+    packing : Packing
+        A 3D periodic sphere packing.
+    l : int, default 6
+        Degree, a non-negative integer.
+    neighbours : "delaunay", float or NeighbourList, default 1.2
+        Neighbour specification of :func:`hardpack.structure.tessellation.neighbour_list`: the
+        regular triangulation, a cutoff in contact distances, or a ready list.
+
+    Returns
+    -------
+    qlm : numpy.ndarray of complex, shape (N, 2l + 1)
+        q_lm(i) = (1/N_b(i)) sum_j Y_lm(r_ij); NaN rows for particles without bonds.
+    neighbours : NeighbourList
+        The neighbour list used.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not 3D, ``l`` is not a non-negative integer, or ``neighbours`` is
+        not a valid specification.
+    """
     _require_dim(packing, (3,), "Steinhardt q_l")
     if int(l) != l or l < 0:
         raise InvalidInputError(f"l must be a non-negative integer, got {l!r}")
@@ -81,7 +118,33 @@ def _invariant(qlm, l):
 
 
 def steinhardt(packing, l: int = 6, neighbours=1.2, particle_weighted: bool = False) -> xr.Dataset:
-    """Global Q_l (bond-averaged, or particle-averaged as freud) and local q_l(i)."""
+    """Global Q_l (bond-averaged, or particle-averaged as freud) and local q_l(i).
+
+    Steinhardt, Nelson & Ronchetti 1983; conventions in the module docstring.
+
+    Parameters
+    ----------
+    packing : Packing
+        A 3D periodic sphere packing.
+    l : int, default 6
+        Degree, a non-negative integer.
+    neighbours : "delaunay", float or NeighbourList, default 1.2
+        Neighbour specification of :func:`hardpack.structure.tessellation.neighbour_list`: the
+        regular triangulation, a cutoff in contact distances, or a ready list.
+    particle_weighted : bool, default False
+        Average q_lm over particles (freud's ``order``) instead of over bonds.
+
+    Returns
+    -------
+    xarray.Dataset
+        Scalar ``Q{l}``, per-particle ``q{l}`` and ``n_bonds`` (dim ``particle``); attributes
+        ``l`` and ``weighting``.
+
+    Raises
+    ------
+    InvalidInputError
+        As :func:`local_qlm`.
+    """
     qlm, nl = local_qlm(packing, l, neighbours)
     if particle_weighted:
         glob = np.nanmean(qlm, axis=0)
@@ -96,7 +159,28 @@ def steinhardt(packing, l: int = 6, neighbours=1.2, particle_weighted: bool = Fa
 
 
 def psi6(packing, neighbours=1.2) -> xr.Dataset:
-    """Hexatic order psi_6 in 2D: local complex psi6(i), global |<psi6>| and <|psi6(i)|>."""
+    """Hexatic order psi_6 in 2D: local complex psi6(i), global |<psi6>| and <|psi6(i)|>.
+
+    Parameters
+    ----------
+    packing : Packing
+        A 2D periodic sphere (disk) packing.
+    neighbours : "delaunay", float or NeighbourList, default 1.2
+        Neighbour specification of :func:`hardpack.structure.tessellation.neighbour_list`: the
+        regular triangulation, a cutoff in contact distances, or a ready list.
+
+    Returns
+    -------
+    xarray.Dataset
+        Scalars ``psi6_global`` |<psi6(i)>| and ``psi6_local_mean`` <|psi6(i)|>, per-particle
+        ``psi6_abs`` and ``n_bonds`` (dim ``particle``); both scalars are 1 for the triangular
+        lattice.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not 2D or ``neighbours`` is not a valid specification.
+    """
     _require_dim(packing, (2,), "psi_6")
     nl = neighbour_list(packing, neighbours)
     theta = np.arctan2(nl.separation[:, 1], nl.separation[:, 0])
@@ -129,7 +213,33 @@ def _reference_shells(d: int, n_shells: int):
 
 def translational_order(packing, n_shells: int = 7, width: float | None = None) -> float:
     """Translational order metric T (module docstring); ``width`` in units of the NN distance
-    (default 0.98 times the smallest spacing of the first ``n_shells`` reference shells)."""
+    (default 0.98 times the smallest spacing of the first ``n_shells`` reference shells).
+
+    Torquato, Truskett & Debenedetti 2000, as used by Torquato & Jiao 2010; the shell width and
+    count are our choice (module docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing, d >= 2.
+    n_shells : int, default 7
+        Neighbour shells N_s of the reference crystal (FCC in 3D, triangular in 2D, D_d in
+        d >= 4) at the packing's number density; a positive integer.
+    width : float, optional
+        Shell width in units of the reference nearest-neighbour distance, below the smallest
+        spacing of the first ``n_shells`` shells.
+
+    Returns
+    -------
+    float
+        T: 1 for the reference crystal, ~0 for an ideal gas.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not a periodic sphere packing, d < 2, ``n_shells`` is not a positive
+        integer, or ``width`` would make the shells overlap (or is not positive).
+    """
     packing.require_periodic_spheres("the structure analysis")
     if int(n_shells) != n_shells or n_shells < 1:
         raise InvalidInputError(f"n_shells must be a positive integer, got {n_shells!r}")
@@ -157,7 +267,34 @@ def translational_order(packing, n_shells: int = 7, width: float | None = None) 
 
 def crystallinity(packing, neighbours="delaunay", threshold: float = 0.65,
                   min_connections: int = 6) -> xr.Dataset:
-    """Ogarko's q6 bond criterion (module docstring): solid-like flags, connections and p_c."""
+    """Ogarko's q6 bond criterion (module docstring): solid-like flags, connections and p_c.
+
+    Ogarko 2014, ch. 3.3.
+
+    Parameters
+    ----------
+    packing : Packing
+        A 3D periodic sphere packing.
+    neighbours : "delaunay", float or NeighbourList, default "delaunay"
+        Neighbour specification (:func:`hardpack.structure.tessellation.neighbour_list`); the
+        regular triangulation is the source's choice.
+    threshold : float, default 0.65
+        A bond is connected when d6(i, j) exceeds it.
+    min_connections : int, default 6
+        Connected bonds from which a particle is solid-like.
+
+    Returns
+    -------
+    xarray.Dataset
+        Per-particle ``solid``, ``connections`` and ``n_bonds`` (dim ``particle``), the scalar
+        ``crystallinity`` p_c (fraction of solid-like particles); attributes ``threshold`` and
+        ``min_connections``.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not 3D or ``neighbours`` is not a valid specification.
+    """
     qlm, nl = local_qlm(packing, 6, neighbours)
     norm = np.linalg.norm(qlm, axis=1)
     unit = qlm / np.where(norm > 0, norm, np.nan)[:, None]
@@ -174,7 +311,25 @@ def crystallinity(packing, neighbours="delaunay", threshold: float = 0.65,
 
 
 def order_map(packings, n_shells: int = 7, width: float | None = None) -> xr.Dataset:
-    """The (phi, T) order map of Torquato & Jiao (seed 003 Fig. 6): one point per packing."""
+    """The (phi, T) order map of Torquato & Jiao (2010, Fig. 6): one point per packing.
+
+    Parameters
+    ----------
+    packings : iterable of Packing
+        The packings, at least one.
+    n_shells, width
+        As in :func:`translational_order`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``phi`` and ``T`` along ``packing``; attributes ``n_shells`` and ``width``.
+
+    Raises
+    ------
+    InvalidInputError
+        If there is no packing, or as :func:`translational_order`.
+    """
     packings = list(packings)
     if not packings:
         raise InvalidInputError("order_map needs at least one packing")

@@ -15,19 +15,19 @@ distribution. With ``self_images=True`` a particle's own images are counted too 
 periodic system, needed for cells smaller than the range, e.g. N = 1 lattices) and the pair
 count in the normalisation becomes N^2/2 (self terms added to the scaled sum likewise).
 
-**Contact delta peak** (Donev dissertation ch. 9, Eq. 9.4 context, ch7-9 L1689-1695): pairs
+**Contact delta peak** (Donev 2006, sec. 9.3.1 and Eq. 9.4, Fig. 9.4): pairs
 with |r / (r_i + r_j) - 1| <= contact_tol are contacts; they are counted separately
 (``n_contacts``, Z_c = 2 n_contacts / N) and left out of both histograms, so g2 holds only the
-continuous part; the full g2 adds Z_c delta(r - D) / (rho s_1(D)) (ch10-14 Eq. 11.5).
+continuous part; the full g2 adds Z_c delta(r - D) / (rho s_1(D)) (Donev 2006, Eq. 11.5).
 
-**Cumulative coordination** (ch. 9, L1633-1646): Z(l) = 2 #{pairs with gap <= l} / N with the
+**Cumulative coordination** (Donev 2006, sec. 9.3.1, Fig. 9.4): Z(l) = 2 #{pairs with gap <= l} / N with the
 relative gap l = r / (r_i + r_j) - 1 (= (r - D)/D for equal spheres), estimated without binning
 from the sorted gaps. With a rattler mask, the backbone version counts only pairs of two
-non-rattlers and divides by the number of non-rattlers N_b (Donev analyses the backbone,
-L1656-1661, L1828-1848).
+non-rattlers and divides by the number of non-rattlers N_b (as Donev 2006 does: secs. 9.3.1
+and 9.3.1.2).
 
-**Near-contact power law** Z(l) = Z_c + a l^alpha (ch. 9 Eq. 9.7 with alpha = 1 - alpha_Donev;
-published alpha ~ 0.6, a ~ 11 for rattler-free jammed spheres, L1788-1789). Fitted by maximum
+**Near-contact power law** Z(l) = Z_c + a l^alpha (Donev 2006, Eq. 9.7 with alpha = 1 - alpha_Donev;
+published alpha ~ 0.6, a ~ 11 for rattler-free jammed spheres, sec. 9.3.1.2, Fig. 9.6). Fitted by maximum
 likelihood: gaps inside a window [l_lo, l_hi] above the contact part are samples of the density
 alpha l^(alpha-1) / (l_hi^alpha - l_lo^alpha); the standard error comes from the Fisher
 information. Pairs sharing particles are not independent, so this error is a lower bound;
@@ -45,14 +45,14 @@ from scipy.optimize import brentq
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
-from hardpack.geometry.neighbours import pairs_within
-from hardpack.structure import _cells
+from hardpack.geometry.neighbours import build_grid, pairs_within
+from hardpack.geometry.neighbours.grid import pair_histograms, stencil
 
 DEFAULT_CONTACT_TOL = 1e-9
 
 
 #: default fit window of the near-contact power law: above the contact delta peak (LS packings at
-#: Z = 1e12 have contact gaps ~1e-12, far below 1e-5 / 100, ch. 9 L1788-1799) and below the
+#: Z = 1e12 have contact gaps ~1e-12, far below 1e-5 / 100, Donev 2006, sec. 9.3.1.2) and below the
 #: first minimum of g2 (l ~ 0.25), where Donev sees 11 l^0.6 hold
 NEAR_CONTACT_FIT = (1e-5, 1e-1)
 
@@ -78,11 +78,42 @@ def pair_correlation(packing, r_max: float | None = None, dr: float | None = Non
                      self_images: bool = False) -> xr.Dataset:
     """g2 in absolute distance r and in scaled distance x = r / (r_i + r_j) (module docstring).
 
-    Defaults: r_max = 5 mean diameters, dr = mean diameter / 200 (Donev's 0.005 D bins for the
-    split second peak, ch7-9 L1854-1867). The pair search reaches max(r_max, x_max times the
-    largest contact distance): lower x_max for wide size distributions. Returns a Dataset with coordinates ``r`` and ``x``
-    (bin centres), variables ``g2``, ``pair_count``, ``ideal_count`` on r, the same with suffix
-    ``_scaled`` on x, and scalars ``n_contacts`` and ``z_contacts`` (the delta-peak weight).
+    The pair search reaches max(r_max, x_max times the largest contact distance): lower x_max for
+    wide size distributions.
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell.
+    r_max : float, optional
+        Range of the histogram in r; default 5 mean diameters.
+    dr : float, optional
+        Bin width in r; default mean diameter / 200, fine enough for the split second peak
+        (Donev 2006, sec. 9.3.1.3, Fig. 9.7; the dissertation does not print its bin width).
+    x_max : float, default 3.0
+        Range of the histogram in the scaled distance x.
+    dx : float, default 0.005
+        Bin width in x.
+    contact_tol : float, default 1e-9
+        Pairs with |x - 1| <= contact_tol are contacts: counted in ``n_contacts`` and left out of
+        both histograms.
+    self_images : bool, default False
+        Count a particle's own periodic images too (the infinite periodic system; needed for cells
+        smaller than the range, e.g. N = 1 lattices).
+
+    Returns
+    -------
+    xarray.Dataset
+        Coordinates ``r`` and ``x`` (bin centres); variables ``g2``, ``pair_count``,
+        ``ideal_count`` on r, the same with suffix ``_scaled`` on x, and scalars ``n_contacts``
+        and ``z_contacts`` (the delta-peak weight Z_c = 2 n_contacts / N).
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not hard spheres in a periodic cell, r_max, dr, x_max or dx is not a
+        positive finite number, contact_tol is negative or not finite, or more than 10^7 bins are
+        requested.
     """
     packing.require_periodic_spheres("the structure analysis")
     diameter = 2.0 * float(np.mean(packing.radii))
@@ -96,10 +127,10 @@ def pair_correlation(packing, r_max: float | None = None, dr: float | None = Non
         raise InvalidInputError(f"{max(n_r, n_x)} bins requested; increase dr/dx or lower r_max/x_max")
     radii = np.ascontiguousarray(packing.radii, dtype=float)
     cutoff = max(n_r * dr, n_x * dx * 2.0 * radii.max())
-    grid = _cells.build_grid(packing, cutoff)
-    hist_r, hist_x, n_contacts = _cells.pair_histograms(
-        grid.x, radii, grid.lattice, grid.n_cells, grid.strides, grid.cell_start, grid.order,
-        grid.offsets, cutoff, dr, n_r, dx, n_x, float(contact_tol), bool(self_images),
+    grid = build_grid(packing.fractional(), packing.lattice, np.full(radii.size, 0.5 * cutoff), per_cell=2)
+    hist_r, hist_x, n_contacts = pair_histograms(
+        grid.x, radii, grid.lattice, grid.n_cells[0], grid.strides[0], grid.cell_start, grid.order,
+        stencil(grid, cutoff), cutoff, dr, n_r, dx, n_x, float(contact_tol), bool(self_images),
     )
     n, d, volume = packing.n_particles, packing.dim, packing.volume
     vd = unit_ball_volume(d)
@@ -144,10 +175,38 @@ def cumulative_coordination(packing, gap_max: float = 0.5, rattlers=None,
                             n_grid: int = 321) -> xr.Dataset:
     """Z(l) from the sorted relative gaps of all pairs with gap <= gap_max (module docstring).
 
-    Returns a Dataset with the sorted gaps (``gap_all`` on dim ``pair_all``; with a rattler mask
-    also ``gap_backbone`` on ``pair_backbone``), Z on a log grid ``gap`` (``Z_all`` and
-    ``Z_backbone``), and scalars ``z_contacts_all`` / ``z_contacts_backbone`` (pairs with
-    |gap| <= contact_tol). Self-image contacts count twice for their particle, as they should.
+    Self-image contacts count twice for their particle, as they should.
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell.
+    gap_max : float, default 0.5
+        Largest relative gap l = r / (r_i + r_j) - 1 searched.
+    rattlers : numpy.ndarray of bool, shape (N,), optional
+        True for rattlers; if given, the backbone version (pairs of two non-rattlers, divided by
+        the number of non-rattlers) is computed too.
+    contact_tol : float, default 1e-9
+        Pairs with |l| <= contact_tol count as contacts in ``z_contacts_*``.
+    gap_min : float, default 1e-16
+        Smallest gap of the logarithmic grid on which Z is tabulated.
+    n_grid : int, default 321
+        Number of points of that grid.
+
+    Returns
+    -------
+    xarray.Dataset
+        The sorted gaps (``gap_all`` on dim ``pair_all``; with a rattler mask also
+        ``gap_backbone`` on ``pair_backbone``), Z on the log grid ``gap`` (``Z_all``, and
+        ``Z_backbone``), scalars ``z_contacts_all`` / ``z_contacts_backbone`` (pairs with
+        |gap| <= contact_tol) and ``n_particles_all`` / ``n_particles_backbone``.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not hard spheres in a periodic cell, gap_max or gap_min is not a positive
+        finite number or gap_min >= gap_max, or rattlers is not a boolean array of shape (N,) or
+        flags every particle.
     """
     packing.require_periodic_spheres("the structure analysis")
     gap_max = _positive("gap_max", gap_max)
@@ -193,9 +252,27 @@ class PowerLawFit:
 def fit_power_law(gaps, n_particles: int, gap_lo: float, gap_hi: float) -> PowerLawFit:
     """Maximum-likelihood fit of Z(l) - Z_c = a l^alpha from pair gaps (module docstring).
 
-    ``gaps`` are the relative gaps of all pairs (any order) of a set of ``n_particles``
-    particles; the window [gap_lo, gap_hi] must lie above the contact part. Z_c is
-    Z(gap_lo) - a gap_lo^alpha.
+    Parameters
+    ----------
+    gaps : array_like
+        Relative gaps of all pairs (any order) of a set of ``n_particles`` particles.
+    n_particles : int
+        Number of particles of that set (Z = 2 #pairs / n_particles).
+    gap_lo, gap_hi : float
+        The fit window (gap_lo, gap_hi]; it must lie above the contact part.
+
+    Returns
+    -------
+    PowerLawFit
+        alpha and amplitude a with their standard errors (from the Fisher information; a lower
+        bound, since pairs sharing particles are not independent), Z_c = Z(gap_lo) - a gap_lo^alpha,
+        the number of gaps in the window and the window.
+
+    Raises
+    ------
+    InvalidInputError
+        If gap_lo or gap_hi is not a positive finite number or gap_lo >= gap_hi, fewer than 10
+        gaps lie in the window, or no alpha in (0, 20) fits them.
     """
     gap_lo, gap_hi = _positive("gap_lo", gap_lo), _positive("gap_hi", gap_hi)
     if gap_lo >= gap_hi:
@@ -235,7 +312,27 @@ def fit_power_law(gaps, n_particles: int, gap_lo: float, gap_hi: float) -> Power
 
 def fit_coordination_power_law(z: xr.Dataset, gap_lo: float, gap_hi: float,
                                backbone: bool = True) -> PowerLawFit:
-    """:func:`fit_power_law` on a :func:`cumulative_coordination` Dataset (backbone if present)."""
+    """:func:`fit_power_law` on a :func:`cumulative_coordination` Dataset (backbone if present).
+
+    Parameters
+    ----------
+    z : xarray.Dataset
+        The result of :func:`cumulative_coordination`.
+    gap_lo, gap_hi : float
+        The fit window (gap_lo, gap_hi]; gap_hi must not exceed the dataset's gap_max.
+    backbone : bool, default True
+        Fit the backbone gaps if the dataset has them; otherwise (or if False) all gaps.
+
+    Returns
+    -------
+    PowerLawFit
+        As :func:`fit_power_law`.
+
+    Raises
+    ------
+    InvalidInputError
+        If gap_hi exceeds the gap range of the dataset, or as :func:`fit_power_law`.
+    """
     name = "backbone" if backbone and "gap_backbone" in z else "all"
     if gap_hi > float(z["gap"].max()):
         raise InvalidInputError(

@@ -1,6 +1,6 @@
 """Structure factor S(k), its k -> 0 extrapolation, and the number variance in spherical windows.
 
-**S(k)** (Donev dissertation ch. 10, ch10-14 L148-168; Ogarko Eq. 3.58):
+**S(k)** (Donev 2006, sec. 10.3; Ogarko 2014, Eq. 3.58):
 S(k) = |sum_j exp(-i k.x_j)|^2 / N for the wavevectors allowed by the periodic cell,
 k = 2 pi L^-T n (n integer, L = lattice with vectors as columns), so k.x_j = 2 pi n.s_j with the
 fractional coordinates s_j. S(k) = S(-k), so only one of +-n is computed. This is freud's
@@ -15,15 +15,15 @@ vectors sharing (n_1 .. n_(d-1)) the sum over particles and all n_d is one compl
 product (BLAS), with the per-axis phase tables computed once per particle chunk.
 
 **Shell average** over spherical shells of thickness 2 pi / V^(1/d) (2 pi / L for a cubic box,
-ch10-14 L163-164); each shell reports its mean |k|, mean S, the standard error of the mean and
+Donev 2006, sec. 10.3); each shell reports its mean |k|, mean S, the standard error of the mean and
 the number of vectors.
 
-**S(0)** (ch10-14 L178-181): weighted least squares of the shell means for k <= k_fit, linear
+**S(0)** (Donev 2006, sec. 10.3, Fig. 10.2): weighted least squares of the shell means for k <= k_fit, linear
 S = S0 + s1 k (Donev's fit for jammed packings, K/2pi < 0.4 with K = kD) or even quadratic
 S = S0 + s2 k^2 (the liquid form), weights = number of vectors per shell; the error comes from
 the residual scatter.
 
-**Number variance** (ch10-14 L228-289): sigma^2(R) = <N_R^2> - <N_R>^2 of the number of centres
+**Number variance** (Donev 2006, sec. 10.4): sigma^2(R) = <N_R^2> - <N_R>^2 of the number of centres
 (all periodic images) inside windows of radius R with uniformly random centres; the standard
 error ``variance_err`` covers only the window sampling: one configuration's variance also
 fluctuates with the configuration (it is a sum of S(k) |window transform|^2 dominated by the
@@ -42,7 +42,8 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import ball_volume
-from hardpack.structure import _cells
+from hardpack.geometry.neighbours import build_grid
+from hardpack.geometry.neighbours.grid import window_counts
 
 _PARTICLE_CHUNK = 8192  # particles per phase table
 _MATRIX_ELEMENTS = 2**21  # rows x particles per GEMM block (operand ~32 MB)
@@ -111,8 +112,29 @@ def _expand(recip, heads, t_lo, t_hi, k_max):
 
 
 def wavevectors(lattice, k_max: float, max_vectors: int = 5 * 10**7):
-    """Integer vectors n (one of each +-n pair) with 0 < |2 pi L^-T n| <= k_max, and their k
-    (shapes (M, d)), grouped by (n_1 .. n_(d-1))."""
+    """Integer vectors n (one of each +-n pair) with 0 < |2 pi L^-T n| <= k_max, and their k.
+
+    Parameters
+    ----------
+    lattice : array_like, shape (d, d)
+        The cell, lattice vectors as columns.
+    k_max : float
+        Largest |k|.
+    max_vectors : int, default 5 * 10**7
+        Refuse k_max values that need more wavevectors than this.
+
+    Returns
+    -------
+    n : numpy.ndarray of int, shape (M, d)
+        The integer vectors, grouped by (n_1 .. n_(d-1)).
+    k : numpy.ndarray, shape (M, d)
+        The wavevectors k = 2 pi L^-T n.
+
+    Raises
+    ------
+    InvalidInputError
+        If k_max is not a positive finite number or needs more than max_vectors wavevectors.
+    """
     recip, heads, t_lo, t_hi = _heads(lattice, k_max, max_vectors)
     n, k, _ = _expand(recip, heads, t_lo, t_hi, k_max)
     return n, k
@@ -201,7 +223,32 @@ def _density_modes(s, heads, t_lo, t_hi):
 
 
 def structure_factor_vectors(packing, k_max: float, max_vectors: int = 5 * 10**7):
-    """S at every allowed wavevector with 0 < |k| <= k_max: returns (n, k vectors, S)."""
+    """S at every allowed wavevector with 0 < |k| <= k_max (one of each +-k pair).
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell.
+    k_max : float
+        Largest |k|.
+    max_vectors : int, default 5 * 10**7
+        Refuse k_max values that need more wavevectors than this.
+
+    Returns
+    -------
+    n : numpy.ndarray of int, shape (M, d)
+        The integer vectors of the wavevectors.
+    k : numpy.ndarray, shape (M, d)
+        The wavevectors k = 2 pi L^-T n.
+    S : numpy.ndarray, shape (M,)
+        S(k) = |sum_j exp(-i k.x_j)|^2 / N.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not hard spheres in a periodic cell, or k_max is not a positive finite
+        number or needs more than max_vectors wavevectors.
+    """
     packing.require_periodic_spheres("the structure analysis")
     recip, heads, t_lo, t_hi = _heads(packing.lattice, k_max, max_vectors)
     rho = _density_modes(packing.fractional(), heads, t_lo, t_hi)
@@ -211,8 +258,30 @@ def structure_factor_vectors(packing, k_max: float, max_vectors: int = 5 * 10**7
 
 
 def structure_factor(packing, k_max: float, shell_width: float | None = None) -> xr.Dataset:
-    """Shell-averaged S(k) (module docstring). Dataset on dim ``k`` (mean |k| of each shell)
-    with ``S``, ``S_err`` (standard error of the shell mean), ``n_vectors``, ``k_lo``, ``k_hi``."""
+    """Shell-averaged S(k) (module docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell.
+    k_max : float
+        Largest |k|.
+    shell_width : float, optional
+        Shell thickness; default 2 pi / V^(1/d).
+
+    Returns
+    -------
+    xarray.Dataset
+        On dim ``k`` (mean |k| of each non-empty shell): ``S`` (shell mean), ``S_err`` (standard
+        error of the shell mean; NaN for a shell with one vector), ``n_vectors``, ``k_lo``, ``k_hi``.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not hard spheres in a periodic cell, k_max is not a positive finite
+        number or needs too many wavevectors, shell_width is not positive and finite, or no allowed
+        wavevector has |k| <= k_max.
+    """
     _, kvec, s = structure_factor_vectors(packing, k_max)
     width = 2 * np.pi / packing.volume ** (1.0 / packing.dim) if shell_width is None else shell_width
     if not np.isfinite(width) or width <= 0:
@@ -239,9 +308,30 @@ def structure_factor(packing, k_max: float, shell_width: float | None = None) ->
 
 
 def extrapolate_s0(sk: xr.Dataset, k_fit: float, form: str = "linear"):
-    """S(0) from a fit of the shell means with k <= k_fit: returns (S0, S0_err, coefficients).
+    """S(0) from a weighted fit of the shell means with k <= k_fit (module docstring).
 
-    ``form`` is "linear" (S0 + s1 k) or "quadratic" (S0 + s2 k^2); see the module docstring.
+    Parameters
+    ----------
+    sk : xarray.Dataset
+        The result of :func:`structure_factor`.
+    k_fit : float
+        Largest shell |k| used in the fit.
+    form : {"linear", "quadratic"}, default "linear"
+        S0 + s1 k or S0 + s2 k^2.
+
+    Returns
+    -------
+    S0 : float
+        The fitted S(0).
+    S0_err : float
+        Its standard error, from the residual scatter.
+    coefficients : numpy.ndarray
+        (S0, s1) or (S0, s2).
+
+    Raises
+    ------
+    InvalidInputError
+        If form is not "linear" or "quadratic", or fewer than 3 shells have k <= k_fit.
     """
     powers = {"linear": (0, 1), "quadratic": (0, 2)}
     if form not in powers:
@@ -265,8 +355,28 @@ def extrapolate_s0(sk: xr.Dataset, k_fit: float, form: str = "linear"):
 def number_variance(packing, window_radii, n_windows: int = 10000, seed: int = 0) -> xr.Dataset:
     """sigma^2(R) of the number of centres in randomly placed spherical windows (module docstring).
 
-    Returns a Dataset on dim ``R`` with ``variance``, ``variance_err``, ``mean`` and the
-    ideal-gas reference ``variance_binomial`` = N p (1 - p).
+    Parameters
+    ----------
+    packing : Packing
+        Hard spheres in a periodic cell.
+    window_radii : array_like
+        Window radii R (any shape; flattened and sorted).
+    n_windows : int, default 10000
+        Number of window centres, uniformly random in the cell.
+    seed : int, default 0
+        Seed of the window centres.
+
+    Returns
+    -------
+    xarray.Dataset
+        On dim ``R`` (ascending): ``variance``, ``variance_err`` (window sampling only), ``mean``
+        and the ideal-gas reference ``variance_binomial`` = N p (1 - p), p = v_d R^d / V.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not hard spheres in a periodic cell, window_radii is empty or not all
+        positive and finite, or n_windows < 2.
     """
     packing.require_periodic_spheres("the structure analysis")
     radii = np.sort(np.asarray(window_radii, dtype=float).ravel())
@@ -276,9 +386,10 @@ def number_variance(packing, window_radii, n_windows: int = 10000, seed: int = 0
         raise InvalidInputError(f"n_windows must be >= 2, got {n_windows}")
     rng = np.random.default_rng(seed)
     centres = rng.random((int(n_windows), packing.dim))
-    grid = _cells.build_grid(packing, float(radii[-1]), per_cutoff=2)
-    counts = _cells.window_counts(centres, grid.x, grid.lattice, grid.n_cells, grid.strides,
-                                  grid.cell_start, grid.order, grid.offsets, radii).astype(float)
+    grid = build_grid(packing.fractional(), packing.lattice, np.full(packing.n_particles, 0.5 * radii[-1]),
+                      per_cell=2)
+    counts = window_counts(centres, grid.x, grid.lattice, 1.0 / grid.heights, grid.n_cells, grid.strides,
+                           grid.cell_offset, grid.cell_start, grid.order, radii).astype(float)
     m = counts.shape[0]
     mean = counts.mean(axis=0)
     dev2 = (counts - mean) ** 2

@@ -2,7 +2,7 @@
 
 The regular triangulation of spheres (centres x_i, weights r_i^2) is the dual of the power
 (Laguerre) diagram; it is the lower convex hull of the lifted points (x_i, |x_i|^2 - r_i^2) in
-d + 1 dimensions (Ogarko dissertation ch. 4, L7085-7200, and ch. 3.3 crystallinity L6728-6815
+d + 1 dimensions (Ogarko 2014, sec. 4.2, and the crystallinity of sec. 3.3.3
 use it through CGAL; this is the same construction through scipy's ConvexHull / Qhull). With
 equal radii it is the ordinary Delaunay triangulation.
 
@@ -38,7 +38,19 @@ from hardpack.geometry.neighbours import pairs_within
 class NeighbourList:
     """Directed neighbour list, sorted by i: j is a neighbour of i through image ``shift``;
     ``separation[k] = x_j + lattice @ shift[k] - x_i``. ``start`` is the CSR offset array
-    (neighbours of i are entries start[i]:start[i+1])."""
+    (neighbours of i are entries start[i]:start[i+1]).
+
+    Parameters
+    ----------
+    i, j : numpy.ndarray of int, shape (M,)
+        The particle and its neighbour, sorted by (i, j); each bond appears in both directions.
+    shift : numpy.ndarray of int, shape (M, d)
+        Lattice image of j.
+    separation : numpy.ndarray of float, shape (M, d)
+        x_j + lattice @ shift - x_i (Cartesian).
+    start : numpy.ndarray of int64, shape (N + 1,)
+        CSR offsets; ``counts`` gives the neighbours per particle.
+    """
 
     i: np.ndarray
     j: np.ndarray
@@ -64,7 +76,25 @@ def cutoff_neighbours(packing, cutoff: float = 1.2) -> NeighbourList:
 
     The default 1.2 includes the second BCC shell (2/sqrt(3) = 1.155) and excludes the second
     FCC/HCP/SC shell (sqrt 2), as in Steinhardt's lattice values; in jammed packings it sits
-    near the first minimum of g2 at 1.25 D (Donev ch. 9, ch7-9 L1788).
+    near the first minimum of g2 at 1.25 D (Donev 2006, sec. 9.3.1.2).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing.
+    cutoff : float, default 1.2
+        Range in units of the contact distance r_i + r_j; positive and finite.
+
+    Returns
+    -------
+    NeighbourList
+        Every pair within range in both directions, all periodic images.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not a periodic sphere packing or ``cutoff`` is not positive and
+        finite.
     """
     packing.require_periodic_spheres("the structure analysis")
     if not np.isfinite(cutoff) or cutoff <= 0:
@@ -100,6 +130,29 @@ def regular_neighbours(packing, weighted: bool = True, margin: float | None = No
     the initial replication depth in mean interparticle spacings (default 2), doubled until all
     simplices around the original particles are certified. Particles whose power cell is empty
     (possible for very unequal radii) have no neighbours.
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing, d >= 2.
+    weighted : bool, default True
+        Weights r_i^2 (regular, power-diagram dual) or none (Delaunay).
+    margin : float, optional
+        Initial replication depth in mean interparticle spacings; default 2 (2 (d + 1) when
+        N < d + 1).
+    max_tries : int, default 4
+        Doublings of the margin before giving up.
+
+    Returns
+    -------
+    NeighbourList
+        The edges of the periodic triangulation at the original particles, both directions.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not a periodic sphere packing, d < 2, or the triangulation cannot be
+        certified within ``max_tries`` margins (degenerate or far too sparse configuration).
     """
     packing.require_periodic_spheres("the structure analysis")
     n, d = packing.n_particles, packing.dim
@@ -176,7 +229,26 @@ def _certified(simplices, x, w, wmax, lat, m_frac) -> bool:
 
 def neighbour_list(packing, neighbours) -> NeighbourList:
     """Neighbours from a specification: "delaunay" (the regular triangulation), a cutoff in
-    contact distances (a number, see :func:`cutoff_neighbours`), or a ready NeighbourList."""
+    contact distances (a number, see :func:`cutoff_neighbours`), or a ready NeighbourList.
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing.
+    neighbours : "delaunay", float or NeighbourList
+        The specification; a NeighbourList is returned as given.
+
+    Returns
+    -------
+    NeighbourList
+        The neighbours.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``neighbours`` is none of these, or as :func:`regular_neighbours` /
+        :func:`cutoff_neighbours`.
+    """
     if isinstance(neighbours, NeighbourList):
         return neighbours
     if isinstance(neighbours, str) and neighbours == "delaunay":

@@ -46,7 +46,8 @@ def finite_size_extrapolation(n, values) -> tuple[float, float, str]:
         dof = max(len(values) - 2, 1)
         sigma2 = float(res[0]) / dof if res.size else 0.0
         cov = sigma2 * np.linalg.inv(design.T @ design)
-        return float(coef[0]), math.sqrt(max(cov[0, 0], 0.0)), f"fit a + b ln N / N over N = {sizes.astype(int).tolist()}"
+        fit = f"fit a + b ln N / N over N = {sizes.astype(int).tolist()}"
+        return float(coef[0]), math.sqrt(max(cov[0, 0], 0.0)), fit
     big = sizes.max()
     return float(values[n == big].mean()), math.nan, f"largest N = {int(big)} only (no extrapolation)"
 
@@ -129,7 +130,8 @@ def simplex_rows(ds) -> list[Row]:
                   f"{np.round(rel, 5).tolist()}; {_cost(sel)}")
         n_iso = int(n_b[iso].max())
         out.append(evaluate(targets[f"donev-t6.1-exact-{suffix}"], samples=sel["exact"].values[iso], n=n_iso,
-                            detail=detail + ("; centre-of-mass value = exact + d ln N_b / N_b" if frozen == "cm" else "")))
+                            detail=detail + ("; centre-of-mass value = exact + d ln N_b / N_b"
+                                             if frozen == "cm" else "")))
         out.append(evaluate(targets[f"donev-t6.1-bcmd-vs-exact-{suffix}"], largest_magnitude(rel), n=n_iso,
                             seeds=int(iso.sum()), detail=detail))
     return out

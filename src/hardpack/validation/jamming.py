@@ -11,9 +11,11 @@ import math
 
 import numpy as np
 
+from hardpack.jamming.result import Verdict
 from hardpack.validation.packings import n_particles, system_key
 from hardpack.validation.rows import Row, evaluate
 from hardpack.validation.targets import load_targets
+
 
 def _system(key) -> str | None:
     """Target suffix of a recognised system: d<d> for monodisperse spheres, binary2d."""
@@ -49,7 +51,7 @@ def verdict_notes(summary) -> str:
     notes = []
     for test in ("collective", "strict"):
         if test in summary:
-            undetermined = int(np.sum(np.asarray(summary[test].values) == -2))
+            undetermined = int(np.sum(np.asarray(summary[test].values) == Verdict.UNDETERMINED))
             if undetermined:
                 notes.append(f"{undetermined} {test} verdict(s) undetermined (counted as not jammed)")
     for name in summary.data_vars:

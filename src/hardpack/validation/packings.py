@@ -31,7 +31,8 @@ def system_key(summary) -> tuple | None:
     kind = spec.get("kind")
     if kind == "monodisperse":
         return ("monodisperse", d)
-    if kind == "bidisperse" and abs(spec.get("size_ratio", 0) - 1.4) < 1e-9 and abs(spec.get("large_fraction", 0) - 0.5) < 1e-9:
+    if (kind == "bidisperse" and abs(spec.get("size_ratio", 0) - 1.4) < 1e-9
+            and abs(spec.get("large_fraction", 0) - 0.5) < 1e-9):
         return ("binary_1.4_equimolar", d)
     if kind == "uniform_size" and abs(spec.get("omega", 0) - 2) < 1e-9:
         return ("us_omega2", d)

@@ -104,6 +104,15 @@ def evaluate(target: Target, reproduced: float = math.nan, uncertainty: float = 
         the row's parameter).
     detail, label : str
         What was measured (protocol, N, seeds), and which ensemble or parameter the row is for.
+
+    Returns
+    -------
+    Row
+        The target's identity and citation, the published value, the reproduced value and its
+        uncertainty, the absolute tolerance with its origin, and the status: pass / fail within
+        tolerance + 2 uncertainties, n/a when the measurement is outside the target's
+        applicability limits, known deviation (or "deviation passes") for targets with a
+        documented deviation.
     """
     missing = 0
     if samples is not None:
@@ -141,7 +150,20 @@ def counts(rows: list[Row]) -> dict[str, Counter]:
 
 def gate(rows: list[Row], min_applicable: int = 0) -> list[str]:
     """Reasons the gate fails (empty when it passes): failing rows, documented deviations that now
-    pass, and fewer than ``min_applicable`` applicable reproduction and analytic rows."""
+    pass, and fewer than ``min_applicable`` applicable reproduction and analytic rows.
+
+    Parameters
+    ----------
+    rows : list of Row
+        The evaluated rows.
+    min_applicable : int, default 0
+        Fewest applicable rows of kind "reproduction" or "analytic" the gate accepts.
+
+    Returns
+    -------
+    list of str
+        One line per problem; empty when the gate passes.
+    """
     problems = [f"{r.target}{f' [{r.label}]' if r.label else ''}: {r.status}: {r.quantity} "
                 f"(published {_fmt(r.published)}, reproduced {_fmt(r.reproduced)})"
                 for r in rows if r.status in (FAIL, DEVIATION_PASSES)]
@@ -153,7 +175,20 @@ def gate(rows: list[Row], min_applicable: int = 0) -> list[str]:
 
 
 def to_dataset(rows: list[Row]) -> xr.Dataset:
-    """Rows as a Dataset over dimension ``row`` (strings, floats; the headline counts in attrs)."""
+    """Rows as a Dataset over dimension ``row`` (strings, floats; the headline counts in attrs).
+
+    Parameters
+    ----------
+    rows : list of Row
+        The evaluated rows.
+
+    Returns
+    -------
+    xarray.Dataset
+        One variable per field of :class:`Row` along ``row`` (float fields as floats, the others
+        as strings); attributes ``hardpack_kind`` = "validation", ``n_rows`` and
+        ``n_<kind>_<status>`` counts. :func:`from_dataset` reads it back.
+    """
     data = {}
     for f in fields(Row):
         values = [getattr(r, f.name) for r in rows]
@@ -203,7 +238,24 @@ def headline(rows: list[Row]) -> list[str]:
 
 def to_markdown(rows: list[Row], problems: list[str], unmeasured: list[Target] = (),
                 title: str = "hardpack validation report") -> str:
-    """A readable report: the gate's verdict, the counts per kind, then one table per study."""
+    """A readable report: the gate's verdict, the counts per kind, then one table per study.
+
+    Parameters
+    ----------
+    rows : list of Row
+        The evaluated rows.
+    problems : list of str
+        The gate's problems (:func:`gate`); empty for a passed gate.
+    unmeasured : sequence of Target, default ()
+        Targets this configuration does not measure, listed at the end.
+    title : str, default "hardpack validation report"
+        The top heading.
+
+    Returns
+    -------
+    str
+        The report in Markdown.
+    """
     verdict = ("**Gate: passed.**" if not problems else
                "**Gate: FAILED.**\n\n" + "\n".join(f"- {p}" for p in problems))
     lines = [f"# {title}", "", verdict, "", *headline(rows), "",

@@ -217,7 +217,27 @@ def _packaged() -> dict[str, Target]:
 
 
 def load_targets(path=None) -> dict[str, Target]:
-    """The validation targets by id: the packaged table, or the YAML file at ``path``."""
+    """The validation targets by id: the packaged table, or the YAML file at ``path``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        A targets YAML file in the schema of ``targets.schema.yaml``; default the packaged
+        ``targets.yaml``.
+
+    Returns
+    -------
+    dict of str to Target
+        The targets by id.
+
+    Raises
+    ------
+    InvalidInputError
+        If the document does not follow the schema, an id repeats, or a known deviation names
+        no table cell (:func:`parse_targets`).
+    OSError
+        If ``path`` cannot be opened.
+    """
     if path is None:
         return dict(_packaged())
     with open(path) as fh:

@@ -1,0 +1,98 @@
+"""Event times of hard-particle dynamics: the roots shared by every event-driven engine.
+
+- :func:`contact_root` / :func:`pair_time`: first contact of two spheres whose contact distance
+  grows linearly, sigma(t) = sigma_0 + g t (derived in :mod:`hardpack.md.kernel`); the MD engine
+  uses it with growth, the bounding-cell MD (:mod:`hardpack.freeenergy`) with g = 0.
+- :func:`exit_time`: a growing sphere touches the inside of its fixed bounding sphere (the
+  near-neighbour lists of Donev 2006, sec. 3.3.2).
+
+The ``*_root`` functions take the dot products and are inlined into the numba kernels' loops;
+the ``*_time`` functions take vectors.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def pair_time(r, u, sig0, g):
+    """First contact time >= 0 of a pair (derivation in :mod:`hardpack.md.kernel`); inf if none. r, u: (d,) arrays."""
+    rr = 0.0
+    ru = 0.0
+    uu = 0.0
+    for k in range(r.shape[0]):
+        rr += r[k] * r[k]
+        ru += r[k] * u[k]
+        uu += u[k] * u[k]
+    return contact_root(rr, ru, uu, sig0, g, np.inf)
+
+
+@njit(cache=True, inline="always")
+def contact_root(rr, ru, uu, sig0, g, tmax):
+    """First contact time in [0, tmax), else inf (derivation in :mod:`hardpack.md.kernel`). When A >= 0 the root is at
+    least C / (-2B), which rejects most pairs before the square root."""
+    b = ru - sig0 * g
+    a = uu - g * g
+    if b >= 0.0 and a >= 0.0:
+        return np.inf
+    c = rr - sig0 * sig0
+    if c <= 0.0:
+        if b < 0.0:
+            return 0.0
+        disc = b * b - a * c
+        disc = max(disc, 0.0)
+        return (b + np.sqrt(disc)) / (-a)
+    if a >= 0.0 and c >= -2.0 * b * tmax:
+        return np.inf
+    disc = b * b - a * c
+    if disc < 0.0:
+        return np.inf
+    if b < 0.0:
+        return c / (-b + np.sqrt(disc))
+    return (b + np.sqrt(disc)) / (-a)  # A < 0 here; same root, no cancellation when B >= 0
+
+
+@njit(cache=True)
+def exit_time(dr, v, rrem, adot):
+    """Time for a sphere (centre offset dr from its bounding centre, velocity v, radius growing at
+    adot) to touch its bounding sphere, whose radius exceeds the particle's by rrem now.
+
+    |dr + v t| = rrem - adot t  ->  A t^2 + 2 B t + C = 0 with A = v.v - adot^2,
+    B = dr.v + rrem adot, C = dr.dr - rrem^2 < 0; first root t = -C / (B + sqrt(B^2 - AC))
+    (derived here, valid for any sign of A). For shrinking particles (adot < 0) the root is
+    genuine because rrem - adot t stays positive.
+    """
+    dd = 0.0
+    dv = 0.0
+    vv = 0.0
+    for k in range(dr.shape[0]):
+        dd += dr[k] * dr[k]
+        dv += dr[k] * v[k]
+        vv += v[k] * v[k]
+    return exit_root(dd, dv, vv, rrem, adot)
+
+
+@njit(cache=True, inline="always")
+def exit_root(dd, dv, vv, rrem, adot):
+    c = dd - rrem * rrem
+    if c >= 0.0:
+        return 0.0
+    a = vv - adot * adot
+    b = dv + rrem * adot
+    disc = b * b - a * c
+    if disc < 0.0:
+        if adot > 0.0:  # round-off: a growing sphere always leaves
+            disc = 0.0
+        else:
+            return np.inf
+    den = b + np.sqrt(disc)
+    if den > 0.0:
+        return -c / den
+    if adot > 0.0:
+        return 0.0
+    return np.inf
+
+
+# --------------------------------------------------------------------------------- event loop

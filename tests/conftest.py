@@ -1,0 +1,30 @@
+"""Packings shared by many test files, built once per test session.
+
+- ``rsa_file``: 100 equal spheres (radius 1/2) at phi = 0.3 in a periodic cube, placed by random
+  sequential addition (seed 2), saved as a packing netCDF (attribute ``seed = 2``): the start of
+  the command-line and MD-limit tests.
+- ``jammed_disks``: the 64-disk bidisperse packing jammed to exact contacts, read from
+  ``tests/data`` (how it was made: ``test_jamming_support.make_jammed_disks``).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from hardpack.distributions import monodisperse
+from hardpack.initial import random_packing
+from hardpack.io import save_packing
+
+
+@pytest.fixture(scope="session")
+def rsa_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rsa") / "init.nc"
+    save_packing(random_packing(100, 3, monodisperse(0.5), 0.3, seed=2), path, attrs={"seed": 2})
+    return path
+
+
+@pytest.fixture(scope="session")
+def jammed_disks():
+    from test_jamming_support import jammed_disks as load
+
+    return load()
