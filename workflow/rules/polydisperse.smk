@@ -83,8 +83,8 @@ rule poly_summary:
         key=one_of(EOS_SUMMARIES),
     threads: 1
     resources:
-        mem_mb=job_mem_mb("eos_summary"),
-        runtime=job_runtime("eos_summary"),
+        mem_mb=job_mem_mb("poly_summary"),
+        runtime=job_runtime("poly_summary"),
     group:
         "summaries"
     conda:
