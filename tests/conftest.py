@@ -1,13 +1,17 @@
-"""Packings shared by many test files, built once per test session.
+"""Fixtures shared by many test files (packings and the workflow's rules), built once per session.
 
 - ``rsa_file``: 100 equal spheres (radius 1/2) at phi = 0.3 in a periodic cube, placed by random
   sequential addition (seed 2), saved as a packing netCDF (attribute ``seed = 2``): the start of
   the command-line and MD-limit tests.
+- ``workflow_rules``: {rule name: its text} of every rule in ``workflow/rules/*.smk``.
 - ``jammed_disks``: the 64-disk bidisperse packing jammed to exact contacts, read from
   ``tests/data`` (how it was made: ``test_jamming_support.make_jammed_disks``).
 """
 
 from __future__ import annotations
+
+import re
+from pathlib import Path
 
 import pytest
 
@@ -28,3 +32,12 @@ def jammed_disks():
     from test_jamming_support import jammed_disks as load
 
     return load()
+
+
+@pytest.fixture(scope="session")
+def workflow_rules():
+    rules = {}
+    for path in sorted((Path(__file__).resolve().parents[1] / "workflow" / "rules").glob("*.smk")):
+        for block in re.split(r"^(?=rule )", path.read_text(), flags=re.M)[1:]:
+            rules[re.match(r"rule (\w+):", block).group(1)] = block
+    return rules

@@ -13,33 +13,24 @@ ROOT = Path(__file__).resolve().parents[1]
 needs_snakemake = pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
 
 
-def _rules():
-    """{rule name: its text} of every rule of the workflow's rule files."""
-    rules = {}
-    for path in sorted((ROOT / "workflow" / "rules").glob("*.smk")):
-        for block in re.split(r"^(?=rule )", path.read_text(), flags=re.M)[1:]:
-            rules[re.match(r"rule (\w+):", block).group(1)] = block
-    return rules
-
-
 def _expected_minutes_rules():
     common = (ROOT / "workflow" / "rules" / "common.smk").read_text()
     table = common.split("EXPECTED_MINUTES = {", 1)[1].split("\n}", 1)[0]
     return set(re.findall(r'^    "(\w+)":', table, re.M))
 
 
-def test_every_rule_takes_its_resources_from_the_cost_model_under_its_own_name():
-    for name, text in _rules().items():
+def test_every_rule_takes_its_resources_from_the_cost_model_under_its_own_name(workflow_rules):
+    for name, text in workflow_rules.items():
         assert re.search(r"^    threads: \w+$", text, re.M), f"rule {name} sets no threads"
         assert f'mem_mb=job_mem_mb("{name}")' in text, f"rule {name}: mem_mb not from job_mem_mb(\"{name}\")"
         assert f'runtime=job_runtime("{name}")' in text, f"rule {name}: runtime not from job_runtime(\"{name}\")"
 
 
-def test_a_rule_without_its_own_cost_runs_in_a_job_group_and_the_profile_sizes_every_group():
+def test_a_rule_without_its_own_cost_runs_in_a_job_group_and_the_profile_sizes_every_group(workflow_rules):
     costed = _expected_minutes_rules()
     profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
     groups = {}
-    for name, text in _rules().items():
+    for name, text in workflow_rules.items():
         group = re.search(r'^    group:\n        "(\w+)"', text, re.M)
         assert (group is None) == (name in costed), f"rule {name}: grouped rules are the tiny ones, without a cost"
         if group:

@@ -74,19 +74,10 @@ def test_snakemake_lint_finds_nothing(configfile):
     assert out.returncode == 0 and "Lints for" not in out.stdout + out.stderr, out.stdout + out.stderr
 
 
-def _rules():
-    """{rule name: its text} of every rule of the workflow's rule files."""
-    rules = {}
-    for path in sorted((ROOT / "workflow" / "rules").glob("*.smk")):
-        for block in re.split(r"^(?=rule )", path.read_text(), flags=re.M)[1:]:
-            rules[re.match(r"rule (\w+):", block).group(1)] = block
-    return rules
-
-
-def test_every_rule_logs_and_benchmarks_by_its_name():
+def test_every_rule_logs_and_benchmarks_by_its_name(workflow_rules):
     """One log convention and one benchmark convention: results/logs/{rule}/... and
     results/benchmarks/{rule}/... (or {rule}.log / {rule}.tsv without wildcards)."""
-    rules = _rules()
+    rules = workflow_rules
     assert {"init", "compress", "slp", "verify", "structure", "combine", "validation"} <= set(rules)
     for name, text in rules.items():
         for directive, folder, suffix in (("log", "logs", "log"), ("benchmark", "benchmarks", "tsv")):
