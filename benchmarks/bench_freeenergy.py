@@ -30,7 +30,7 @@ def fcc(phi=None, delta=None):
 
 def bcmd_rate(p, **kw):
     t = time.process_time()
-    a = run_bcmd(p, partial=True, **kw).dataset.attrs
+    a = run_bcmd(p, partial=True, **kw).to_dataset().attrs
     return a["n_events"] / (time.process_time() - t)
 
 

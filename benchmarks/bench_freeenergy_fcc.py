@@ -49,7 +49,7 @@ def main() -> None:
                     print(
                         f"{case:8s} N={n:5d} gamma0={g:.0e} seed={seed} value={value:.4f} "
                         f"published={PUBLISHED[case]} diff={value - PUBLISHED[case]:+.4f} "
-                        f"3lnN/N={3 * np.log(n) / n:.4f} events={res.dataset.attrs['n_events']} "
+                        f"3lnN/N={3 * np.log(n) / n:.4f} events={res.to_dataset().attrs['n_events']} "
                         f"time={el:.0f}s",
                         flush=True,
                     )

@@ -21,12 +21,12 @@ def test_disjoint_cells_reference(name, reps, frozen):
     # CM-frame K differs from the total K by O(1/N) fluctuations of the CM momentum, hence the
     # looser tolerance there. The reference f_c = -d ln dmu - ln V_p (Eq. 6.10).
     res, exact = disjoint_cells(name, reps, frozen)
-    d = res.dataset.attrs["dim"]
+    d = res.to_dataset().attrs["dim"]
     tol = 2e-3 if frozen == "particle" else 0.05
     assert res.delta_f == pytest.approx(exact, abs=tol)
     vp = np.pi / 6 if d == 3 else np.pi / 4  # unit-diameter particle (length unit = diameter)
     assert res.f_c == pytest.approx(-d * np.log(0.05) - np.log(vp), rel=1e-12)
-    ds = res.dataset
+    ds = res.to_dataset()
     # cell pressure p_c = mu / dmu for disjoint cells (derived here; Fig. 6.4's asymptote);
     # per-segment noise is a few per cent, so compare the mean ratio (1 %)
     ratio = ds.p_c / ((1 + ds.dmu_mid) / ds.dmu_mid)
@@ -61,13 +61,13 @@ def _extrapolated(state):
                 # lattice-centred cells, dmu_max = 1, theta = 1 (the paper's schedule), gamma0 = 3e-3
                 q = p.replace(radii=p.radii * (0.545 / p.phi) ** (1 / 3))
                 res = run_bcmd(q, dmu_max=1.0, gamma0=3e-3, theta=1.0, seed=seed)
-                assert res.dataset.attrs["dmu_min"] == pytest.approx((0.74048048969 / 0.545) ** (1 / 3) - 1, rel=1e-9)
+                assert res.to_dataset().attrs["dmu_min"] == pytest.approx((0.74048048969 / 0.545) ** (1 / 3) - 1, rel=1e-9)
                 values.append(res.excess)
             else:
                 # at contact shrunk by delta = 1e-6, dmu_max = 10 delta, gamma0 = 1e-3, theta = 0.5
                 q = p.replace(radii=p.radii * (1 - 1e-6))
                 res = run_bcmd(q, dmu_max=1e-5, gamma0=1e-3, theta=0.5, seed=seed)
-                assert res.dataset.attrs["dmu_min"] == pytest.approx(1e-6, rel=1e-5)
+                assert res.to_dataset().attrs["dmu_min"] == pytest.approx(1e-6, rel=1e-5)
                 values.append(res.delta_f)
             n.append(p.n_particles)
     a, err, _ = finite_size_extrapolation(n, values)
@@ -97,7 +97,7 @@ def test_velocity_redraws_are_chained():
     p = lattice_packing("fcc", (2, 2, 2))
     p = p.replace(radii=p.radii * 0.5)
     res = run_bcmd(p, dmu_max=0.5, dmu_min=0.05, gamma0=2e-3, theta=0.0, seed=1, reset_ratio=2.0)
-    assert res.dataset.attrs["n_redraws"] >= 5  # K grows by 10^2 overall
+    assert res.to_dataset().attrs["n_redraws"] >= 5  # K grows by 10^2 overall
     assert res.delta_f == pytest.approx(3 * np.log(10.0), abs=2e-3)
 
 

@@ -35,7 +35,7 @@ Donev 2006, dissertation sec. 6.3 (the journal version is Donev et al. 2007, Sec
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
@@ -99,7 +99,7 @@ def disjoint_dmu(nb: Neighbours) -> float:
 
 @dataclass(frozen=True)
 class BCMDResult:
-    """Outcome of :func:`run_bcmd`; ``dataset`` holds the per-segment series and all numbers.
+    """Outcome of :func:`run_bcmd`; :meth:`to_dataset` gives the per-segment series and all numbers.
 
     Attributes
     ----------
@@ -111,15 +111,18 @@ class BCMDResult:
         Free energy per moving particle; NaN for a partial run.
     excess : float
         f - f_ideal with f_ideal = -ln(V/N) - 1 (Eq. 6.15).
-    dataset : xarray.Dataset
-        Per-segment series and all parameters and numbers in its attrs.
     """
 
     delta_f: float  # (d/2) ln(K/K0) chained = f_c(dmu_min) - f
     f_c: float  # disjoint-cell reference at dmu_min (units: mean diameter)
     f: float  # free energy per moving particle
     excess: float  # f - f_ideal
-    dataset: xr.Dataset
+    _dataset: xr.Dataset = field(repr=False)
+
+    def to_dataset(self) -> xr.Dataset:
+        """The per-segment series (dimension ``segment``) with every parameter and number of the
+        run in its attributes (a copy: changing it leaves the result as it is)."""
+        return self._dataset.copy()
 
 
 def _check(name, value, lo=0.0, hi=np.inf, lo_open=True):

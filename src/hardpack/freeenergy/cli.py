@@ -166,7 +166,7 @@ def cmd_bcmd(args) -> int:
         seed=args.seed,
         reset_ratio=args.reset_ratio,
     )
-    ds = res.dataset
+    ds = res.to_dataset()
     ds.attrs["source"] = str(args.packing)
     if args.delta is not None:
         ds.attrs["delta"] = args.delta

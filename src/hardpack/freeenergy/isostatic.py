@@ -217,7 +217,7 @@ def simplex_test(
     shrunk = backbone.replace(radii=backbone.radii * (1.0 - delta))
     res = run_bcmd(shrunk, dmu_max=dmu_max_ratio * ref.dmu_min, gamma0=gamma0, theta=theta,
                    frozen=frozen, seed=seed)
-    ds = res.dataset
+    ds = res.to_dataset()
     ds.attrs.update(attrs)
     ds.attrs.update(hardpack_kind="bcmd_simplex", bcmd=res.delta_f,
                     rel_diff=(res.delta_f - exact) / exact,

@@ -95,7 +95,7 @@ def ladder_dataset(seeds=tuple(range(3, 13))) -> xr.Dataset:
     runs = [disjoint_cells(seed=s) for s in seeds]
     exact = runs[0][1]
     df, df_err = _mean_error([res.delta_f - exact for res, _ in runs])
-    ratios = np.concatenate([(res.dataset.p_c / ((1 + res.dataset.dmu_mid) / res.dataset.dmu_mid)).values
+    ratios = np.concatenate([(res.to_dataset().p_c / ((1 + res.to_dataset().dmu_mid) / res.to_dataset().dmu_mid)).values
                              for res, _ in runs]) - 1.0
     pc, pc_err = _mean_error(ratios)
     t_cells = time.perf_counter() - t
