@@ -46,7 +46,7 @@ def test_wall_time_from_inside(seed):
 
 def test_wall_time_right_after_a_bounce():
     # a point exactly on the wall (|dr| = rho) moving inwards: the next hit is the later root
-    # -2B/A, not 0 (the form md.kernel._exit_root uses cancels to 0 here); moving outwards: 0
+    # -2B/A, not 0 (the form hardpack.events.roots.exit_root uses cancels to 0 here); moving outwards: 0
     rho, w = 0.7, -0.01
     dr = np.array([rho, 0.0, 0.0])
     v = np.array([-0.8, 0.3, 0.0])

@@ -16,16 +16,23 @@ import numpy as np
 from numba import njit
 
 
+@njit(cache=True, inline="always")
+def dot_products(a, b):
+    """(a.a, a.b, b.b) of two (d,) vectors: the inputs of the ``*_root`` functions."""
+    aa = 0.0
+    ab = 0.0
+    bb = 0.0
+    for k in range(a.shape[0]):
+        aa += a[k] * a[k]
+        ab += a[k] * b[k]
+        bb += b[k] * b[k]
+    return aa, ab, bb
+
+
 @njit(cache=True)
 def pair_time(r, u, sig0, g):
     """First contact time >= 0 of a pair (derivation in :mod:`hardpack.md.kernel`); inf if none. r, u: (d,) arrays."""
-    rr = 0.0
-    ru = 0.0
-    uu = 0.0
-    for k in range(r.shape[0]):
-        rr += r[k] * r[k]
-        ru += r[k] * u[k]
-        uu += u[k] * u[k]
+    rr, ru, uu = dot_products(r, u)
     return contact_root(rr, ru, uu, sig0, g, np.inf)
 
 
@@ -64,13 +71,7 @@ def exit_time(dr, v, rrem, adot):
     (derived here, valid for any sign of A). For shrinking particles (adot < 0) the root is
     genuine because rrem - adot t stays positive.
     """
-    dd = 0.0
-    dv = 0.0
-    vv = 0.0
-    for k in range(dr.shape[0]):
-        dd += dr[k] * dr[k]
-        dv += dr[k] * v[k]
-        vv += v[k] * v[k]
+    dd, dv, vv = dot_products(dr, v)
     return exit_root(dd, dv, vv, rrem, adot)
 
 

@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from hardpack.events.heap import heap_set
-from hardpack.events.roots import contact_root
+from hardpack.events.roots import contact_root, dot_products
 
 WALL = -1  # event: the particle hits its cell wall
 NONE = -2  # nothing predicted
@@ -48,7 +48,7 @@ def _wall_root(dd, dv, vv, rho, adot):
 
     A s^2 + 2 B s + C = 0 with A = vv - adot^2, B = dv + rho adot, C = dd - rho^2 (the md
     kernel's exit equation). The wanted root is the later one, (-B + sqrt(B^2 - AC)) / A, written
-    as -C / (B + sqrt(B^2 - AC)) when B > 0. Unlike md.kernel._exit_root (which uses the second
+    as -C / (B + sqrt(B^2 - AC)) when B > 0. Unlike :func:`hardpack.events.roots.exit_root` (which uses the second
     form for every B), the first form is used for B <= 0: right after a bounce the point sits on
     the wall (C ~ 0) moving inwards (B < 0), where B + sqrt(B^2 - AC) cancels to 0 and the md
     form returns 0 or inf instead of the next hit -2B/A.
@@ -71,13 +71,7 @@ def _wall_root(dd, dv, vv, rho, adot):
 def wall_time(dr, v, rho0, w):
     """First t >= 0 with |dr + v t| = rho0 + w t for a point inside a ball whose radius moves
     at w (<= 0: shrinking); inf if none (see :func:`_wall_root`)."""
-    dd = 0.0
-    dv = 0.0
-    vv = 0.0
-    for k in range(dr.shape[0]):
-        dd += dr[k] * dr[k]
-        dv += dr[k] * v[k]
-        vv += v[k] * v[k]
+    dd, dv, vv = dot_products(dr, v)
     return _wall_root(dd, dv, vv, rho0, -w)
 
 

@@ -6,6 +6,7 @@ from hardpack.io.store import (
     dataset_to_packing,
     load_dataset,
     load_judged_packing,
+    load_judged_packings,
     load_packing,
     packing_to_dataset,
     save_packing,
@@ -14,5 +15,5 @@ from hardpack.io.store import (
 
 __all__ = [
     "provenance", "packing_to_dataset", "dataset_to_packing", "save_packing", "load_packing",
-    "load_dataset", "load_judged_packing", "write_dataset", "combine_ensemble",
+    "load_dataset", "load_judged_packing", "load_judged_packings", "write_dataset", "combine_ensemble",
 ]

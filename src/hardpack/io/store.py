@@ -396,6 +396,37 @@ def load_judged_packing(path, verdict_path) -> tuple[xr.Dataset, Packing, xr.Dat
     return ds, dataset_to_packing(ds, source=str(path)), verdict
 
 
+def load_judged_packings(packing_paths, verdict_paths, what: str) -> list:
+    """:func:`load_judged_packing` for each packing and its verdict, given as two lists in the
+    same order; ``what`` names the caller in the message when the lists do not pair up.
+
+    Parameters
+    ----------
+    packing_paths : sequence of str or os.PathLike
+        The packing files.
+    verdict_paths : sequence of str or os.PathLike
+        Their verdict files, ``verdict_paths[k]`` judging ``packing_paths[k]``.
+    what : str
+        What the packings are for, e.g. "order map" (starts the error message).
+
+    Returns
+    -------
+    list of tuple
+        One ``(packing_dataset, packing, verdict)`` per packing, in order.
+
+    Raises
+    ------
+    InvalidInputError
+        If there are no packings or not one verdict per packing, or as :func:`load_judged_packing`.
+    """
+    packing_paths, verdict_paths = list(packing_paths), list(verdict_paths)
+    if not packing_paths or len(packing_paths) != len(verdict_paths):
+        raise InvalidInputError(
+            f"{what}: need one verdict per packing, got {len(packing_paths)} packings and "
+            f"{len(verdict_paths)} verdicts")
+    return [load_judged_packing(path, verdict) for path, verdict in zip(packing_paths, verdict_paths)]
+
+
 def _check_members(dsets, names, index) -> None:
     """Refuse an ensemble whose members do not belong together (the message names the files)."""
     seen: dict = {}

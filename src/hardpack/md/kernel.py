@@ -236,7 +236,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     hkey : numpy.ndarray of float64, shape (N,)
         Heap / events: key (predicted event time) of heap slot k, in heap order.
     heap : numpy.ndarray of int32, shape (N,)
-        Heap / events: particle in heap slot k (4-ary min-heap, :mod:`hardpack.md.heap`).
+        Heap / events: particle in heap slot k (4-ary min-heap, :mod:`hardpack.events.heap`).
     hpos : numpy.ndarray of int32, shape (N,)
         Heap / events: heap slot of every particle (reset to -1 at entry).
 

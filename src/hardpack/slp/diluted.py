@@ -43,7 +43,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry import ball_volume
 from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
-from hardpack.io import load_judged_packing
+from hardpack.io import load_judged_packings
 from hardpack.slp.driver import run_slp
 from hardpack.slp.lp import Bounds
 
@@ -260,13 +260,9 @@ def diluted_summary(packing_paths, verdict_paths) -> xr.Dataset:
     from hardpack.structure.order import translational_order
 
     packing_paths, verdict_paths = list(packing_paths), list(verdict_paths)
-    if not packing_paths or len(packing_paths) != len(verdict_paths):
-        raise InvalidInputError(
-            f"diluted summary: need one verdict per packing, got {len(packing_paths)} packings and "
-            f"{len(verdict_paths)} verdicts")
+    judged = load_judged_packings(packing_paths, verdict_paths, "diluted summary")
     cells, attrs = {}, {}
-    for path, verdict_path in zip(packing_paths, verdict_paths):
-        ds, packing, verdict = load_judged_packing(path, verdict_path)
+    for path, verdict_path, (ds, packing, verdict) in zip(packing_paths, verdict_paths, judged):
         rattler = np.asarray(verdict["rattler"].values, bool)
         if rattler.shape != (packing.n_particles,):
             raise InvalidInputError(f"{verdict_path} has {rattler.size} spheres, {path} has {packing.n_particles}")

@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from hardpack.errors import InvalidInputError
-from hardpack.io import load_judged_packing
+from hardpack.io import load_judged_packings
 from hardpack.structure.order import translational_order
 
 SETTINGS = ("alpha", "strain_bound", "shear_bound", "displacement_bound", "lp_method", "seed")
@@ -50,13 +50,9 @@ def order_map_summary(packing_paths, verdict_paths) -> xr.Dataset:
         If a file is missing, unreadable or of the wrong kind.
     """
     packing_paths, verdict_paths = list(packing_paths), list(verdict_paths)
-    if not packing_paths or len(packing_paths) != len(verdict_paths):
-        raise InvalidInputError(
-            f"order map: need one verdict per packing, got {len(packing_paths)} packings and "
-            f"{len(verdict_paths)} verdicts")
+    judged = load_judged_packings(packing_paths, verdict_paths, "order map")
     rows = {name: [] for name in ("phi", "N", "T", *SETTINGS, *VERDICT)}
-    for path, verdict_path in zip(packing_paths, verdict_paths):
-        ds, packing, verdict = load_judged_packing(path, verdict_path)
+    for path, verdict_path, (ds, packing, verdict) in zip(packing_paths, verdict_paths, judged):
         if packing.dim != 3:
             raise InvalidInputError(f"{path}: the order map is 3D (FCC reference), got d = {packing.dim}")
         rows["phi"].append(packing.phi)
