@@ -79,8 +79,8 @@ def jamming_rows(summaries) -> list[Row]:
             continue
         n, seeds, label = n_particles(s), s.sizes["sample"], s.attrs.get("ensemble", "")
         size = f"N = {n}, {seeds} seeds"
-        if verdict_notes(s):
-            size += f"; {verdict_notes(s)}"
+        if notes := verdict_notes(s):
+            size += f"; {notes}"
         gaps = np.asarray(s["isostaticity_gap"].values, float)
         if f"donev-ch9-isostatic-{system}" in targets:
             out.append(evaluate(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hardpack.jamming.result import Verdict
 from hardpack.validation.jamming import fraction_statistics, verdict_fraction, verdict_notes
 from hardpack.validation.packings import n_particles, system_key
 from hardpack.validation.rows import Row, evaluate
@@ -45,7 +46,8 @@ def mrj_jamming_rows(summaries) -> list[Row]:
             continue
         label, d = s.attrs.get("ensemble", ""), key[1]
         n, seeds = n_particles(s), s.sizes["sample"]
-        size = f"N = {n}, {seeds} seeds" + (f"; {verdict_notes(s)}" if verdict_notes(s) else "")
+        notes = verdict_notes(s)
+        size = f"N = {n}, {seeds} seeds" + (f"; {notes}" if notes else "")
         rattler_target = (f"tj-t1-slp-rattlers-d{d}" if key[0] == "monodisperse" else
                           "tj-sec5-poly2d-rattlers" if key == ("us_omega2", 2) else None)
         if rattler_target in targets:
@@ -91,7 +93,7 @@ def diluted_rows(summary) -> list[Row]:
     phi = diluted["phi"].values.ravel()
     if phi.size == 0:
         return []
-    jammed = np.where(diluted["strict"].values.ravel() == 1, phi, np.nan)  # the paper's are jammed
+    jammed = np.where(diluted["strict"].values.ravel() == Verdict.JAMMED, phi, np.nan)  # the paper's are jammed
     k = int(np.nanargmin(jammed)) if np.any(np.isfinite(jammed)) else int(np.nanargmin(phi))
     flat = {name: diluted[name].values.ravel() for name in ("phi_no_rattlers", "z_mean", "N", "strict")}
     seeds, rounds = diluted.sizes["seed"], diluted.sizes["round"]
