@@ -15,7 +15,7 @@ from hardpack.distributions import bidisperse, monodisperse
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
-from hardpack.io import load_dataset, load_packing
+from hardpack.io import dataset_to_packing, load_dataset, load_packing
 from hardpack.md import StopCriteria, compress
 
 
@@ -123,6 +123,15 @@ def test_outputs_are_written_with_run_attributes(tmp_path, jammed3d):
     assert ts.sizes["window"] == jammed3d.stats["windows"]
     for name in ("phi", "Z", "phi_J_est", "collisions", "time", "kT"):
         assert name in ts
+
+
+def test_to_dataset_is_the_packing_with_the_run_stats(jammed3d):
+    ds = jammed3d.to_dataset()
+    assert ds.attrs["hardpack_kind"] == "packing"
+    assert ds.attrs["stop_reason"] == jammed3d.stats["stop_reason"]
+    back = dataset_to_packing(ds)
+    np.testing.assert_array_equal(back.positions, jammed3d.packing.positions)
+    np.testing.assert_array_equal(back.radii, jammed3d.packing.radii)
 
 
 @pytest.mark.parametrize(

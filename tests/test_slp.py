@@ -11,6 +11,7 @@ from hardpack import InvalidInputError, Packing
 from hardpack.distributions import monodisperse
 from hardpack.geometry import ball_volume, pairs_within
 from hardpack.initial import random_packing
+from hardpack.io import dataset_to_packing
 from hardpack.slp import Bounds, run_slp, solve_step
 from hardpack.slp.driver import _apply
 from hardpack.slp.lp import redundancy_radius
@@ -72,6 +73,14 @@ def test_single_sphere_lattice_reaches_the_densest_lattice(d, expected):
         result = run_slp(random_lattice(d, 0.1, seed), alpha=3.5, bounds=SMALL)
         assert result.converged
         assert result.packing.phi == pytest.approx(expected, abs=1e-6)
+
+
+def test_result_dataset_carries_the_packing_and_the_outcome():
+    result = run_slp(random_lattice(2, 0.1, 0), alpha=3.5, bounds=SMALL)
+    ds = result.to_dataset(alpha=3.5)
+    assert ds.attrs["hardpack_kind"] == "packing"
+    assert (ds.attrs["converged"], ds.attrs["n_steps"], ds.attrs["alpha"]) == (1, result.n_steps, 3.5)
+    assert dataset_to_packing(ds).phi == pytest.approx(result.packing.phi, rel=1e-14)
 
 
 @pytest.mark.slow

@@ -71,7 +71,7 @@ import xarray as xr
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.io import checkpoint as ckpt
-from hardpack.io import interrupt
+from hardpack.io import interrupt, packing_to_dataset, write_dataset
 from hardpack.md.simulation import (
     RECORD_FIELDS,
     Simulation,
@@ -193,14 +193,23 @@ class CompressResult:
     #: variables (:func:`hardpack.md.contacts.ContactAccumulator.result`), else None
     contacts: xr.Dataset | None = None
 
-    def save(self, packing_path, timeseries_path=None, config=None):
-        """Write the packing (with the stats as attributes, and the MD contact forces as extra
-        variables when they were accumulated) and optionally the time series."""
-        from hardpack.io import save_packing, write_dataset
+    def to_dataset(self) -> xr.Dataset:
+        """The final packing as a Dataset, with the stats as attributes and the MD contact forces
+        as extra variables when they were accumulated.
 
+        Returns
+        -------
+        xarray.Dataset
+            The packing layout of :func:`hardpack.io.packing_to_dataset` (``hardpack_kind`` =
+            "packing"), ``stats`` in its attributes, and the ``md_contact_*`` variables of
+            :attr:`contacts` if any. The time series is :attr:`timeseries`.
+        """
         extra = None if self.contacts is None else dict(self.contacts.data_vars)
-        save_packing(self.packing, packing_path, attrs=self.stats, extra=extra, config=config,
-                     seed=self.stats.get("seed"))
+        return packing_to_dataset(self.packing, self.stats, extra)
+
+    def save(self, packing_path, timeseries_path=None, config=None):
+        """Write :meth:`to_dataset` and optionally the time series, atomically with provenance."""
+        write_dataset(self.to_dataset(), packing_path, config=config, seed=self.stats.get("seed"))
         if timeseries_path is not None:
             write_dataset(self.timeseries, timeseries_path, config=config, seed=self.stats.get("seed"))
 

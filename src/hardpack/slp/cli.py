@@ -55,10 +55,8 @@ def cmd_slp(args) -> int:
                      checkpoint_interval=args.checkpoint_interval, keep_checkpoint=True)
     params = _settings(args)
     attrs = dict(args.attr or [])
-    attrs.update(params, init=str(args.init), converged=result.converged, n_steps=result.n_steps,
-                 n_rejected=result.n_rejected, wall_seconds=result.wall_seconds,
-                 cpu_seconds=result.cpu_seconds, lp_solver=_solver(args))
-    save_packing(result.packing, args.out, attrs=_inherit(attrs, args.init), config=params)
+    attrs.update(params, init=str(args.init), lp_solver=_solver(args))
+    write_dataset(result.to_dataset(**_inherit(attrs, args.init)), args.out, config=params)
     if args.history:
         write_dataset(result.history, args.history, attrs=params)
     if args.checkpoint is not None:  # only now that the results are safely written

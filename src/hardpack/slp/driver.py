@@ -42,7 +42,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.geometry.reduction import lll_reduce
 from hardpack.io import checkpoint as ckpt
-from hardpack.io import interrupt
+from hardpack.io import interrupt, packing_to_dataset
 from hardpack.slp.lp import Bounds, solve_step
 
 log = logging.getLogger(__name__)
@@ -84,6 +84,25 @@ class SLPResult:
     n_rejected: int
     wall_seconds: float
     cpu_seconds: float
+
+    def to_dataset(self, **attrs) -> xr.Dataset:
+        """The last accepted packing as a Dataset with the run's outcome as attributes.
+
+        Parameters
+        ----------
+        **attrs
+            Further attributes (e.g. the protocol parameters and the start file).
+
+        Returns
+        -------
+        xarray.Dataset
+            The packing layout of :func:`hardpack.io.packing_to_dataset` with the attributes
+            ``converged``, ``n_steps``, ``n_rejected``, ``wall_seconds``, ``cpu_seconds`` and
+            ``attrs``. The LP history is :attr:`history`.
+        """
+        outcome = dict(converged=self.converged, n_steps=self.n_steps, n_rejected=self.n_rejected,
+                       wall_seconds=self.wall_seconds, cpu_seconds=self.cpu_seconds)
+        return packing_to_dataset(self.packing, {**attrs, **outcome})
 
 
 def _reduced(packing: Packing) -> Packing:
