@@ -263,7 +263,23 @@ def test_jamming_rows_pass_for_isostatic_packings_and_fail_otherwise():
     assert large["donev-ch9-isostatic-d3"].status == NA
     disks = {r.target: r for r in jamming_rows([_jamming_summary([0, 1], [0.05, 0.04], [1, 1], d=2,
                                                                   kind="bidisperse")])}
-    assert set(disks) == {"donev-ch9-isostatic-binary2d", "donev-4.7.2-collective-binary2d"}
+    assert set(disks) == {"donev-ch9-isostatic-binary2d", "donev-4.7.2-collective-binary2d",
+                          "donev-eq5.29-slope-binary2d"}
+    assert disks["donev-eq5.29-slope-binary2d"].status == FAIL  # no seed carried s_phi
+
+
+@pytest.mark.parametrize("slopes, n, status", [
+    ([0.451, 0.457], 1000, PASS),  # mean 0.454, within 0.0005 + 2 x 0.003
+    ([0.440, 0.442], 1000, FAIL),  # mean 0.441, 0.013 off with u = 0.001
+    ([0.451, 0.457], 64, NA),  # below the N of Donev's binary-disk packings
+])
+def test_ellipse_slope_row_compares_the_mean_over_seeds(slopes, n, status):
+    from hardpack.validation.jamming import jamming_rows
+
+    summary = _jamming_summary([0, 0], [0.05, 0.04], [1, 1], d=2, kind="bidisperse", n=n)
+    summary["ellipse_slope"] = ("sample", slopes)
+    rows = {r.target: r for r in jamming_rows([summary])}
+    assert rows["donev-eq5.29-slope-binary2d"].status == status
 
 
 def test_structure_rows_group_by_the_ensemble_attribute_not_the_path():

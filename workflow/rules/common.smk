@@ -307,7 +307,7 @@ def poly_jam_files(protocol, family):
 
 JAMMING_VARIABLES = ("z_mean", "rattler_fraction", "isostaticity_gap", "local", "collective", "strict",
                      "fallback_lp_default_tolerances", "fallback_lp_working_set_to_highs",
-                     "fallback_uniform_forces_lp_failed")
+                     "fallback_uniform_forces_lp_failed", "ellipse_slope")
 
 
 def _combined(inputs, index, variables=(), attrs=None):

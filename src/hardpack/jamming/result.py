@@ -46,6 +46,8 @@ class JammingResult:
     - ``network``: all contacts within delta; ``forces.forces`` is the backbone self-stress.
     - ``undetermined``: the tests that could not decide, with the reason (their verdict is None).
     - ``fallbacks``: how many times each numerical fallback of :data:`FALLBACKS` happened.
+    - ``ellipse_slope``: for disks with a self-stress, s_phi of the ellipses made from them
+      (:func:`hardpack.jamming.near_sphere.ellipse_slope`, Donev 2006 Eq. 5.29); else None.
     """
 
     params: dict
@@ -60,6 +62,7 @@ class JammingResult:
     statics: Statics
     volume: float
     md_pressure: float | None = None
+    ellipse_slope: float | None = None
     seconds: dict = field(default_factory=dict)
     fallbacks: dict = field(default_factory=lambda: dict.fromkeys(FALLBACKS, 0))
 
@@ -229,6 +232,8 @@ class JammingResult:
         )
         if self.md_pressure is not None:
             attrs["md_pressure"] = self.md_pressure
+        if self.ellipse_slope is not None:
+            attrs["ellipse_slope"] = self.ellipse_slope
         for test in ("collective", "strict"):
             for key, value in self.unjamming(test).items():
                 attrs[f"{test}_unjamming_{key}"] = value

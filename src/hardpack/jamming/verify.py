@@ -37,6 +37,7 @@ from hardpack.jamming.contacts import check_delta, contact_network
 from hardpack.jamming.forces import jamming_point_forces, self_stress, statics
 from hardpack.jamming.highs import FALLBACKS, recording_fallbacks
 from hardpack.jamming.ideal import ideal_test
+from hardpack.jamming.near_sphere import ellipse_slope
 from hardpack.jamming.rattlers import remove_rattlers
 from hardpack.jamming.result import CATEGORIES, JammingResult
 from hardpack.jamming.sequential import sequential_test
@@ -314,6 +315,9 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
     if forces is None:
         forces = self_stress(net, backbone)
     stat = statics(net, backbone, forces, packing.volume, counted)
+    slope = None
+    if d == 2 and forces.exists:
+        slope = ellipse_slope(net.separation, net.i, net.j, forces.forces, packing.radii).slope
     seconds["forces"] = time.perf_counter() - t0
 
     if checkpoint is not None:
@@ -333,5 +337,5 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
         local_rattler=~local_active, local_escape=escape,
         collective_test=collective, strict_test=strict, rattler=~backbone,
         forces=forces, statics=stat, volume=packing.volume, md_pressure=md_pressure,
-        seconds=seconds,
+        ellipse_slope=slope, seconds=seconds,
     )

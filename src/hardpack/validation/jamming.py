@@ -1,4 +1,5 @@
-"""Validation rows of the jamming verdicts of the LS packings (Donev 2006, ch. 4 and ch. 9).
+"""Validation rows of the jamming verdicts of the LS packings (Donev 2006, ch. 4 and ch. 9) and
+of the ellipse density slope from their self-stress (Donev 2006, Sec. 5.9.2.1).
 
 Input: ensemble jamming summaries (``jamming_summary`` rule: per seed z_mean, rattler_fraction,
 isostaticity_gap, collective, ...), matched to a published system by
@@ -97,4 +98,16 @@ def jamming_rows(summaries) -> list[Row]:
             out.append(evaluate(targets[f"donev-4.7.2-collective-{system}"],
                                 verdict_fraction(s["collective"].values), n=n, seeds=seeds, label=label,
                                 detail=size))
+        if f"donev-eq5.29-slope-{system}" in targets:
+            out.append(_slope_row(targets[f"donev-eq5.29-slope-{system}"], s, n, seeds, label, size))
     return out
+
+
+def _slope_row(target, summary, n: int, seeds: int, label: str, size: str) -> Row:
+    """s_phi of Eq. 5.29 from the backbone self-stress of every seed (NaN when a seed had none)."""
+    if "ellipse_slope" not in summary:
+        return evaluate(target, math.nan, n=n, seeds=seeds, label=label,
+                        detail=f"{size}; no seed has a self-stress to compute s_phi from")
+    values = np.asarray(summary["ellipse_slope"].values, float)
+    return evaluate(target, samples=values, n=n, seeds=seeds, label=label,
+                    detail=f"{size}; per seed {', '.join(f'{v:.4f}' for v in values)}")
