@@ -1,5 +1,5 @@
 """The sign of the Perram-Wertheim potential against an independent overlap verdict: the algebraic
-separation condition of Wang, Wang & Kim (2001) for ellipsoids and its analogue for ellipses
+separation condition of Wang, Wang & Kim 2001 for ellipsoids and its analogue for ellipses
 (Choi, Wang, Liu & Kim 2006).
 
 For quadrics x^T M x = 0 in homogeneous coordinates (M = [[X, -X c], [-c^T X, c^T X c - 1]], the
@@ -31,7 +31,7 @@ def homogeneous(x, centres):
 
 
 def separated_algebraic(x_a, c_a, x_b, c_b):
-    """Wang, Wang & Kim (2001) verdict per pair: True iff det(lam M_A + M_B) = 0 has two distinct
+    """Wang, Wang & Kim 2001 verdict per pair: True iff det(lam M_A + M_B) = 0 has two distinct
     positive real roots (the roots are the eigenvalues of -M_A^-1 M_B)."""
     roots = np.linalg.eigvals(np.linalg.solve(homogeneous(x_a, c_a), -homogeneous(x_b, c_b)))
     positive = (roots.imag == 0) & (roots.real > 0)

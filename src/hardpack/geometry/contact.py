@@ -46,7 +46,7 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
-__all__ = ["shape_inverse", "pw_contact", "contact_point", "pw_rate"]
+__all__ = ["shape_inverse", "pw_contact", "contact_point", "pw_rate", "inverse_shapes", "pair_potentials"]
 
 _EPS = np.finfo(np.float64).eps
 MAX_ITERATIONS = 200
@@ -294,3 +294,58 @@ def pw_rate(lam, n, r_a, r_b, r_c, v_a, v_b, w_a, w_b, g_a, g_b):
     for i in range(d):
         nv += n[i] * (v_b[i] - v_a[i] + g_b * xb[i] - g_a * xa[i])
     return 2.0 * lam * (1.0 - lam) * nv
+
+
+@numba.njit(cache=True)
+def inverse_shapes(semiaxes, orientations):
+    """X^-1 of every particle (:func:`shape_inverse` applied row by row).
+
+    Parameters
+    ----------
+    semiaxes : ndarray, shape (N, d)
+        Body-frame semiaxes.
+    orientations : ndarray, shape (N, 4) in 3D or (N, 1) in 2D
+        Unit quaternions or angles (2D angles of shape (N,) are reshaped to (N, 1) by the caller).
+
+    Returns
+    -------
+    ndarray, shape (N, d, d)
+        The inverse shape matrices.
+    """
+    n, d = semiaxes.shape
+    out = np.empty((n, d, d))
+    for k in range(n):
+        shape_inverse(semiaxes[k], orientations[k], out[k])
+    return out
+
+
+@numba.njit(cache=True)
+def pair_potentials(separations, i, j, inv_shapes, bounding_radii):
+    """Perram-Wertheim potential and maximiser of many pairs (:func:`pw_contact` on each).
+
+    Parameters
+    ----------
+    separations : ndarray, shape (M, d)
+        r_j - r_i of each pair (the image already chosen).
+    i, j : ndarray of int, shape (M,)
+        The particles of each pair.
+    inv_shapes : ndarray, shape (N, d, d)
+        X^-1 of every particle (:func:`inverse_shapes`).
+    bounding_radii : ndarray, shape (N,)
+        Largest semiaxes; the initial guess is O_i / (O_i + O_j) (Donev 2006, Sec. 2.2.2.1).
+
+    Returns
+    -------
+    zeta : ndarray, shape (M,)
+        mu^2 - 1 of each pair.
+    lam : ndarray, shape (M,)
+        The maximiser of each pair.
+    """
+    m = separations.shape[0]
+    zeta = np.empty(m)
+    lam = np.empty(m)
+    for k in range(m):
+        a, b = i[k], j[k]
+        guess = bounding_radii[a] / (bounding_radii[a] + bounding_radii[b])
+        zeta[k], lam[k], _ = pw_contact(separations[k], inv_shapes[a], inv_shapes[b], guess)
+    return zeta, lam
