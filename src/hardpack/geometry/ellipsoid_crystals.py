@@ -99,7 +99,7 @@ def laminate(alpha: float) -> Packing:
     semiaxes = np.tile([alpha, 1.0, 1.0], (4, 1))
     orientations = np.array([_LONG_Y, _LONG_Y, _IDENTITY, _IDENTITY])
     lattice = np.diag([side, side, 2 * z])
-    return Packing(positions, lattice=lattice, shape=Ellipsoids(semiaxes, orientations), allow_overlap=True)
+    return Packing(positions, lattice=lattice, shape=Ellipsoids(semiaxes, orientations))
 
 
 def stretched_alpha(s: float) -> float:
@@ -153,4 +153,4 @@ def stretched_laminate(s: float) -> Packing:
         semiaxes.append(np.sqrt(values))
         orientations.append(_quaternion(vectors.T))
     return Packing(base.positions @ f.T, lattice=f @ base.lattice,
-                   shape=Ellipsoids(np.array(semiaxes), np.array(orientations)), allow_overlap=True)
+                   shape=Ellipsoids(np.array(semiaxes), np.array(orientations)))
