@@ -1,0 +1,132 @@
+"""Figures of the ellipsoid study: phi_J and Z vs aspect ratio (after Donev 2006, Figs. 5.2-5.3)
+and a rendered snapshot of a jammed packing (after Fig. 5.1)."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.collections import EllipseCollection
+
+from hardpack.plots.style import figure
+from hardpack.validation.rows import seed_statistics
+
+#: isostatic contact numbers 2 f (Donev 2006, Sec. 5.2): f = 3 for ellipses, 5 for spheroids
+#: (the spin about the symmetry axis is trivial), 6 for general ellipsoids
+ISOSTATIC = {"ellipses": 6, "spheroids": 10, "ellipsoids": 12}
+
+
+def _per_alpha(summary, beta, name):
+    """(alpha, mean, s.e.) of ``name`` over seeds for the samples of one beta."""
+    mask = np.isclose(np.asarray(summary["beta"].values, float), beta)
+    alphas = np.asarray(summary["alpha"].values, float)[mask]
+    values = np.asarray(summary[name].values, float)[mask]
+    rows = []
+    for alpha in np.unique(alphas):
+        mean, sem, _, _ = seed_statistics(values[alphas == alpha])
+        rows.append((alpha, mean, 0.0 if not np.isfinite(sem) else sem))
+    return np.array(rows).reshape(-1, 3)
+
+
+def plot_jamming_vs_alpha(summary, dim: int = 3):
+    """phi_J (left) and the mean contact number of the rattler-free backbone (right) vs the aspect
+    ratio alpha, one curve per shape family beta (semiaxes 1 : alpha^beta : alpha), mean +- s.e.
+    over seeds, with the isostatic 2 f lines.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        One sample per packing with the variables ``beta``, ``alpha``, ``phi`` and ``z_mean``.
+    dim : int, default 3
+        2 for ellipses (one family, beta = 1), 3 for ellipsoids.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, (left, right) = figure(1, 2, figsize=(7.2, 3.0))
+    betas = np.unique(np.asarray(summary["beta"].values, float))
+    for k, beta in enumerate(betas):
+        label = "ellipses" if dim == 2 else rf"$\beta = {beta:g}$"
+        for ax, name in ((left, "phi"), (right, "z_mean")):
+            rows = _per_alpha(summary, beta, name)
+            ax.errorbar(rows[:, 0], rows[:, 1], rows[:, 2], fmt="o-", ms=3.5, color=f"C{k}", label=label)
+    if dim == 2:
+        right.axhline(ISOSTATIC["ellipses"], color="k", ls="--", lw=1, label="isostatic 6")
+    else:
+        right.axhline(ISOSTATIC["spheroids"], color="k", ls=":", lw=1, label="isostatic, spheroids (10)")
+        right.axhline(ISOSTATIC["ellipsoids"], color="k", ls="--", lw=1, label="isostatic, ellipsoids (12)")
+        right.axhline(6, color="0.5", ls="-.", lw=1, label="spheres (6)")
+    left.set_xlabel(r"aspect ratio $\alpha$")
+    left.set_ylabel(r"jamming density $\phi_J$")
+    right.set_xlabel(r"aspect ratio $\alpha$")
+    right.set_ylabel(r"mean contact number $\bar Z$ (rattlers removed)")
+    left.legend(loc="lower right")
+    right.legend(loc="lower right")
+    fig.tight_layout()
+    return fig
+
+
+def _shadow(packing):
+    """Centres, widths, heights and angles (degrees) of the particles' orthographic shadows on the
+    xy plane: the shadow of r^T X r <= 1 is the ellipse of the xy block of X^-1."""
+    inverse = np.linalg.inv(packing.shape.shape_matrices())[:, :2, :2]
+    values, vectors = np.linalg.eigh(inverse)
+    axes = 2 * np.sqrt(values)
+    angles = np.degrees(np.arctan2(vectors[:, 1, 1], vectors[:, 0, 1]))
+    return axes[:, 1], axes[:, 0], angles
+
+
+def plot_snapshot(packing, slab: float | None = None):
+    """A picture of an ellipse or ellipsoid packing (after Donev 2006, Fig. 5.1).
+
+    Ellipses are drawn as they are, coloured by the orientation of their long axis, with their
+    periodic images across the cell's edges. Ellipsoids
+    are drawn as their shadows on the xy plane, back to front, shaded by height, for the particles
+    whose centres lie in a slab of the cell (default: the whole cell), so the front layer reads
+    like a rendered picture.
+
+    Parameters
+    ----------
+    packing : Packing
+        A packing of ``Ellipsoids`` in an orthorhombic cell, d = 2 or 3.
+    slab : float, optional
+        Thickness of the slab of centres drawn (3D), from the top of the cell.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    box = np.diag(packing.lattice)
+    pos = packing.positions - np.floor(packing.positions / box) * box
+    images = np.array([(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1)], float) * box[:2]
+    fig, ax = figure(1, 1, figsize=(4.6, 4.6 * box[1] / box[0]))
+    if packing.dim == 2:
+        shape = packing.shape
+        long_axis = np.argmax(shape.semiaxes, axis=1)
+        angle = np.degrees(shape.orientations) + 90.0 * long_axis
+        colour = np.mod(angle, 180.0) / 180.0
+        widths, heights = 2 * shape.semiaxes[:, 0], 2 * shape.semiaxes[:, 1]
+        k = len(images)
+        ax.add_collection(EllipseCollection(
+            np.tile(widths, k), np.tile(heights, k), np.tile(np.degrees(shape.orientations), k), units="xy",
+            offsets=(pos[None] + images[:, None]).reshape(-1, 2), offset_transform=ax.transData,
+            array=np.tile(colour, k), cmap="twilight", edgecolors="k", linewidths=0.3))
+    else:
+        top = box[2]
+        keep = pos[:, 2] >= top - (top if slab is None else slab)
+        order = np.argsort(pos[keep, 2])
+        widths, heights, angles = (v[keep][order] for v in _shadow(packing))
+        depth = (pos[keep, 2][order] - pos[keep, 2].min()) / max(np.ptp(pos[keep, 2]), 1e-300)
+        k, centres = len(images), pos[keep][order, :2]
+        # back to front: every periodic copy of a layer before the next layer
+        ax.add_collection(EllipseCollection(
+            np.repeat(widths, k), np.repeat(heights, k), np.repeat(angles, k), units="xy",
+            offsets=(centres[:, None] + images[None]).reshape(-1, 2), offset_transform=ax.transData,
+            array=np.repeat(depth, k), cmap="viridis", edgecolors="k", linewidths=0.3))
+    ax.set_xlim(0, box[0])
+    ax.set_ylim(0, box[1])
+    ax.set_aspect("equal")
+    ax.grid(False)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title(f"{packing.shape.name}, N = {packing.n_particles}, $\\phi$ = {packing.phi:.4f}")
+    return fig
