@@ -70,7 +70,14 @@ def cmd_glass_entropy(args) -> int:
     from hardpack.io import load_dataset, write_dataset
 
     eos = load_dataset(args.eos, kind="glass_eos")
-    bcmd = [load_dataset(p, kind="bcmd") for p in args.bcmd]
+    bcmd = []
+    for path in args.bcmd:
+        ds = load_dataset(path, kind="bcmd")
+        snap = load_dataset(ds.attrs["source"], kind="packing").attrs
+        # the snapshot's density as targeted (a stage reaches its target exactly unless it jammed)
+        ds.attrs.update(phi0=round(float(snap["phi"]), 4), growth_rate=float(snap["growth_rate"]),
+                        seed=int(snap["seed"]))
+        bcmd.append(ds)
     ds = entropy_dataset(eos, bcmd, x_large=float(eos.attrs["x_large"]), attrs={"system": eos.attrs["system"]})
     write_dataset(ds, args.out)
     for i in range(ds.sizes["sample"]):
