@@ -613,7 +613,6 @@ EXPECTED_MINUTES = {
     "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],
                                                          GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
     "glass_bcmd": glass_bcmd_minutes,
-    "glass_eos": lambda w: 0.3 + len(glass_timeseries(w.system)) / 100,
 }
 
 

@@ -147,7 +147,7 @@ rule glass_eos:
 
 
 rule glass_bcmd:
-    """BCMD free energy of a glass snapshot in bounding cells (Delta mu from glass.bcmd.dmu_max to the disjoint point)."""
+    """BCMD free energy of a glass snapshot in bounding cells (Delta mu from glass.bcmd.dmu_max to the disjoint point), radii shrunk by (1 - glass.bcmd.delta) so that the cells become disjoint at Delta mu ~ delta (an MD snapshot has pairs within ~1e-10 of contact, and the BCMD cost grows as 1 / Delta mu_min)."""
     input:
         "results/glass/{system}/g{rate}/phi{phi}/seed{seed}.nc",
     output:
@@ -168,7 +168,7 @@ rule glass_bcmd:
     benchmark:
         "results/benchmarks/glass_bcmd/{system}/g{rate}/phi{phi}/seed{seed}.tsv"
     shell:
-        "hardpack bcmd {input} --out {output} --dmu-max {params.b[dmu_max]} --gamma0 {params.b[gamma0]}"
+        "hardpack bcmd {input} --out {output} --delta {params.b[delta]} --dmu-max {params.b[dmu_max]} --gamma0 {params.b[gamma0]}"
         " --theta {params.b[theta]} --seed {wildcards.seed} > {log} 2>&1"
 
 
