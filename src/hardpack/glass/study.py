@@ -150,9 +150,8 @@ def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float 
         rates.append(rate)
         ok = np.flatnonzero(np.isfinite(res["Z"]))
         if math.isfinite(rate) and rate > 0 and ok.size:
-            # a compression from low density: integrate up to the first empty bin
-            last = ok[0] + np.argmax(np.diff(np.concatenate([ok, [ok[-1] + 2]])) > 1)
-            span = np.arange(ok[0], last + 1)
+            # a compression from low density: the trapezoid integral over the non-empty bins
+            span = ok
             f, fe = thermo.excess_free_energy(res["phi"][span], res["Z"][span], res["Z_err"][span], slope0=slope0)
             vars_["excess"][b, span], vars_["excess_err"][b, span] = f, fe
     ds = xr.Dataset(
@@ -286,7 +285,20 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
     precipitate's density. The monodisperse EOS joins the slowest compression below
     ``phi_join`` and the decompression of the crystal above; the mixture's EOS is its slowest
     compression; mu~_B from the mixtures at x_A +- dx (``plus``: x_A + dx, i.e. x_large - dx),
-    or 0 without them (recorded in ``mu_tilde``)."""
+    or 0 without them (recorded in ``mu_tilde``). Data that do not allow a solution (too few
+    points, no sign change) give NaN with the reason in ``status``."""
+    attrs = {"hardpack_kind": "glass_freezing", "kappa": kappa, "x_large": x_large, "phi_join": phi_join,
+             "n_particles": int(mixture.attrs.get("N", 0))}
+    try:
+        values, how = _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join)
+        attrs.update(status="solved", mu_tilde=how)
+    except InvalidInputError as exc:
+        values = dict.fromkeys(("phi_freeze", "phi_precipitate", "pressure", "mu"), math.nan)
+        attrs.update(status=f"not solved: {exc}", mu_tilde="-")
+    return xr.Dataset({k: ((), v) for k, v in values.items()}, attrs=attrs)
+
+
+def _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join):
     from hardpack.glass import freezing as fz
 
     slope_mono = thermo.second_virial_slope(2)
@@ -307,15 +319,6 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
         mix_phase = fz.Phase(mix_phase.z, mix_phase.excess, max(mix_phase.phi_lo, lo),
                              min(mix_phase.phi_hi, hi))
         mu_tilde, how = fz.composition_derivative(fp.excess, fm.excess, dx), f"central difference, dx = {dx}"
-    mix = fz.Mixture(kappa, x_large)
-    attrs = {"hardpack_kind": "glass_freezing", "kappa": kappa, "x_large": x_large, "phi_join": phi_join,
-             "mu_tilde": how, "n_particles": int(mixture.attrs.get("N", 0))}
-    try:
-        res = fz.freezing_point(pure, mix_phase, mix, mu_tilde)
-        values = {"phi_freeze": res.phi_freeze, "phi_precipitate": res.phi_precipitate,
-                  "pressure": res.pressure, "mu": res.mu}
-        attrs["status"] = "solved"
-    except InvalidInputError as exc:
-        values = dict.fromkeys(("phi_freeze", "phi_precipitate", "pressure", "mu"), math.nan)
-        attrs["status"] = str(exc)
-    return xr.Dataset({k: ((), v) for k, v in values.items()}, attrs=attrs)
+    res = fz.freezing_point(pure, mix_phase, fz.Mixture(kappa, x_large), mu_tilde)
+    return {"phi_freeze": res.phi_freeze, "phi_precipitate": res.phi_precipitate,
+            "pressure": res.pressure, "mu": res.mu}, how
