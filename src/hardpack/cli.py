@@ -19,7 +19,7 @@ from hardpack.errors import InvalidInputError
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
     "hardpack.md.cli", "hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli",
-    "hardpack.structure.cli", "hardpack.jamming.cli", "hardpack.freeenergy.cli",
+    "hardpack.structure.cli", "hardpack.jamming.cli", "hardpack.freeenergy.cli", "hardpack.glass.cli",
 )
 
 

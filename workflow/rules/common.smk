@@ -44,6 +44,7 @@ SLP_ORDER = SLP.get("order_map")
 RATES = config.get("rates")
 FREEENERGY = config.get("freeenergy")
 POLY = config.get("polydisperse", {})
+GLASS = config.get("glass")
 VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
 
@@ -93,6 +94,14 @@ def check_config():
         if missing:
             raise ValueError(f"config: freeenergy.simplex.seeds {sorted(missing)} are not seeds of ensemble "
                              f"{simplex['ensemble']!r} (its LS packings are the inputs)")
+    if GLASS:
+        if GLASS["N"] % 2:
+            raise ValueError(f"config: glass.N = {GLASS['N']} must be even (the triangular crystal has 2 disks per cell)")
+        if not max(GLASS["snapshots"]) < GLASS["phi_end"]:
+            raise ValueError("config: glass.phi_end must be above every glass.snapshots density")
+        dx = GLASS["composition"]["dx"]
+        if not (0 < GLASS["x_large"] - dx and GLASS["x_large"] + dx < 1):
+            raise ValueError("config: glass.x_large -+ glass.composition.dx must stay in (0, 1)")
 
 
 check_config()
@@ -301,6 +310,95 @@ def poly_jam_files(protocol, family):
             for w in runs["widths"][family] for seed in runs["seeds"] for member in POLY_SYSTEMS]
 
 
+
+# ---------------------------------------------------------------------------------------------
+# Binary hard-disk glasses (Donev 2006, ch. 13). Systems: the mixture `binary`, monodisperse
+# disks `mono`, and the mixtures at x_large -+ dx (`binary_xm`, `binary_xp`: x_A + dx and x_A - dx)
+# for mu~_B. A compression runs in stages through its snapshot densities, each stage a
+# `hardpack compress` from the previous stage's packing:
+#   results/glass/{system}/g{rate}/phi{phi}/seed{seed}.nc (+ ts_seed{seed}.nc, its time series)
+
+def _glass_systems():
+    if not GLASS:
+        return {}
+    x, dx = GLASS["x_large"], GLASS["composition"]["dx"]
+    comp = GLASS["composition"]
+    full = dict(rates=GLASS["rates"], stages=sorted(GLASS["snapshots"]) + [GLASS["phi_end"]])
+    return {
+        "binary": dict(kappa=GLASS["kappa"], x=x, **full),
+        "mono": dict(kappa=1.0, x=0.0, **full),
+        "binary_xm": dict(kappa=GLASS["kappa"], x=x - dx, rates=[comp["rate"]], stages=[comp["phi_end"]]),
+        "binary_xp": dict(kappa=GLASS["kappa"], x=x + dx, rates=[comp["rate"]], stages=[comp["phi_end"]]),
+    }
+
+
+GLASS_SYSTEMS = _glass_systems()
+
+
+def glass_distribution(wildcards):
+    spec = GLASS_SYSTEMS[wildcards.system]
+    if spec["x"] == 0.0:
+        return json.dumps({"kind": "monodisperse"})
+    return json.dumps({"kind": "bidisperse", "size_ratio": spec["kappa"], "large_fraction": spec["x"]})
+
+
+def glass_previous(wildcards):
+    """The packing a compression stage starts from: the previous stage's or the RSA start."""
+    stages = GLASS_SYSTEMS[wildcards.system]["stages"]
+    k = [f"{p:g}" for p in stages].index(wildcards.phi)
+    if k == 0:
+        return f"results/glass/{wildcards.system}/init/seed{wildcards.seed}.nc"
+    return f"results/glass/{wildcards.system}/g{wildcards.rate}/phi{stages[k - 1]:g}/seed{wildcards.seed}.nc"
+
+
+def glass_timeseries(system):
+    spec = GLASS_SYSTEMS[system]
+    files = [f"results/glass/{system}/g{rate:g}/phi{phi:g}/ts_seed{seed}.nc"
+             for rate in spec["rates"] for phi in spec["stages"] for seed in GLASS["seeds"]]
+    if system == "mono":
+        files += [f"results/glass/mono/decompression/ts_seed{seed}.nc" for seed in GLASS["seeds"]]
+    return files
+
+
+def glass_bcmd_files(system):
+    rate = min(GLASS_SYSTEMS[system]["rates"])
+    return [f"results/glass/{system}/bcmd/g{rate:g}/phi{phi:g}/seed{seed}.nc"
+            for phi in sorted(GLASS["snapshots"]) for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
+
+
+def glass_crystal_cells():
+    """(nx, ny) of the triangular crystal of N = 2 nx ny disks, the box closest to square (nx ~ 2 ny)."""
+    half = GLASS["N"] // 2
+    ny = min((k for k in range(1, half + 1) if half % k == 0), key=lambda k: abs(half // k - 2 * k))
+    return half // ny, ny
+
+
+GLASS_PHI = r"0\.[0-9]+"
+
+
+def glass_minutes_compress(n, rate, phi0, phi1):
+    """Expected minutes of one stage from phi0 to phi1: collisions per particle ~ 0.55 (H(phi1) -
+    H(phi0)) / Gamma with H Henderson's EOS integral (a proxy of the binary-disk one; measured
+    N = 256, Gamma = 1e-3, 0.05 -> 0.80: 3.2e3 per particle), at 1e6 collisions per second in 2D."""
+    def henderson_excess(p):
+        return 9 / 8 * p / (1 - p) - 7 / 8 * math.log(1 - p)
+    collisions = 0.55 * abs(henderson_excess(phi1) - henderson_excess(phi0)) / abs(rate) * n
+    return 0.3 + collisions / 1e6 / 60
+
+
+def glass_stage_minutes(w):
+    spec = GLASS_SYSTEMS[w.system]
+    stages = spec["stages"]
+    k = [f"{p:g}" for p in stages].index(w.phi)
+    phi0 = GLASS["init_phi"] if k == 0 else stages[k - 1]
+    return glass_minutes_compress(GLASS["N"], float(w.rate), phi0, stages[k])
+
+
+def glass_bcmd_minutes(w):
+    """BCMD from dmu_max = 1 to the disjoint point: ~40 / gamma0 events per particle (pair
+    collisions at large cells dominate), 1e6 events per second."""
+    return 0.3 + GLASS["N"] * 40 / GLASS["bcmd"]["gamma0"] / 1e6 / 60
+
 # ---------------------------------------------------------------------------------------------
 # Summaries: results/{key}_summary.nc. COMBINED are written by `hardpack combine` (the per-seed
 # files as one Dataset indexed by their attributes), EOS_SUMMARIES by `hardpack poly-summary`.
@@ -405,6 +503,7 @@ def figures():
     names += ["phij_vs_omega"] if POLY_PROTOCOLS["phij"].get("widths") else []
     names += ["crystallisation_vs_omega"] if POLY_PROTOCOLS["crystallisation"].get("widths", {}).get("uniform_size") else []
     names += ["eos_vs_bmcsl"] if POLY_FLUID.get("widths") else []
+    names += ["glass_eos", "glass_entropy"] if GLASS else []
     return [f"results/figures/{name}.pdf" for name in names]
 
 
@@ -429,6 +528,10 @@ def validation_inputs():
         inputs["bcmd_density"] = [summary("bcmd_fcc/density"), summary("bcmd_fcc/eos")]
         inputs["bcmd_simplex"] = [summary(f"bcmd_simplex/{FREEENERGY['simplex']['ensemble']}/simplex")]
         inputs["bcmd_ladder"] = ["results/bcmd_ladder/ladder.nc"]
+    if GLASS:
+        inputs["glass_eos"] = [summary("glass/binary/eos")]
+        inputs["glass_entropy"] = [summary("glass/binary/entropy"), summary("glass/mono/entropy")]
+        inputs["glass_freezing"] = [summary("glass/freezing")]
     poly = [summary(key) for key in EOS_SUMMARIES]
     if poly:
         inputs["polydisperse"] = poly
@@ -506,6 +609,10 @@ EXPECTED_MINUTES = {
     "fcc_eos": lambda w: 0.3 + FREEENERGY["density"]["eos_collisions"] / 6e7,
     "bcmd_simplex": lambda w: 0.3 + 3.0 * SYSTEMS["ls"][w.ensemble]["N"] / 1000,
     "poly_fluid": lambda w: 0.3 + 3 * len(POLY_FLUID["phi"]) * (POLY_FLUID["collisions"] + 50 * POLY_FLUID["N"]) / 6e6,
+    "glass_compress": glass_stage_minutes,
+    "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],
+                                                         GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
+    "glass_bcmd": glass_bcmd_minutes,
 }
 
 
@@ -529,6 +636,8 @@ PARTICLES = {
     "fcc_eos": lambda w: 4 * int(w.reps) ** 3,
     "bcmd_simplex": lambda w: SYSTEMS["ls"][w.ensemble]["N"],
     "poly_fluid": lambda w: POLY_FLUID["N"],
+    **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd"),
+                    lambda w: GLASS["N"]),
 }
 
 

@@ -21,6 +21,7 @@ from hardpack.io import load_dataset, write_dataset
 from hardpack.io.atomic import write_text
 from hardpack.validation.analytic import hgrid_rows, moment_table_rows
 from hardpack.validation.freeenergy import bcmd_rows, density_rows, ladder_rows, simplex_rows
+from hardpack.validation.glass import entropy_rows, eos_rows, freezing_rows, smix_rows
 from hardpack.validation.jamming import jamming_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
 from hardpack.validation.polydisperse import polydisperse_rows
@@ -49,6 +50,9 @@ ROW_BUILDERS = {
     "bcmd_simplex": lambda datasets: [row for ds in datasets for row in simplex_rows(ds)],
     "bcmd_ladder": lambda datasets: [row for ds in datasets for row in ladder_rows(ds)],
     "polydisperse": polydisperse_rows,
+    "glass_eos": lambda datasets: [row for ds in datasets for row in eos_rows(ds)],
+    "glass_entropy": lambda datasets: [row for ds in datasets for row in entropy_rows(ds)],
+    "glass_freezing": lambda datasets: [row for ds in datasets for row in freezing_rows(ds)],
 }
 
 
@@ -67,7 +71,7 @@ def parse_inputs(items: list[str]) -> dict[str, list[str]]:
 
 def build_rows(inputs: dict[str, list[str]]) -> list:
     """Every validation row: the analytic ones and those of each named summary."""
-    rows = moment_table_rows() + hgrid_rows()
+    rows = moment_table_rows() + hgrid_rows() + smix_rows()
     for name, paths in inputs.items():
         rows += ROW_BUILDERS[name]([load_dataset(p) for p in paths])
     return rows

@@ -1,0 +1,148 @@
+"""``hardpack glass-crystal``: the triangular start crystal of the monodisperse EOS;
+``hardpack glass-eos``: binned EOS, fits (Eqs. 13.3-13.4) and free energies of one system from its
+compression (and decompression) time series; ``hardpack glass-entropy``: s_c - s_mix of the SOC
+glasses from the EOS summary and their BCMD results; ``hardpack glass-freezing``: phi_F by
+chemical-potential matching (Eq. 13.2). Donev 2006, ch. 13 (:mod:`hardpack.glass`).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import defaultdict
+
+import numpy as np
+
+from hardpack.errors import InvalidInputError
+
+log = logging.getLogger(__name__)
+
+
+def cmd_glass_crystal(args) -> int:
+    """Monodisperse triangular crystal in an orthorhombic periodic box at a given phi."""
+    from hardpack.glass.study import triangular_crystal
+    from hardpack.io import save_packing
+
+    packing = triangular_crystal(args.nx, args.ny, args.phi)
+    save_packing(packing, args.out, attrs={"protocol": "triangular_crystal", "nx": args.nx, "ny": args.ny})
+    log.info("wrote %s: %r", args.out, packing)
+    return 0
+
+
+def _branch_name(rate: float) -> str:
+    return "decompression" if rate < 0 else f"{rate:g}"
+
+
+def cmd_glass_eos(args) -> int:
+    """Binned EOS of a system's compressions (one branch per growth rate) and decompression."""
+    from hardpack.glass.study import eos_dataset
+    from hardpack.glass.thermo import second_virial_slope
+    from hardpack.io import load_dataset, write_dataset
+
+    runs = defaultdict(lambda: defaultdict(list))
+    n = d = None
+    for path in args.files:
+        ts = load_dataset(path, kind="md_timeseries")
+        rate, seed = float(ts.attrs["growth_rate"]), int(ts.attrs["seed"])
+        runs[_branch_name(rate)][seed].append(ts)
+        n, d = int(ts.attrs["N"]), int(ts.attrs["d"])
+    branches = {}
+    for name in sorted(runs, key=lambda s: (s == "decompression", -float(s) if s != "decompression" else 0)):
+        branches[name] = [sorted(series, key=lambda ts: float(ts["phi"].values[0]), reverse=name == "decompression")
+                          for _, series in sorted(runs[name].items())]
+    if not np.isclose(args.bin_width * round((args.phi_max - args.phi_min) / args.bin_width),
+                      args.phi_max - args.phi_min):
+        raise InvalidInputError("--phi-max - --phi-min must be a whole number of --bin-width")
+    edges = np.linspace(args.phi_min, args.phi_max, round((args.phi_max - args.phi_min) / args.bin_width) + 1)
+    slope0 = second_virial_slope(d, args.kappa, args.x_large)
+    ds = eos_dataset(branches, edges, d=d, slope0=slope0, liquid_range=tuple(args.liquid_range),
+                     glass_range=tuple(args.glass_range),
+                     attrs={"system": args.system, "kappa": args.kappa, "x_large": args.x_large, "N": n})
+    write_dataset(ds, args.out)
+    c, ce = ds["cubic"].values, ds["cubic_err"].values
+    log.info("%s: branches %s; Eq. 13.3 fit %s +- %s; alpha %s", args.system, list(branches),
+             np.round(c, 4).tolist(), np.round(ce, 4).tolist(), np.round(ds["alpha"].values, 4).tolist())
+    return 0
+
+
+def cmd_glass_entropy(args) -> int:
+    """s_c - s_mix of the SOC glasses (Donev 2006, Eq. 13.5, Fig. 13.12)."""
+    from hardpack.glass.study import entropy_dataset
+    from hardpack.io import load_dataset, write_dataset
+
+    eos = load_dataset(args.eos, kind="glass_eos")
+    bcmd = []
+    for path in args.bcmd:
+        ds = load_dataset(path, kind="bcmd")
+        snap = load_dataset(ds.attrs["source"], kind="packing").attrs
+        # the snapshot's density as targeted (a stage reaches its target exactly unless it jammed)
+        ds.attrs.update(phi0=round(float(snap["phi"]), 4), growth_rate=float(snap["growth_rate"]),
+                        seed=int(snap["seed"]))
+        bcmd.append(ds)
+    ds = entropy_dataset(eos, bcmd, x_large=float(eos.attrs["x_large"]), attrs={"system": eos.attrs["system"]})
+    write_dataset(ds, args.out)
+    for i in range(ds.sizes["sample"]):
+        r = ds.isel(sample=i)
+        log.info("phi0 = %.3f seed %d: Delta f_g = %.4f, Delta f_L = %.4f, s_c - s_mix = %.4f +- %.4f",
+                 float(r["phi0"]), int(r["seed"]), float(r["glass_excess"]), float(r["liquid_excess"]),
+                 float(r["sc_minus_smix"]), float(r["sc_minus_smix_err"]))
+    return 0
+
+
+def cmd_glass_freezing(args) -> int:
+    """Freezing density of the mixture and its large-disk precipitate (Donev 2006, Eq. 13.2)."""
+    from hardpack.glass.study import freezing_dataset
+    from hardpack.io import load_dataset, write_dataset
+
+    if (args.plus is None) != (args.minus is None):
+        raise InvalidInputError("give both --plus and --minus (the neighbouring compositions) or neither")
+    eos = {k: None if p is None else load_dataset(p, kind="glass_eos")
+           for k, p in (("mono", args.mono), ("mixture", args.mixture), ("plus", args.plus), ("minus", args.minus))}
+    ds = freezing_dataset(eos["mono"], eos["mixture"], eos["plus"], eos["minus"], kappa=args.kappa,
+                          x_large=args.x_large, dx=args.dx, phi_join=args.phi_join)
+    write_dataset(ds, args.out)
+    log.info("freezing: %s; phi_F = %.4f, precipitate phi = %.4f", ds.attrs["status"],
+             float(ds["phi_freeze"]), float(ds["phi_precipitate"]))
+    return 0
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("glass-crystal", help=cmd_glass_crystal.__doc__)
+    p.add_argument("--nx", type=int, required=True, help="rectangular 2-disk cells along x")
+    p.add_argument("--ny", type=int, required=True, help="rectangular 2-disk cells along y")
+    p.add_argument("--phi", type=float, required=True, help="volume fraction (< pi/sqrt(12))")
+    p.add_argument("--out", required=True, help="packing netCDF")
+    p.set_defaults(func=cmd_glass_crystal)
+
+    p = subparsers.add_parser("glass-eos", help=cmd_glass_eos.__doc__)
+    p.add_argument("files", nargs="+", help="compression / decompression time series of one system")
+    p.add_argument("--system", required=True, help="system name (stored)")
+    p.add_argument("--kappa", type=float, default=1.0, help="diameter ratio (1: monodisperse)")
+    p.add_argument("--x-large", type=float, default=0.0, help="number fraction of the large disks")
+    p.add_argument("--bin-width", type=float, default=0.005, help="phi bin width (default 0.005)")
+    p.add_argument("--phi-min", type=float, default=0.0, help="lowest bin edge (default 0)")
+    p.add_argument("--phi-max", type=float, default=0.9, help="highest bin edge (default 0.9)")
+    p.add_argument("--liquid-range", type=float, nargs=2, default=[0.70, 0.80],
+                   help="phi range of the Eq. 13.3 cubic fit (default 0.70 0.80)")
+    p.add_argument("--glass-range", type=float, nargs=2, default=[0.80, 0.84],
+                   help="phi range of the Eq. 13.4 glass-branch fit (default 0.80 0.84)")
+    p.add_argument("--out", required=True, help="EOS summary netCDF")
+    p.set_defaults(func=cmd_glass_eos)
+
+    p = subparsers.add_parser("glass-entropy", help=cmd_glass_entropy.__doc__)
+    p.add_argument("--eos", required=True, help="the system's glass-eos summary")
+    p.add_argument("bcmd", nargs="+", help="BCMD results of the glass snapshots")
+    p.add_argument("--out", required=True, help="entropy summary netCDF")
+    p.set_defaults(func=cmd_glass_entropy)
+
+    p = subparsers.add_parser("glass-freezing", help=cmd_glass_freezing.__doc__)
+    p.add_argument("--mono", required=True, help="glass-eos summary of monodisperse disks (with a decompression)")
+    p.add_argument("--mixture", required=True, help="glass-eos summary of the mixture")
+    p.add_argument("--plus", help="glass-eos summary at x_A + dx (x_large - dx)")
+    p.add_argument("--minus", help="glass-eos summary at x_A - dx (x_large + dx)")
+    p.add_argument("--dx", type=float, default=0.05, help="composition step of --plus / --minus")
+    p.add_argument("--kappa", type=float, required=True, help="diameter ratio")
+    p.add_argument("--x-large", type=float, required=True, help="number fraction of the large disks")
+    p.add_argument("--phi-join", type=float, default=0.70,
+                   help="monodisperse EOS: compression below, decompression from here up (default 0.70)")
+    p.add_argument("--out", required=True, help="freezing netCDF")
+    p.set_defaults(func=cmd_glass_freezing)

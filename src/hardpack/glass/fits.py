@@ -1,0 +1,142 @@
+"""Fits of the estimated jamming density phi~_J(phi) = phi / (1 - d/Z) of compressed binary disks
+(Donev 2006, sec. 13.3; Donev, Stillinger & Torquato 2006).
+
+- Liquid-branch extension, Eq. 13.3: phi~_J(phi) = c0 + c1 phi + c2 phi^2 + c3 phi^3, fitted to the
+  slowest compressions below the kinetic glass transition; published c = (3.136, -8.4826, 10.277,
+  -4.0356) (:data:`PUBLISHED_CUBIC`), "just a fit", not meant beyond phi ~ 0.8.
+- Glassy branch, Eq. 13.4: phi~_J(phi) = (1 + alpha) phi_J - alpha phi above phi_g ~ 0.8, with
+  alpha ~ 0.133 (:data:`PUBLISHED_ALPHA`); equivalently the pressure p = d / (1 - phi / phi~_J).
+
+Both are weighted linear least squares in phi (weights 1/err^2 of phi~_J, propagated from the
+errors of Z). The covariance is (A^T W A)^-1 scaled by max(1, chi^2 / dof) (errors that
+understate the scatter widen the coefficient errors; errors that overstate it are kept).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hardpack.errors import InvalidInputError
+
+#: Donev 2006, Eq. 13.3 (c0, c1, c2, c3)
+PUBLISHED_CUBIC = (3.136, -8.4826, 10.277, -4.0356)
+#: Donev 2006, Eq. 13.4
+PUBLISHED_ALPHA = 0.133
+
+
+def estimated_jamming_density(phi, z, z_err=None, d: int = 2):
+    """phi~_J = phi / (1 - d/Z) (Donev 2006, Eq. 1.2, the free-volume EOS inverted) and its error
+    |d phi~_J / dZ| z_err = phi d / (Z - d)^2 z_err. Z <= d gives NaN (no finite estimate)."""
+    phi, z = np.asarray(phi, float), np.asarray(z, float)
+    z_err = np.zeros_like(z) if z_err is None else np.asarray(z_err, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ok = z > d
+        est = np.where(ok, phi / (1.0 - d / z), np.nan)
+        err = np.where(ok, phi * d / (z - d) ** 2 * z_err, np.nan)
+    return est, err
+
+
+def cubic_phij(phi, coefficients=PUBLISHED_CUBIC):
+    """Eq. 13.3 evaluated at ``phi`` (default: the published coefficients)."""
+    c = np.asarray(coefficients, float)
+    phi = np.asarray(phi, float)
+    return c[0] + c[1] * phi + c[2] * phi**2 + c[3] * phi**3
+
+
+def glass_phij(phi, phi_j, alpha=PUBLISHED_ALPHA):
+    """Eq. 13.4: phi~_J = (1 + alpha) phi_J - alpha phi."""
+    return (1.0 + alpha) * phi_j - alpha * np.asarray(phi, float)
+
+
+def pressure_from_phij(phi, phij, d: int = 2):
+    """Z = d / (1 - phi / phi~_J), the free-volume form behind both fits."""
+    phi = np.asarray(phi, float)
+    return d / (1.0 - phi / np.asarray(phij, float))
+
+
+@dataclass(frozen=True)
+class LinearFit:
+    """Weighted least-squares coefficients (lowest power first) with their covariance."""
+
+    coefficients: np.ndarray
+    covariance: np.ndarray
+    chi2: float
+    dof: int
+
+    @property
+    def errors(self) -> np.ndarray:
+        """Standard errors of the coefficients."""
+        return np.sqrt(np.diag(self.covariance))
+
+    def __call__(self, x):
+        return np.polynomial.polynomial.polyval(np.asarray(x, float), self.coefficients)
+
+
+def weighted_polyfit(x, y, y_err, degree: int) -> LinearFit:
+    """Weighted least-squares polynomial of ``degree`` (module docstring for the covariance).
+
+    Parameters
+    ----------
+    x, y : array_like
+        Points (finite entries only are used).
+    y_err : array_like or None
+        Standard errors of y; None or non-positive entries give unit weights to all points.
+    degree : int
+        Polynomial degree (>= 0); needs more points than coefficients.
+    """
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    err = np.ones_like(y) if y_err is None else np.asarray(y_err, float)
+    keep = np.isfinite(x) & np.isfinite(y) & np.isfinite(err)
+    x, y, err = x[keep], y[keep], err[keep]
+    if not np.all(err > 0):
+        err = np.ones_like(y)
+    n_coef = degree + 1
+    if x.size <= n_coef:
+        raise InvalidInputError(f"a degree-{degree} fit needs more than {n_coef} points, got {x.size}")
+    design = np.vander(x, n_coef, increasing=True) / err[:, None]
+    rhs = y / err
+    coef, *_ = np.linalg.lstsq(design, rhs, rcond=None)
+    resid = rhs - design @ coef
+    chi2 = float(resid @ resid)
+    dof = x.size - n_coef
+    cov = np.linalg.inv(design.T @ design) * max(1.0, chi2 / dof)
+    return LinearFit(coef, cov, chi2, dof)
+
+
+def fit_liquid_cubic(phi, phij, phij_err=None, phi_max: float = 0.8) -> LinearFit:
+    """Eq. 13.3: the cubic phi~_J(phi) fitted to the points with phi <= ``phi_max``."""
+    phi = np.asarray(phi, float)
+    sel = phi <= phi_max
+    err = None if phij_err is None else np.asarray(phij_err, float)[sel]
+    return weighted_polyfit(phi[sel], np.asarray(phij, float)[sel], err, 3)
+
+
+@dataclass(frozen=True)
+class GlassFit:
+    """Eq. 13.4 fitted: alpha and phi_J with standard errors and their correlation."""
+
+    alpha: float
+    alpha_err: float
+    phi_j: float
+    phi_j_err: float
+    line: LinearFit
+
+
+def fit_glass_branch(phi, phij, phij_err=None, phi_min: float = 0.8) -> GlassFit:
+    """Eq. 13.4 fitted to the points with phi >= ``phi_min``: the line phi~_J = a + b phi gives
+    alpha = -b and phi_J = a / (1 + alpha), errors by first-order propagation of the line's
+    covariance (d phi_J / da = 1/(1+alpha), d phi_J / db = a/(1+alpha)^2)."""
+    phi = np.asarray(phi, float)
+    sel = phi >= phi_min
+    err = None if phij_err is None else np.asarray(phij_err, float)[sel]
+    line = weighted_polyfit(phi[sel], np.asarray(phij, float)[sel], err, 1)
+    a, b = line.coefficients
+    alpha = -b
+    if not 1.0 + alpha > 0:
+        raise InvalidInputError(f"the glass branch has slope {b:.3g} >= 1: no phi_J (not a glass branch)")
+    grad = np.array([1.0 / (1.0 + alpha), a / (1.0 + alpha) ** 2])
+    phi_j = a / (1.0 + alpha)
+    return GlassFit(alpha, float(np.sqrt(line.covariance[1, 1])), phi_j,
+                    float(np.sqrt(grad @ line.covariance @ grad)), line)

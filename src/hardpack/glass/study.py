@@ -1,0 +1,324 @@
+"""The binary hard-disk glass study (Donev 2006, ch. 13; Donev, Stillinger & Torquato 2006): the
+triangular start crystal, the EOS of compressions binned in phi, and the summaries of the
+pipeline (EOS with fits and free energies; configurational entropy of the SOC glasses).
+
+EOS from compressions (sec. 13.3): every window of an LS compression (or decompression) gives
+its phi (the window's mid point) and Z; windows are binned in phi (``bin_width``), each run gives
+the mean Z per bin, and the runs of one growth rate are averaged with the standard error over
+runs (or, with one run, over its windows in the bin: then the windows' correlation makes the
+error an underestimate, recorded as ``z_err_kind``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.packing import Packing
+from hardpack.glass import fits, thermo
+
+PHI_TRIANGULAR = math.pi / math.sqrt(12.0)
+
+
+def triangular_crystal(nx: int, ny: int, phi: float) -> Packing:
+    """Monodisperse triangular crystal of 2 nx ny disks in an orthorhombic periodic box (the
+    2-disk rectangular cell a x a sqrt(3)), radii scaled to volume fraction ``phi``.
+
+    Parameters
+    ----------
+    nx, ny : int
+        Rectangular cells along x and y (>= 1; nx = 2 ny gives a nearly square box).
+    phi : float
+        Volume fraction in (0, pi / sqrt(12)).
+    """
+    if nx < 1 or ny < 1:
+        raise InvalidInputError(f"nx and ny must be >= 1, got {nx}, {ny}")
+    if not 0 < phi < PHI_TRIANGULAR:
+        raise InvalidInputError(f"phi must be in (0, {PHI_TRIANGULAR:.6f}) (close packing), got {phi}")
+    s3 = math.sqrt(3.0)
+    basis = np.array([[0.0, 0.0], [0.5, s3 / 2]])
+    ix, iy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    origins = np.column_stack([ix.ravel(), s3 * iy.ravel()])
+    positions = (origins[:, None, :] + basis[None, :, :]).reshape(-1, 2) + 0.25
+    radius = 0.5 * math.sqrt(phi / PHI_TRIANGULAR)
+    return Packing(positions, np.full(len(positions), radius), np.diag([nx, s3 * ny]))
+
+
+def window_points(ts: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
+    """(phi at each window's mid point, Z of the window) of an MD time series."""
+    phi_end = ts["phi"].values
+    start = float(ts.attrs.get("phi_start", phi_end[0]))
+    phi_start = np.concatenate([[start], phi_end[:-1]])
+    return 0.5 * (phi_start + phi_end), ts["Z"].values
+
+
+def bin_runs(runs: list[list[xr.Dataset]], edges: np.ndarray) -> dict[str, np.ndarray]:
+    """Mean Z per phi bin of each run (a run: its time series, e.g. consecutive segments), then
+    the mean and standard error over runs (module docstring).
+
+    Returns
+    -------
+    dict
+        ``phi`` (mean phi of the windows in each bin, over runs), ``Z``, ``Z_err``, ``n_runs``,
+        ``n_windows`` per bin; ``err_from_windows`` (bool) when only one run had the bin.
+    """
+    nb = edges.size - 1
+    per_run_z = np.full((len(runs), nb), np.nan)
+    per_run_phi = np.full((len(runs), nb), np.nan)
+    var_win = np.full((len(runs), nb), np.nan)
+    n_win = np.zeros(nb, int)
+    for r, series in enumerate(runs):
+        phi = np.concatenate([window_points(ts)[0] for ts in series]) if series else np.zeros(0)
+        z = np.concatenate([window_points(ts)[1] for ts in series]) if series else np.zeros(0)
+        keep = np.isfinite(phi) & np.isfinite(z)
+        idx = np.digitize(phi[keep], edges) - 1
+        for b in range(nb):
+            sel = idx == b
+            k = int(sel.sum())
+            if k:
+                per_run_z[r, b] = z[keep][sel].mean()
+                per_run_phi[r, b] = phi[keep][sel].mean()
+                var_win[r, b] = z[keep][sel].var(ddof=1) / k if k > 1 else np.nan
+                n_win[b] += k
+    n_runs = np.sum(np.isfinite(per_run_z), axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"), _quiet():
+        z_mean = np.nanmean(per_run_z, axis=0)
+        phi_mean = np.nanmean(per_run_phi, axis=0)
+        z_err = np.nanstd(per_run_z, axis=0, ddof=1) / np.sqrt(n_runs)
+        single = n_runs == 1
+        z_err[single] = np.sqrt(np.nanmax(var_win, axis=0)[single])
+    return {"phi": phi_mean, "Z": z_mean, "Z_err": z_err, "n_runs": n_runs, "n_windows": n_win,
+            "err_from_windows": single}
+
+
+class _quiet:
+    def __enter__(self):
+        import warnings
+
+        self._w = warnings.catch_warnings()
+        self._w.__enter__()
+        warnings.simplefilter("ignore", RuntimeWarning)
+
+    def __exit__(self, *exc):
+        self._w.__exit__(*exc)
+
+
+def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float = 2.0,
+                liquid_range=(0.70, 0.80), glass_range=(0.80, 0.84), attrs: dict | None = None) -> xr.Dataset:
+    """The EOS summary of one system: Z(phi) per branch (growth rate, or "decompression") with
+    phi~_J, the excess free energy Delta f(phi) integrated from the ideal gas along each
+    compression branch, and the fits of Eq. 13.3 (to the slowest compression) and Eq. 13.4
+    (to each compression branch), with their coefficient errors.
+
+    Parameters
+    ----------
+    branches : dict
+        Branch name -> list of runs, a run being the list of its time-series Datasets in order.
+        Names of compressions are their growth rates as strings ("1e-05"); other names (e.g.
+        "decompression") are binned but get no free energy (they do not start at low density).
+    edges : numpy.ndarray
+        phi bin edges.
+    d : int, default 2
+        Dimension (the free-volume prefactor of phi~_J).
+    slope0 : float, default 2.0
+        (Z - 1)/phi at phi = 0 (:func:`hardpack.glass.thermo.second_virial_slope`).
+    liquid_range, glass_range : (float, float)
+        phi ranges of the Eq. 13.3 and Eq. 13.4 fits.
+    attrs : dict, optional
+        Attributes to add (system, kappa, x_large, N, ...).
+    """
+    names = list(branches)
+    if not names:
+        raise InvalidInputError("no EOS branches given")
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    vars_ = {k: np.full((len(names), centres.size), np.nan)
+             for k in ("phi_mean", "Z", "Z_err", "phij", "phij_err", "excess", "excess_err")}
+    n_runs = np.zeros((len(names), centres.size), int)
+    rates = []
+    for b, name in enumerate(names):
+        res = bin_runs(branches[name], edges)
+        vars_["phi_mean"][b], vars_["Z"][b], vars_["Z_err"][b] = res["phi"], res["Z"], res["Z_err"]
+        n_runs[b] = res["n_runs"]
+        vars_["phij"][b], vars_["phij_err"][b] = fits.estimated_jamming_density(res["phi"], res["Z"], res["Z_err"], d)
+        try:
+            rate = float(name)
+        except ValueError:
+            rate = math.nan
+        rates.append(rate)
+        ok = np.flatnonzero(np.isfinite(res["Z"]))
+        if math.isfinite(rate) and rate > 0 and ok.size:
+            # a compression from low density: the trapezoid integral over the non-empty bins
+            span = ok
+            f, fe = thermo.excess_free_energy(res["phi"][span], res["Z"][span], res["Z_err"][span], slope0=slope0)
+            vars_["excess"][b, span], vars_["excess_err"][b, span] = f, fe
+    ds = xr.Dataset(
+        {k: (("branch", "phi"), v) for k, v in vars_.items()} | {"n_runs": (("branch", "phi"), n_runs)},
+        coords={"branch": names, "phi": centres, "growth_rate": ("branch", np.array(rates))},
+    )
+    ds.attrs.update({"hardpack_kind": "glass_eos", "bin_width": float(edges[1] - edges[0]), "d": d,
+                     "slope0": slope0, **(attrs or {})})
+    _add_fits(ds, liquid_range, glass_range)
+    return ds
+
+
+def _add_fits(ds: xr.Dataset, liquid_range, glass_range) -> None:
+    """Eq. 13.3 to the slowest compression, Eq. 13.4 to every compression (NaN where too few
+    points); coefficients and errors as variables, the ranges as attributes."""
+    rates = ds["growth_rate"].values
+    comp = np.flatnonzero(np.isfinite(rates) & (rates > 0))
+    cubic = np.full(4, np.nan)
+    cubic_err = np.full(4, np.nan)
+    if comp.size:
+        slow = comp[np.argmin(rates[comp])]
+        row = ds.isel(branch=slow)
+        phi, pj, pe = row["phi_mean"].values, row["phij"].values, row["phij_err"].values
+        sel = (phi >= liquid_range[0]) & (phi <= liquid_range[1]) & np.isfinite(pj)
+        if sel.sum() > 4:
+            fit = fits.fit_liquid_cubic(phi[sel], pj[sel], pe[sel], phi_max=liquid_range[1])
+            cubic, cubic_err = fit.coefficients, fit.errors
+        ds.attrs["cubic_branch"] = str(ds["branch"].values[slow])
+    ds["cubic"] = ("power", cubic)
+    ds["cubic_err"] = ("power", cubic_err)
+    alpha = np.full(rates.size, np.nan)
+    alpha_err, phi_j, phi_j_err = alpha.copy(), alpha.copy(), alpha.copy()
+    for b in comp:
+        row = ds.isel(branch=b)
+        phi, pj, pe = row["phi_mean"].values, row["phij"].values, row["phij_err"].values
+        sel = (phi >= glass_range[0]) & (phi <= glass_range[1]) & np.isfinite(pj)
+        if sel.sum() > 2:
+            try:
+                g = fits.fit_glass_branch(phi[sel], pj[sel], pe[sel], phi_min=glass_range[0])
+            except InvalidInputError:
+                continue
+            alpha[b], alpha_err[b], phi_j[b], phi_j_err[b] = g.alpha, g.alpha_err, g.phi_j, g.phi_j_err
+    ds["alpha"], ds["alpha_err"] = ("branch", alpha), ("branch", alpha_err)
+    ds["glass_phi_j"], ds["glass_phi_j_err"] = ("branch", phi_j), ("branch", phi_j_err)
+    ds.attrs.update(liquid_fit_range=list(liquid_range), glass_fit_range=list(glass_range))
+
+
+def liquid_excess_at(eos: xr.Dataset, phi: float, branch: str | None = None) -> tuple[float, float]:
+    """Delta f_L and its error at ``phi`` by the EOS integral of ``branch`` (default: the
+    slowest compression), i.e. the trapezoid integral continued to ``phi`` from the nearest bin
+    below it with the straight line of (Z - 1)/phi between the bins."""
+    if branch is None:
+        branch = eos.attrs.get("cubic_branch")
+    row = eos.sel(branch=branch)
+    p, z, f, fe = (row[k].values for k in ("phi_mean", "Z", "excess", "excess_err"))
+    ok = np.isfinite(f)
+    p, z, f, fe = p[ok], z[ok], f[ok], fe[ok]
+    if p.size < 2 or not p[0] <= phi <= p[-1]:
+        return math.nan, math.nan
+    k = int(np.clip(np.searchsorted(p, phi) - 1, 0, p.size - 2))
+    y = (z - 1.0) / p
+    y_at = np.interp(phi, p, y)
+    return float(f[k] + 0.5 * (phi - p[k]) * (y[k] + y_at)), float(max(fe[k], fe[min(k + 1, p.size - 1)]))
+
+
+def entropy_dataset(eos: xr.Dataset, bcmd: list[xr.Dataset], *, x_large: float,
+                    attrs: dict | None = None) -> xr.Dataset:
+    """s_c - s_mix = Delta f_g - Delta f_L per SOC glass (Donev 2006, Eq. 13.5, Fig. 13.12).
+
+    Parameters
+    ----------
+    eos : xarray.Dataset
+        The system's EOS summary (:func:`eos_dataset`); Delta f_L from its slowest compression.
+    bcmd : list of xarray.Dataset
+        BCMD results of the glass snapshots (:func:`hardpack.freeenergy.run_bcmd`), each with the
+        attributes ``phi0``, ``growth_rate`` and ``seed`` of its snapshot.
+    x_large : float
+        Number fraction of the large disks (0 for a monodisperse system): s_mix.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``sample`` (indexed by phi0, growth_rate, seed): ``glass_excess``, ``liquid_excess``,
+        ``liquid_excess_err``, ``sc_minus_smix``, ``sc_minus_smix_err``, ``sc``, ``dmu_min``,
+        ``n_events``, ``seconds``; attributes ``s_mix``.
+    """
+    if not bcmd:
+        raise InvalidInputError("no BCMD results given")
+    s_mix = thermo.mixing_entropy(x_large)
+    rows = []
+    for ds in bcmd:
+        a = ds.attrs
+        for key in ("phi0", "growth_rate", "seed"):
+            if key not in a:
+                raise InvalidInputError(f"BCMD result without the snapshot attribute {key!r}")
+        f_l, f_l_err = liquid_excess_at(eos, float(a["phi"]))
+        s, s_err = thermo.configurational_entropy_excess(a["excess"], f_l, 0.0, f_l_err)
+        rows.append((float(a["phi0"]), float(a["growth_rate"]), int(a["seed"]), float(a["phi"]),
+                     float(a["excess"]), f_l, f_l_err, float(s), float(s_err), float(a["dmu_min"]),
+                     int(a["n_events"]), float(a["seconds"]), int(a["n_particles"])))
+    rows.sort()
+    arr = list(zip(*rows))
+    names = ("phi0", "growth_rate", "seed", "phi", "glass_excess", "liquid_excess", "liquid_excess_err",
+             "sc_minus_smix", "sc_minus_smix_err", "dmu_min", "n_events", "seconds", "n_particles")
+    data = {n: ("sample", np.asarray(v)) for n, v in zip(names, arr) if n not in ("phi0", "growth_rate", "seed")}
+    data["sc"] = ("sample", np.asarray(arr[7]) + s_mix)
+    coords = {n: ("sample", np.asarray(v)) for n, v in zip(names[:3], arr[:3])}
+    out = xr.Dataset(data, coords=coords)
+    out.attrs.update({"hardpack_kind": "glass_entropy", "s_mix": s_mix, "x_large": x_large, **(attrs or {})})
+    return out
+
+
+def joint_branch(eos: xr.Dataset, low: str, high: str, phi_join: float):
+    """(phi, Z, Z_err) of one smooth EOS: branch ``low`` below ``phi_join`` and ``high`` from it
+    up (monodisperse disks: the liquid compression and the crystal decompression, treated as one
+    phase, Donev 2006, sec. 13.2), empty bins dropped."""
+    lo, hi = eos.sel(branch=low), eos.sel(branch=high)
+    take_lo = (lo["phi_mean"].values < phi_join) & np.isfinite(lo["Z"].values)
+    take_hi = (hi["phi_mean"].values >= phi_join) & np.isfinite(hi["Z"].values)
+    parts = [(lo, take_lo), (hi, take_hi)]
+    phi = np.concatenate([r["phi_mean"].values[t] for r, t in parts])
+    z = np.concatenate([r["Z"].values[t] for r, t in parts])
+    z_err = np.concatenate([r["Z_err"].values[t] for r, t in parts])
+    order = np.argsort(phi)
+    return phi[order], z[order], z_err[order]
+
+
+def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | None, minus: xr.Dataset | None,
+                     *, kappa: float, x_large: float, dx: float, phi_join: float) -> xr.Dataset:
+    """Freezing of the mixture against the pure large-disk crystal (Eq. 13.2): phi_F and the
+    precipitate's density. The monodisperse EOS joins the slowest compression below
+    ``phi_join`` and the decompression of the crystal above; the mixture's EOS is its slowest
+    compression; mu~_B from the mixtures at x_A +- dx (``plus``: x_A + dx, i.e. x_large - dx),
+    or 0 without them (recorded in ``mu_tilde``). Data that do not allow a solution (too few
+    points, no sign change) give NaN with the reason in ``status``."""
+    attrs = {"hardpack_kind": "glass_freezing", "kappa": kappa, "x_large": x_large, "phi_join": phi_join,
+             "n_particles": int(mixture.attrs.get("N", 0))}
+    try:
+        values, how = _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join)
+        attrs.update(status="solved", mu_tilde=how)
+    except InvalidInputError as exc:
+        values = dict.fromkeys(("phi_freeze", "phi_precipitate", "pressure", "mu"), math.nan)
+        attrs.update(status=f"not solved: {exc}", mu_tilde="-")
+    return xr.Dataset({k: ((), v) for k, v in values.items()}, attrs=attrs)
+
+
+def _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join):
+    from hardpack.glass import freezing as fz
+
+    slope_mono = thermo.second_virial_slope(2)
+    p, z, ze = joint_branch(mono, mono.attrs["cubic_branch"], "decompression", phi_join)
+    f, _ = thermo.excess_free_energy(p, z, ze, slope0=slope_mono)
+    pure = fz.tabulated_phase(p, z, f)
+
+    def branch_phase(eos):
+        row = eos.sel(branch=eos.attrs["cubic_branch"])
+        ok = np.isfinite(row["excess"].values)
+        return fz.tabulated_phase(row["phi_mean"].values[ok], row["Z"].values[ok], row["excess"].values[ok])
+
+    mix_phase = branch_phase(mixture)
+    mu_tilde, how = 0.0, "0 (no neighbouring compositions)"
+    if plus is not None and minus is not None:
+        fp, fm = branch_phase(plus), branch_phase(minus)
+        lo, hi = max(fp.phi_lo, fm.phi_lo), min(fp.phi_hi, fm.phi_hi)
+        mix_phase = fz.Phase(mix_phase.z, mix_phase.excess, max(mix_phase.phi_lo, lo),
+                             min(mix_phase.phi_hi, hi))
+        mu_tilde, how = fz.composition_derivative(fp.excess, fm.excess, dx), f"central difference, dx = {dx}"
+    res = fz.freezing_point(pure, mix_phase, fz.Mixture(kappa, x_large), mu_tilde)
+    return {"phi_freeze": res.phi_freeze, "phi_precipitate": res.phi_precipitate,
+            "pressure": res.pressure, "mu": res.mu}, how

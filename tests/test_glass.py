@@ -1,0 +1,203 @@
+"""The binary-disk glass library (Donev 2006, ch. 13) against closed forms and printed numbers."""
+
+import math
+
+import numpy as np
+import pytest
+
+from hardpack.eos.theory import henderson
+from hardpack.errors import InvalidInputError
+from hardpack.glass import fits, freezing, study, thermo
+
+
+# --- (a) free energy from the EOS --------------------------------------------------------------
+
+def test_mixing_entropy_printed_value():
+    # Donev 2006, sec. 13.4: s_mix ~ 0.6365 for x = 1/3 (printed without the minus sign)
+    assert thermo.mixing_entropy(1 / 3) == pytest.approx(math.log(3) - 2 / 3 * math.log(2), abs=1e-15)
+    assert round(thermo.mixing_entropy(1 / 3), 4) == 0.6365
+    assert thermo.mixing_entropy(0.0) == 0.0 == thermo.mixing_entropy(1.0)
+    with pytest.raises(InvalidInputError):
+        thermo.mixing_entropy(1.2)
+
+
+def test_second_virial_slope():
+    assert thermo.second_virial_slope(2) == pytest.approx(2.0)
+    assert thermo.second_virial_slope(3) == pytest.approx(4.0)
+    # binary disks: 1 + <D>^2 / <D^2>
+    x, k = 1 / 3, 1.4
+    m1, m2 = (1 - x) + x * k, (1 - x) + x * k**2
+    assert thermo.second_virial_slope(2, k, x) == pytest.approx(1 + m1**2 / m2)
+    # Henderson's EOS has (Z - 1)/phi -> 2 at phi -> 0
+    assert (henderson(1e-8) - 1) / 1e-8 == pytest.approx(2.0, rel=1e-6)
+
+
+def test_excess_free_energy_converges_to_henderson_integral():
+    target = float(thermo.henderson_excess(0.7))
+    errors = []
+    for h in (0.02, 0.01, 0.005):
+        phi = np.arange(h, 0.7 + h / 2, h)
+        f, _ = thermo.excess_free_energy(phi, henderson(phi))
+        errors.append(abs(f[-1] - target))
+    assert errors[-1] < 3e-4
+    # second order: halving h divides the error by ~4
+    assert errors[0] / errors[1] == pytest.approx(4, rel=0.1)
+    assert errors[1] / errors[2] == pytest.approx(4, rel=0.1)
+
+
+def test_excess_free_energy_error_propagation_is_exact():
+    rng = np.random.default_rng(3)
+    phi = np.linspace(0.05, 0.6, 12)
+    err = 0.01 + 0.02 * rng.random(12)
+    _, f_err = thermo.excess_free_energy(phi, henderson(phi), err)
+    z = henderson(phi)
+    base, _ = thermo.excess_free_energy(phi, z)
+    grad = np.zeros((12, 12))
+    for i in range(12):
+        dz = z.copy()
+        dz[i] += 1e-6
+        grad[:, i] = (thermo.excess_free_energy(phi, dz)[0] - base) / 1e-6
+    assert f_err == pytest.approx(np.sqrt(grad**2 @ err**2), rel=1e-5)
+
+
+def test_integrate_eos_matches_closed_form():
+    phi = np.array([0.1, 0.4, 0.69])
+    assert thermo.integrate_eos(henderson, phi) == pytest.approx(thermo.henderson_excess(phi), rel=1e-10)
+
+
+def test_excess_free_energy_refuses_bad_tables():
+    with pytest.raises(InvalidInputError):
+        thermo.excess_free_energy([0.3, 0.2], [2.0, 3.0])
+    with pytest.raises(InvalidInputError):
+        thermo.excess_free_energy([0.2, 0.3], [2.0, np.nan])
+
+
+# --- (b) fits -----------------------------------------------------------------------------------
+
+def test_published_cubic_values():
+    # Eq. 13.3 with the printed coefficients (our arithmetic at the printed digits)
+    values = fits.cubic_phij([0.70, 0.75, 0.775, 0.80, 0.82])
+    assert values == pytest.approx([0.8497, 0.8523, 0.8561, 0.8610, 0.8654], abs=6e-5)
+    # the liquid extension stays between the glass jamming densities of sec. 13.3 (~0.84-0.86)
+    assert np.all((values > 0.84) & (values < 0.87))
+    # p = 2 / (1 - phi / phi~_J) ~ 28.2 at phi = 0.8
+    assert fits.pressure_from_phij(0.8, values[3]) == pytest.approx(28.2, abs=0.1)
+
+
+def test_cubic_fit_recovers_published_coefficients_with_errors():
+    rng = np.random.default_rng(1)
+    phi = np.linspace(0.70, 0.80, 41)
+    sigma = 2e-4
+    truth = fits.cubic_phij(phi)
+    pulls = []
+    for _ in range(200):
+        fit = fits.fit_liquid_cubic(phi, truth + sigma * rng.normal(size=phi.size), np.full(phi.size, sigma))
+        pulls.append((fit.coefficients - fits.PUBLISHED_CUBIC) / fit.errors)
+    pulls = np.array(pulls)
+    # unbiased, and the errors are the spread (pull sd ~ 1, 200 trials: sd of sd ~ 0.05)
+    assert np.abs(pulls.mean(axis=0)).max() < 0.25
+    assert pulls.std(axis=0) == pytest.approx(np.ones(4), abs=0.2)
+    exact = fits.fit_liquid_cubic(phi, truth)
+    assert exact.coefficients == pytest.approx(fits.PUBLISHED_CUBIC, abs=1e-8)
+
+
+def test_glass_branch_fit_and_continuity_with_cubic():
+    phi = np.linspace(0.80, 0.83, 13)
+    phi_j = 0.85
+    line = fits.glass_phij(phi, phi_j)
+    g = fits.fit_glass_branch(phi, line, np.full(phi.size, 1e-4))
+    assert g.alpha == pytest.approx(fits.PUBLISHED_ALPHA, abs=1e-9)
+    assert g.phi_j == pytest.approx(phi_j, abs=1e-9)
+    # errors by propagation against Monte Carlo
+    rng = np.random.default_rng(2)
+    samples = [fits.fit_glass_branch(phi, line + 1e-4 * rng.normal(size=phi.size), np.full(phi.size, 1e-4))
+               for _ in range(300)]
+    assert np.std([s.phi_j for s in samples]) == pytest.approx(g.phi_j_err, rel=0.2)
+    assert np.std([s.alpha for s in samples]) == pytest.approx(g.alpha_err, rel=0.2)
+
+
+def test_estimated_jamming_density():
+    est, err = fits.estimated_jamming_density(0.8, 28.2, 0.1)
+    assert est == pytest.approx(0.8 / (1 - 2 / 28.2))
+    assert err == pytest.approx(0.8 * 2 / (28.2 - 2) ** 2 * 0.1)
+    assert np.isnan(fits.estimated_jamming_density(0.1, 1.5)[0])
+
+
+# --- (c) freezing -------------------------------------------------------------------------------
+
+def _ideal():
+    return freezing.Phase(lambda p: 1.0, lambda p: 0.0, 0.01, 0.9)
+
+
+def test_ideal_gas_mu_difference_is_ln_x():
+    mix = freezing.Mixture(1.4, 1 / 3)
+    for pressure in (0.05, 0.2, 0.4):
+        diff = freezing.mu_difference(pressure, _ideal(), _ideal(), mix, lambda p: 0.0)
+        assert diff == pytest.approx(math.log(1 / 3), abs=1e-10)
+
+
+def test_freezing_identical_species_never_freezes():
+    # kappa = 1: labels only; mu_AB - mu_B = ln x_B < 0 at every pressure (Henderson liquid)
+    phi = np.linspace(0.05, 0.69, 200)
+    z = henderson(phi)
+    phase = freezing.tabulated_phase(phi, z, thermo.henderson_excess(phi))
+    mix = freezing.Mixture(1.0, 0.3)
+    assert freezing.mu_difference(5.0, phase, phase, mix, lambda p: 0.0) == pytest.approx(math.log(0.3), abs=1e-3)
+    with pytest.raises(InvalidInputError, match="no freezing"):
+        freezing.freezing_point(phase, phase, mix)
+
+
+def test_freezing_point_of_constructed_model():
+    # the pure phase's excess raised by a constant c: mu_B shifts by c, so the root moves to where
+    # the difference of the unshifted model equals c
+    phi = np.linspace(0.05, 0.69, 300)
+    z = henderson(phi)
+    f = thermo.henderson_excess(phi)
+    mix = freezing.Mixture(1.2, 0.5)
+    pure = freezing.tabulated_phase(phi, z, f)
+    target = 1.0
+    c = freezing.mu_difference(target, pure, pure, mix, lambda p: 0.0)
+    shifted = freezing.Phase(pure.z, lambda p: pure.excess(p) + c, pure.phi_lo, pure.phi_hi)
+    res = freezing.freezing_point(shifted, pure, mix)
+    assert res.pressure == pytest.approx(target, rel=1e-6)
+    assert res.phi_precipitate * henderson(res.phi_precipitate) / 1.2**2 == pytest.approx(target, rel=1e-4)
+
+
+def test_composition_derivative():
+    mt = freezing.composition_derivative(lambda p: 2 * p, lambda p: p, 0.05)
+    assert mt(0.5) == pytest.approx(0.5 / 0.1)
+
+
+# --- (d) configurational entropy, crystal, binning ----------------------------------------------
+
+def test_configurational_entropy_excess():
+    s, e = thermo.configurational_entropy_excess(7.0, 6.5, 0.03, 0.04)
+    assert float(s) == pytest.approx(0.5)
+    assert float(e) == pytest.approx(0.05)
+
+
+def test_triangular_crystal():
+    p = study.triangular_crystal(8, 4, 0.8)
+    assert p.n_particles == 64
+    assert p.phi == pytest.approx(0.8)
+    # every disk has 6 neighbours at the lattice spacing 1
+    d = np.linalg.norm(p.minimum_image(p.positions[:, None] - p.positions[None]), axis=-1)
+    assert np.all(np.sum(np.isclose(d, 1.0), axis=1) == 6)
+    with pytest.raises(InvalidInputError):
+        study.triangular_crystal(8, 4, 0.95)
+
+
+def test_bin_runs_mean_and_error():
+    import xarray as xr
+
+    def ts(phi, z):
+        return xr.Dataset({"phi": ("window", np.asarray(phi, float)), "Z": ("window", np.asarray(z, float))})
+
+    # window mid points: run 1 at 0.11, 0.12, 0.21, 0.29; run 2 at 0.12, 0.12, 0.21, 0.29
+    runs = [[ts([0.11, 0.13, 0.29, 0.29], [2.0, 2.0, 3.0, 3.0])], [ts([0.12, 0.12, 0.30, 0.28], [4.0, 4.0, 5.0, 5.0])]]
+    res = study.bin_runs(runs, np.array([0.1, 0.2, 0.3]))
+    assert res["n_runs"].tolist() == [2, 2]
+    assert res["Z"][0] == pytest.approx(3.0)
+    assert res["Z_err"][0] == pytest.approx(np.std([2.0, 4.0], ddof=1) / np.sqrt(2))
+    assert res["Z"][1] == pytest.approx(4.0)
+    assert res["phi"][0] == pytest.approx((0.115 + 0.12) / 2)

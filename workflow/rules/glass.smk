@@ -1,0 +1,277 @@
+# Configurational entropy of binary hard-disk glasses (Donev 2006, ch. 13; Donev, Stillinger &
+# Torquato 2006): compressions of the 1:2 mixture of disks with diameter ratio 1.4 and of
+# monodisperse disks at several growth rates in stages through the snapshot densities, the
+# decompression of the triangular crystal, BCMD of the snapshots of the slowest compression in
+# bounding cells, the EOS summaries with the fits of Eqs. 13.3-13.4, s_c - s_mix (Eq. 13.5) and the
+# freezing point (Eq. 13.2). The micro-segregated packings of sec. 13.5 need a constant-pressure,
+# deforming-cell MD that hardpack does not have; they are not part of the study.
+
+
+
+rule glass_init:
+    """RSA start of a glass system at low density (the EOS integral starts there)."""
+    output:
+        "results/glass/{system}/init/seed{seed}.nc",
+    params:
+        spec=glass_distribution,
+        n=GLASS["N"] if GLASS else None,
+        phi=GLASS["init_phi"] if GLASS else None,
+    wildcard_constraints:
+        system=one_of(GLASS_SYSTEMS),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_init"),
+        runtime=job_runtime("glass_init"),
+    group:
+        "setup"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_init/{system}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_init/{system}/seed{seed}.tsv"
+    shell:
+        "hardpack init --n {params.n} --d 2 --phi {params.phi} --distribution '{params.spec}'"
+        " --seed {wildcards.seed} --out {output} > {log} 2>&1"
+
+
+rule glass_compress:
+    """One LS compression stage at growth rate {rate} from the previous stage (or the start) to phi{phi}, stopped early if Z reaches max_pressure; the packing is a snapshot."""
+    input:
+        glass_previous,
+    output:
+        packing="results/glass/{system}/g{rate}/phi{phi}/seed{seed}.nc",
+        timeseries="results/glass/{system}/g{rate}/phi{phi}/ts_seed{seed}.nc",
+    params:
+        checkpoint=checkpoint_beside,
+        max_pressure=GLASS["max_pressure"] if GLASS else None,
+    wildcard_constraints:
+        system=one_of(GLASS_SYSTEMS),
+        rate=r"[0-9.e+-]+",
+        phi=GLASS_PHI,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_compress"),
+        runtime=job_runtime("glass_compress"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_compress/{system}/g{rate}/phi{phi}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_compress/{system}/g{rate}/phi{phi}/seed{seed}.tsv"
+    shell:
+        "hardpack compress --init {input} --growth-rate {wildcards.rate} --seed {wildcards.seed}"
+        " --target-phi {wildcards.phi} --max-pressure {params.max_pressure} --out {output.packing}"
+        " --timeseries {output.timeseries} --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
+rule glass_crystal:
+    """Monodisperse triangular crystal of N disks at glass.mono.crystal_phi."""
+    output:
+        "results/glass/mono/crystal.nc",
+    params:
+        cells=lambda w: glass_crystal_cells(),
+        phi=GLASS["mono"]["crystal_phi"] if GLASS else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_crystal"),
+        runtime=job_runtime("glass_crystal"),
+    group:
+        "setup"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_crystal/crystal.log",
+    benchmark:
+        "results/benchmarks/glass_crystal/crystal.tsv"
+    shell:
+        "hardpack glass-crystal --nx {params.cells[0]} --ny {params.cells[1]} --phi {params.phi}"
+        " --out {output} > {log} 2>&1"
+
+
+rule glass_decompress:
+    """Slow decompression of the triangular crystal (growth rate -glass.mono.rate) to glass.mono.decompress_to."""
+    input:
+        "results/glass/mono/crystal.nc",
+    output:
+        packing="results/glass/mono/decompression/seed{seed}.nc",
+        timeseries="results/glass/mono/decompression/ts_seed{seed}.nc",
+    params:
+        checkpoint=checkpoint_beside,
+        rate=GLASS["mono"]["rate"] if GLASS else None,
+        phi=GLASS["mono"]["decompress_to"] if GLASS else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_decompress"),
+        runtime=job_runtime("glass_decompress"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_decompress/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_decompress/seed{seed}.tsv"
+    shell:
+        "hardpack compress --init {input} --growth-rate -{params.rate} --seed {wildcards.seed}"
+        " --target-phi {params.phi} --out {output.packing} --timeseries {output.timeseries}"
+        " --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
+rule glass_eos:
+    """Binned EOS of a glass system, its EOS integral from the ideal gas and the fits of Eqs. 13.3-13.4."""
+    input:
+        lambda w: glass_timeseries(w.system),
+    output:
+        "results/glass/{system}/eos_summary.nc",
+    params:
+        kappa=lambda w: GLASS_SYSTEMS[w.system]["kappa"],
+        x=lambda w: GLASS_SYSTEMS[w.system]["x"],
+        e=GLASS["eos"] if GLASS else None,
+    wildcard_constraints:
+        system=one_of(GLASS_SYSTEMS),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_eos"),
+        runtime=job_runtime("glass_eos"),
+    group:
+        "summaries"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_eos/{system}.log",
+    benchmark:
+        "results/benchmarks/glass_eos/{system}.tsv"
+    shell:
+        "hardpack glass-eos {input} --system {wildcards.system} --kappa {params.kappa} --x-large {params.x}"
+        " --bin-width {params.e[bin_width]} --liquid-range {params.e[liquid_range][0]} {params.e[liquid_range][1]}"
+        " --glass-range {params.e[glass_range][0]} {params.e[glass_range][1]} --out {output} > {log} 2>&1"
+
+
+rule glass_bcmd:
+    """BCMD free energy of a glass snapshot in bounding cells (Delta mu from glass.bcmd.dmu_max to the disjoint point), radii shrunk by (1 - glass.bcmd.delta) so that the cells become disjoint at Delta mu ~ delta (an MD snapshot has pairs within ~1e-10 of contact, and the BCMD cost grows as 1 / Delta mu_min)."""
+    input:
+        "results/glass/{system}/g{rate}/phi{phi}/seed{seed}.nc",
+    output:
+        "results/glass/{system}/bcmd/g{rate}/phi{phi}/seed{seed}.nc",
+    params:
+        b=GLASS["bcmd"] if GLASS else None,
+    wildcard_constraints:
+        system="binary|mono",
+        phi=GLASS_PHI,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_bcmd"),
+        runtime=job_runtime("glass_bcmd"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_bcmd/{system}/g{rate}/phi{phi}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_bcmd/{system}/g{rate}/phi{phi}/seed{seed}.tsv"
+    shell:
+        "hardpack bcmd {input} --out {output} --delta {params.b[delta]} --dmu-max {params.b[dmu_max]} --gamma0 {params.b[gamma0]}"
+        " --theta {params.b[theta]} --seed {wildcards.seed} > {log} 2>&1"
+
+
+rule glass_entropy:
+    """s_c - s_mix of the SOC glasses of a system (Donev 2006, Eq. 13.5, Fig. 13.12)."""
+    input:
+        eos="results/glass/{system}/eos_summary.nc",
+        bcmd=lambda w: glass_bcmd_files(w.system),
+    output:
+        "results/glass/{system}/entropy_summary.nc",
+    wildcard_constraints:
+        system="binary|mono",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_entropy"),
+        runtime=job_runtime("glass_entropy"),
+    group:
+        "summaries"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_entropy/{system}.log",
+    benchmark:
+        "results/benchmarks/glass_entropy/{system}.tsv"
+    shell:
+        "hardpack glass-entropy --eos {input.eos} {input.bcmd} --out {output} > {log} 2>&1"
+
+
+rule glass_freezing:
+    """Freezing of the mixture against the pure large-disk crystal (Donev 2006, Eq. 13.2)."""
+    input:
+        mono="results/glass/mono/eos_summary.nc",
+        mixture="results/glass/binary/eos_summary.nc",
+        plus="results/glass/binary_xm/eos_summary.nc",
+        minus="results/glass/binary_xp/eos_summary.nc",
+    output:
+        "results/glass/freezing_summary.nc",
+    params:
+        kappa=GLASS["kappa"] if GLASS else None,
+        x=GLASS["x_large"] if GLASS else None,
+        dx=GLASS["composition"]["dx"] if GLASS else None,
+        join=GLASS["eos"]["phi_join"] if GLASS else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_freezing"),
+        runtime=job_runtime("glass_freezing"),
+    group:
+        "summaries"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_freezing/freezing.log",
+    benchmark:
+        "results/benchmarks/glass_freezing/freezing.tsv"
+    shell:
+        "hardpack glass-freezing --mono {input.mono} --mixture {input.mixture} --plus {input.plus}"
+        " --minus {input.minus} --dx {params.dx} --kappa {params.kappa} --x-large {params.x}"
+        " --phi-join {params.join} --out {output} > {log} 2>&1"
+
+
+rule fig_glass_eos:
+    """phi~_J(phi) of the compressions and decompression (mono, binary) with the published and fitted Eq. 13.3, 13.4 (Donev 2006, Figs. 13.1, 13.6)."""
+    input:
+        binary="results/glass/binary/eos_summary.nc",
+        mono="results/glass/mono/eos_summary.nc",
+    output:
+        pdf="results/figures/glass_eos.pdf",
+        png=report("results/figures/glass_eos.png", caption="../report/glass_eos.rst", category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_eos"),
+        runtime=job_runtime("fig_glass_eos"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_eos.log",
+    benchmark:
+        "results/benchmarks/fig_glass_eos.tsv"
+    script:
+        "../scripts/plot_glass_eos.py"
+
+
+rule fig_glass_entropy:
+    """Excess free energies of liquid and SOC glasses and s_c - s_mix vs phi (Donev 2006, Figs. 13.11-13.12)."""
+    input:
+        binary="results/glass/binary/entropy_summary.nc",
+        mono="results/glass/mono/entropy_summary.nc",
+    output:
+        pdf="results/figures/glass_entropy.pdf",
+        png=report("results/figures/glass_entropy.png", caption="../report/glass_entropy.rst", category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_entropy"),
+        runtime=job_runtime("fig_glass_entropy"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_entropy.log",
+    benchmark:
+        "results/benchmarks/fig_glass_entropy.tsv"
+    script:
+        "../scripts/plot_glass_entropy.py"
