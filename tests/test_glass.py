@@ -9,7 +9,6 @@ from hardpack.eos.theory import henderson
 from hardpack.errors import InvalidInputError
 from hardpack.glass import fits, freezing, study, thermo
 
-
 # --- (a) free energy from the EOS --------------------------------------------------------------
 
 def test_mixing_entropy_printed_value():

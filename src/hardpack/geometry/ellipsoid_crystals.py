@@ -55,7 +55,8 @@ def _zeta(offset, a_inv, b_inv) -> float:
 
 
 def square_side(alpha: float) -> float:
-    """Side L of the face-centred square layer (Eq. 8.1; 2 alpha beyond sqrt(3), where the neighbours along the long axis touch)."""
+    """Side L of the face-centred square layer: Eq. 8.1, or 2 alpha beyond sqrt(3), where the
+    neighbours along the long axis touch."""
     return max(4 * alpha / math.sqrt(1 + alpha**2), 2 * alpha)
 
 
