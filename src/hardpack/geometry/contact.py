@@ -26,8 +26,11 @@ A -> B, Eq. 2.14), D = dY/dlam = B - A and dY^-1/dlam = -Y^-1 D Y^-1, so dn/dlam
 f'' < 0 by concavity (at the maximiser it equals Donev's zeta_lambda_lambda = -2 n^T Z n,
 Z = [lam X_A + (1 - lam) X_B]^-1). The iteration is a safeguarded Newton method on f' over the
 bracket [lo, hi] that holds the root (f'(lo) > 0 > f'(hi)): a Newton step that leaves the bracket,
-or does not halve the previous step, is replaced by bisection, so it converges for every valid input
-and ends when the step is below a few machine epsilons of lam.
+or does not halve the previous step, is replaced by bisection, so it converges for every valid input.
+It ends when the Newton step is below 4 machine epsilons of lam, or when a step below 1e-9 lam stops
+shrinking (round-off in f' then sets the precision: a few to a hundred epsilons for aspect ratios
+up to 10), or when bisection has narrowed the bracket to 4 epsilons of lam. Random pairs take about
+7 iterations from lam0 = 1/2.
 
 Time derivative (Donev 2006, Sec. 2.2.3, Eq. 2.21): d zeta/dt = 2 lam (1 - lam) n . v_C, where v_C
 is the velocity of the contact point r_C (Eq. 2.13) as a point of B minus as a point of A. It
@@ -49,6 +52,7 @@ from numba.extending import overload
 __all__ = ["shape_inverse", "pw_contact", "contact_point", "pw_rate", "inverse_shapes", "pair_potentials"]
 
 _EPS = np.finfo(np.float64).eps
+_NOISE = 1e-9  # relative Newton step below which a step that stops shrinking is round-off
 MAX_ITERATIONS = 200
 
 
@@ -143,6 +147,13 @@ def pw_contact(r_ab, a_inv, b_inv, lam0):
     ValueError
         If ``lam0`` is not in [0, 1] or ``r_ab`` is not finite.
     """
+    zeta, lam, n, _ = _pw_maximise(r_ab, a_inv, b_inv, lam0)
+    return zeta, lam, n
+
+
+@numba.njit(cache=True)
+def _pw_maximise(r_ab, a_inv, b_inv, lam0):
+    """:func:`pw_contact` and the number of Newton/bisection iterations it took."""
     d = r_ab.shape[0]
     if not (lam0 >= 0.0 and lam0 <= 1.0):
         raise ValueError("pw_contact: the initial guess lam0 must be in [0, 1]")
@@ -153,7 +164,7 @@ def pw_contact(r_ab, a_inv, b_inv, lam0):
         raise ValueError("pw_contact: the separation r_ab must be finite")
     n = np.zeros(d)
     if rr == 0.0:
-        return -1.0, lam0, n
+        return -1.0, lam0, n, 0
     y = np.empty((d, d))
     y_inv = np.empty((d, d))
     dn = np.empty(d)
@@ -161,7 +172,9 @@ def pw_contact(r_ab, a_inv, b_inv, lam0):
     lo, hi = 0.0, 1.0
     last_step = 1.0
     rn = 0.0
-    for _ in range(MAX_ITERATIONS):
+    iterations = 0
+    while iterations < MAX_ITERATIONS:
+        iterations += 1
         for i in range(d):
             for j in range(d):
                 y[i, j] = lam * b_inv[i, j] + (1.0 - lam) * a_inv[i, j]
@@ -192,18 +205,21 @@ def pw_contact(r_ab, a_inv, b_inv, lam0):
             hi = lam
         else:
             break
-        tol = 4.0 * _EPS * min(lam, 1.0 - lam)
+        tol = 4.0 * _EPS * lam
         new = lam - fp / fpp if fpp < 0.0 else -1.0
-        if lo < new < hi and abs(new - lam) <= 0.5 * last_step:
-            if abs(new - lam) <= tol:
-                break
-        else:
+        step = abs(new - lam)
+        if step <= tol:
+            break
+        if lo < new < hi and step >= 0.5 * last_step and last_step <= _NOISE * lam:
+            break  # round-off in f' stops Newton from converging further: lambda is as exact as f' allows
+        if not (lo < new < hi and step < 0.5 * last_step):
             if hi - lo <= tol:
                 break
             new = 0.5 * (lo + hi)
-        last_step = abs(new - lam)
+            step = abs(new - lam)
+        last_step = step
         lam = new
-    return lam * (1.0 - lam) * rn - 1.0, lam, n
+    return lam * (1.0 - lam) * rn - 1.0, lam, n, iterations
 
 
 @numba.njit(cache=True)
