@@ -61,3 +61,23 @@ def test_lattice_command_refuses_bad_repetitions(tmp_path, capsys):
         main(["lattice", "--name", "fcc", "--reps", "1.5", "--out", str(out)])
     assert "invalid int value: '1.5'" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_init_ellipses_scale_the_semiaxes_by_the_size_distribution(tmp_path):
+    """Binary ellipses (Donev 2006, Sec. 5.2): one third 1.4 times larger, shape 1 : 1.5."""
+    out = tmp_path / "e.nc"
+    spec = json.dumps({"kind": "bidisperse", "size_ratio": 1.4, "large_fraction": 1 / 3})
+    assert main(["init", "--n", "60", "--d", "2", "--phi", "0.3", "--distribution", spec,
+                 "--semiaxes", "1", "1.5", "--seed", "3", "--out", str(out)]) == 0
+    p = load_packing(out)
+    assert p.shape.kind == "ellipsoid" and p.phi == pytest.approx(0.3)
+    assert sorted(set(np.round(p.shape.semiaxes[:, 0], 12))) == [1.0, 1.4]
+    assert np.allclose(p.shape.semiaxes[:, 1] / p.shape.semiaxes[:, 0], 1.5)
+    assert (p.shape.semiaxes[:, 0] == 1.4).sum() == 20
+    assert load_dataset(out).attrs["semiaxes"].tolist() == [1.0, 1.5]
+
+
+def test_init_refuses_semiaxes_of_the_wrong_dimension(tmp_path, capsys):
+    assert main(["init", "--n", "5", "--d", "3", "--phi", "0.1", "--semiaxes", "1", "2",
+                 "--seed", "1", "--out", str(tmp_path / "e.nc")]) != 0
+    assert "--semiaxes needs d = 3 numbers" in capsys.readouterr().err

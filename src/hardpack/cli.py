@@ -43,17 +43,26 @@ def _key_value(text: str):
 def cmd_init(args) -> int:
     """Random sequential addition start configuration, written as a packing netCDF."""
     from hardpack.distributions import from_spec
-    from hardpack.initial import random_packing
+    from hardpack.initial import random_ellipsoid_packing, random_packing
     from hardpack.io import save_packing
 
     dist = from_spec(args.distribution)
-    packing = random_packing(args.n, args.d, dist, args.phi, args.seed)
     attrs = dict(args.attr or [])
+    config = {"n": args.n, "d": args.d, "phi": args.phi, "distribution": args.distribution, "seed": args.seed}
+    if args.semiaxes is None:
+        packing = random_packing(args.n, args.d, dist, args.phi, args.seed)
+    else:
+        if len(args.semiaxes) != args.d:
+            raise InvalidInputError(f"--semiaxes needs d = {args.d} numbers, one per body axis; got {args.semiaxes}")
+        sizes = dist.sample(args.n, np.random.default_rng(args.seed))
+        semiaxes = np.outer(sizes / sizes.min(), args.semiaxes)  # the smallest particle has --semiaxes
+        packing = random_ellipsoid_packing(args.n, semiaxes, args.phi, args.seed)
+        attrs["semiaxes"] = list(args.semiaxes)
+        config["semiaxes"] = list(args.semiaxes)
     attrs.update(
         seed=args.seed, distribution=args.distribution["kind"],
         distribution_params=args.distribution, init_phi=args.phi, protocol="rsa",
     )
-    config = {"n": args.n, "d": args.d, "phi": args.phi, "distribution": args.distribution, "seed": args.seed}
     save_packing(packing, args.out, attrs=attrs, config=config)
     logging.info("wrote %s: %r", args.out, packing)
     return 0
@@ -141,6 +150,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--phi", type=float, required=True, help="initial volume fraction (below RSA saturation)")
     p.add_argument("--distribution", type=_json_arg, default={"kind": "monodisperse"},
                    help='size distribution as JSON, e.g. \'{"kind": "uniform_volume", "omega": 4}\'')
+    p.add_argument("--semiaxes", type=float, nargs="+",
+                   help="ellipses (d = 2) or ellipsoids (d = 3) instead of spheres: the body-frame "
+                        "semiaxes of the smallest particle, the others scaled by the size distribution; "
+                        "random orientations")
     p.add_argument("--seed", type=int, required=True, help="random seed")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",
