@@ -19,6 +19,7 @@ include: "workflow/rules/ls.smk"            # LS figures: size distributions, ph
 include: "workflow/rules/slp.smk"           # SLP order map and diluted MRJ summaries, SLP figures
 include: "workflow/rules/freeenergy.smk"    # BCMD free energies of FCC and of LS packings
 include: "workflow/rules/polydisperse.smk"  # polydisperse vs bi- and tridisperse equivalents
+include: "workflow/rules/ellipsoids.smk"     # hard ellipsoids and ellipses: contacts, figures after Figs. 5.1-5.3
 include: "workflow/rules/glass.smk"         # binary hard-disk glasses: EOS, fits, SOC free energies, s_c
 include: "workflow/rules/validation.smk"    # validation report and gate
 

@@ -45,6 +45,7 @@ RATES = config.get("rates")
 FREEENERGY = config.get("freeenergy")
 POLY = config.get("polydisperse", {})
 GLASS = config.get("glass")
+ELLIPSOIDS = config.get("ellipsoids")
 VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
 
@@ -104,7 +105,15 @@ def check_config():
             raise ValueError("config: glass.x_large -+ glass.composition.dx must stay in (0, 1)")
 
 
+def check_ellipsoids():
+    """The M&M system names one of the ellipsoid families."""
+    if ELLIPSOIDS and "mm" in ELLIPSOIDS and ELLIPSOIDS["mm"]["family"] not in ELLIPSOIDS["families"]:
+        raise ValueError(f"config: ellipsoids.mm.family {ELLIPSOIDS['mm']['family']!r} is not one of "
+                         f"ellipsoids.families {sorted(ELLIPSOIDS['families'])}")
+
+
 check_config()
+check_ellipsoids()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -116,6 +125,8 @@ check_config()
 #   slp_densest    SLP from N = 3^d starts (Table II), names d{d}
 #   slp_order_map  starts n{N}, one SLP run per setting s{k} (Fig. 6)
 #   slp_diluted    diluted-MRJ rounds from an ensemble's SLP MRJ packings (Sec. VI)
+#   ellipsoids     LS packings of ellipsoids {family}_a{alpha} and binary ellipses ellipses_a{alpha}
+#                  (Donev 2006, Sec. 5.2): init -> jammed (+ timeseries) -> contacts
 
 def slp_flags(settings):
     """The `hardpack slp` options of one (alpha, bounds) setting."""
@@ -179,12 +190,60 @@ def _systems():
             ens["N"], ens["d"], SLP_DILUTED["seeds"], start=f"results/slp_mrj/{name}/slp/seed{{seed}}.nc",
             rounds=SLP_DILUTED["rounds"], slp=slp_flags(SLP_MRJ),
             dilute=f"--fraction {SLP_DILUTED['fraction']} --rounds {SLP_DILUTED['rounds']}")
+    systems["ellipsoids"] = _ellipsoid_systems()
     return systems
+
+
+def _ellipsoid_shapes():
+    """(family, beta, alpha) of every 3D ellipsoid system: semiaxes 1 : alpha^beta : alpha."""
+    shapes = [(family, beta, alpha) for family, beta in ELLIPSOIDS["families"].items()
+              for alpha in ELLIPSOIDS["alphas"]]
+    if "mm" in ELLIPSOIDS:
+        family = ELLIPSOIDS["mm"]["family"]
+        shapes.append((family, ELLIPSOIDS["families"][family], ELLIPSOIDS["mm"]["alpha"]))
+    return list(dict.fromkeys(shapes))
+
+
+def _ellipsoid_systems():
+    if not ELLIPSOIDS:
+        return {}
+    e = ELLIPSOIDS
+    compress = (f"--growth-rate {e['growth_rate']} --final-growth-rate {e['final_growth_rate']}"
+                f" --switch-pressure {e['switch_pressure']} --max-pressure {e['max_pressure']}")
+    systems = {}
+    for family, beta, alpha in _ellipsoid_shapes():
+        systems[f"{family}_a{alpha:g}"] = _system(
+            e["N"], 3, e["seeds"], e["init_phi"], attrs={"family": family, "beta": beta, "alpha": alpha},
+            semiaxes=[1.0, alpha**beta, alpha], compress=compress)
+    ell = e.get("ellipses")
+    for alpha in ell["alphas"] if ell else []:
+        sizes = {"kind": "bidisperse", "size_ratio": ell["size_ratio"], "large_fraction": ell["large_fraction"]}
+        systems[f"ellipses_a{alpha:g}"] = _system(
+            ell["N"], 2, ell["seeds"], e["init_phi"], sizes, attrs={"family": "ellipses", "beta": 1.0, "alpha": alpha},
+            semiaxes=[1.0, alpha], compress=compress)
+    return systems
+
+
+def ellipsoid_files(dim, step):
+    """Per-seed files of every ellipsoid (dim 3) or ellipse (dim 2) system."""
+    return [path for name, spec in SYSTEMS["ellipsoids"].items() if spec["d"] == dim
+            for path in seed_files("ellipsoids", name, step)]
+
+
+def mm_system():
+    """The name of the M&M-shaped ellipsoid system (Donev 2006, Fig. 5.1)."""
+    return f"{ELLIPSOIDS['mm']['family']}_a{ELLIPSOIDS['mm']['alpha']:g}"
+
+
+def init_shape(wildcards):
+    """`hardpack init --semiaxes` of an ellipsoid system (empty for spheres)."""
+    semiaxes = system(wildcards).get("semiaxes")
+    return "--semiaxes " + " ".join(f"{a:.17g}" for a in semiaxes) if semiaxes else ""
 
 
 SYSTEMS = _systems()
 #: the packing step each study's verdicts judge
-PACKED = {"ls": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted": "slp"}
+PACKED = {"ls": "jammed", "ellipsoids": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted": "slp"}
 
 
 def system(wildcards):
@@ -408,6 +467,11 @@ JAMMING_VARIABLES = ("z_mean", "rattler_fraction", "isostaticity_gap", "local", 
                      "fallback_uniform_forces_lp_failed", "ellipse_slope")
 
 
+#: per-packing numbers of the ellipsoid contact analysis (workflow/scripts/ellipsoid_contacts.py)
+ELLIPSOID_VARIABLES = ("z_mean", "z_all", "rattler_fraction", "nematic_S", "pressure", "phi_J_est",
+                       "collisions", "wall_time")
+
+
 def _combined(inputs, index, variables=(), attrs=None):
     options = [f"--index {' '.join(index)}", *(f"--variable {v}" for v in variables), attr_options(attrs or {})]
     return {"inputs": inputs, "options": " ".join(o for o in options if o)}
@@ -445,6 +509,10 @@ def _combined_summaries():
             simplex_files(ensemble), ["seed", "frozen"],
             ["exact", "bcmd", "rel_diff", "isostatic", "isostaticity_gap", "n_backbone", "dim", "n_events",
              "seconds_bcmd", "next_gap"])
+    for dim in (2, 3):
+        files = ellipsoid_files(dim, "contacts")
+        if files:
+            table[f"ellipsoids/contacts{dim}d"] = _combined(files, ["beta", "alpha", "seed"], ELLIPSOID_VARIABLES)
     return table
 
 
@@ -503,6 +571,9 @@ def figures():
     names += ["phij_vs_omega"] if POLY_PROTOCOLS["phij"].get("widths") else []
     names += ["crystallisation_vs_omega"] if POLY_PROTOCOLS["crystallisation"].get("widths", {}).get("uniform_size") else []
     names += ["eos_vs_bmcsl"] if POLY_FLUID.get("widths") else []
+    names += ["ellipsoid_jamming"] if any(s["d"] == 3 for s in SYSTEMS["ellipsoids"].values()) else []
+    names += ["ellipse_jamming"] if any(s["d"] == 2 for s in SYSTEMS["ellipsoids"].values()) else []
+    names += ["ellipsoid_snapshot"] if ELLIPSOIDS and "mm" in ELLIPSOIDS else []
     names += ["glass_eos", "glass_entropy"] if GLASS else []
     return [f"results/figures/{name}.pdf" for name in names]
 
@@ -535,6 +606,9 @@ def validation_inputs():
     poly = [summary(key) for key in EOS_SUMMARIES]
     if poly:
         inputs["polydisperse"] = poly
+    ellipsoids = [summary(key) for key in COMBINED if key.startswith("ellipsoids/")]
+    if ellipsoids:
+        inputs["ellipsoids"] = ellipsoids
     return inputs
 
 
@@ -569,6 +643,8 @@ MD_DIMENSION_COST = {2: 0.6, 3: 1.0, 4: 2.6, 5: 4.7, 6: 6.2}
 SLP_MINUTES_PER_N2 = 1.6e-5  # SLP to convergence, 3D: 1.6 min at N = 500, 6-24 min at N = 1000
 #: SLP cost against 3D at the same N (2D N = 500: 12 s; 4D N = 250: 1.5 min; 5D N = 243: 6 min; 6D N = 250: 25 min)
 SLP_DIMENSION_COST = {2: 0.05, 3: 1.0, 4: 1.5, 5: 6.5, 6: 25.0}
+#: cost of an LS compression of ellipsoids against spheres at the same N, d and growth rate
+ELLIPSOID_MD_COST = 10.0
 #: rules that never take long: they run as one cluster job per group (--group-components in the
 #: slurm profile), with these expected minutes
 TINY_MINUTES = 0.3
@@ -599,7 +675,8 @@ def _slowest_rate(spec):
 
 #: expected minutes of one job of each rule (rules not listed are TINY_MINUTES)
 EXPECTED_MINUTES = {
-    "compress": lambda w: md_minutes(system(w)["N"], system(w)["d"], _slowest_rate(system(w))),
+    "compress": lambda w: md_minutes(system(w)["N"], system(w)["d"], _slowest_rate(system(w)))
+    * (ELLIPSOID_MD_COST if "semiaxes" in system(w) else 1.0),
     "poly_jam": lambda w: md_minutes(poly_protocol(w)["N"], 3, poly_protocol(w)["final_growth_rate"]),
     "slp": lambda w: slp_minutes(system(w)["N"], system(w)["d"]),
     "slp_dilute": lambda w: system(w)["rounds"] * slp_minutes(system(w)["N"], system(w)["d"]),

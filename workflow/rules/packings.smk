@@ -4,7 +4,8 @@
 
 
 rule init:
-    """Random sequential addition start configuration of one system and seed."""
+    """Random sequential addition start configuration of one system and seed (spheres, or ellipsoids
+    with the system's semiaxes)."""
     output:
         "results/{study}/{name}/init/seed{seed}.nc",
     params:
@@ -13,8 +14,9 @@ rule init:
         phi=lambda w: system(w)["init_phi"],
         distribution=lambda w: json.dumps(system(w)["distribution"]),
         attrs=lambda w: attr_options(system(w)["attrs"]),
+        shape=init_shape,
     wildcard_constraints:
-        study="ls|slp_mrj|slp_densest|slp_order_map",
+        study="ls|slp_mrj|slp_densest|slp_order_map|ellipsoids",
     threads: 1
     resources:
         mem_mb=job_mem_mb("init"),
@@ -29,13 +31,14 @@ rule init:
         "results/benchmarks/init/{study}/{name}/seed{seed}.tsv"
     shell:
         "hardpack init --n {params.n} --d {params.d} --phi {params.phi}"
-        " --distribution '{params.distribution}' --seed {wildcards.seed} {params.attrs}"
+        " --distribution '{params.distribution}' {params.shape} --seed {wildcards.seed} {params.attrs}"
         " --out {output} > {log} 2>&1"
 
 
 rule compress:
     """LS compression of one start configuration to the system's reduced pressure: the LS ensembles'
-    two-stage protocol (with contact forces), or one growth rate of the rate scan."""
+    two-stage protocol (with contact forces), one growth rate of the rate scan, or the ellipsoid
+    study's two-stage protocol."""
     input:
         start_packing,
     output:
@@ -45,7 +48,7 @@ rule compress:
         options=lambda w: system(w)["compress"],
         checkpoint=checkpoint_beside,
     wildcard_constraints:
-        study="ls|ls_rates",
+        study="ls|ls_rates|ellipsoids",
     threads: 1
     resources:
         mem_mb=job_mem_mb("compress"),

@@ -1,0 +1,101 @@
+# Hard ellipsoids and ellipses (Donev 2006, Sec. 5.2): the contacts of the LS packings (the init
+# and compress jobs are the generic ones of packings.smk) and the figures after Figs. 5.1-5.3.
+
+
+rule ellipsoid_contacts:
+    """Contacts within contact_tol of touching, rattlers removed iteratively, mean contact number
+    and nematic order of one jammed ellipsoid or ellipse packing."""
+    input:
+        "results/ellipsoids/{name}/jammed/seed{seed}.nc",
+    output:
+        "results/ellipsoids/{name}/contacts/seed{seed}.nc",
+    params:
+        tol=lambda w: ELLIPSOIDS["contact_tol"],
+        attrs=lambda w: SYSTEMS["ellipsoids"][w.name]["attrs"],
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("ellipsoid_contacts"),
+        runtime=job_runtime("ellipsoid_contacts"),
+    group:
+        "analyses"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/ellipsoid_contacts/{name}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/ellipsoid_contacts/{name}/seed{seed}.tsv"
+    script:
+        "../scripts/ellipsoid_contacts.py"
+
+
+rule fig_ellipsoid_jamming:
+    """phi_J and Z vs aspect ratio of every ellipsoid family (after Donev 2006, Fig. 5.2)."""
+    input:
+        summary("ellipsoids/contacts3d"),
+    output:
+        pdf="results/figures/ellipsoid_jamming.pdf",
+        png=report("results/figures/ellipsoid_jamming.png", caption="../report/ellipsoid_jamming.rst", category="6 ellipsoids"),
+    params:
+        dim=3,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_ellipsoid_jamming"),
+        runtime=job_runtime("fig_ellipsoid_jamming"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_ellipsoid_jamming.log",
+    benchmark:
+        "results/benchmarks/fig_ellipsoid_jamming.tsv"
+    script:
+        "../scripts/plot_ellipsoid_jamming.py"
+
+
+rule fig_ellipse_jamming:
+    """phi_J and Z vs aspect ratio of the binary ellipses (after Donev 2006, Fig. 5.3)."""
+    input:
+        summary("ellipsoids/contacts2d"),
+    output:
+        pdf="results/figures/ellipse_jamming.pdf",
+        png=report("results/figures/ellipse_jamming.png", caption="../report/ellipsoid_jamming.rst", category="6 ellipsoids"),
+    params:
+        dim=2,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_ellipse_jamming"),
+        runtime=job_runtime("fig_ellipse_jamming"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_ellipse_jamming.log",
+    benchmark:
+        "results/benchmarks/fig_ellipse_jamming.tsv"
+    script:
+        "../scripts/plot_ellipsoid_jamming.py"
+
+
+rule fig_ellipsoid_snapshot:
+    """A jammed packing of M&M-shaped oblate spheroids (after Donev 2006, Fig. 5.1)."""
+    input:
+        lambda w: seed_files("ellipsoids", mm_system(), "jammed")[0],
+    output:
+        pdf="results/figures/ellipsoid_snapshot.pdf",
+        png=report("results/figures/ellipsoid_snapshot.png", caption="../report/ellipsoid_snapshot.rst", category="6 ellipsoids"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_ellipsoid_snapshot"),
+        runtime=job_runtime("fig_ellipsoid_snapshot"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_ellipsoid_snapshot.log",
+    benchmark:
+        "results/benchmarks/fig_ellipsoid_snapshot.tsv"
+    script:
+        "../scripts/plot_ellipsoid_snapshot.py"
