@@ -6,8 +6,9 @@
   (Donev 2006, Sec. 1.4.3) on known rotations; every refused input.
 - Boundaries: spheres in hard walls and in a spherical container (containment, phi over the
   container, no images across walls, fractional coordinates, tiling); every refused lattice.
-- Ellipsoid overlaps and containment are decided exactly by their bounding spheres or raise
-  NotImplementedError (the ellipsoid contact function is not implemented).
+- Ellipsoid overlaps by the Perram-Wertheim contact function on exact cases (parallel ellipsoids,
+  spheres as ellipsoids), hard walls by the ellipsoid's extent; a spherical container by the
+  bounding spheres or NotImplementedError (the containment potential is not implemented).
 - The netCDF store: shapes and boundaries round trip bit for bit, files of format 1 (written by
   the code before particle shapes, tests/data) load as spheres in a periodic cell, damaged or
   newer files are refused.
@@ -177,32 +178,84 @@ def test_radii_of_ellipsoids_are_refused_and_replace_keeps_the_shape():
     assert np.array_equal(big.shape.orientations[p.n_particles:2 * p.n_particles], p.shape.orientations)
 
 
-# ---------------------------------------------------------------- ellipsoid overlaps: bounding spheres or refusal
-def test_ellipsoids_with_disjoint_bounding_spheres_are_accepted_others_not_decided():
-    p = sparse_ellipsoids()
-    assert p.overlap_report().n_overlapping == 0
-    x = p.positions.copy()
-    x[1] = x[0] + [p.shape.bounding_radii[0] + p.shape.bounding_radii[1] - 0.01, 0, 0]
-    with pytest.raises(NotImplementedError, match="ellipsoid contact function .* Donev 2006, Sec. 2.2.2"):
-        p.replace(positions=x)
-    assert p.replace(positions=x, allow_overlap=True).n_particles == p.n_particles
-    # a pair that meets only through a periodic image is found too
-    x = p.positions.copy()
-    x[1] = x[0] + [p.lattice[0, 0] - (p.shape.bounding_radii[0] + p.shape.bounding_radii[1]) + 0.01, 0, 0]
-    with pytest.raises(NotImplementedError, match=r"1 pair\(s\) of hard ellipsoids"):
-        p.replace(positions=x)
+# ---------------------------------------------------------------- ellipsoid overlaps: Perram-Wertheim
+def needles(distance, direction, d=3, box=10.0, **kwargs):
+    """Two parallel ellipsoids with semiaxes (1, 0.5, 0.5) at ``distance`` along ``direction``: they
+    touch at distance 2 along x and 1 along y, and mu = distance / contact distance exactly."""
+    axes = [[1.0, 0.5, 0.5][:d]] * 2
+    orient = [[1, 0, 0, 0]] * 2 if d == 3 else [0.0, 0.0]
+    x0 = np.full(d, 3.0)
+    return Packing([x0, x0 + distance * np.asarray(direction, dtype=float)], lattice=box * np.eye(d),
+                   shape=Ellipsoids(axes, orient), **kwargs)
 
 
-def test_ellipsoid_containment_is_decided_by_bounding_spheres_or_not_at_all():
+@pytest.mark.parametrize("d", [2, 3])
+def test_ellipsoid_overlaps_are_decided_by_the_contact_function(d):
+    x, y = np.eye(d)[0], np.eye(d)[1]
+    # side by side: the bounding spheres (radius 1) overlap, the ellipsoids do not
+    side = needles(1.2, y, d)
+    assert side.overlap_report().n_overlapping == 0
+    assert side.overlap_report().overlap == pytest.approx(1 - 1.2, rel=1e-13)
+    assert needles(2 * (1 + 1e-6), x, d).overlap_report().worst_i == -1  # bounding spheres disjoint
+    assert needles(2 * (1 - 1e-10), x, d).overlap_report().overlap == pytest.approx(1e-10, rel=1e-4)
+    with pytest.raises(InvalidInputError, match=r"1 overlapping pair\(s\); worst: particles 0 and 1 .* by 1\.000e-06"):
+        needles(2 * (1 - 1e-6), x, d)
+    with pytest.raises(InvalidInputError, match=r"particles 0 and 1 .* by 1\.000e-01"):
+        needles(0.9, y, d)
+    # within the tolerance: accepted
+    assert needles(1 - 1e-10, y, d).overlap_report().overlap == pytest.approx(1e-10, rel=1e-4)
+    # a pair that meets only through a periodic image is found and named with its image
+    across = needles(1.2, y, d, allow_overlap=True)
+    positions = across.positions.copy()
+    positions[:, 1] = [0.3, 9.4]
+    with pytest.raises(InvalidInputError, match=r"particles 0 and 1 \(image \(0, -1.* by 1\.000e-01"):
+        across.replace(positions=positions, allow_overlap=False)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_the_ellipsoid_overlap_of_spheres_is_the_sphere_overlap(d):
+    """Ellipsoids with equal semiaxes give the sphere check's worst pair and relative overlap."""
+    rng = np.random.default_rng(7)
+    n = 40
+    radii = rng.uniform(0.3, 0.6, n)
+    x = rng.uniform(0, 5.0, (n, d))
+    orient = random_quaternions(n, rng) if d == 3 else rng.uniform(-np.pi, np.pi, n)
+    spheres = Packing(x, radii, 5.0 * np.eye(d), allow_overlap=True)
+    balls = Packing(x, lattice=5.0 * np.eye(d), shape=Ellipsoids(np.repeat(radii[:, None], d, 1), orient),
+                    allow_overlap=True)
+    a, b = spheres.overlap_report(), balls.overlap_report()
+    assert (a.n_overlapping, a.worst_i, a.worst_j, a.shift) == (b.n_overlapping, b.worst_i, b.worst_j, b.shift)
+    assert a.n_overlapping > 5 and b.overlap == pytest.approx(a.overlap, rel=1e-13)
+
+
+def test_ellipsoids_between_hard_walls_are_checked_by_their_extent_along_the_wall_normal():
+    """An ellipsoid reaches sqrt(e_k^T X^-1 e_k) along axis k (Donev 2006, Sec. 2.2.5.1)."""
+    walls = HardWalls((0, 1, 2))
+    along_x = Ellipsoids([[1.0, 0.5, 0.5], [1.0, 0.5, 0.5]], [[1, 0, 0, 0]] * 2)
+    quarter = math.sqrt(0.5)
+    along_y = Ellipsoids([[1.0, 0.5, 0.5], [1.0, 0.5, 0.5]], [[quarter, 0, 0, quarter]] * 2)
+    with pytest.raises(InvalidInputError, match="particle 0 crosses the wall x_0 = 0 by 4.000e-01"):
+        Packing([[0.6, 2, 2], [5, 5, 5]], lattice=8 * np.eye(3), shape=along_x, boundary=walls)
+    turned = Packing([[0.6, 2, 2], [5, 5, 5]], lattice=8 * np.eye(3), shape=along_y, boundary=walls)
+    assert turned.containment_report().overlap == pytest.approx(1 - 0.6 / 0.5, rel=1e-12)
+    with pytest.raises(InvalidInputError, match="particle 1 crosses the wall x_1 = 8 by 1.000e-01"):
+        turned.replace(positions=[[0.6, 2, 2], [5, 7.1, 5]])
+    # 2D, turned by 45 degrees: extent sqrt((a^2 + b^2) / 2) along both axes
+    tilted = Ellipsoids([[2.0, 1.0]], [math.pi / 4])
+    reach = math.sqrt(2.5)
+    ok = Packing([[reach * (1 + 1e-12), 4.0]], lattice=8 * np.eye(2), shape=tilted, boundary=HardWalls(0))
+    assert ok.containment_report().overlap == pytest.approx(0, abs=1e-11)
+    with pytest.raises(InvalidInputError, match="crosses the wall x_0 = 0"):
+        ok.replace(positions=[[reach * (1 - 1e-6), 4.0]])
+
+
+def test_ellipsoids_in_a_spherical_container_are_decided_by_bounding_spheres_or_not_at_all():
     shape = Ellipsoids([[1.0, 0.5, 0.5], [1.0, 0.5, 0.5]], [[1, 0, 0, 0]] * 2)
-    inside = Packing([[2, 2, 2], [5, 5, 5]], lattice=8 * np.eye(3), shape=shape, boundary=HardWalls((0, 1, 2)))
+    inside = Packing([[4, 4, 4], [4, 4, 6]], lattice=8 * np.eye(3), shape=shape,
+                     boundary=SphericalContainer((4, 4, 4), 3.2))
     assert inside.containment_report().n_outside == 0
-    # x = 0.6: the bounding sphere crosses the wall x = 0, the ellipsoid (semiaxis 1 along x) too
-    with pytest.raises(NotImplementedError, match="bounding spheres of 1 .* ellipsoid contact function"):
-        inside.replace(positions=[[0.6, 2, 2], [5, 5, 5]])
-    with pytest.raises(NotImplementedError, match="ellipsoid contact function"):
-        Packing([[4, 4, 4], [4, 4, 6.5]], lattice=8 * np.eye(3), shape=shape,
-                boundary=SphericalContainer((4, 4, 4), 3.2))
+    with pytest.raises(NotImplementedError, match=r"containment potential .* \(Donev 2006, Sec. 2\.2\.2\.2\)"):
+        inside.replace(positions=[[4, 4, 4], [4, 4, 6.5]])
 
 
 # ---------------------------------------------------------------- hard walls
@@ -320,6 +373,7 @@ def _same(p, q):
 def test_ellipsoids_walls_and_containers_round_trip(tmp_path, d):
     cases = [sparse_ellipsoids(d=d)]
     cases.append(sparse_ellipsoids(d=d, walls=HardWalls([0])))
+    cases.append(needles(1.2, np.eye(d)[1], d))  # bounding spheres overlap: decided on loading too
     box = 10 * np.eye(d)
     cases.append(Packing(np.full((1, d), 5.0), [0.5], box, boundary=SphericalContainer(np.full(d, 5.0), 5.0)))
     cases.append(Packing(np.full((1, d), 5.0), [0.5], box, boundary=HardWalls(range(d)), species=[3]))

@@ -46,3 +46,64 @@ def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed:
     positions = random_sequential_addition(radii, box, rng, max_trials)
     species = distribution.species_of(radii) if isinstance(distribution, Discrete) else None
     return Packing(positions, radii, np.diag(box), species=species)
+
+
+def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=None,
+                             max_trials: int = 100_000) -> Packing:
+    """Seeded RSA packing of ``n`` ellipsoids (or ellipses) with random orientations at volume fraction ``phi``.
+
+    The particles are placed largest bounding radius first (a stable sort, so equal particles keep
+    their order) at uniformly random positions and orientations by
+    :func:`hardpack.geometry.ellipsoid_rsa.ellipsoid_rsa` (Perram-Wertheim overlap test, Donev 2006,
+    Sec. 2.2.2), in a periodic box whose size gives ``phi``. The result depends only on the arguments.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles, >= 1.
+    semiaxes : array_like, shape (d,) or (n, d), d = 2 or 3
+        Body-frame semiaxes of every particle (one row for all, or one per particle).
+    phi : float
+        Volume fraction in (0, 1); RSA saturates well below jamming, so keep it low (e.g. <= 0.3).
+    seed : int
+        Seed of ``numpy.random.default_rng``.
+    box_shape : sequence of d floats, optional
+        Relative box lengths (default a cube).
+    max_trials : int, default 100000
+        Trials per particle before giving up.
+
+    Returns
+    -------
+    Packing
+        Ellipsoids in a periodic orthorhombic cell, checked for overlaps by the packing model.
+
+    Raises
+    ------
+    InvalidInputError
+        For a bad n, semiaxes, phi, seed or box shape, or when RSA cannot place a particle.
+    """
+    from hardpack.geometry.ellipsoid_rsa import ellipsoid_rsa
+    from hardpack.geometry.shapes import ELLIPSOID_DIMS, Ellipsoids, as_finite_array
+
+    if isinstance(n, bool) or int(n) != n or n < 1:
+        raise InvalidInputError(f"n must be a positive integer, got {n!r}")
+    n = int(n)
+    axes = as_finite_array("semiaxes", semiaxes, "(d,) or (n, d)")
+    if axes.ndim == 1:
+        axes = np.tile(axes, (n, 1))
+    if axes.ndim != 2 or axes.shape[0] != n or axes.shape[1] not in ELLIPSOID_DIMS or not (axes > 0).all():
+        raise InvalidInputError(f"semiaxes must be positive, of shape (d,) or ({n}, d) with d in {ELLIPSOID_DIMS}, "
+                                f"got {np.shape(semiaxes)}")
+    d = axes.shape[1]
+    if not (np.isfinite(phi) and 0 < phi < 1):
+        raise InvalidInputError(f"phi must be in (0, 1), got {phi!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    shape = np.ones(d) if box_shape is None else np.asarray(box_shape, float)
+    if shape.shape != (d,) or not (np.isfinite(shape).all() and (shape > 0).all()):
+        raise InvalidInputError(f"box_shape must be {d} positive numbers, got {box_shape!r}")
+    axes = axes[np.argsort(-axes.max(axis=1), kind="stable")]
+    volume = Ellipsoids(axes, np.zeros(n) if d == 2 else np.tile([1.0, 0, 0, 0], (n, 1))).volumes(d).sum()
+    box = shape * (volume / (phi * np.prod(shape))) ** (1.0 / d)
+    positions, orientations = ellipsoid_rsa(axes, box, np.random.default_rng(seed), max_trials)
+    return Packing(positions, lattice=np.diag(box), shape=Ellipsoids(axes, orientations))

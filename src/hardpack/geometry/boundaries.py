@@ -159,13 +159,16 @@ class HardWalls:
         return float(abs(np.linalg.det(lattice)))
 
     def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
-        """Relative overlap 1 - h / r of every sphere with its nearest wall (h = centre-wall distance)."""
+        """Relative overlap 1 - h / r of every particle with its worst wall (h = centre-wall distance;
+        r the radius (N,), or the particle's extent along each axis (N, d), e.g. of an ellipsoid)."""
         axes = list(self.axes)
         x = positions[:, axes]
         length = np.diag(lattice)[axes]
         h = np.concatenate([x, length - x], axis=1)  # distance to the wall at 0, then at L, per axis
-        nearest = np.argmin(h, axis=1)
-        overlap = 1.0 - h[np.arange(len(h)), nearest] / radii
+        reach = radii[:, None] if radii.ndim == 1 else np.tile(radii[:, axes], 2)
+        rel = 1.0 - h / reach
+        nearest = np.argmax(rel, axis=1)
+        overlap = rel[np.arange(len(h)), nearest]
         names = [f"the wall x_{k} = 0" for k in axes] + [f"the wall x_{k} = {v:.6g}" for k, v in zip(axes, length)]
         return _report(overlap, lambda i: names[nearest[i]], tol)
 

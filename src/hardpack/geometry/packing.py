@@ -25,10 +25,14 @@ and a wall when its centre is closer than r (1 - tol) to the wall. The default r
 and far below any physical gap that matters (LS packings at reduced pressure 1e12 have relative
 gaps of ~1e-12 that round-off may turn into overlaps of ~1e-14).
 
-Ellipsoids are checked exactly only as far as their bounding spheres decide: particles whose
-bounding spheres are disjoint (or inside the walls) do not overlap (or cross a wall). Any other
-case needs the ellipsoid contact function (Perram-Wertheim overlap and containment potentials,
-Donev 2006, Sec. 2.2.2 and 2.2.5.1) and raises :class:`NotImplementedError` until it exists.
+Ellipsoids overlap when their Perram-Wertheim scale factor mu = sqrt(zeta + 1) (Donev 2006,
+Sec. 2.2.2.1; :mod:`hardpack.geometry.contact`) is below 1 - tol: the relative overlap 1 - mu is
+the sphere's 1 - distance / (r_i + r_j) for equal semiaxes. Candidate pairs are those whose bounding
+spheres overlap (:mod:`hardpack.geometry.ellipsoid_pairs`). An ellipsoid crosses a hard wall when
+its centre is closer to the wall than (1 - tol) times its extent sqrt(e_k^T X^-1 e_k) along the
+wall normal e_k (the distance of the tangent plane, Donev 2006, Sec. 2.2.5.1). Ellipsoids in a
+spherical container are decided by their bounding spheres only; any other case needs the
+containment potential (Donev 2006, Sec. 2.2.2.2) and raises :class:`NotImplementedError`.
 """
 
 from __future__ import annotations
@@ -50,10 +54,9 @@ from hardpack.geometry.shapes import Ellipsoids, Spheres, as_finite_array
 DEFAULT_OVERLAP_TOL = 1e-9
 MIN_DIM, MAX_DIM = 1, 12
 SHAPES = (Spheres, Ellipsoids)
-PENDING_ELLIPSOID_CONTACT = (
-    "needs the ellipsoid contact function (Perram-Wertheim overlap and containment potentials, "
-    "Donev 2006, Sec. 2.2.2 and 2.2.5.1), which is not implemented yet: it comes with hard-ellipsoid "
-    "support"
+PENDING_ELLIPSOID_CONTAINMENT = (
+    "needs the containment potential of an ellipsoid in a sphere (Donev 2006, Sec. 2.2.2.2), which is "
+    "not implemented yet"
 )
 
 
@@ -143,8 +146,8 @@ class Packing:
         does not fit the lattice; overlap_tol is outside [0, 1); or, unless ``allow_overlap``,
         particles overlap or cross the boundary beyond ``overlap_tol``.
     NotImplementedError
-        Unless ``allow_overlap``, when ellipsoids' bounding spheres overlap or cross the boundary
-        (the ellipsoid contact function is not implemented yet).
+        Unless ``allow_overlap``, when the bounding spheres of ellipsoids cross a spherical
+        container (the containment potential is not implemented yet).
     """
 
     positions: np.ndarray
@@ -363,30 +366,25 @@ class Packing:
 
     # ------------------------------------------------------------------ overlaps
     def overlap_report(self, tol: float = DEFAULT_OVERLAP_TOL) -> OverlapReport:
-        """Count pairs with distance < (r_i + r_j)(1 - tol), with every periodic image.
+        """Count pairs with relative overlap 1 - mu > tol, with every periodic image.
 
-        The worst pair (largest relative overlap 1 - dist/(r_i + r_j)) is named even when it
-        is within tolerance, so callers can report how close the packing is to touching.
-        Ellipsoids: a packing whose bounding spheres are disjoint has no overlaps; any other
-        raises NotImplementedError (the ellipsoid contact function is pending).
+        Spheres: mu = distance / (r_i + r_j). Ellipsoids: mu = sqrt(zeta + 1) of the Perram-Wertheim
+        potential (module docstring) of the pairs whose bounding spheres overlap. The worst pair
+        (largest relative overlap) is named even when it is within tolerance, so callers can report
+        how close the packing is to touching.
         """
         from hardpack.geometry.neighbours import pairs_within
 
-        pairs = pairs_within(self, rel_gap=0.0)  # bounding spheres, images along periodic axes only
-        if self.shape.kind != "sphere":
-            undecided = np.flatnonzero(pairs.distance < pairs.contact)
-            if len(undecided):
-                k = undecided[0]
-                raise NotImplementedError(
-                    f"{len(undecided)} pair(s) of {self.shape.name} have overlapping bounding spheres "
-                    f"(e.g. particles {pairs.i[k]} and {pairs.j[k]}); deciding whether they overlap "
-                    f"{PENDING_ELLIPSOID_CONTACT}. Only {self.shape.name} with disjoint bounding spheres "
-                    "can be checked now; Packing(..., allow_overlap=True) skips the check"
-                )
-            return OverlapReport(0, -1, -1, (), float("-inf"))
+        if self.shape.kind == "sphere":
+            pairs = pairs_within(self, rel_gap=0.0)  # images along periodic axes only
+            rel = 1.0 - pairs.distance / pairs.contact
+        else:
+            from hardpack.geometry.ellipsoid_pairs import potential_pairs
+
+            near = potential_pairs(self, rel_gap=0.0)
+            pairs, rel = near.pairs, 1.0 - near.mu
         if len(pairs.i) == 0:
             return OverlapReport(0, -1, -1, (), float("-inf"))
-        rel = 1.0 - pairs.distance / pairs.contact
         k = int(np.argmax(rel))
         return OverlapReport(
             n_overlapping=int((rel > tol).sum()),
@@ -400,17 +398,24 @@ class Packing:
         """Count particles crossing a hard wall or the container by more than ``tol`` of their
         radius (see :mod:`hardpack.geometry.boundaries`); the worst particle is named.
 
-        Ellipsoids: a packing whose bounding spheres are inside has none; any other raises
-        NotImplementedError (the ellipsoid contact function is pending).
+        Ellipsoids: against hard walls, by their extent along each wall normal (module docstring);
+        in a spherical container, a packing whose bounding spheres are inside has none and any
+        other raises NotImplementedError (the containment potential is pending).
         """
         if self.shape.kind == "sphere":
             return self.boundary.containment(self.positions, self.shape.radii, self.lattice, tol)
+        if self.boundary.kind == "hard_walls":
+            from hardpack.geometry.contact import inverse_shapes
+
+            inv = inverse_shapes(self.shape.semiaxes, self.shape.orientations.reshape(self.n_particles, -1))
+            extents = np.sqrt(np.einsum("nkk->nk", inv))  # sqrt(e_k^T X^-1 e_k), Donev 2006, Sec. 2.2.5.1
+            return self.boundary.containment(self.positions, extents, self.lattice, tol)
         report = self.boundary.containment(self.positions, self.shape.bounding_radii, self.lattice, 0.0)
         if report.n_outside:
             raise NotImplementedError(
                 f"the bounding spheres of {report.n_outside} of the {self.shape.name} cross the boundary "
                 f"(e.g. particle {report.worst} and {report.wall}); deciding whether the particles cross it "
-                f"{PENDING_ELLIPSOID_CONTACT}. Packing(..., allow_overlap=True) skips the check"
+                f"{PENDING_ELLIPSOID_CONTAINMENT}. Packing(..., allow_overlap=True) skips the check"
             )
         return ContainmentReport(0, -1, "every bounding sphere is inside", float("-inf"))
 
