@@ -56,40 +56,10 @@ def check_ellipsoid_packing(packing: Packing) -> None:
                                 "cells only; this lattice is sheared: pass a diagonal lattice")
     if packing.n_particles < 2:
         raise InvalidInputError("MD needs at least 2 particles")
-    report = ellipsoid_overlaps(packing)
-    if report["n_overlapping"]:
+    report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
+    if report.n_overlapping:
         raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
                                 "hard-particle MD needs a non-overlapping start")
-
-
-def ellipsoid_overlaps(packing: Packing, tol: float = DEFAULT_OVERLAP_TOL) -> dict:
-    """Overlap check of an ellipsoid packing with the Perram-Wertheim potential
-    (:func:`hardpack.geometry.contact.pw_contact`) over every pair (all periodic images) whose
-    bounding spheres overlap: relative overlap 1 - mu with mu = sqrt(1 + zeta) the common scaling
-    to tangency (1 - r / (a_i + a_j) for spheres). Returns ``n_overlapping`` (pairs above ``tol``),
-    the ``worst`` relative overlap and its pair."""
-    from hardpack.geometry.contact import pw_contact, shape_inverse
-    from hardpack.geometry.neighbours import pairs_within
-
-    shape = packing.shape
-    pairs = pairs_within(packing, rel_gap=0.0)
-    worst, wi, wj, count = -np.inf, -1, -1, 0
-    d = packing.dim
-    orient = shape.orientations.reshape(packing.n_particles, -1)
-    xa, xb = np.empty((d, d)), np.empty((d, d))
-    close = np.flatnonzero(np.asarray(pairs.distance) < np.asarray(pairs.contact))
-    shifts = np.asarray(pairs.shift, dtype=float) @ np.asarray(packing.lattice).T
-    for k in close:
-        i, j = int(pairs.i[k]), int(pairs.j[k])
-        r = packing.positions[j] + shifts[k] - packing.positions[i]
-        shape_inverse(np.ascontiguousarray(shape.semiaxes[i]), np.ascontiguousarray(orient[i]), xa)
-        shape_inverse(np.ascontiguousarray(shape.semiaxes[j]), np.ascontiguousarray(orient[j]), xb)
-        zeta, _, _ = pw_contact(np.ascontiguousarray(r), xa, xb, 0.5)
-        ov = 1.0 - math.sqrt(max(1.0 + zeta, 0.0))
-        if ov > worst:
-            worst, wi, wj = ov, i, j
-        count += ov > tol
-    return {"n_overlapping": int(count), "worst": float(worst), "worst_pair": (wi, wj)}
 
 
 def random_angular_velocities(n: int, d: int, inertia: np.ndarray, seed) -> np.ndarray:
@@ -133,8 +103,9 @@ class EllipsoidSimulation(Simulation):
         return inv
 
     def packing(self) -> Packing:
-        """The current configuration in the caller's order, centres wrapped into the box; the
-        overlap check is :func:`ellipsoid_overlaps` (done by the callers)."""
+        """The current configuration in the caller's order, centres wrapped into the box, not
+        checked for overlaps (callers check it with :meth:`Packing.overlap_report`, the
+        Perram-Wertheim potential)."""
         inv = self._inverse()
         eng = self.engine
         pos = eng.positions[inv]
@@ -326,9 +297,10 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
                 last_ckpt = time.perf_counter()
 
     final = sim.packing()
-    report = ellipsoid_overlaps(final, overlap_tol)
-    if report["n_overlapping"]:
-        raise OverlapError(f"the final ellipsoid packing has overlaps: {report}")
+    report = final.overlap_report(overlap_tol)
+    if report.n_overlapping:
+        raise OverlapError(f"the final ellipsoid packing has overlaps beyond {overlap_tol:g}: {report}")
+    final = final.replace(allow_overlap=False)
     last = {k: (sim.records[k][-1] if sim.records[k] else float("nan")) for k in ("Z", "phi_J_est")}
     stats = {
         "protocol": "lubachevsky_stillinger" if final_growth_rate is None
@@ -339,7 +311,7 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
         "events": int(sim.events), "windows": int(sim.windows), "md_time": float(sim.time),
         "wall_time": float(sim.wall_time), "window_collisions_per_particle": stage_window(growth_rate),
         "overlap_tol": overlap_tol, "eps_f": float(eps_f),
-        "max_overlap": float(report["worst"]), "n_overlapping": int(report["n_overlapping"]),
+        "max_overlap": float(report.overlap), "n_overlapping": int(report.n_overlapping),
         "overlap_check": "passed", "mass": 1.0, "kT": 1.0,
         "moment_of_inertia": "spherically symmetric: (2/15)(a^2+b^2+c^2) in 3D, (a^2+b^2)/4 in 2D",
     }

@@ -120,7 +120,8 @@ class EllipsoidEngine(Engine):
                    rebuild: bool = False, log=None) -> WindowResult:
         """Run one window from a synchronisation point and synchronise at its end (as
         :meth:`hardpack.md.engine.Engine.run_window`; ``log`` is not supported). ``checks``
-        (CHECK events) is stored in :attr:`last_checks`."""
+        (CHECK events) and contact-function evaluations are stored in :attr:`last_checks` and
+        :attr:`last_evaluations`."""
         if log is not None:
             raise NotImplementedError("collision logging (contact forces) is not implemented for ellipsoids")
         if not rebuild and self.lists_valid:
@@ -138,7 +139,7 @@ class EllipsoidEngine(Engine):
             if kappa < 0.0:
                 cap = min(cap, 0.5 / -kappa)
             self.cnt[:] = 0
-            acc = np.array([0.0, 0.0, 0.0, self.totals()[0], 0.0])
+            acc = np.array([0.0, 0.0, 0.0, self.totals()[0], 0.0, 0.0])
             iacc = np.zeros(ek.N_COUNTERS, dtype=np.int64)
             status = WindowStatus(ek.run_events(
                 self.P, self.box, kappa, self.eps_f, eff_skin, self.sfac, self.imgvec, self.lvl,
@@ -165,6 +166,7 @@ class EllipsoidEngine(Engine):
         ek.synchronise(self.P, duration, kappa)
         worst, n_over = ek.max_overlap(self.P, self.imgvec, self.nb, self.nn)
         self.last_checks = int(iacc[ek.I_CHECK])
+        self.last_evaluations = int(acc[ek.A_EVAL])
         return WindowResult(
             duration=duration, virial=float(acc[1]), ke_integral=float(acc[2]),
             ke_end=self.totals()[0], collisions=int(iacc[0]), events=int(iacc[1]),

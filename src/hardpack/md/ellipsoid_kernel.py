@@ -40,10 +40,12 @@ the overlap interval [t_in, t_out] of the two growing bounding spheres comes fro
 quadratic as a sphere collision (:func:`hardpack.events.roots.contact_root` for t_in, the other
 root for t_out). On it, trace event location: steps [t0, t0 + h] with zeta and zeta_dot at both
 ends define a cubic Hermite interpolant, whose error is estimated at the midpoint,
-e = |H(1/2) - zeta(t0 + h/2)|. A step is accepted when e <= eps_F and the interpolant's minimum
-over the step stays above 2 e (so no dip below zero hides between the samples unless the
-interpolant errs by more than twice its estimated error); otherwise h is halved (the midpoint
-becomes the new end). The first sample with zeta <= 0 brackets the collision, which a safeguarded
+e = |H(1/2) - zeta(t0 + h/2)|. A step is accepted when e <= max(eps_F, RELATIVE_TOL m) and
+m > 2 e, with m the interpolant's minimum over the step (so no dip below zero hides between the
+samples unless the interpolant errs by more than twice its estimated error; far from contact,
+where m is large, the steps may err by a tenth of m, which keeps them long without any risk of
+missing the zero); otherwise h is halved (the midpoint becomes the new end). The next step is
+h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= 0 brackets the collision, which a safeguarded
 Newton iteration (bisection when a Newton step leaves the bracket) locates to round-off; the
 earlier end of the final bracket (zeta >= 0, no overlap) is returned. If zeta <= 0 at t_in: a
 collision now when zeta_dot < 0; otherwise (round-off after a collision of the pair) zeta is
@@ -51,7 +53,10 @@ taken as 0 and traced on (Algorithm 11 step d). After MAX_TRACE_STEPS accepted s
 stops with a CHECK event at the time reached: the particle re-predicts from there (a "safe time",
 Algorithm 11 step e). Steps shorter than ``MIN_STEP_FRACTION`` of the first one are accepted
 unconditionally, so every trace advances. The neighbours are traced in the order of their t_in and
-the search stops at the first t_in after the earliest event found.
+the search stops at the first t_in after the earliest event found. The horizon of every trace
+is also capped by the first contact time of the inscribed spheres (radius the smallest semiaxis)
+of any listed pair: the particle collides by then at the latest (if no collision is located
+before it, which round-off alone could cause, a CHECK is scheduled there).
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
 here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
@@ -87,9 +92,13 @@ CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
 #: extra counter (after the sphere engine's): CHECK events
 I_CHECK = 5
 N_COUNTERS = 6
+#: extra accumulator: contact-function evaluations
+A_EVAL = 5
 
 #: default tolerance on the Hermite interpolation error of zeta (Donev 2006, sec. 3.5.1: 1e-4..1e-3)
 EPS_F = 1e-4
+#: far from contact a step may also err by this fraction of the interpolant's minimum
+RELATIVE_TOL = 0.1
 #: accepted trace steps before a CHECK event (Donev 2006, Algorithm 11: 100-250)
 MAX_TRACE_STEPS = 200
 #: steps shorter than this fraction of the first step of a trace are accepted unconditionally
@@ -177,7 +186,7 @@ def _pose(P, i, t, kappa, shift, x, xinv, o, ax):
 def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     """(zeta, zeta_dot, lambda) of particles i and j (j shifted by ``shift``) at window time t.
 
-    ``ws`` (10, 4) (row 8 zeros) and ``wm`` (2, d, d) are scratch arrays; on return ws[0, :d],
+    ``ws`` (11, 4) (row 8 zeros, ws[10, 0] counts the evaluations) and ``wm`` (2, d, d) are scratch arrays; on return ws[0, :d],
     ws[1, :d] hold the centres, ws[4, :d] the contact point, ws[5, :d] the normal n and wm[0],
     wm[1] the inverse shape matrices."""
     d = shift.shape[0]
@@ -190,6 +199,7 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     for k in range(d):
         r[k] = xb[k] - xa[k]
     zeta, lam, n = pw_contact(r, wm[0], wm[1], lam0)
+    ws[10, 0] += 1.0
     contact_point(xa, wm[0], lam, n, rc)
     for k in range(d):
         ws[5, k] = n[k]
@@ -245,7 +255,9 @@ def _hermite_min(z0, z1, d0, d1):
 @njit(cache=True)
 def _refine(P, i, j, shift, t, kappa, lo, hi, guess, lam, ws, wm):
     """Collision time in the bracket [lo, hi] (zeta(lo) >= 0 >= zeta(hi)) by safeguarded Newton
-    from ``guess``; returns the earlier end of the final bracket (no overlap)."""
+    from ``guess`` (bisection when a step leaves the bracket); ends at a time with zeta >= 0 whose
+    Newton step is below round-off of the time, or at the earlier end of a bracket narrowed to
+    round-off (no overlap either way)."""
     tt = guess if lo < guess < hi else 0.5 * (lo + hi)
     for _ in range(100):
         z, zd, lam = pair_zeta(P, i, j, shift, t + tt, kappa, lam, ws, wm)
@@ -253,9 +265,11 @@ def _refine(P, i, j, shift, t, kappa, lo, hi, guess, lam, ws, wm):
             lo = tt
         else:
             hi = tt
+        nt = tt - z / zd if zd != 0.0 else -1.0
+        if z >= 0.0 and abs(nt - tt) <= 4e-16 * (t + tt):
+            return tt
         if hi - lo <= 4e-16 * (t + hi) + 1e-300:
             break
-        nt = tt - z / zd if zd != 0.0 else -1.0
         if not (lo < nt < hi):
             nt = 0.5 * (lo + hi)
         if nt == tt:
@@ -319,7 +333,8 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
                                t0 + 0.5 * h * (1.0 + min(root, 1.0)), lamm, ws, wm) + t, 0
             err = abs(0.5 * (z0 + z1) + 0.125 * h * (d0 - d1) - zm)
             hmin, root = _hermite_min(z0, z1, d0 * h, d1 * h)
-            if (err <= eps_f and hmin > 2.0 * err) or h <= hmin_step:
+            tol = max(eps_f, RELATIVE_TOL * hmin)
+            if (err <= tol and hmin > 2.0 * err) or h <= hmin_step:
                 break
             # halve: the midpoint becomes the end
             h *= 0.5
@@ -329,7 +344,7 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
         t0 = t1
         z0, d0, lam = z1, d1, lam1
         if err > 0.0:
-            fac = 0.8 * (max(min(eps_f, 0.5 * hmin), 0.0) / err) ** 0.25
+            fac = 0.8 * (max(min(tol, 0.5 * hmin), 0.0) / err) ** 0.25
             h *= min(max(fac, 0.5), 4.0)
         else:
             h *= 4.0
@@ -489,7 +504,7 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
     particle index (Algorithm 5 with NNLs; pairs by :func:`predict_pair` in the order of their
     bounding-sphere contact times)."""
     d = bs.shape[1] - 1
-    cv, ct, cr, _, _, _, _, _ = columns(d)
+    cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 2 * d
     cmask = (1 << cbits) - 1
     dt = t - P[i, ct]
@@ -507,6 +522,10 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
     best = exit_root(dd, dv, vv, bs[i, d] - ri * grow, ri * kappa)
     partner = EXIT if best < np.inf else NONE
     best += t
+    horizon = best  # no collision of i is later than the first contact of inscribed spheres
+    amin_i = P[i, cax]
+    for k in range(1, d):
+        amin_i = min(amin_i, P[i, cax + k])
     m_n = nn[i]
     for m in range(m_n):  # bounding-sphere overlap intervals
         e = nb[i, m]
@@ -530,9 +549,15 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
         c = rr - sig0 * sig0
         # start of the overlap interval: now if the bounding spheres overlap already (the sphere
         # root would skip a separating pair), else their first contact
-        tin = 0.0 if c <= 0.0 else contact_root(rr, ru, uu, sig0, g, best - t)
+        tin = 0.0 if c <= 0.0 else contact_root(rr, ru, uu, sig0, g, horizon - t)
         tins[m] = tin
         done[m] = 0
+        if tin < np.inf:
+            amin_j = P[j, cax]
+            for k in range(1, d):
+                amin_j = min(amin_j, P[j, cax + k])
+            s_in = amin_i + amin_j
+            horizon = min(horizon, t + contact_root(rr, ru, uu, s_in * grow, s_in * kappa, horizon - t))
         if tin < np.inf:
             if a <= 0.0:
                 touts[m] = np.inf
@@ -551,7 +576,7 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
             if done[m] == 0 and tins[m] < tq:
                 tq = tins[m]
                 q = m
-        if q < 0 or t + tq >= best:
+        if q < 0 or t + tq >= min(best, horizon):
             break
         done[q] = 1
         e = nb[i, q]
@@ -559,10 +584,13 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
         im = e & cmask
         for k in range(d):
             sh[k] = imgvec[im, k]
-        tc, kind = predict_pair(P, i, j, sh, t, best, tq, touts[q], kappa, eps_f, ws, wm)
+        tc, kind = predict_pair(P, i, j, sh, t, min(best, horizon), tq, touts[q], kappa, eps_f, ws, wm)
         if tc < best:
             best = tc
             partner = j if kind == 0 else CHECK
+    if horizon < best:  # the inscribed spheres of a pair touch, yet no collision was located
+        best = horizon
+        partner = CHECK
     return best, partner
 
 
@@ -638,7 +666,20 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     """One window of ellipsoid MD; arguments, accumulators and return codes as in
     :func:`hardpack.md.kernel.run_events` (no ``dims``: d is the length of ``L``; ``eps_f`` the
     trace tolerance; ``iacc`` has N_COUNTERS entries, the last counting CHECK events; acc[A_KE]
-    enters the current translational kinetic energy)."""
+    enters the current translational kinetic energy; ``acc`` has a sixth entry, A_EVAL, that
+    receives the number of contact-function evaluations)."""
+    ws = np.zeros((11, 4))
+    status = _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
+                  slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
+                  coll_target, t_cap, rebuild_lists, ws)
+    acc[A_EVAL] = ws[10, 0]
+    return status
+
+
+@njit(cache=True)
+def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
+         slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
+         coll_target, t_cap, rebuild_lists, ws):
     d = L.shape[0]
     n = P.shape[0]
     cap = nb.shape[1]
@@ -650,7 +691,6 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     tins = np.empty(cap)
     touts = np.empty(cap)
     done = np.empty(cap, dtype=np.int8)
-    ws = np.zeros((10, 4))
     wm = np.empty((2, d, d))
     scratch = np.empty(4)
     upd = np.empty(2, dtype=np.int64)
@@ -789,7 +829,7 @@ def max_overlap(P, imgvec, nb, nn):
     the number of pairs with a positive one. Every touching pair is listed."""
     d = imgvec.shape[1]
     cbits = 2 * d
-    ws = np.zeros((10, 4))
+    ws = np.zeros((11, 4))
     wm = np.empty((2, d, d))
     worst = -np.inf
     count = 0
