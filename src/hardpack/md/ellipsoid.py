@@ -137,19 +137,16 @@ class EllipsoidCompressResult:
     stats: dict = field(default_factory=dict)
 
     def to_dataset(self) -> xr.Dataset:
-        """The final packing as a Dataset (:func:`hardpack.io.store.packing_dataset`) with the
-        stats as attributes and the velocities as extra variables."""
-        from hardpack.io.store import packing_dataset
+        """The final packing as a Dataset (:func:`hardpack.io.store.packing_to_dataset`) with the
+        stats as attributes and the final velocities and angular velocities as variables."""
+        from hardpack.io.store import packing_to_dataset
 
-        ds = packing_dataset(self.packing)
-        d = self.packing.dim
-        ds["velocity"] = (("particle", "dim"), self.velocities)
-        if d == 2:
-            ds["angular_velocity"] = (("particle",), self.angular_velocities)
+        extra = {"velocity": (("particle", "dim"), self.velocities)}
+        if self.packing.dim == 2:
+            extra["angular_velocity"] = (("particle",), self.angular_velocities)
         else:
-            ds["angular_velocity"] = (("particle", "component3"), self.angular_velocities)
-        ds.attrs.update({k: v for k, v in self.stats.items() if v is not None})
-        return ds
+            extra["angular_velocity"] = (("particle", "rotation_axis"), self.angular_velocities)
+        return packing_to_dataset(self.packing, attrs=self.stats, extra=extra)
 
     def save(self, packing_path, timeseries_path=None, config=None):
         """Write the packing (stats as attributes) and optionally the time series."""
