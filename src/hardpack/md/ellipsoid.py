@@ -1,0 +1,322 @@
+"""Lubachevsky-Stillinger compression of hard ellipsoids (3D) and ellipses (2D).
+
+Event-driven MD with rotation and growing semiaxes (Donev 2006, dissertation sec. 3.5; kernels and
+physics in :mod:`hardpack.md.ellipsoid_kernel`), run window by window exactly as the sphere
+compression (:mod:`hardpack.md.compress`): velocities (translational and angular) rescaled to
+kT = 1 at every synchronisation of a growing run, the reduced pressure of each window from the
+collision virial, stop criteria (:class:`hardpack.md.StopCriteria`), checkpoint/resume bit for bit
+and progress lines.
+
+Conventions: masses 1, spherically symmetric moments of inertia
+(:func:`hardpack.md.ellipsoid_engine.moments_of_inertia`), kT = 2 (KE_trans + KE_rot) /
+((d + d_rot) N) with d_rot = 3 in 3D and 1 in 2D. Every semiaxis grows at one relative rate,
+a(t) = a(0) (1 + kappa t); the growth rate Gamma = d<D>/dt / sqrt(kT/m) has the sphere engine's
+meaning with D the diameter of the volume-equivalent sphere, D = 2 (prod_k a_k)^(1/d), so
+kappa = Gamma / (2 <(prod a)^(1/d)>) and spheres run exactly as in the sphere engine.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
+from hardpack.geometry.shapes import Ellipsoids
+from hardpack.io import checkpoint as ckpt
+from hardpack.io import interrupt
+from hardpack.md.compress import StopCriteria, _check_final_stage, _stop_reason, default_window, \
+    timeseries_dataset
+from hardpack.md.ellipsoid_engine import EllipsoidEngine, rotational_dof
+from hardpack.md.ellipsoid_kernel import EPS_F
+from hardpack.md.simulation import RECORD_FIELDS, SHELL_START, SORT_EVERY, OverlapError, Simulation, \
+    maxwell_boltzmann
+
+log = logging.getLogger("hardpack.md")
+
+
+def check_ellipsoid_packing(packing: Packing) -> None:
+    """Refuse packings the ellipsoid engine cannot run (other shapes or boundaries, sheared
+    cells, fewer than 2 particles, boxes too small, overlaps)."""
+    if not isinstance(packing, Packing):
+        raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
+    if packing.shape.kind != "ellipsoid":
+        raise InvalidInputError(f"the ellipsoid MD engine runs ellipsoids or ellipses; this packing "
+                                f"holds {packing.shape.name} (use hardpack.md.compress for spheres)")
+    if packing.boundary.kind != "periodic":
+        raise InvalidInputError("the ellipsoid MD engine needs a periodic cell (hard walls and "
+                                "containers are not implemented for it)")
+    if not packing.is_orthorhombic:
+        raise InvalidInputError("the ellipsoid MD engine supports orthorhombic (diagonal) periodic "
+                                "cells only; this lattice is sheared: pass a diagonal lattice")
+    if packing.n_particles < 2:
+        raise InvalidInputError("MD needs at least 2 particles")
+    report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
+    if report.n_overlapping:
+        raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
+                                "hard-particle MD needs a non-overlapping start")
+
+
+def random_angular_velocities(n: int, d: int, inertia: np.ndarray, seed) -> np.ndarray:
+    """Maxwell-Boltzmann angular velocities at kT = 1 (omega_k ~ N(0, 1/I)), zero total angular
+    momentum not enforced (a periodic box does not conserve it); (n, 3) in 3D, (n,) in 2D."""
+    rng = np.random.default_rng(seed)
+    w = rng.standard_normal((n, rotational_dof(d))) / np.sqrt(inertia)[:, None]
+    return w[:, 0] if d == 2 else w
+
+
+class EllipsoidSimulation(Simulation):
+    """State of one ellipsoid run (the sphere :class:`hardpack.md.simulation.Simulation` with the
+    ellipsoid engine, its temperature and its packing)."""
+
+    def __init__(self, packing: Packing, velocities: np.ndarray, angular_velocities: np.ndarray,
+                 growth_rate: float, overlap_tol: float = DEFAULT_OVERLAP_TOL, eps_f: float = EPS_F):
+        self.lattice = np.array(packing.lattice)
+        self.species = packing.species
+        self.box = np.diag(self.lattice).copy()
+        self.n, self.d = packing.n_particles, packing.dim
+        self.growth_rate = float(growth_rate)
+        self.overlap_tol = float(overlap_tol)
+        self.perm = np.arange(self.n)
+        shape = packing.shape
+        self.engine = EllipsoidEngine(packing.fractional() * self.box, velocities, shape.semiaxes,
+                                      shape.orientations, angular_velocities, self.box, eps_f=eps_f)
+        self.time = 0.0
+        self.collisions = 0
+        self.events = 0
+        self.windows = 0
+        self.shell = SHELL_START
+        self.since_sort = SORT_EVERY
+        self.wall_time = 0.0
+        self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
+        self.contacts = None
+        self._log = None
+
+    def _inverse(self) -> np.ndarray:
+        inv = np.empty(self.n, dtype=np.int64)
+        inv[self.perm] = np.arange(self.n)
+        return inv
+
+    def packing(self) -> Packing:
+        """The current configuration in the caller's order, centres wrapped into the box, not
+        checked for overlaps (callers check it with :meth:`Packing.overlap_report`, the
+        Perram-Wertheim potential)."""
+        inv = self._inverse()
+        eng = self.engine
+        pos = eng.positions[inv]
+        pos = pos - np.floor(pos / self.box) * self.box
+        pos[pos >= self.box] = 0.0
+        shape = Ellipsoids(eng.semiaxes[inv].copy(), eng.orientations[inv].copy())
+        return Packing(pos, lattice=self.lattice, species=self.species, shape=shape,
+                       overlap_tol=self.overlap_tol, allow_overlap=True)
+
+    def angular_velocities(self) -> np.ndarray:
+        return self.engine.angular_velocities[self._inverse()].copy()
+
+    def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
+        """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the full
+        (translational and rotational) kinetic temperature at the end of the window."""
+        record = super().run_window(coll_target, target_phi)
+        return record
+
+
+@dataclass
+class EllipsoidCompressResult:
+    """Final ellipsoid packing, final velocities and angular velocities (m = 1, kT = 1), the
+    per-window time series and the run stats."""
+
+    packing: Packing
+    velocities: np.ndarray
+    angular_velocities: np.ndarray
+    timeseries: xr.Dataset
+    stats: dict = field(default_factory=dict)
+
+    def to_dataset(self) -> xr.Dataset:
+        """The final packing as a Dataset (:func:`hardpack.io.store.packing_to_dataset`) with the
+        stats as attributes and the final velocities and angular velocities as variables."""
+        from hardpack.io.store import packing_to_dataset
+
+        extra = {"velocity": (("particle", "dim"), self.velocities)}
+        if self.packing.dim == 2:
+            extra["angular_velocity"] = (("particle",), self.angular_velocities)
+        else:
+            extra["angular_velocity"] = (("particle", "rotation_axis"), self.angular_velocities)
+        return packing_to_dataset(self.packing, attrs=self.stats, extra=extra)
+
+    def save(self, packing_path, timeseries_path=None, config=None):
+        """Write the packing (stats as attributes) and optionally the time series."""
+        from hardpack.io import save_packing, write_dataset
+
+        save_packing(self.packing, packing_path, attrs=self.stats, config=config, seed=self.stats.get("seed"))
+        if timeseries_path is not None:
+            write_dataset(self.timeseries, timeseries_path, config=config, seed=self.stats.get("seed"))
+
+
+def _fingerprint(packing: Packing, **params) -> str:
+    shape = packing.shape
+    return ckpt.fingerprint(_FingerprintView(packing.positions, shape.semiaxes, shape.orientations,
+                                             packing.lattice), **params)
+
+
+@dataclass
+class _FingerprintView:
+    """What :func:`hardpack.io.checkpoint.fingerprint` hashes (positions, radii, lattice): the
+    semiaxes and orientations stand in for the radii."""
+
+    positions: np.ndarray
+    semiaxes: np.ndarray
+    orientations: np.ndarray
+    lattice: np.ndarray
+
+    @property
+    def radii(self) -> np.ndarray:
+        return np.concatenate([self.semiaxes.ravel(), np.asarray(self.orientations, dtype=float).ravel()])
+
+
+def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria | None = None,
+                        checkpoint=None, progress=None, *, window: float | None = None,
+                        checkpoint_interval: float = 300.0, progress_interval: float = 10.0,
+                        overlap_tol: float = DEFAULT_OVERLAP_TOL, final_growth_rate: float | None = None,
+                        switch_pressure: float = 1e3, eps_f: float = EPS_F,
+                        keep_checkpoint: bool = False) -> EllipsoidCompressResult:
+    """LS compression of an ellipsoid or ellipse packing (module docstring); the arguments mean
+    what they mean for :func:`hardpack.md.compress` (no contact forces).
+
+    Parameters
+    ----------
+    packing : Packing
+        Periodic, orthorhombic, N >= 2 ellipsoids (3D) or ellipses (2D) without overlaps.
+    growth_rate : float
+        Gamma (module docstring), finite.
+    seed : int
+        Non-negative seed of the Maxwell-Boltzmann velocities and angular velocities.
+    stop : StopCriteria, optional
+        Default: reduced pressure 1e12.
+    checkpoint : path, optional
+        Resumable checkpoint, written every ``checkpoint_interval`` seconds at points where the
+        continuation is bit-identical, and on SIGINT / SIGTERM.
+    progress : callable, optional
+        Receives each window's record.
+    window : float, optional
+        Collisions per particle between synchronisations (default :func:`default_window`).
+    checkpoint_interval, progress_interval : float
+        Seconds between checkpoints and between progress log lines.
+    overlap_tol : float
+        Relative overlap tolerance (1 - mu) checked at every synchronisation and at the end.
+    final_growth_rate, switch_pressure : float
+        Slow final stage from the first window with Z >= switch_pressure on.
+    eps_f : float
+        Tolerance on the Hermite interpolation error of the trace event location (default 1e-4,
+        Donev 2006, sec. 3.5.1).
+    keep_checkpoint : bool
+        Leave the checkpoint for the caller to remove.
+
+    Returns
+    -------
+    EllipsoidCompressResult
+
+    Raises
+    ------
+    InvalidInputError
+        Invalid packing or parameters (as :func:`hardpack.md.compress`).
+    OverlapError
+        Overlap beyond ``overlap_tol`` at a synchronisation point or at the end.
+    """
+    check_ellipsoid_packing(packing)
+    if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(growth_rate):
+        raise InvalidInputError(f"growth_rate must be a finite number, got {growth_rate!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    if not (math.isfinite(eps_f) and 0 < eps_f < 1):
+        raise InvalidInputError(f"eps_f must be in (0, 1), got {eps_f!r}")
+    stop = StopCriteria() if stop is None else stop
+    stop.check(float(growth_rate), packing.phi)
+    _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)
+    if window is not None and not (math.isfinite(window) and window > 0):
+        raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
+    n, d = packing.n_particles, packing.dim
+
+    def stage_window(rate: float) -> float:
+        return default_window(rate, d) if window is None else float(window)
+
+    from hardpack.md.ellipsoid_engine import moments_of_inertia
+
+    seeds = np.random.SeedSequence(seed).spawn(2)
+    inertia = moments_of_inertia(packing.shape.semiaxes)
+    sim = EllipsoidSimulation(packing, maxwell_boltzmann(n, d, seeds[0]),
+                              random_angular_velocities(n, d, inertia, seeds[1]), growth_rate,
+                              overlap_tol=overlap_tol, eps_f=eps_f)
+    sim.engine.rescale_velocities(1.0)
+    fp = _fingerprint(packing, growth_rate=float(growth_rate), seed=int(seed), window=window,
+                      overlap_tol=overlap_tol, final_growth_rate=final_growth_rate, eps_f=float(eps_f),
+                      switch_pressure=float(switch_pressure) if final_growth_rate else None,
+                      kind="ellipsoid")
+    state = None if checkpoint is None else ckpt.load(checkpoint, fp)
+    if state is not None:
+        sim.restore(state)
+    started = time.perf_counter()
+    last_ckpt = last_log = started
+    last_coll = sim.collisions
+    with interrupt.deferred():
+        if state is not None:
+            log.info("resumed from %s at window %d (%d collisions)", checkpoint, sim.windows, sim.collisions)
+        while (reason := _stop_reason(stop, sim, started)) is None:
+            budget = max(1, round(stage_window(sim.growth_rate) * n))
+            if stop.max_collisions is not None:
+                budget = min(budget, int(stop.max_collisions) - sim.collisions)
+            record = sim.run_window(budget, stop.target_phi)
+            if final_growth_rate is not None and sim.growth_rate != final_growth_rate \
+                    and record["Z"] >= switch_pressure:
+                sim.growth_rate = float(final_growth_rate)
+                log.info("Z=%.4g >= %.4g after %d collisions: growth rate now %g", record["Z"],
+                         switch_pressure, sim.collisions, final_growth_rate)
+            if progress is not None:
+                progress(record)
+            now = time.perf_counter()
+            if now - last_log >= progress_interval:
+                log.info("ellipsoids: phi=%.6f Z=%.4g collisions=%d (%.3g /s)", record["phi"],
+                         record["Z"], sim.collisions, (sim.collisions - last_coll) / (now - last_log))
+                last_log, last_coll = now, sim.collisions
+            if interrupt.requested() is not None and (checkpoint is None or sim.checkpoint_ready):
+                if checkpoint is not None:
+                    ckpt.save(checkpoint, fp, sim.state())
+                raise interrupt.stop(checkpoint, f"phi = {record['phi']:.6f}, Z = {record['Z']:.4g}, "
+                                                 f"{sim.collisions} collisions")
+            if checkpoint is not None and now - last_ckpt >= checkpoint_interval \
+                    and sim.checkpoint_ready and _stop_reason(stop, sim, started) is None:
+                ckpt.save(checkpoint, fp, sim.state())
+                last_ckpt = time.perf_counter()
+
+    final = sim.packing()
+    report = final.overlap_report(overlap_tol)
+    if report.n_overlapping:
+        raise OverlapError(f"the final ellipsoid packing has overlaps beyond {overlap_tol:g}: {report}")
+    final = final.replace(allow_overlap=False)
+    last = {k: (sim.records[k][-1] if sim.records[k] else float("nan")) for k in ("Z", "phi_J_est")}
+    stats = {
+        "protocol": "lubachevsky_stillinger" if final_growth_rate is None
+        else "lubachevsky_stillinger_two_stage",
+        "shape_kind": "ellipsoid", "growth_rate": float(growth_rate), "seed": int(seed),
+        "stop_reason": reason, "Z": float(last["Z"]), "phi": float(final.phi),
+        "phi_J_est": float(last["phi_J_est"]), "collisions": int(sim.collisions),
+        "events": int(sim.events), "windows": int(sim.windows), "md_time": float(sim.time),
+        "wall_time": float(sim.wall_time), "window_collisions_per_particle": stage_window(growth_rate),
+        "overlap_tol": overlap_tol, "eps_f": float(eps_f),
+        "max_overlap": float(report.overlap), "n_overlapping": int(report.n_overlapping),
+        "overlap_check": "passed", "mass": 1.0, "kT": 1.0,
+        "moment_of_inertia": "spherically symmetric: (2/15)(a^2+b^2+c^2) in 3D, (a^2+b^2)/4 in 2D",
+    }
+    if final_growth_rate is not None:
+        stats.update({"final_growth_rate": float(final_growth_rate), "switch_pressure": float(switch_pressure)})
+    ts_attrs = {k: stats[k] for k in ("growth_rate", "seed", "stop_reason", "final_growth_rate",
+                                      "switch_pressure") if k in stats}
+    ts = timeseries_dataset(sim, ts_attrs | {"N": n, "d": d, "shape_kind": "ellipsoid"})
+    if checkpoint is not None and not keep_checkpoint:
+        ckpt.remove(checkpoint)
+    return EllipsoidCompressResult(final, sim.velocities(), sim.angular_velocities(), ts, stats)

@@ -1,0 +1,184 @@
+"""One ellipsoid (3D) or ellipse (2D) MD system in numba arrays, run window by window.
+
+The window logic (neighbour-list persistence, spatial sorts, capacity doubling and redo of a
+window after an overflow, bounding-radius caps, grid levels) is the sphere engine's
+(:class:`hardpack.md.engine.Engine`), which this class extends: the bounding radius of a particle
+(its largest semiaxis) plays the sphere radius there, so ``radii`` are bounding radii. The kernels
+are :mod:`hardpack.md.ellipsoid_kernel`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hardpack.md import ellipsoid_kernel as ek
+from hardpack.md.engine import SKIN_SLACK, Engine, WindowResult, _aligned_rows
+from hardpack.md.kernel import WindowStatus
+
+
+def moments_of_inertia(semiaxes: np.ndarray) -> np.ndarray:
+    """Spherically symmetric moment of inertia of unit-mass ellipsoids (N, 3) or ellipses (N, 2):
+    (2/15)(a^2 + b^2 + c^2), the mean principal moment (exact for spheres), or (a^2 + b^2)/4
+    (module docstring of :mod:`hardpack.md.ellipsoid_kernel`)."""
+    sq = np.einsum("ij,ij->i", semiaxes, semiaxes)
+    return sq / 4.0 if semiaxes.shape[1] == 2 else 2.0 * sq / 15.0
+
+
+def rotational_dof(d: int) -> int:
+    """Rotational degrees of freedom of one particle: 1 in 2D, 3 in 3D."""
+    return 1 if d == 2 else 3
+
+
+class EllipsoidEngine(Engine):
+    """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box."""
+
+    def __init__(self, positions, velocities, semiaxes, orientations, angular_velocities, box,
+                 capacity: int = 32, eps_f: float = ek.EPS_F):
+        n, d = positions.shape
+        self.n, self.d = n, d
+        self.eps_f = float(eps_f)
+        self.box = np.ascontiguousarray(box, dtype=float)
+        cv, ct, cr, cax, cor, cw, cii, width = ek.columns(d)
+        self.P = _aligned_rows(n, width)
+        self.P[:, :d] = positions
+        self.P[:, cv:cv + d] = velocities
+        self.P[:, cr] = semiaxes.max(axis=1)
+        self.P[:, cax:cax + d] = semiaxes
+        self.P[:, cor:cw] = np.asarray(orientations, dtype=float).reshape(n, -1)
+        self.P[:, cw:cii] = np.asarray(angular_velocities, dtype=float).reshape(n, -1)
+        self.P[:, cii] = 1.0 / moments_of_inertia(semiaxes)
+        self.cols = (cv, ct, cr, cax, cor, cw, cii)
+        self.dims = tuple(range(d))
+        from hardpack.md.engine import image_vectors
+
+        self.imgvec = image_vectors(self.box)
+        self.cnt = np.zeros(n, dtype=np.int32)
+        self.ep = np.zeros(n, dtype=np.int32)
+        self.ec = np.zeros(n, dtype=np.int32)
+        self.hkey = np.zeros(n)
+        self.heap = np.zeros(n, dtype=np.int32)
+        self.hpos = np.zeros(n, dtype=np.int32)
+        self.bs = np.zeros((n, d + 1))
+        self.nn = np.zeros(n, dtype=np.int32)
+        self.mark = np.zeros(n, dtype=np.int8)
+        self.slot_of = np.zeros(n, dtype=np.int32)
+        self.cell_capacity = 0
+        self.cell_floor = 1
+        self.lists_valid = False
+        self.last_duration = 0.0
+        self.alloc_lists(capacity)
+
+    # ----------------------------------------------------------------- views of the state
+    @property
+    def velocities(self) -> np.ndarray:
+        return self.P[:, self.cols[0]: self.cols[0] + self.d]
+
+    @property
+    def radii(self) -> np.ndarray:
+        """Bounding radii (largest semiaxes): what the neighbour grid and lists use."""
+        return self.P[:, self.cols[2]]
+
+    @property
+    def semiaxes(self) -> np.ndarray:
+        return self.P[:, self.cols[3]: self.cols[3] + self.d]
+
+    @property
+    def orientations(self) -> np.ndarray:
+        o = self.P[:, self.cols[4]: self.cols[5]]
+        return o[:, 0] if self.d == 2 else o
+
+    @property
+    def angular_velocities(self) -> np.ndarray:
+        w = self.P[:, self.cols[5]: self.cols[6]]
+        return w[:, 0] if self.d == 2 else w
+
+    @property
+    def inertia(self) -> np.ndarray:
+        return 1.0 / self.P[:, self.cols[6]]
+
+    def totals(self) -> tuple[float, float, float]:
+        """(translational kinetic energy, sum of volume-equivalent radii (prod a)^(1/d), sum of
+        prod a), summed in a fixed order: the sphere engine's triple, so that phi and the growth
+        rate convention (mean volume-equivalent radius) carry over."""
+        ket, _, s1, sd = ek.totals(self.P)
+        return float(ket), float(s1), float(sd)
+
+    def energies(self) -> tuple[float, float]:
+        """(translational, rotational) kinetic energy."""
+        ket, ker, _, _ = ek.totals(self.P)
+        return float(ket), float(ker)
+
+    def momentum(self) -> np.ndarray:
+        return self.velocities.sum(axis=0)
+
+    def kinetic_temperature(self) -> float:
+        """kT = 2 (KE_trans + KE_rot) / ((d + d_rot) N)."""
+        return 2.0 * sum(self.energies()) / ((self.d + rotational_dof(self.d)) * self.n)
+
+    # ----------------------------------------------------------------- one window
+    def run_window(self, kappa: float, skin: float, coll_target: int, t_cap: float,
+                   rebuild: bool = False, log=None) -> WindowResult:
+        """Run one window from a synchronisation point and synchronise at its end (as
+        :meth:`hardpack.md.engine.Engine.run_window`; ``log`` is not supported). ``checks``
+        (CHECK events) and contact-function evaluations are stored in :attr:`last_checks` and
+        :attr:`last_evaluations`."""
+        if log is not None:
+            raise NotImplementedError("collision logging (contact forces) is not implemented for ellipsoids")
+        if not rebuild and self.lists_valid:
+            eff_skin = min(skin, self._room())
+            rebuild = eff_skin < skin / SKIN_SLACK or \
+                self._grid_time(kappa, eff_skin) < 2.0 * self.last_duration
+        else:
+            rebuild = True
+        if rebuild:
+            self._new_bounds(skin)
+        start = self.P.copy()
+        while True:
+            eff_skin = min(skin, self._room())
+            cap = min(t_cap, self._grid_time(kappa, eff_skin))
+            if kappa < 0.0:
+                cap = min(cap, 0.5 / -kappa)
+            self.cnt[:] = 0
+            acc = np.array([0.0, 0.0, 0.0, self.totals()[0], 0.0, 0.0])
+            iacc = np.zeros(ek.N_COUNTERS, dtype=np.int64)
+            status = WindowStatus(ek.run_events(
+                self.P, self.box, kappa, self.eps_f, eff_skin, self.sfac, self.imgvec, self.lvl,
+                self.rcap, self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
+                self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
+                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild))
+            if status in (WindowStatus.OVERFLOW, WindowStatus.CELL_OVERFLOW, WindowStatus.BOUND_TOO_SMALL):
+                self.P[:] = start
+                if status == WindowStatus.OVERFLOW:
+                    self.alloc_lists(2 * self.capacity)
+                elif status == WindowStatus.CELL_OVERFLOW:
+                    self.cell_floor = 2 * self.cell_capacity
+                    self.alloc_cells(self.cell_floor)
+                else:
+                    self._new_bounds(skin)
+                rebuild = True
+                continue
+            if status == WindowStatus.STUCK:
+                raise RuntimeError("no event can ever happen: no particle moves and none grows")
+            break
+        self.lists_valid = True
+        duration = float(acc[0])
+        self.last_duration = duration
+        ek.synchronise(self.P, duration, kappa)
+        worst, n_over = ek.max_overlap(self.P, self.imgvec, self.nb, self.nn)
+        self.last_checks = int(iacc[ek.I_CHECK])
+        self.last_evaluations = int(acc[ek.A_EVAL])
+        return WindowResult(
+            duration=duration, virial=float(acc[1]), ke_integral=float(acc[2]),
+            ke_end=self.totals()[0], collisions=int(iacc[0]), events=int(iacc[1]),
+            stale=int(iacc[2]), exits=int(iacc[3]), grazing=int(iacc[4]),
+            max_overlap=float(worst), n_overlapping=int(n_over), mean_neighbours=float(self.nn.mean()),
+        )
+
+    def rescale_velocities(self, kt: float = 1.0) -> None:
+        """Scale translational and angular velocities by one factor so that
+        kT = 2 (KE_trans + KE_rot) / ((d + d_rot) N) equals ``kt`` (Donev 2006, sec. 3.2.4.1:
+        collisions keep equipartition, so one factor serves both)."""
+        s = np.sqrt(kt / self.kinetic_temperature())
+        cv, _, _, _, _, cw, cii = self.cols
+        self.P[:, cv:cv + self.d] *= s
+        self.P[:, cw:cii] *= s

@@ -1,0 +1,856 @@
+"""Numba kernels of event-driven MD of hard ellipsoids (d = 3) and ellipses (d = 2).
+
+The event loop is the one of the sphere engine (:mod:`hardpack.md.kernel`: one predicted event
+per particle in a 4-ary heap with lazy invalidation by collision counters, neighbour lists with
+immobile bounding spheres rebuilt particle by particle on a cell grid, time measured from the last
+synchronisation); what differs is the particle state, the pair prediction and the collision law
+(Donev 2006, dissertation sec. 3.5).
+
+**State.** Row i of ``P`` (``ncol(d)`` columns, masses 1), at the particle's own update time t_i:
+position x (d), velocity v (d), t_i, bounding radius R_i (the largest semiaxis) at window time 0,
+semiaxes at window time 0 (d), orientation (a unit quaternion (s, p_1, p_2, p_3) in 3D, the angle
+of the first semiaxis with the x axis in 2D; conventions of :mod:`hardpack.geometry.shapes`),
+angular velocity w in the lab frame (3 components in 3D, one in 2D) and the inverse moment of
+inertia 1/I_i. Column offsets: :func:`columns`.
+
+**Free flight.** x(t) = x + v (t - t_i); the orientation turns uniformly about the fixed axis w
+(Donev 2006, sec. 1.4.3, Algorithm 1): the body-to-lab rotation R = Q^T of the quaternion w_q
+(Q as in :mod:`hardpack.geometry.shapes`) is that of the active quaternion rotation, so a turn by
+phi = |w| dt about the lab axis w-hat is w_q <- [cos(phi/2), sin(phi/2) w-hat] w_q (composition
+Eq. 1.9 with the turn on the LEFT because w is a lab-frame vector; checked against
+dX/dt = W X - X W, Donev 2006, Eq. 2.9, in the tests); in 2D phi <- phi + w dt.
+Free rotation is uniform only because the moment of inertia is taken spherically symmetric
+(Donev 2006, sec. 3.5: "we assume a spherically symmetric moment of inertia"): I is the mean of
+the three principal moments of a uniform ellipsoid, I = (2/15)(a^2 + b^2 + c^2) (the exact value
+2 a^2 / 5 for a sphere, the trace of the true tensor kept), and in 2D the exact moment of an
+ellipse, I = (a^2 + b^2) / 4 (one rotational axis, so always "spherical"). Rotations then do not
+couple to the shape and w is constant between collisions; equilibrium (equation of state,
+packings) does not depend on the moments of inertia.
+
+**Growth.** Every semiaxis grows at one relative rate, a(t) = a(0) (1 + kappa t) (as the radii of
+the sphere engine), so the relative rate at window time t is g = kappa / (1 + kappa t). The moment
+of inertia is kept at its window-start value within a window (it is recomputed at every
+synchronisation, where the growing runs rescale the velocities anyway); with kappa = 0 the
+dynamics is exactly energy conserving.
+
+**Pair prediction** (Donev 2006, sec. 3.5.1, Algorithm 11). The Perram-Wertheim potential
+zeta(t) (> 0 disjoint; :func:`hardpack.geometry.contact.pw_contact`) and its rate (Eq. 2.21,
+:func:`hardpack.geometry.contact.pw_rate`) are followed only while the bounding spheres overlap:
+the overlap interval [t_in, t_out] of the two growing bounding spheres comes from the same
+quadratic as a sphere collision (:func:`hardpack.events.roots.contact_root` for t_in, the other
+root for t_out). On it, trace event location: steps [t0, t0 + h] with zeta and zeta_dot at both
+ends define a cubic Hermite interpolant, whose error is estimated at the midpoint,
+e = |H(1/2) - zeta(t0 + h/2)|. A step is accepted when e <= max(eps_F, RELATIVE_TOL m) and
+m > 2 e, with m the interpolant's minimum over the step (so no dip below zero hides between the
+samples unless the interpolant errs by more than twice its estimated error; far from contact,
+where m is large, the steps may err by a tenth of m, which keeps them long without any risk of
+missing the zero); otherwise h is halved (the midpoint becomes the new end). The next step is
+h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= 0 brackets the collision, which a safeguarded
+Newton iteration (bisection when a Newton step leaves the bracket) locates to round-off; the
+earlier end of the final bracket (zeta >= 0, no overlap) is returned. If zeta <= 0 at t_in: a
+collision now when zeta_dot < 0; otherwise (round-off after a collision of the pair) zeta is
+taken as 0 and traced on (Algorithm 11 step d). After MAX_TRACE_STEPS accepted steps the trace
+stops with a CHECK event at the time reached: the particle re-predicts from there (a "safe time",
+Algorithm 11 step e). Steps shorter than ``MIN_STEP_FRACTION`` of the first one are accepted
+unconditionally, so every trace advances. The neighbours are traced in the order of their t_in and
+the search stops at the first t_in after the earliest event found. The horizon of every trace
+is also capped by the first contact time of the inscribed spheres (radius the smallest semiaxis)
+of any listed pair: the particle collides by then at the latest (if no collision is located
+before it, which round-off alone could cause, a CHECK is scheduled there).
+
+**Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
+here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
+unit normal from A to B at the contact point r_C, the contact velocity
+v_C = [v_B + w_B x (r_C - r_B) + g (r_C - r_B)] - [v_A + w_A x (r_C - r_A) + g (r_C - r_A)]
+and v_n = n . v_C < 0 for an approaching pair, the impulse J n on B (-J n on A) with
+J = -2 v_n / (1/m_A + 1/m_B + |(r_C - r_A) x n|^2 / I_A + |(r_C - r_B) x n|^2 / I_B)
+reverses v_n and conserves momentum, angular momentum about any point and, without growth, the
+kinetic energy (translational plus rotational): v_B += J n, v_A -= J n,
+w_B += J (r_C - r_B) x n / I_B, w_A -= J (r_C - r_A) x n / I_A (2D: the cross products are
+scalars). With growth the energy rises by the growth part of v_n, as for spheres. Collisions with
+v_n >= 0 are skipped (grazing or mispredicted, Algorithm 12 step 3).
+
+**Pressure.** The virial accumulates r_AB . J n (centre-to-centre vector, the molecular virial), so
+Z = PV/(NkT) = 1 + virial / (2 integral of the translational kinetic energy dt), as for spheres.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from hardpack.events.heap import heap_set
+from hardpack.events.roots import contact_root, exit_root
+from hardpack.geometry.contact import contact_point, pw_contact, pw_rate, shape_inverse
+from hardpack.md.kernel import A_KE, A_KEINT, A_T, A_TKE, A_VIRIAL, I_COLL, I_EVENTS, I_EXIT, \
+    I_GRAZE, I_STALE, WindowStatus
+
+EXIT = -1  # event: the particle leaves its bounding sphere
+NONE = -2  # nothing predicted
+CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
+
+#: extra counter (after the sphere engine's): CHECK events
+I_CHECK = 5
+N_COUNTERS = 6
+#: extra accumulator: contact-function evaluations
+A_EVAL = 5
+
+#: default tolerance on the Hermite interpolation error of zeta (Donev 2006, sec. 3.5.1: 1e-4..1e-3)
+EPS_F = 1e-4
+#: far from contact a step may also err by this fraction of the interpolant's minimum
+RELATIVE_TOL = 0.1
+#: accepted trace steps before a CHECK event (Donev 2006, Algorithm 11: 100-250)
+MAX_TRACE_STEPS = 200
+#: steps shorter than this fraction of the first step of a trace are accepted unconditionally
+MIN_STEP_FRACTION = 1e-9
+#: first trace step: this fraction of the smallest semiaxis of the pair over its relative speed
+FIRST_STEP = 0.25
+
+
+@njit(cache=True, inline="always")
+def columns(d):
+    """Column offsets of a row of P: (velocity, time, bounding radius, semiaxes, orientation,
+    angular velocity, inverse inertia, width)."""
+    no = 4 if d == 3 else 1
+    nw = 3 if d == 3 else 1
+    cax = 2 * d + 2
+    cor = cax + d
+    cw = cor + no
+    cii = cw + nw
+    return d, 2 * d, 2 * d + 1, cax, cor, cw, cii, cii + 1
+
+
+def ncol(d: int) -> int:
+    """Width of a row of P in d dimensions (19 in 3D, 11 in 2D)."""
+    return columns(d)[7]
+
+
+@njit(cache=True)
+def orientation_at(P, i, t, out):
+    """Orientation of particle i at window time t (Algorithm 1, module docstring) into ``out``."""
+    d = 2 if P.shape[1] == 11 else 3
+    _, ct, _, _, cor, cw, _, _ = columns(d)
+    dt = t - P[i, ct]
+    if d == 2:
+        out[0] = P[i, cor] + P[i, cw] * dt
+        return
+    w0, w1, w2 = P[i, cw], P[i, cw + 1], P[i, cw + 2]
+    wn = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    s, p1, p2, p3 = P[i, cor], P[i, cor + 1], P[i, cor + 2], P[i, cor + 3]
+    if wn == 0.0 or dt == 0.0:
+        out[0], out[1], out[2], out[3] = s, p1, p2, p3
+        return
+    half = 0.5 * wn * dt
+    c = np.cos(half)
+    f = np.sin(half) / wn
+    a1, a2, a3 = f * w0, f * w1, f * w2
+    # [c, a] [s, p] = [c s - a.p, c p + s a + a x p]  (Donev 2006, Eq. 1.9)
+    out[0] = c * s - (a1 * p1 + a2 * p2 + a3 * p3)
+    out[1] = c * p1 + s * a1 + (a2 * p3 - a3 * p2)
+    out[2] = c * p2 + s * a2 + (a3 * p1 - a1 * p3)
+    out[3] = c * p3 + s * a3 + (a1 * p2 - a2 * p1)
+
+
+@njit(cache=True)
+def advance(P, i, t, scratch):
+    """Move particle i to window time t (position and orientation) and set t_i = t."""
+    d = 2 if P.shape[1] == 11 else 3
+    cv, ct, _, _, cor, _, _, _ = columns(d)
+    dt = t - P[i, ct]
+    if dt == 0.0:
+        return
+    orientation_at(P, i, t, scratch)
+    no = 4 if d == 3 else 1
+    for k in range(no):
+        P[i, cor + k] = scratch[k]
+    for k in range(d):
+        P[i, k] += P[i, cv + k] * dt
+    P[i, ct] = t
+
+
+@njit(cache=True)
+def _pose(P, i, t, kappa, shift, x, xinv, o, ax):
+    """Centre (plus ``shift``) and inverse shape matrix of particle i at window time t."""
+    d = x.shape[0]
+    cv, ct, _, cax, _, _, _, _ = columns(d)
+    dt = t - P[i, ct]
+    grow = 1.0 + kappa * t
+    for k in range(d):
+        x[k] = P[i, k] + P[i, cv + k] * dt + shift[k]
+        ax[k] = P[i, cax + k] * grow
+    orientation_at(P, i, t, o)
+    shape_inverse(ax, o, xinv)
+
+
+@njit(cache=True)
+def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
+    """(zeta, zeta_dot, lambda) of particles i and j (j shifted by ``shift``) at window time t.
+
+    ``ws`` (11, 4) (row 8 zeros, ws[10, 0] counts the evaluations) and ``wm`` (2, d, d) are scratch arrays; on return ws[0, :d],
+    ws[1, :d] hold the centres, ws[4, :d] the contact point, ws[5, :d] the normal n and wm[0],
+    wm[1] the inverse shape matrices."""
+    d = shift.shape[0]
+    cv, _, _, _, _, cw, _, _ = columns(d)
+    xa, xb, oa, ob, rc = ws[0, :d], ws[1, :d], ws[2], ws[3], ws[4, :d]
+    ax = ws[6, :d]
+    _pose(P, i, t, kappa, ws[8, :d], xa, wm[0], oa, ax)
+    _pose(P, j, t, kappa, shift, xb, wm[1], ob, ax)
+    r = ws[7, :d]
+    for k in range(d):
+        r[k] = xb[k] - xa[k]
+    zeta, lam, n = pw_contact(r, wm[0], wm[1], lam0)
+    ws[10, 0] += 1.0
+    contact_point(xa, wm[0], lam, n, rc)
+    for k in range(d):
+        ws[5, k] = n[k]
+    nw = 3 if d == 3 else 1
+    g = kappa / (1.0 + kappa * t)
+    zdot = pw_rate(lam, n, xa, xb, rc, P[i, cv:cv + d], P[j, cv:cv + d], P[i, cw:cw + nw],
+                   P[j, cw:cw + nw], g, g)
+    return zeta, zdot, lam
+
+
+@njit(cache=True)
+def _hermite_min(z0, z1, d0, d1):
+    """Minimum over s in (0, 1] of the cubic Hermite interpolant with values z0, z1 and
+    derivatives d0, d1 (per unit s) at s = 0, 1, and the first root s in (0, 1] (or 2.0)."""
+    # H(s) = z0 + d0 s + c2 s^2 + c3 s^3
+    c2 = 3.0 * (z1 - z0) - 2.0 * d0 - d1
+    c3 = 2.0 * (z0 - z1) + d0 + d1
+    hmin = z1
+    # critical points: d0 + 2 c2 s + 3 c3 s^2 = 0
+    qa, qb, qc = 3.0 * c3, 2.0 * c2, d0
+    if qa == 0.0:
+        if qb != 0.0:
+            s = -qc / qb
+            if 0.0 < s < 1.0:
+                hmin = min(hmin, z0 + s * (d0 + s * (c2 + s * c3)))
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            sq = np.sqrt(disc)
+            for s in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)):
+                if 0.0 < s < 1.0:
+                    hmin = min(hmin, z0 + s * (d0 + s * (c2 + s * c3)))
+    root = 2.0
+    if hmin <= 0.0:  # first sign change on a fine grid, then bisection
+        prev = 0.0
+        m = 16
+        for q in range(1, m + 1):
+            s = q / m
+            if z0 + s * (d0 + s * (c2 + s * c3)) <= 0.0:
+                lo, hi = prev, s
+                for _ in range(40):
+                    mid = 0.5 * (lo + hi)
+                    if z0 + mid * (d0 + mid * (c2 + mid * c3)) <= 0.0:
+                        hi = mid
+                    else:
+                        lo = mid
+                root = hi
+                break
+            prev = s
+    return hmin, root
+
+
+@njit(cache=True)
+def _refine(P, i, j, shift, t, kappa, lo, hi, guess, lam, ws, wm):
+    """Collision time in the bracket [lo, hi] (zeta(lo) >= 0 >= zeta(hi)) by safeguarded Newton
+    from ``guess`` (bisection when a step leaves the bracket); ends at a time with zeta >= 0 whose
+    Newton step is below round-off of the time, or at the earlier end of a bracket narrowed to
+    round-off (no overlap either way)."""
+    tt = guess if lo < guess < hi else 0.5 * (lo + hi)
+    for _ in range(100):
+        z, zd, lam = pair_zeta(P, i, j, shift, t + tt, kappa, lam, ws, wm)
+        if z > 0.0:
+            lo = tt
+        else:
+            hi = tt
+        nt = tt - z / zd if zd != 0.0 else -1.0
+        if z >= 0.0 and abs(nt - tt) <= 4e-16 * (t + tt):
+            return tt
+        if hi - lo <= 4e-16 * (t + hi) + 1e-300:
+            break
+        if not (lo < nt < hi):
+            nt = 0.5 * (lo + hi)
+        if nt == tt:
+            break
+        tt = nt
+    return lo
+
+
+@njit(cache=True)
+def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
+    """Earliest collision of i and j (shifted) in window time [t + tin, min(t + tout, tmax)) by
+    trace event location (module docstring). Returns (time, kind) with kind 0 collision, 1 CHECK,
+    and time inf when nothing happens before the end."""
+    d = shift.shape[0]
+    cv, _, cr, cax, _, cw, _, _ = columns(d)
+    end = min(tout, tmax - t)
+    lam = P[i, cr] / (P[i, cr] + P[j, cr])
+    t0 = tin
+    z0, d0, lam = pair_zeta(P, i, j, shift, t + t0, kappa, lam, ws, wm)
+    if z0 <= 0.0:
+        if d0 < 0.0:
+            return t + t0, 0
+        z0 = 0.0
+    # first step from the relative speed of the surfaces
+    amin = P[i, cax]
+    for k in range(1, d):
+        amin = min(amin, P[i, cax + k])
+    for k in range(d):
+        amin = min(amin, P[j, cax + k])
+    amin *= 1.0 + kappa * (t + t0)
+    uu = 0.0
+    for k in range(d):
+        du = P[j, cv + k] - P[i, cv + k]
+        uu += du * du
+    ww_i = 0.0
+    ww_j = 0.0
+    nw = 3 if d == 3 else 1
+    for k in range(nw):
+        ww_i += P[i, cw + k] ** 2
+        ww_j += P[j, cw + k] ** 2
+    speed = np.sqrt(uu) + (np.sqrt(ww_i) + abs(kappa)) * P[i, cr] * (1.0 + kappa * (t + t0)) \
+        + (np.sqrt(ww_j) + abs(kappa)) * P[j, cr] * (1.0 + kappa * (t + t0))
+    h = FIRST_STEP * amin / speed if speed > 0.0 else end - t0
+    hmin_step = MIN_STEP_FRACTION * h
+    steps = 0
+    while t0 < end:
+        if steps >= MAX_TRACE_STEPS:
+            return t + t0, 1
+        h = min(h, end - t0)
+        t1 = t0 + h
+        z1, d1, lam1 = pair_zeta(P, i, j, shift, t + t1, kappa, lam, ws, wm)
+        while True:
+            zm, dm, lamm = pair_zeta(P, i, j, shift, t + t0 + 0.5 * h, kappa, lam, ws, wm)
+            if zm <= 0.0:  # bracket [t0, t0 + h/2]
+                hm, root = _hermite_min(z0, zm, d0 * 0.5 * h, dm * 0.5 * h)
+                return _refine(P, i, j, shift, t, kappa, t0, t0 + 0.5 * h,
+                               t0 + 0.5 * h * min(root, 1.0), lam, ws, wm) + t, 0
+            if z1 <= 0.0:  # bracket [t0 + h/2, t1]
+                hm, root = _hermite_min(zm, z1, dm * 0.5 * h, d1 * 0.5 * h)
+                return _refine(P, i, j, shift, t, kappa, t0 + 0.5 * h, t1,
+                               t0 + 0.5 * h * (1.0 + min(root, 1.0)), lamm, ws, wm) + t, 0
+            err = abs(0.5 * (z0 + z1) + 0.125 * h * (d0 - d1) - zm)
+            hmin, root = _hermite_min(z0, z1, d0 * h, d1 * h)
+            tol = max(eps_f, RELATIVE_TOL * hmin)
+            if (err <= tol and hmin > 2.0 * err) or h <= hmin_step:
+                break
+            # halve: the midpoint becomes the end
+            h *= 0.5
+            t1 = t0 + h
+            z1, d1, lam1 = zm, dm, lamm
+        steps += 1
+        t0 = t1
+        z0, d0, lam = z1, d1, lam1
+        if err > 0.0:
+            fac = 0.8 * (max(min(tol, 0.5 * hmin), 0.0) / err) ** 0.25
+            h *= min(max(fac, 0.5), 4.0)
+        else:
+            h *= 4.0
+    return np.inf, 0
+
+
+@njit(cache=True)
+def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of,
+             bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch):
+    """Partial NNL update of particle i at window time t (Donev 2006, Algorithm 10), as in
+    :func:`hardpack.md.kernel.run_events` stage (1) with the bounding radius R_i (largest
+    semiaxis) in place of the sphere radius. Returns 0 or a :class:`WindowStatus` to stop with."""
+    d = L.shape[0]
+    cbits = 2 * d
+    cmask = (1 << cbits) - 1
+    cback = cmask // 3 * 2
+    cap = nb.shape[1]
+    ccap = cid.shape[0] // ccount.shape[0]
+    nlev = ncl.shape[0]
+    _, _, cr, _, _, _, _, _ = columns(d)
+    advance(P, i, t, scratch)
+    nold = nn[i]
+    for m in range(nold):
+        j = nb[i, m] >> cbits
+        oldnb[m] = j
+        mark[j] = 1
+    nn[i] = 0
+    wrapped = False
+    h = lvl[i]
+    c = coff[h]
+    stride = 1
+    for k in range(d):
+        x = P[i, k]
+        if x < 0.0 or x >= L[k]:
+            x -= L[k] * np.floor(x * invL[k])
+            if x >= L[k]:
+                x -= L[k]
+            x = max(x, 0.0)
+            P[i, k] = x
+            wrapped = True
+        bs[i, k] = x
+        gk = int(x * invL[k] * ncl[h, k])
+        if gk >= ncl[h, k]:
+            gk = ncl[h, k] - 1
+        c += gk * stride
+        stride *= ncl[h, k]
+    a = P[i, cr] * (1.0 + kappa * t)
+    ri = a + skin * sfac[i]
+    if ri > rcap[h]:
+        ri = rcap[h]
+        if a + 0.25 * skin * sfac[i] >= rcap[h]:
+            return WindowStatus.BOUND_TOO_SMALL
+    bs[i, d] = ri
+    slot = slot_of[i]
+    if slot < 0 or slot // ccap != c:
+        if ccount[c] >= ccap:
+            return WindowStatus.CELL_OVERFLOW
+        if slot >= 0:
+            old = slot // ccap
+            last = old * ccap + ccount[old] - 1
+            moved = cid[last]
+            cid[slot] = moved
+            for k in range(d + 1):
+                cbs[slot, k] = cbs[last, k]
+            slot_of[moved] = slot
+            ccount[old] -= 1
+        slot = c * ccap + ccount[c]
+        ccount[c] += 1
+        cid[slot] = i
+        slot_of[i] = slot
+    for k in range(d + 1):
+        cbs[slot, k] = bs[i, k]
+    for lv in range(nlev):
+        beta = ri + rcap[lv]
+        ncells = 1
+        for k in range(d):
+            m = ncl[lv, k]
+            lo = int(np.floor((bs[i, k] - beta) * invL[k] * m))
+            span = int(np.floor((bs[i, k] + beta) * invL[k] * m)) - lo + 1
+            if span >= m:
+                lo = 0
+                span = m
+            clo[k] = lo
+            cspan[k] = span
+            codo[k] = 0
+            ncells *= span
+        for _ in range(ncells):
+            gc = coff[lv]
+            stride = 1
+            gap2 = 0.0
+            for k in range(d):
+                m = ncl[lv, k]
+                u = clo[k] + codo[k]
+                if cspan[k] < m:
+                    w = L[k] / m
+                    gap = max(u * w - bs[i, k], bs[i, k] - (u + 1) * w, 0.0)
+                    gap2 += gap * gap
+                gc += (u % m) * stride
+                stride *= m
+            for k in range(d):
+                codo[k] += 1
+                if codo[k] < cspan[k]:
+                    break
+                codo[k] = 0
+            if gap2 >= beta * beta:
+                continue
+            base = gc * ccap
+            for sj in range(base, base + ccount[gc]):
+                j = cid[sj]
+                if j != i:
+                    code = 0
+                    d2 = 0.0
+                    for k in range(d):
+                        dx = cbs[sj, k] - bs[i, k]
+                        sh = 1
+                        if dx > 0.5 * L[k]:
+                            dx -= L[k]
+                            sh = 0
+                        elif dx < -0.5 * L[k]:
+                            dx += L[k]
+                            sh = 2
+                        code += sh << (2 * k)
+                        d2 += dx * dx
+                    s = ri + cbs[sj, d]
+                    if d2 < s * s:
+                        if nn[i] >= cap or nn[j] >= cap:
+                            return WindowStatus.OVERFLOW
+                        nb[i, nn[i]] = (j << cbits) | code
+                        nn[i] += 1
+                        back = (i << cbits) | (cback - code)
+                        if mark[j] == 0:
+                            nb[j, nn[j]] = back
+                            nn[j] += 1
+                        else:
+                            mark[j] = 0
+                            if wrapped:
+                                for q2 in range(nn[j]):
+                                    if nb[j, q2] >> cbits == i:
+                                        nb[j, q2] = back
+                                        break
+    for m in range(nold):
+        j = oldnb[m]
+        if mark[j] == 1:
+            mark[j] = 0
+            last = nn[j] - 1
+            for q2 in range(last + 1):
+                if nb[j, q2] >> cbits == i:
+                    nb[j, q2] = nb[j, last]
+                    nn[j] = last
+                    break
+    return 0
+
+
+@njit(cache=True)
+def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, wm):
+    """Next event of particle i from window time t: (time, partner), partner EXIT, CHECK or a
+    particle index (Algorithm 5 with NNLs; pairs by :func:`predict_pair` in the order of their
+    bounding-sphere contact times)."""
+    d = bs.shape[1] - 1
+    cv, ct, cr, cax, _, _, _, _ = columns(d)
+    cbits = 2 * d
+    cmask = (1 << cbits) - 1
+    dt = t - P[i, ct]
+    ri = P[i, cr]
+    grow = 1.0 + kappa * t
+    dd = 0.0
+    dv = 0.0
+    vv = 0.0
+    for k in range(d):
+        vk = P[i, cv + k]
+        dx = P[i, k] + vk * dt - bs[i, k]
+        dd += dx * dx
+        dv += dx * vk
+        vv += vk * vk
+    best = exit_root(dd, dv, vv, bs[i, d] - ri * grow, ri * kappa)
+    partner = EXIT if best < np.inf else NONE
+    best += t
+    horizon = best  # no collision of i is later than the first contact of inscribed spheres
+    amin_i = P[i, cax]
+    for k in range(1, d):
+        amin_i = min(amin_i, P[i, cax + k])
+    m_n = nn[i]
+    for m in range(m_n):  # bounding-sphere overlap intervals
+        e = nb[i, m]
+        j = e >> cbits
+        im = e & cmask
+        dtj = t - P[j, ct]
+        rr = 0.0
+        ru = 0.0
+        uu = 0.0
+        for k in range(d):
+            r = P[j, k] + P[j, cv + k] * dtj + imgvec[im, k] - P[i, k] - P[i, cv + k] * dt
+            u = P[j, cv + k] - P[i, cv + k]
+            rr += r * r
+            ru += r * u
+            uu += u * u
+        s = ri + P[j, cr]
+        sig0 = s * grow
+        g = s * kappa
+        a = uu - g * g
+        b = ru - sig0 * g
+        c = rr - sig0 * sig0
+        # start of the overlap interval: now if the bounding spheres overlap already (the sphere
+        # root would skip a separating pair), else their first contact
+        tin = 0.0 if c <= 0.0 else contact_root(rr, ru, uu, sig0, g, horizon - t)
+        tins[m] = tin
+        done[m] = 0
+        if tin < np.inf:
+            amin_j = P[j, cax]
+            for k in range(1, d):
+                amin_j = min(amin_j, P[j, cax + k])
+            s_in = amin_i + amin_j
+            horizon = min(horizon, t + contact_root(rr, ru, uu, s_in * grow, s_in * kappa, horizon - t))
+        if tin < np.inf:
+            if a <= 0.0:
+                touts[m] = np.inf
+            else:
+                disc = max(b * b - a * c, 0.0)
+                if b <= 0.0:
+                    touts[m] = (-b + np.sqrt(disc)) / a
+                else:
+                    den = b + np.sqrt(disc)
+                    touts[m] = -c / den if den > 0.0 else 0.0
+    sh = ws[9, :d]
+    for _ in range(m_n):  # trace in the order of the overlap starts
+        q = -1
+        tq = np.inf
+        for m in range(m_n):
+            if done[m] == 0 and tins[m] < tq:
+                tq = tins[m]
+                q = m
+        if q < 0 or t + tq >= min(best, horizon):
+            break
+        done[q] = 1
+        e = nb[i, q]
+        j = e >> cbits
+        im = e & cmask
+        for k in range(d):
+            sh[k] = imgvec[im, k]
+        tc, kind = predict_pair(P, i, j, sh, t, min(best, horizon), tq, touts[q], kappa, eps_f, ws, wm)
+        if tc < best:
+            best = tc
+            partner = j if kind == 0 else CHECK
+    if horizon < best:  # the inscribed spheres of a pair touch, yet no collision was located
+        best = horizon
+        partner = CHECK
+    return best, partner
+
+
+@njit(cache=True)
+def _cross_n(x, n, out):
+    """out = x cross n (3D); in 2D out[0] = x_0 n_1 - x_1 n_0."""
+    if x.shape[0] == 2:
+        out[0] = x[0] * n[1] - x[1] * n[0]
+        return out[0] * out[0]
+    out[0] = x[1] * n[2] - x[2] * n[1]
+    out[1] = x[2] * n[0] - x[0] * n[2]
+    out[2] = x[0] * n[1] - x[1] * n[0]
+    return out[0] * out[0] + out[1] * out[1] + out[2] * out[2]
+
+
+@njit(cache=True)
+def collide(P, i, j, t, L, kappa, ws, wm):
+    """Collision of i and j at window time t (module docstring, Algorithm 12); both particles are
+    first advanced to t. Returns (impulse J >= 0 on j along n, r_ij . n J, change of the
+    translational kinetic energy), J = 0 for a skipped (separating) pair."""
+    d = L.shape[0]
+    cv, ct, cr, _, _, cw, cii, _ = columns(d)
+    nw = 3 if d == 3 else 1
+    advance(P, i, t, ws[2])
+    advance(P, j, t, ws[2])
+    sh = ws[9, :d]
+    for k in range(d):
+        dx = P[j, k] - P[i, k]
+        sh[k] = -L[k] * np.floor(dx / L[k] + 0.5)
+    lam0 = P[i, cr] / (P[i, cr] + P[j, cr])
+    zeta, zdot, lam = pair_zeta(P, i, j, sh, t, kappa, lam0, ws, wm)
+    xa, xb, rc, n = ws[0, :d], ws[1, :d], ws[4, :d], ws[5, :d]
+    nrm = 0.0
+    for k in range(d):
+        nrm += n[k] * n[k]
+    nrm = np.sqrt(nrm)
+    for k in range(d):
+        n[k] /= nrm
+    # normal contact velocity (zeta_dot = 2 lam (1 - lam) |n_raw| v_n)
+    vn = zdot / (2.0 * lam * (1.0 - lam) * nrm)
+    if not vn < 0.0:
+        return 0.0, 0.0, 0.0
+    ra = ws[6, :d]
+    rb = ws[7, :d]
+    ca = ws[2]
+    cb = ws[3]
+    for k in range(d):
+        ra[k] = rc[k] - xa[k]
+        rb[k] = rc[k] - xb[k]
+    la = _cross_n(ra, n, ca)
+    lb = _cross_n(rb, n, cb)
+    inv = 2.0 + la * P[i, cii] + lb * P[j, cii]
+    jimp = -2.0 * vn / inv
+    ke0 = 0.0
+    ke1 = 0.0
+    rn = 0.0
+    for k in range(d):
+        ke0 += P[i, cv + k] ** 2 + P[j, cv + k] ** 2
+        P[i, cv + k] -= jimp * n[k]
+        P[j, cv + k] += jimp * n[k]
+        ke1 += P[i, cv + k] ** 2 + P[j, cv + k] ** 2
+        rn += (xb[k] - xa[k]) * n[k]
+    for k in range(nw):
+        P[i, cw + k] -= jimp * P[i, cii] * ca[k]
+        P[j, cw + k] += jimp * P[j, cii] * cb[k]
+    return jimp, rn * jimp, 0.5 * (ke1 - ke0)
+
+
+@njit(cache=True)
+def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
+               slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
+               coll_target, t_cap, rebuild_lists):
+    """One window of ellipsoid MD; arguments, accumulators and return codes as in
+    :func:`hardpack.md.kernel.run_events` (no ``dims``: d is the length of ``L``; ``eps_f`` the
+    trace tolerance; ``iacc`` has N_COUNTERS entries, the last counting CHECK events; acc[A_KE]
+    enters the current translational kinetic energy; ``acc`` has a sixth entry, A_EVAL, that
+    receives the number of contact-function evaluations)."""
+    ws = np.zeros((11, 4))
+    status = _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
+                  slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
+                  coll_target, t_cap, rebuild_lists, ws)
+    acc[A_EVAL] = ws[10, 0]
+    return status
+
+
+@njit(cache=True)
+def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
+         slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
+         coll_target, t_cap, rebuild_lists, ws):
+    d = L.shape[0]
+    n = P.shape[0]
+    cap = nb.shape[1]
+    invL = 1.0 / L
+    oldnb = np.empty(cap, dtype=np.int64)
+    clo = np.empty(d, dtype=np.int64)
+    cspan = np.empty(d, dtype=np.int64)
+    codo = np.empty(d, dtype=np.int64)
+    tins = np.empty(cap)
+    touts = np.empty(cap)
+    done = np.empty(cap, dtype=np.int8)
+    wm = np.empty((2, d, d))
+    scratch = np.empty(4)
+    upd = np.empty(2, dtype=np.int64)
+    mark[:] = 0
+    hpos[:] = -1
+    hsize = 0
+    if rebuild_lists:
+        ccount[:] = 0
+        slot_of[:] = -1
+        nn[:] = 0
+        for i in range(n):
+            status = _rebuild(i, 0.0, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount,
+                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch)
+            if status != 0:
+                acc[A_T] = 0.0
+                return status
+    for i in range(n):
+        key, partner = _predict(i, 0.0, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, wm)
+        ep[i] = partner
+        if partner >= 0:
+            ec[i] = cnt[partner]
+        hsize = heap_set(hkey, heap, hpos, hsize, i, key)
+    while True:
+        i = heap[0]
+        t = hkey[0]
+        if t > t_cap:
+            acc[A_T] = t_cap
+            acc[A_KEINT] += acc[A_KE] * (t_cap - acc[A_TKE])
+            acc[A_TKE] = t_cap
+            return WindowStatus.DONE_TIME
+        if t == np.inf:
+            return WindowStatus.STUCK
+        iacc[I_EVENTS] += 1
+        p = ep[i]
+        npred = 1
+        upd[0] = i
+        if p == EXIT:
+            iacc[I_EXIT] += 1
+            status = _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount,
+                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch)
+            if status != 0:
+                acc[A_T] = t
+                return status
+        elif p == CHECK:
+            iacc[I_CHECK] += 1
+        elif p < 0 or ec[i] != cnt[p]:
+            iacc[I_STALE] += 1
+        else:
+            j = p
+            jimp, vir, dke = collide(P, i, j, t, L, kappa, ws, wm)
+            if jimp > 0.0:
+                acc[A_VIRIAL] += vir
+                acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+                acc[A_TKE] = t
+                acc[A_KE] += dke
+                cnt[i] += 1
+                cnt[j] += 1
+                iacc[I_COLL] += 1
+            else:
+                iacc[I_GRAZE] += 1
+            upd[1] = j
+            npred = 2
+        for q in range(npred):
+            k = upd[q]
+            key, partner = _predict(k, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done,
+                                    ws, wm)
+            ep[k] = partner
+            if partner >= 0:
+                ec[k] = cnt[partner]
+            hsize = heap_set(hkey, heap, hpos, hsize, k, key)
+        if iacc[I_COLL] >= coll_target and npred == 2:
+            acc[A_T] = t
+            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+            acc[A_TKE] = t
+            return WindowStatus.DONE_COLLISIONS
+
+
+@njit(cache=True)
+def synchronise(P, t, kappa):
+    """Advance every particle to window time t, grow semiaxes, bounding radii and moments of
+    inertia to their size at t, renormalise quaternions (Algorithm 1) and wrap 2D angles into
+    [0, 2 pi), and reset the time origin (Algorithm 3)."""
+    d = 2 if P.shape[1] == 11 else 3
+    _, ct, cr, cax, cor, _, cii, _ = columns(d)
+    grow = 1.0 + kappa * t
+    scratch = np.empty(4)
+    for i in range(P.shape[0]):
+        advance(P, i, t, scratch)
+        P[i, ct] = 0.0
+        P[i, cr] *= grow
+        for k in range(d):
+            P[i, cax + k] *= grow
+        P[i, cii] /= grow * grow
+        if d == 3:
+            nq = 0.0
+            for k in range(4):
+                nq += P[i, cor + k] ** 2
+            if abs(nq - 1.0) > 1e-14:
+                nq = np.sqrt(nq)
+                for k in range(4):
+                    P[i, cor + k] /= nq
+        else:
+            P[i, cor] -= 2.0 * np.pi * np.floor(P[i, cor] / (2.0 * np.pi))
+
+
+@njit(cache=True)
+def totals(P):
+    """(translational KE, rotational KE, sum of volume-equivalent radii (prod a)^(1/d),
+    sum of prod a) in a fixed summation order (bit-identical after a resume)."""
+    d = 2 if P.shape[1] == 11 else 3
+    cv, _, _, cax, _, cw, cii, _ = columns(d)
+    nw = 3 if d == 3 else 1
+    ket = 0.0
+    ker = 0.0
+    s1 = 0.0
+    sd = 0.0
+    for i in range(P.shape[0]):
+        for k in range(d):
+            ket += 0.5 * P[i, cv + k] ** 2
+        w2 = 0.0
+        for k in range(nw):
+            w2 += P[i, cw + k] ** 2
+        ker += 0.5 * w2 / P[i, cii]
+        pa = 1.0
+        for k in range(d):
+            pa *= P[i, cax + k]
+        s1 += pa ** (1.0 / d)
+        sd += pa
+    return ket, ker, s1, sd
+
+
+@njit(cache=True)
+def max_overlap(P, imgvec, nb, nn):
+    """Largest relative overlap 1 - mu (mu = sqrt(1 + zeta), the Perram-Wertheim scaling factor to
+    tangency; 1 - r / (a_i + a_j) for spheres) over the listed pairs at a synchronisation point, and
+    the number of pairs with a positive one. Every touching pair is listed."""
+    d = imgvec.shape[1]
+    cbits = 2 * d
+    ws = np.zeros((11, 4))
+    wm = np.empty((2, d, d))
+    worst = -np.inf
+    count = 0
+    _, _, cr, _, _, _, _, _ = columns(d)
+    for i in range(P.shape[0]):
+        for m in range(nn[i]):
+            j = nb[i, m] >> cbits
+            if j < i:
+                continue
+            im = nb[i, m] & ((1 << cbits) - 1)
+            sh = ws[9, :d]
+            d2 = 0.0
+            for k in range(d):
+                sh[k] = imgvec[im, k]
+                dx = P[j, k] + sh[k] - P[i, k]
+                d2 += dx * dx
+            if d2 >= (P[i, cr] + P[j, cr]) ** 2:
+                continue
+            zeta, _, _ = pair_zeta(P, i, j, sh, 0.0, 0.0, P[i, cr] / (P[i, cr] + P[j, cr]), ws, wm)
+            ov = 1.0 - np.sqrt(max(1.0 + zeta, 0.0))
+            worst = max(worst, ov)
+            if ov > 0.0:
+                count += 1
+    return worst, count
