@@ -122,22 +122,23 @@ def test_every_long_command_checks_its_outputs(tmp_path, capsys, rsa_file):
 
 
 def test_checkpoint_is_kept_until_the_output_is_written(tmp_path, capsys, rsa_file, monkeypatch):
-    import hardpack.io
+    import sys
 
+    writer = sys.modules["hardpack.md.compress"]  # the module (hardpack.md.compress is the function)
     reference = compress(load_packing(rsa_file), 0.05, 1, stop=StopCriteria(max_pressure=1e8)).packing
     out, ckpt = tmp_path / "out.nc", tmp_path / "run.ckpt.npz"
     args = ["compress", "--init", str(rsa_file), "--out", str(out), "--growth-rate", "0.05", "--seed", "1",
             "--max-pressure", "1e8", "--checkpoint", str(ckpt), "--checkpoint-interval", "0"]
-    saved = hardpack.io.save_packing
+    saved = writer.write_dataset
 
     def fails(*a, **k):
         raise OSError(28, "No space left on device", str(out))
 
-    monkeypatch.setattr(hardpack.io, "save_packing", fails)
+    monkeypatch.setattr(writer, "write_dataset", fails)
     assert main(args) == 2
     assert "No space left on device" in _error(capsys)
     assert ckpt.exists() and not out.exists()
-    monkeypatch.setattr(hardpack.io, "save_packing", saved)
+    monkeypatch.setattr(writer, "write_dataset", saved)
     assert main(args) == 0
     final = load_packing(out)
     np.testing.assert_array_equal(final.positions, reference.positions)

@@ -29,25 +29,36 @@ def _optional_float(text: str):
 
 
 def cmd_compress(args) -> int:
-    """LS compression of a start packing to jamming (event-driven MD with growing spheres)."""
+    """LS compression of a start packing to jamming (event-driven MD with growing spheres, or
+    ellipsoids and ellipses with rotation)."""
+    from hardpack.errors import InvalidInputError
     from hardpack.io import checkpoint as ckpt
     from hardpack.io import load_packing
     from hardpack.md import StopCriteria, compress
+    from hardpack.md.ellipsoid import compress_ellipsoids
 
     packing = load_packing(args.init)
     stop = StopCriteria(max_pressure=args.max_pressure, target_phi=args.target_phi,
                         max_collisions=args.max_collisions, max_wall_time=args.max_wall_time)
-    result = compress(packing, args.growth_rate, args.seed, stop=stop, checkpoint=args.checkpoint,
-                      window=args.window, checkpoint_interval=args.checkpoint_interval,
-                      final_growth_rate=args.final_growth_rate, switch_pressure=args.switch_pressure,
-                      contact_forces=args.contact_forces, contact_windows=args.contact_windows,
-                      keep_checkpoint=True)
+    common = dict(stop=stop, checkpoint=args.checkpoint, window=args.window,
+                  checkpoint_interval=args.checkpoint_interval, final_growth_rate=args.final_growth_rate,
+                  switch_pressure=args.switch_pressure, keep_checkpoint=True)
+    ellipsoids = packing.shape.kind == "ellipsoid"
+    if ellipsoids:
+        if args.contact_forces:
+            raise InvalidInputError("--contact-forces is implemented for spheres only; drop it for "
+                                    f"{packing.shape.name}")
+        result = compress_ellipsoids(packing, args.growth_rate, args.seed, eps_f=args.eps_f, **common)
+    else:
+        result = compress(packing, args.growth_rate, args.seed, contact_forces=args.contact_forces,
+                          contact_windows=args.contact_windows, **common)
     config = {"init": str(args.init), "growth_rate": args.growth_rate, "seed": args.seed,
               "max_pressure": args.max_pressure, "target_phi": args.target_phi,
               "max_collisions": args.max_collisions, "window": args.window,
               "final_growth_rate": args.final_growth_rate,
               "switch_pressure": args.switch_pressure if args.final_growth_rate else None,
-              "contact_windows": args.contact_windows if args.contact_forces else None}
+              "contact_windows": args.contact_windows if args.contact_forces else None,
+              "eps_f": args.eps_f if ellipsoids else None}
     result.save(args.out, args.timeseries, config=config)
     if args.checkpoint is not None:  # only now that the results are safely written
         ckpt.remove(args.checkpoint)
@@ -76,35 +87,6 @@ def cmd_eos(args) -> int:
     for path in checkpoints:  # only now that the result is safely written
         ckpt.remove(path)
     log.info("wrote %s: phi=%.6f Z=%.5f +- %.5f", args.out, res.phi, res.Z, res.Z_err)
-    return 0
-
-
-def cmd_compress_ellipsoids(args) -> int:
-    """LS compression of an ellipsoid or ellipse packing (event-driven MD with rotation and growth)."""
-    from hardpack.io import checkpoint as ckpt
-    from hardpack.io import load_packing
-    from hardpack.md import StopCriteria
-    from hardpack.md.ellipsoid import compress_ellipsoids
-
-    packing = load_packing(args.init)
-    stop = StopCriteria(max_pressure=args.max_pressure, target_phi=args.target_phi,
-                        max_collisions=args.max_collisions, max_wall_time=args.max_wall_time)
-    result = compress_ellipsoids(packing, args.growth_rate, args.seed, stop=stop, checkpoint=args.checkpoint,
-                                 window=args.window, checkpoint_interval=args.checkpoint_interval,
-                                 final_growth_rate=args.final_growth_rate,
-                                 switch_pressure=args.switch_pressure, eps_f=args.eps_f,
-                                 keep_checkpoint=True)
-    config = {"init": str(args.init), "growth_rate": args.growth_rate, "seed": args.seed,
-              "max_pressure": args.max_pressure, "target_phi": args.target_phi,
-              "max_collisions": args.max_collisions, "window": args.window,
-              "final_growth_rate": args.final_growth_rate, "eps_f": args.eps_f,
-              "switch_pressure": args.switch_pressure if args.final_growth_rate else None}
-    result.save(args.out, args.timeseries, config=config)
-    if args.checkpoint is not None:
-        ckpt.remove(args.checkpoint)
-    s = result.stats
-    log.info("wrote %s: phi=%.8f Z=%.4g phi_J_est=%.8f (%s, %d collisions, %.1f s)", args.out,
-             s["phi"], s["Z"], s["phi_J_est"], s["stop_reason"], s["collisions"], s["wall_time"])
     return 0
 
 
@@ -137,32 +119,10 @@ def register(subparsers) -> None:
                         "last --contact-windows windows) as md_contact_* variables in --out")
     p.add_argument("--contact-windows", type=int, default=10,
                    help="windows averaged for --contact-forces (default 10)")
-    p.set_defaults(func=cmd_compress)
-
-    p = subparsers.add_parser("compress-ellipsoids", help=cmd_compress_ellipsoids.__doc__)
-    p.add_argument("--init", required=True, help="start packing of ellipsoids or ellipses (netCDF)")
-    p.add_argument("--out", required=True, help="final packing (netCDF)")
-    p.add_argument("--timeseries", help="per-window time series (netCDF)")
-    p.add_argument("--growth-rate", type=float, required=True,
-                   help="Gamma = (d<D>/dt)/sqrt(kT/m), D the volume-equivalent diameter")
-    p.add_argument("--seed", type=int, required=True, help="seed of the initial (angular) velocities")
-    p.add_argument("--max-pressure", type=_optional_float, default=1e12,
-                   help="stop at this reduced pressure pV/(NkT) (default 1e12; 'none' disables)")
-    p.add_argument("--target-phi", type=float, help="stop exactly at this volume fraction")
-    p.add_argument("--max-collisions", type=int, help="stop after this many collisions")
-    p.add_argument("--max-wall-time", type=float, help="stop after this many seconds")
-    p.add_argument("--checkpoint", help="checkpoint file (as for compress)")
-    p.add_argument("--checkpoint-interval", type=float, default=300.0,
-                   help="seconds between checkpoints (default 300)")
-    p.add_argument("--window", type=float,
-                   help="collisions per particle between velocity rescalings (default: from Gamma)")
-    p.add_argument("--final-growth-rate", type=float, help="slow final stage from --switch-pressure on")
-    p.add_argument("--switch-pressure", type=float, default=1e3,
-                   help="reduced pressure at which --final-growth-rate takes over (default 1e3)")
     p.add_argument("--eps-f", type=float, default=1e-4,
-                   help="tolerance of the collision search on the contact function (default 1e-4, "
-                        "Donev 2006 sec. 3.5.1)")
-    p.set_defaults(func=cmd_compress_ellipsoids)
+                   help="ellipsoids: tolerance of the collision search on the contact function "
+                        "(default 1e-4, Donev 2006 sec. 3.5.1)")
+    p.set_defaults(func=cmd_compress)
 
     p = subparsers.add_parser("eos", help=cmd_eos.__doc__)
     p.add_argument("--init", required=True, help="start packing (netCDF)")
