@@ -1,0 +1,547 @@
+"""First- and second-order jamming tests of packings of ellipses and ellipsoids.
+
+Donev 2006, dissertation Secs. 5.5.1-5.5.3 (first-order flexes, self-stresses, the stress matrix
+and the test for ideal packings) and Sec. 5.6 (the shifted form for large packings). Contacts,
+rigidity and stress matrices are those of :mod:`hardpack.jamming.ellipsoids`.
+
+Degrees of freedom. The columns are the particles' translations and rotations, reduced by:
+
+- frozen particles (argument ``frozen``): all their columns are removed; they are fixed obstacles
+  (Donev 2006, Fig. 5.5 and Sec. 5.5.4: fixed ellipses);
+- trivial spins: a particle symmetric about an axis (a spheroid: two equal semiaxes; an ellipse
+  with equal semiaxes, i.e. a disk; a sphere: all three rotations) does not change its shape under
+  a rotation about that axis, so that column of A^T and of the stress matrix vanishes identically.
+  We remove it from the basis (exact, decided from the semiaxes to a relative 1e-12, not from
+  the numbers of A): the rotational basis of a spheroid is the two directions orthogonal to its
+  symmetry axis (Donev 2006, Sec. 5.6 penalises the same spin with k u u^T instead). The dof per
+  particle are then 3 (ellipses), 2 (disks), 6 (general ellipsoids), 5 (spheroids), 3 (spheres);
+- global translations: with no frozen particle in a periodic cell the d uniform translations of
+  the backbone are trivial floppy modes; they are projected out of the floppy space.
+
+Procedure (Donev 2006, Sec. 5.5.3, on the rattler-free backbone; dense linear algebra):
+
+1. rank r of A^T (SVD, relative tolerance ``rank_tol``): N_stresses = M - r,
+   N_floppy = n - r - t (n reduced dof, t trivial motions);
+2. self-stress LP (Eq. 5.9): max eps s.t. A F = 0, F >= eps, sum F = M. No self-stress
+   (infeasible or eps < 0): *not jammed*, decided at first order (a strict first-order flex
+   exists, Eqs. 5.6-5.7). eps = 0 (a self-stress, but none strict): *undetermined* (Donev: the
+   test is inconclusive); the packing is not first-order rigid;
+3. strict self-stress and N_floppy = 0: *jammed* at first order (first-order rigid). Hypostatic
+   packings (M < n - t) always have N_floppy > 0 and go on;
+4. the projected stiffness K_V = V^T K V, V an orthonormal basis of the nontrivial floppy space
+   (null(A^T) orthogonal to the trivial motions) and K = -sum_c (F_c / s_c) Hess zeta_c the
+   negative of Donev's stress matrix (Eq. 5.16; sign convention in
+   :mod:`hardpack.jamming.ellipsoids`). lambda_min(K_V) > tol: *jammed* at second order
+   (pre-stress stable with the LP's self-stress F, Eq. 5.17); lambda_min < -tol with a unique
+   self-stress: *not jammed* (second-order flexible: V x_min extends to an unjamming motion,
+   Eq. 5.14); otherwise (several self-stresses, for which a semidefinite program would be needed,
+   or |lambda_min| <= tol) *undetermined*. tol = ``eig_tol`` times the largest |K| entry.
+
+Local test: each particle among its neighbours, which are fixed (its own columns only, no
+trivial motion); the same procedure, so a particle held only at second order (Fig. 5.5) is
+locally jammed. Particles that are not locally jammed are rattlers and are removed iteratively
+(their contacts dropped), as in the sphere code (Donev 2006, Sec. 4.2.4.1).
+
+Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): Donev's shifted form
+(Sec. 5.6): the smallest eigenvalue of k A A^T + k P_T + K, P_T the projector on the trivial
+motions, k = ``shift`` times |K| / |A A^T|, by scipy.sparse.linalg.eigsh in shift-invert mode
+about a small negative sigma. For large k it is positive iff K_V is positive definite (and then
+also says whether there are nontrivial floppy modes: the smallest eigenvalue of A A^T + P_T).
+N_stresses is then not computed (stored as -1), so a negative eigenvalue gives *undetermined*
+unless M <= n - t + 1 ... see :func:`_decide_sparse`.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.packing import Packing
+from hardpack.jamming.ellipsoids import (
+    EllipsoidContacts,
+    check_ellipsoid_packing,
+    contact_hessians,
+    dof_per_particle,
+    ellipsoid_contacts,
+    rigidity_transpose_full,
+    stiffness_matrix_full,
+)
+from hardpack.jamming.highs import LPFailure, recording_fallbacks, solve_lp
+from hardpack.jamming.result import Verdict
+
+__all__ = ["EllipsoidJammingResult", "Decision", "verify_ellipsoids", "DEFAULT_DELTA", "DENSE_LIMIT"]
+
+#: contact tolerance mu - 1 of exact (ideal) packings
+DEFAULT_DELTA = 1e-9
+#: reduced dof above which method="auto" uses the sparse shifted form
+DENSE_LIMIT = 3000
+#: symmetric semiaxes: equal to this relative tolerance
+SYMMETRY_RTOL = 1e-12
+#: numerical fallbacks recorded in the result
+FALLBACKS = {
+    "sparse_eigsh_dense": "eigsh did not converge on the shifted matrix; a dense eigh was used",
+}
+
+
+# ------------------------------------------------------------------------------------- dof basis
+def rotation_basis(semiaxes: np.ndarray, shape_inv: np.ndarray) -> list[np.ndarray]:
+    """Per particle, an orthonormal basis (k, r_i) of its nontrivial rotations (module docstring)."""
+    d = semiaxes.shape[1]
+    out = []
+    for axes, inv in zip(semiaxes, shape_inv):
+        s = np.sort(axes)
+        close = np.isclose(s[1:], s[:-1], rtol=SYMMETRY_RTOL, atol=0.0)
+        if d == 2:
+            out.append(np.zeros((1, 0)) if close[0] else np.ones((1, 1)))
+            continue
+        if close.all():
+            out.append(np.zeros((3, 0)))
+        elif not close.any():
+            out.append(np.eye(3))
+        else:
+            w, vecs = np.linalg.eigh(inv)  # eigenvalues a_k^2, ascending
+            axis = vecs[:, 2] if close[0] else vecs[:, 0]  # the distinct semiaxis
+            q, _ = np.linalg.qr(np.column_stack([axis, np.eye(3)]))
+            out.append(q[:, 1:3])
+    return out
+
+
+def dof_basis(net: EllipsoidContacts, moving: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
+    """(T, dof per particle): T maps the reduced dof of the ``moving`` particles to all N d_f
+    columns (frozen particles and trivial spins removed)."""
+    d, n = net.dim, net.n_particles
+    f = dof_per_particle(d)
+    rot = rotation_basis(net.semiaxes, net.shape_inv)
+    rows, cols, vals = [], [], []
+    counts = np.zeros(n, dtype=np.int64)
+    col = 0
+    for p in np.flatnonzero(moving):
+        for k in range(d):
+            rows.append(p * f + k), cols.append(col), vals.append(1.0)
+            col += 1
+        basis = rot[p]
+        for b in range(basis.shape[1]):
+            for a in range(basis.shape[0]):
+                rows.append(p * f + d + a), cols.append(col), vals.append(basis[a, b])
+            col += 1
+        counts[p] = d + basis.shape[1]
+    t = sp.csr_matrix((vals, (rows, cols)), shape=(n * f, col))
+    return t, counts
+
+
+def trivial_translations(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray) -> np.ndarray:
+    """Orthonormal (n_red, d) uniform translations of the ``moving`` particles in reduced dof."""
+    d, n = net.dim, net.n_particles
+    f = dof_per_particle(d)
+    full = np.zeros((n * f, d))
+    for k in range(d):
+        full[np.flatnonzero(moving) * f + k, k] = 1.0
+    red = t.T @ full
+    return red / np.linalg.norm(red, axis=0)
+
+
+# ------------------------------------------------------------------------------------- decisions
+@dataclass
+class Decision:
+    """Outcome of the procedure of the module docstring on one (sub)packing.
+
+    ``verdict``: :class:`Verdict` code; ``order``: "first", "second" or "undetermined";
+    ``first_order_rigid``: no nontrivial first-order flex; ``lambda_min``: smallest eigenvalue of
+    the projected stiffness (NaN when not computed); ``forces``: the LP self-stress (zeros when
+    none); ``n_stresses`` (-1: not computed), ``n_floppy`` (nontrivial; -1: not computed),
+    ``n_dof`` (reduced, minus trivial), ``n_constraints`` (M); ``reason``: why, in words.
+    """
+
+    verdict: Verdict
+    order: str
+    first_order_rigid: bool
+    reason: str
+    forces: np.ndarray
+    n_stresses: int
+    n_floppy: int
+    n_dof: int
+    n_constraints: int
+    stress_margin: float = float("nan")
+    lambda_min: float = float("nan")
+    motion: np.ndarray | None = None
+    fallbacks: int = 0  # dense eigh after eigsh failed (sparse path)
+
+
+def self_stress_lp(a: sp.spmatrix) -> tuple[float, np.ndarray]:
+    """Donev 2006, Eq. 5.9: max eps s.t. A F = 0, F >= eps, sum F = M. Returns (eps*, F); eps* is
+    -inf (and F zeros) when no F with A F = 0 and sum F = M exists."""
+    nrow, m = a.shape
+    if m == 0:
+        return float("-inf"), np.zeros(0)
+    a = sp.csr_matrix(a)
+    a_eq = sp.vstack([sp.hstack([a, sp.csr_matrix((nrow, 1))]),
+                      sp.csr_matrix(np.concatenate([np.ones(m), [0.0]])[None, :])], format="csr")
+    b_eq = np.concatenate([np.zeros(nrow), [float(m)]])
+    a_ub = sp.hstack([-sp.identity(m, format="csr"), sp.csr_matrix(np.ones((m, 1)))], format="csr")
+    cost = np.zeros(m + 1)
+    cost[-1] = -1.0
+    bounds = [(None, None)] * m + [(None, 1.0)]
+    try:
+        res = solve_lp(cost, A_ub=a_ub, b_ub=np.zeros(m), A_eq=a_eq, b_eq=b_eq, bounds=bounds)
+    except LPFailure:
+        return float("-inf"), np.zeros(m)
+    return float(res.x[-1]), np.asarray(res.x[:m])
+
+
+def _first_order(at: sp.spmatrix, stress_tol: float) -> tuple[float, np.ndarray, str | None]:
+    """Self-stress step (2. of the module docstring): (eps*, F, reason if not strict)."""
+    eps, forces = self_stress_lp(at.T)
+    if eps < -stress_tol:
+        return eps, np.zeros(at.shape[0]), (
+            "no self-stress (force and torque balance with F >= 0 fails; LP 5.9 optimum "
+            f"{eps:.3g}): a strict first-order flex exists")
+    if eps <= stress_tol:
+        return eps, np.clip(forces, 0.0, None), (
+            "a self-stress exists but none is strict (LP 5.9 optimum 0): some contact carries no "
+            "force, the first-order test is inconclusive (Donev 2006, Sec. 5.5.3)")
+    return eps, forces, None
+
+
+def decide_dense(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: float = 1e-9,
+                 stress_tol: float = 1e-9, eig_tol: float = 1e-9) -> Decision:
+    """The procedure of the module docstring with dense linear algebra.
+
+    Parameters
+    ----------
+    at : sparse matrix, shape (M, n)
+        A^T in reduced dof.
+    stiffness : callable
+        forces (M,) -> dense (n, n) projected-on-reduced-dof stiffness K.
+    trivial : ndarray, shape (n, t)
+        Orthonormal trivial motions (translations), t may be 0.
+    rank_tol, stress_tol, eig_tol : float
+        Relative tolerances of the rank, of the LP's eps*, of lambda_min.
+
+    Returns
+    -------
+    Decision
+    """
+    m, n = at.shape
+    t = trivial.shape[1]
+    dense = at.toarray()
+    if m:
+        u, s, vh = np.linalg.svd(dense, full_matrices=True)
+        rank = int((s > rank_tol * s.max()).sum()) if s.size and s.max() > 0 else 0
+    else:
+        vh, rank = np.eye(n), 0
+    n_stresses, n_floppy = m - rank, n - rank - t
+    common = dict(n_stresses=n_stresses, n_floppy=n_floppy, n_dof=n - t, n_constraints=m)
+    if n - t == 0:
+        return Decision(Verdict.JAMMED, "first", True, "no nontrivial degree of freedom",
+                        np.zeros(m), **common)
+    if m == 0:
+        return Decision(Verdict.NOT_JAMMED, "first", False, "no contacts", np.zeros(0), **common)
+    eps, forces, why = _first_order(at, stress_tol)
+    if why is not None:
+        verdict = Verdict.NOT_JAMMED if eps < -stress_tol else Verdict.UNDETERMINED
+        return Decision(verdict, "first" if verdict == Verdict.NOT_JAMMED else "undetermined",
+                        False, why, forces, stress_margin=eps, **common)
+    if n_floppy <= 0:
+        return Decision(Verdict.JAMMED, "first", True,
+                        "strict self-stress and no nontrivial floppy mode: first-order rigid",
+                        forces, stress_margin=eps, **common)
+    null = vh[rank:].T  # (n, n - rank)
+    if t:
+        null = null - trivial @ (trivial.T @ null)
+        q, sv, _ = np.linalg.svd(null, full_matrices=False)
+        null = q[:, : n_floppy]
+    k = stiffness(forces)
+    kv = null.T @ k @ null
+    w, x = np.linalg.eigh(0.5 * (kv + kv.T))
+    scale = max(np.abs(k).max(), 1e-300)
+    lam = float(w[0])
+    common.update(stress_margin=eps, lambda_min=lam / scale)
+    if lam > eig_tol * scale:
+        return Decision(Verdict.JAMMED, "second", False,
+                        f"{n_floppy} floppy mode(s), all blocked by the stress matrix "
+                        f"(lambda_min(K_V) = {lam / scale:.3g} of max |K|): second-order jammed", forces, **common)
+    motion = null @ x[:, 0]
+    if lam < -eig_tol * scale and n_stresses == 1:
+        return Decision(Verdict.NOT_JAMMED, "second", False,
+                        "a floppy mode with negative stiffness and a unique self-stress: "
+                        "second-order flexible", forces, motion=motion, **common)
+    why = ("several self-stresses: the LP's does not block every floppy mode, another might "
+           "(a semidefinite program would decide, Donev 2006, Sec. 5.5.2.1)" if lam < 0 else
+           "lambda_min(K_V) is zero within the tolerance: higher orders would decide")
+    return Decision(Verdict.UNDETERMINED, "undetermined", False, why, forces, motion=motion, **common)
+
+
+def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, stress_tol: float = 1e-9,
+                  eig_tol: float = 1e-9, shift: float = 1e3) -> Decision:
+    """Donev's shifted form (Sec. 5.6) for large packings: the smallest eigenvalues of
+    A A^T + P_T (floppy modes?) and of k (A A^T + P_T) + K (second order), by eigsh in
+    shift-invert mode. N_stresses and N_floppy are not computed (-1); a negative eigenvalue is
+    reported as not jammed only when the packing has M <= n - t + 1 (then a strict self-stress
+    is unique unless A is rank deficient, which the LP's uniqueness cannot show: recorded in
+    the reason)."""
+    m, n = at.shape
+    t = trivial.shape[1]
+    common = dict(n_stresses=-1, n_floppy=-1, n_dof=n - t, n_constraints=m)
+    eps, forces, why = _first_order(at, stress_tol)
+    if why is not None:
+        verdict = Verdict.NOT_JAMMED if eps < -stress_tol else Verdict.UNDETERMINED
+        return Decision(verdict, "first" if verdict == Verdict.NOT_JAMMED else "undetermined",
+                        False, why, forces, stress_margin=eps, **common)
+    gram = (at.T @ at).tocsc()
+    if t:
+        gram = gram + sp.csc_matrix(trivial @ trivial.T)
+    k = sp.csc_matrix(stiffness(forces))
+    gscale = max(abs(gram).max(), 1e-300)
+    kscale = max(abs(k).max(), 1e-300)
+    g_min, fell1 = _smallest_eigenvalue(gram / gscale)
+    if g_min > eig_tol:
+        return Decision(Verdict.JAMMED, "first", True,
+                        "strict self-stress and no nontrivial floppy mode: first-order rigid",
+                        forces, stress_margin=eps, fallbacks=int(fell1), **common)
+    k_shift = shift * kscale / gscale
+    lam, fell2 = _smallest_eigenvalue((k_shift * gram + k) / kscale)
+    common["fallbacks"] = int(fell1) + int(fell2)
+    common.update(stress_margin=eps, lambda_min=lam)
+    if lam > eig_tol:
+        return Decision(Verdict.JAMMED, "second", False,
+                        f"floppy modes blocked by the stress matrix (smallest eigenvalue of the "
+                        f"shifted form {lam:.3g} of max |K|): second-order jammed", forces, **common)
+    return Decision(Verdict.UNDETERMINED, "undetermined", False,
+                    "the shifted form has a non-positive eigenvalue; the sparse path does not count "
+                    "self-stresses, so it cannot tell second-order flexible from undetermined "
+                    "(use method='dense')", forces, **common)
+
+
+def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
+    """(smallest eigenvalue of a sparse symmetric matrix by shift-invert about -1e-3 (its scale is
+    1), whether eigsh failed and a dense eigh gave it)."""
+    if mat.shape[0] <= 200:
+        return float(np.linalg.eigvalsh(mat.toarray())[0]), False
+    try:
+        w = spla.eigsh(mat, k=1, sigma=-1e-3, which="LM", return_eigenvectors=False)
+        return float(w.min()), False
+    except (spla.ArpackNoConvergence, RuntimeError):
+        return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
+
+
+# ------------------------------------------------------------------------------------- result
+@dataclass
+class EllipsoidJammingResult:
+    """What :func:`verify_ellipsoids` found (see the module docstring).
+
+    ``local``: Verdict per particle of the local test (NOT_RUN for frozen particles);
+    ``rattler``: particles removed by the iterated local test; ``collective``: the
+    :class:`Decision` on the backbone; ``dof``: reduced dof per particle (0 for frozen ones).
+    """
+
+    params: dict
+    network: EllipsoidContacts
+    frozen: np.ndarray
+    local: np.ndarray
+    rattler: np.ndarray
+    collective: Decision
+    contacts_used: np.ndarray
+    dof: np.ndarray
+    seconds: dict = field(default_factory=dict)
+    fallbacks: dict = field(default_factory=dict)
+
+    @property
+    def verdict(self) -> Verdict:
+        return self.collective.verdict
+
+    @property
+    def order(self) -> str:
+        """"first", "second" or "undetermined": the order of the test that decided."""
+        return self.collective.order
+
+    @property
+    def backbone(self) -> np.ndarray:
+        return ~self.frozen & ~self.rattler
+
+    @property
+    def z_mean(self) -> float:
+        """Mean contacts per backbone particle (contacts with frozen particles included)."""
+        nb = int(self.backbone.sum())
+        if not nb:
+            return float("nan")
+        used = self.network.subset(self.contacts_used)
+        return float(used.counts()[self.backbone].sum() / nb)
+
+    @property
+    def isostaticity_gap(self) -> int:
+        """M_b - N_f: constraints minus nontrivial dof of the backbone (0 or 1: isostatic,
+        Donev 2006, Sec. 5.4.1; negative: hypostatic)."""
+        return self.collective.n_constraints - self.collective.n_dof
+
+    def summary(self) -> str:
+        c = self.collective
+        nb = int(self.backbone.sum())
+        lines = [
+            f"verdict: {self.verdict.name.lower().replace('_', ' ')} (decided at order: {self.order}); {c.reason}",
+            (f"N={self.network.n_particles}, frozen={int(self.frozen.sum())}, rattlers="
+             f"{int(self.rattler.sum())}, backbone={nb}, contacts M_b={c.n_constraints}, Z={self.z_mean:.4f}"),
+            (f"dof N_f={c.n_dof} (per particle: {np.unique(self.dof[self.backbone]).tolist()}), "
+             f"M_b - N_f = {self.isostaticity_gap}, self-stresses {c.n_stresses}, nontrivial floppy "
+             f"modes {c.n_floppy}, lambda_min(K_V) = {c.lambda_min:.4g}"),
+        ]
+        for name, count in self.fallbacks.items():
+            if count:
+                lines.append(f"numerical fallback {name}: {count}")
+        return "\n".join(lines)
+
+    def to_dataset(self) -> xr.Dataset:
+        """Per-particle and per-contact arrays and scalar attributes (verdict codes of
+        :class:`Verdict`: 1 jammed, 0 not jammed, -1 not run, -2 undetermined)."""
+        net, c = self.network, self.collective
+        forces = np.zeros(net.n_contacts)
+        forces[self.contacts_used] = c.forces
+        data = {
+            "contact_i": (("contact",), net.i),
+            "contact_j": (("contact",), net.j),
+            "contact_shift": (("contact", "dim"), net.shift),
+            "contact_gap": (("contact",), net.gap),
+            "contact_normal": (("contact", "dim"), net.normal),
+            "contact_used": (("contact",), self.contacts_used.astype(np.int8)),
+            "force": (("contact",), forces),
+            "frozen": (("particle",), self.frozen.astype(np.int8)),
+            "rattler": (("particle",), self.rattler.astype(np.int8)),
+            "local": (("particle",), self.local.astype(np.int8)),
+            "dof": (("particle",), self.dof),
+        }
+        attrs = dict(
+            hardpack_kind="ellipsoid_jamming", verdict=int(self.verdict), order=self.order,
+            reason=c.reason, first_order_rigid=int(c.first_order_rigid),
+            N=net.n_particles, d=net.dim, n_contacts=net.n_contacts, n_frozen=int(self.frozen.sum()),
+            n_rattlers=int(self.rattler.sum()), n_backbone=int(self.backbone.sum()),
+            n_backbone_contacts=c.n_constraints, n_dof=c.n_dof, z_mean=self.z_mean,
+            isostaticity_gap=self.isostaticity_gap, n_stresses=c.n_stresses, n_floppy=c.n_floppy,
+            lambda_min=c.lambda_min, stress_margin=c.stress_margin,
+            n_local_undetermined=int((self.local == Verdict.UNDETERMINED).sum()),
+            **{k: v for k, v in self.params.items() if v is not None},
+            **{f"fallback_{k}": int(v) for k, v in self.fallbacks.items()},
+            **{f"seconds_{k}": v for k, v in self.seconds.items()},
+        )
+        return xr.Dataset(data, attrs=attrs)
+
+
+# ------------------------------------------------------------------------------------- verify
+def _submatrices(net, at_full, hess, t_full, owner, contacts, moving):
+    """(A^T, dense stiffness(forces), sparse stiffness(forces), T) restricted to ``contacts`` and
+    the reduced dof of the ``moving`` particles (``owner``: the particle of each reduced column)."""
+    tm = t_full[:, np.flatnonzero(moving[owner])]
+    at = (at_full[contacts] @ tm).tocsr()
+    sub = net.subset(contacts)
+    sub_hess = hess[contacts]
+
+    def stiffness_sparse(forces):
+        return (tm.T @ stiffness_matrix_full(sub, forces, sub_hess) @ tm).tocsc()
+
+    def stiffness(forces):
+        return stiffness_sparse(forces).toarray()
+
+    return at, stiffness, stiffness_sparse, tm
+
+
+def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
+                      method: str = "auto", local: bool = True, rank_tol: float = 1e-9,
+                      stress_tol: float = 1e-9, eig_tol: float = 1e-9) -> EllipsoidJammingResult:
+    """Jamming test of a periodic packing of ellipses or ellipsoids (module docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        Ellipses or ellipsoids in a periodic cell (the contacts must be exact to ``delta``).
+    delta : float, optional
+        Contact tolerance mu - 1 (default DEFAULT_DELTA, 1e-9).
+    frozen : array_like of bool, shape (N,), optional
+        Fixed particles (obstacles): no dof, no balance equations.
+    method : {"auto", "dense", "sparse"}
+        Linear algebra of the collective test ("auto": dense up to DENSE_LIMIT reduced dof).
+    local : bool, default True
+        Run the iterated local test (rattler removal) before the collective test.
+    rank_tol, stress_tol, eig_tol : float
+        Relative tolerances of the rank of A, of the self-stress LP's margin, of lambda_min.
+
+    Returns
+    -------
+    EllipsoidJammingResult
+
+    Raises
+    ------
+    InvalidInputError
+        For a packing that is not a periodic ellipsoid packing, a bad ``delta``, ``frozen`` of
+        the wrong shape, an unknown ``method`` or non-positive tolerances.
+    """
+    check_ellipsoid_packing(packing)
+    n = packing.n_particles
+    if method not in ("auto", "dense", "sparse"):
+        raise InvalidInputError(f"method must be 'auto', 'dense' or 'sparse', got {method!r}")
+    for name, value in (("rank_tol", rank_tol), ("stress_tol", stress_tol), ("eig_tol", eig_tol)):
+        if not (np.isfinite(value) and 0 < value < 1):
+            raise InvalidInputError(f"{name} must be in (0, 1), got {value!r}")
+    frozen = np.zeros(n, dtype=bool) if frozen is None else np.asarray(frozen)
+    if frozen.shape != (n,) or frozen.dtype != bool:
+        raise InvalidInputError(f"frozen must be a boolean array of shape ({n},), got {frozen.dtype} {frozen.shape}")
+    delta = DEFAULT_DELTA if delta is None else delta
+    seconds = {}
+    t0 = time.perf_counter()
+    net = ellipsoid_contacts(packing, delta)
+    at_full = rigidity_transpose_full(net)
+    hess = contact_hessians(net)
+    t_full, dof = dof_basis(net, ~frozen)
+    owner = np.repeat(np.flatnonzero(~frozen), dof[~frozen])
+    seconds["contacts"] = time.perf_counter() - t0
+    tols = dict(stress_tol=stress_tol, eig_tol=eig_tol)
+    with recording_fallbacks() as fallbacks:
+        t0 = time.perf_counter()
+        local_verdict = np.full(n, int(Verdict.NOT_RUN), dtype=np.int64)
+        active = ~frozen
+        if local:
+            changed = True
+            while changed:
+                changed = False
+                for p in np.flatnonzero(active):
+                    present = active | frozen
+                    contacts = np.flatnonzero(((net.i == p) | (net.j == p)) & present[net.i] & present[net.j])
+                    only = np.zeros(n, dtype=bool)
+                    only[p] = True
+                    at, stiff, _, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only)
+                    dec = decide_dense(at, stiff, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
+                    local_verdict[p] = int(dec.verdict)
+                    if dec.verdict == Verdict.NOT_JAMMED:
+                        active[p] = False
+                        changed = True
+        seconds["local"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        present = active | frozen
+        used = present[net.i] & present[net.j] & (active[net.i] | active[net.j])
+        contacts = np.flatnonzero(used)
+        at, stiff, stiff_sparse, tm = _submatrices(net, at_full, hess, t_full, owner, contacts, active)
+        trivial = (trivial_translations(tm, net, active) if not frozen.any() and active.any()
+                   else np.zeros((at.shape[1], 0)))
+        dense = method == "dense" or (method == "auto" and at.shape[1] <= DENSE_LIMIT)
+        if not active.any():
+            dec = Decision(Verdict.NOT_JAMMED, "first", False,
+                           "every particle is a rattler: nothing is jammed", np.zeros(len(contacts)),
+                           0, 0, 0, len(contacts))
+        elif dense:
+            dec = decide_dense(at, stiff, trivial, rank_tol=rank_tol, **tols)
+        else:
+            dec = decide_sparse(at, stiff_sparse, trivial, **tols)
+        seconds["collective"] = time.perf_counter() - t0
+    params = dict(delta=float(delta), method="dense" if dense else "sparse", rank_tol=rank_tol,
+                  stress_tol=stress_tol, eig_tol=eig_tol)
+    rattler = ~frozen & ~active
+    return EllipsoidJammingResult(
+        params=params, network=net, frozen=frozen, local=local_verdict, rattler=rattler,
+        collective=dec, contacts_used=used, dof=np.where(frozen, 0, dof), seconds=seconds,
+        fallbacks={**{k: int(v) for k, v in fallbacks.items()},
+                   "sparse_eigsh_dense": dec.fallbacks},
+    )
