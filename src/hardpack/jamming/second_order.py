@@ -84,6 +84,8 @@ DEFAULT_DELTA = 1e-9
 DENSE_LIMIT = 3000
 #: symmetric semiaxes: equal to this relative tolerance
 SYMMETRY_RTOL = 1e-12
+#: codes of the order that decided a test, as stored in datasets
+ORDER_CODES = {"undetermined": 0, "first": 1, "second": 2}
 #: numerical fallbacks recorded in the result
 FALLBACKS = {
     "sparse_eigsh_dense": "eigsh did not converge on the shifted matrix; a dense eigh was used",
@@ -154,7 +156,8 @@ class Decision:
 
     ``verdict``: :class:`Verdict` code; ``order``: "first", "second" or "undetermined";
     ``first_order_rigid``: no nontrivial first-order flex; ``lambda_min``: smallest eigenvalue of
-    the projected stiffness (NaN when not computed); ``forces``: the LP self-stress (zeros when
+    the projected stiffness K_V (sparse path: of the shifted form; NaN when not computed), in the
+    units of K, whose largest |entry| is ``stiffness_scale``; ``forces``: the LP self-stress (zeros when
     none); ``n_stresses`` (-1: not computed), ``n_floppy`` (nontrivial; -1: not computed),
     ``n_dof`` (reduced, minus trivial), ``n_constraints`` (M); ``reason``: why, in words.
     """
@@ -170,6 +173,7 @@ class Decision:
     n_constraints: int
     stress_margin: float = float("nan")
     lambda_min: float = float("nan")
+    stiffness_scale: float = float("nan")
     motion: np.ndarray | None = None
     fallbacks: int = 0  # dense eigh after eigsh failed (sparse path)
 
@@ -209,7 +213,7 @@ def _first_order(at: sp.spmatrix, stress_tol: float) -> tuple[float, np.ndarray,
     return eps, forces, None
 
 
-def decide_dense(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: float = 1e-9,
+def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, rank_tol: float = 1e-9,
                  stress_tol: float = 1e-9, eig_tol: float = 1e-9) -> Decision:
     """The procedure of the module docstring with dense linear algebra.
 
@@ -218,7 +222,9 @@ def decide_dense(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: f
     at : sparse matrix, shape (M, n)
         A^T in reduced dof.
     stiffness : callable
-        forces (M,) -> dense (n, n) projected-on-reduced-dof stiffness K.
+        forces (M,) -> dense (n, n) stiffness K in reduced dof.
+    quadratic : callable
+        y (n, k) -> (M, k): y_k^T K_c y_k per contact (K = sum_c F_c K_c), for several stresses.
     trivial : ndarray, shape (n, t)
         Orthonormal trivial motions (translations), t may be 0.
     rank_tol, stress_tol, eig_tol : float
@@ -258,24 +264,88 @@ def decide_dense(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: f
         q, sv, _ = np.linalg.svd(null, full_matrices=False)
         null = q[:, : n_floppy]
     k = stiffness(forces)
-    kv = null.T @ k @ null
-    w, x = np.linalg.eigh(0.5 * (kv + kv.T))
     scale = max(np.abs(k).max(), 1e-300)
+    w, x = _projected_eigh(k, null)
+    note = ""
+    if w[0] <= eig_tol * scale and n_stresses > 1:
+        forces, w, x, flex = _best_stress(at, stiffness, quadratic, null, forces, w, x, eig_tol * scale)
+        k = stiffness(forces)
+        scale = max(np.abs(k).max(), 1e-300)
+        note = (" (the self-stress that maximises lambda_min(K_V) among the "
+                f"{n_stresses}-dimensional space of self-stresses)")
+    else:
+        flex = None
     lam = float(w[0])
-    common.update(stress_margin=eps, lambda_min=lam / scale)
+    common.update(stress_margin=eps, lambda_min=lam, stiffness_scale=scale)
     if lam > eig_tol * scale:
         return Decision(Verdict.JAMMED, "second", False,
                         f"{n_floppy} floppy mode(s), all blocked by the stress matrix "
-                        f"(lambda_min(K_V) = {lam / scale:.3g} of max |K|): second-order jammed", forces, **common)
+                        f"(lambda_min(K_V) = {lam / scale:.3g} of max |K|){note}: second-order jammed",
+                        forces, **common)
     motion = null @ x[:, 0]
     if lam < -eig_tol * scale and n_stresses == 1:
         return Decision(Verdict.NOT_JAMMED, "second", False,
                         "a floppy mode with negative stiffness and a unique self-stress: "
                         "second-order flexible", forces, motion=motion, **common)
-    why = ("several self-stresses: the LP's does not block every floppy mode, another might "
-           "(a semidefinite program would decide, Donev 2006, Sec. 5.5.2.1)" if lam < 0 else
+    if flex is not None:
+        return Decision(Verdict.NOT_JAMMED, "second", False,
+                        f"a floppy mode on which every self-stress has negative stiffness (LP 5.15 "
+                        f"optimum {flex[0]:.3g}): second-order flexible", forces, motion=null @ flex[1],
+                        **common)
+    why = ("several self-stresses and none blocks every floppy mode, while each mode tried is "
+           "blocked by some self-stress (Donev 2006, Sec. 5.5.2.1: the general case)" if lam < 0 else
            "lambda_min(K_V) is zero within the tolerance: higher orders would decide")
     return Decision(Verdict.UNDETERMINED, "undetermined", False, why, forces, motion=motion, **common)
+
+
+def _projected_eigh(k: np.ndarray, null: np.ndarray):
+    kv = null.T @ k @ null
+    return np.linalg.eigh(0.5 * (kv + kv.T))
+
+
+#: iterations of the cutting-plane search of :func:`_best_stress`
+MAX_CUTS = 100
+
+
+def _best_stress(at, stiffness, quadratic, null, forces, w, x, tol):
+    """Maximise lambda_min(K_V(F)) over the self-stresses F >= 0, sum F = M (concave in F) by
+    Kelley's cutting planes: each eigenvector x of K_V(F) gives the linear cut
+    t <= sum_c F_c x^T V^T K_c V x. Stops when lambda_min > tol (pre-stress stable), when the
+    LP's bound t <= tol (no self-stress blocks all floppy modes), or after MAX_CUTS LPs.
+
+    Returns (F, eigenvalues, eigenvectors, flex) with flex = (optimum, x) when a floppy mode x
+    was found on which every self-stress has negative stiffness (max_F x^T K_V(F) x < -tol, the
+    dual LP 5.15 of a strict second-order flex), else None."""
+    m = at.shape[0]
+    a = sp.csr_matrix(at.T)
+    nrow = a.shape[0]
+    a_eq = sp.vstack([sp.hstack([a, sp.csr_matrix((nrow, 1))]),
+                      sp.csr_matrix(np.concatenate([np.ones(m), [0.0]])[None, :])], format="csr")
+    b_eq = np.concatenate([np.zeros(nrow), [float(m)]])
+    cost = np.zeros(m + 1)
+    cost[-1] = -1.0
+    bounds = [(0.0, None)] * m + [(None, None)]
+    cuts = []
+    best = (w, x, forces)
+    for _ in range(MAX_CUTS):
+        use = x[:, : max(1, int((w <= w[0] + abs(w[0]) + tol).sum()))]
+        q = quadratic(null @ use)  # (M, k)
+        for col in range(q.shape[1]):
+            if q[:, col] @ forces <= tol:
+                # a mode this stress does not block: is it blocked by any self-stress?
+                res = solve_lp(-np.concatenate([q[:, col], [0.0]]), A_eq=a_eq, b_eq=b_eq, bounds=bounds[:m] + [(0.0, 0.0)])
+                if -res.fun < -tol:
+                    return best[2], best[0], best[1], (float(-res.fun), use[:, col])
+            cuts.append(q[:, col])
+        a_ub = np.column_stack([-np.array(cuts), np.ones(len(cuts))])
+        res = solve_lp(cost, A_ub=a_ub, b_ub=np.zeros(len(cuts)), A_eq=a_eq, b_eq=b_eq, bounds=bounds)
+        forces, bound = np.clip(res.x[:m], 0.0, None), float(res.x[-1])
+        w, x = _projected_eigh(stiffness(forces), null)
+        if w[0] > best[0][0]:
+            best = (w, x, forces)
+        if best[0][0] > tol or bound <= tol or bound - best[0][0] <= tol:
+            break
+    return best[2], best[0], best[1], None
 
 
 def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, stress_tol: float = 1e-9,
@@ -308,7 +378,7 @@ def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, stress_tol
     k_shift = shift * kscale / gscale
     lam, fell2 = _smallest_eigenvalue((k_shift * gram + k) / kscale)
     common["fallbacks"] = int(fell1) + int(fell2)
-    common.update(stress_margin=eps, lambda_min=lam)
+    common.update(stress_margin=eps, lambda_min=lam * kscale, stiffness_scale=kscale)
     if lam > eig_tol:
         return Decision(Verdict.JAMMED, "second", False,
                         f"floppy modes blocked by the stress matrix (smallest eigenvalue of the "
@@ -336,7 +406,8 @@ def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
 class EllipsoidJammingResult:
     """What :func:`verify_ellipsoids` found (see the module docstring).
 
-    ``local``: Verdict per particle of the local test (NOT_RUN for frozen particles);
+    ``local``: Verdict per particle of the local test (NOT_RUN for frozen particles), decided at
+    ``local_order`` (:data:`ORDER_CODES`: 1 first, 2 second, 0 undetermined or not run);
     ``rattler``: particles removed by the iterated local test; ``collective``: the
     :class:`Decision` on the backbone; ``dof``: reduced dof per particle (0 for frozen ones).
     """
@@ -345,6 +416,7 @@ class EllipsoidJammingResult:
     network: EllipsoidContacts
     frozen: np.ndarray
     local: np.ndarray
+    local_order: np.ndarray
     rattler: np.ndarray
     collective: Decision
     contacts_used: np.ndarray
@@ -413,6 +485,7 @@ class EllipsoidJammingResult:
             "frozen": (("particle",), self.frozen.astype(np.int8)),
             "rattler": (("particle",), self.rattler.astype(np.int8)),
             "local": (("particle",), self.local.astype(np.int8)),
+            "local_order": (("particle",), self.local_order.astype(np.int8)),
             "dof": (("particle",), self.dof),
         }
         attrs = dict(
@@ -422,7 +495,7 @@ class EllipsoidJammingResult:
             n_rattlers=int(self.rattler.sum()), n_backbone=int(self.backbone.sum()),
             n_backbone_contacts=c.n_constraints, n_dof=c.n_dof, z_mean=self.z_mean,
             isostaticity_gap=self.isostaticity_gap, n_stresses=c.n_stresses, n_floppy=c.n_floppy,
-            lambda_min=c.lambda_min, stress_margin=c.stress_margin,
+            lambda_min=c.lambda_min, stiffness_scale=c.stiffness_scale, stress_margin=c.stress_margin,
             n_local_undetermined=int((self.local == Verdict.UNDETERMINED).sum()),
             **{k: v for k, v in self.params.items() if v is not None},
             **{f"fallback_{k}": int(v) for k, v in self.fallbacks.items()},
@@ -446,7 +519,15 @@ def _submatrices(net, at_full, hess, t_full, owner, contacts, moving):
     def stiffness(forces):
         return stiffness_sparse(forces).toarray()
 
-    return at, stiffness, stiffness_sparse, tm
+    f = dof_per_particle(net.dim)
+    idx = np.concatenate([sub.i[:, None] * f + np.arange(f), sub.j[:, None] * f + np.arange(f)], axis=1)
+
+    def quadratic(y):
+        """(M, k): y_k^T K_c y_k of every contact c for the columns y_k of y (n_red, k)."""
+        yc = (tm @ y)[idx]  # (M, 2 d_f, k)
+        return -np.einsum("cak,cab,cbk->ck", yc, sub_hess, yc) / sub.scale[:, None]
+
+    return at, stiffness, stiffness_sparse, quadratic, tm
 
 
 def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
@@ -502,6 +583,7 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     with recording_fallbacks() as fallbacks:
         t0 = time.perf_counter()
         local_verdict = np.full(n, int(Verdict.NOT_RUN), dtype=np.int64)
+        local_order = np.zeros(n, dtype=np.int64)
         active = ~frozen
         if local:
             changed = True
@@ -512,9 +594,10 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
                     contacts = np.flatnonzero(((net.i == p) | (net.j == p)) & present[net.i] & present[net.j])
                     only = np.zeros(n, dtype=bool)
                     only[p] = True
-                    at, stiff, _, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only)
-                    dec = decide_dense(at, stiff, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
+                    at, stiff, _, quad, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only)
+                    dec = decide_dense(at, stiff, quad, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
                     local_verdict[p] = int(dec.verdict)
+                    local_order[p] = ORDER_CODES[dec.order]
                     if dec.verdict == Verdict.NOT_JAMMED:
                         active[p] = False
                         changed = True
@@ -523,16 +606,19 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
         present = active | frozen
         used = present[net.i] & present[net.j] & (active[net.i] | active[net.j])
         contacts = np.flatnonzero(used)
-        at, stiff, stiff_sparse, tm = _submatrices(net, at_full, hess, t_full, owner, contacts, active)
+        at, stiff, stiff_sparse, quad, tm = _submatrices(net, at_full, hess, t_full, owner, contacts, active)
         trivial = (trivial_translations(tm, net, active) if not frozen.any() and active.any()
                    else np.zeros((at.shape[1], 0)))
         dense = method == "dense" or (method == "auto" and at.shape[1] <= DENSE_LIMIT)
         if not active.any():
-            dec = Decision(Verdict.NOT_JAMMED, "first", False,
-                           "every particle is a rattler: nothing is jammed", np.zeros(len(contacts)),
-                           0, 0, 0, len(contacts))
+            second = (local_order == ORDER_CODES["second"]).any()
+            dec = Decision(Verdict.NOT_JAMMED, "second" if second else "first", False,
+                           "every particle is a rattler (the local test"
+                           + (", at second order for some," if second else "")
+                           + " found an unjamming motion of each): nothing is jammed",
+                           np.zeros(len(contacts)), 0, 0, 0, len(contacts))
         elif dense:
-            dec = decide_dense(at, stiff, trivial, rank_tol=rank_tol, **tols)
+            dec = decide_dense(at, stiff, quad, trivial, rank_tol=rank_tol, **tols)
         else:
             dec = decide_sparse(at, stiff_sparse, trivial, **tols)
         seconds["collective"] = time.perf_counter() - t0
@@ -540,7 +626,8 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
                   stress_tol=stress_tol, eig_tol=eig_tol)
     rattler = ~frozen & ~active
     return EllipsoidJammingResult(
-        params=params, network=net, frozen=frozen, local=local_verdict, rattler=rattler,
+        params=params, network=net, frozen=frozen, local=local_verdict, local_order=local_order,
+        rattler=rattler,
         collective=dec, contacts_used=used, dof=np.where(frozen, 0, dof), seconds=seconds,
         fallbacks={**{k: int(v) for k, v in fallbacks.items()},
                    "sparse_eigsh_dense": dec.fallbacks},
