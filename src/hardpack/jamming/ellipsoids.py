@@ -54,6 +54,7 @@ from hardpack.geometry.packing import Packing
 __all__ = [
     "EllipsoidContacts",
     "ellipsoid_contacts",
+    "contacts_of_pairs",
     "dof_per_particle",
     "rigidity_transpose_full",
     "stiffness_matrix_full",
@@ -226,6 +227,45 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
         normal=u, raw_normal=raw, lever_i=point - x[ii], lever_j=point - (x[ii] + sep),
         scale=2.0 * lam * (1.0 - lam) * norm, positions=x, lattice=np.array(packing.lattice, float),
         shape_inv=inv, semiaxes=semiaxes, delta=delta,
+    )
+
+
+def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> EllipsoidContacts:
+    """The contact data of given pairs (i, j, image shift), touching or not (``delta`` = inf).
+
+    Parameters
+    ----------
+    packing : Packing
+        Ellipses or ellipsoids in a periodic cell.
+    i, j : array_like of int, shape (M,)
+        The pairs.
+    shift : array_like of int, shape (M, d)
+        Lattice images: the separation is x_j + L shift - x_i.
+    positions : ndarray, shape (N, d), optional
+        The centres x the shifts refer to (default ``packing.positions`` as given, not wrapped).
+
+    Returns
+    -------
+    EllipsoidContacts
+    """
+    check_ellipsoid_packing(packing)
+    shape = packing.shape
+    n = packing.n_particles
+    semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
+    orient = np.ascontiguousarray(np.asarray(shape.orientations, dtype=float).reshape(n, -1))
+    inv = _shape_inverses(semiaxes, orient)
+    x = np.ascontiguousarray(packing.positions if positions is None else positions, dtype=float)
+    ii, jj = np.asarray(i, np.int64), np.asarray(j, np.int64)
+    shift = np.asarray(shift, np.int64).reshape(len(ii), packing.dim)
+    lattice = np.array(packing.lattice, float)
+    sep = np.ascontiguousarray(x[jj] + shift @ lattice.T - x[ii])
+    zeta, lam, raw, point = _pair_contacts(x, inv, np.asarray(shape.bounding_radii, float), ii, jj, sep)
+    norm = np.linalg.norm(raw, axis=1)
+    return EllipsoidContacts(
+        i=ii, j=jj, shift=shift, separation=sep, zeta=zeta, lam=lam, normal=raw / norm[:, None],
+        raw_normal=raw, lever_i=point - x[ii], lever_j=point - (x[ii] + sep),
+        scale=2.0 * lam * (1.0 - lam) * norm, positions=x, lattice=lattice, shape_inv=inv,
+        semiaxes=semiaxes, delta=float("inf"),
     )
 
 
