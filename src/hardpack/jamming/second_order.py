@@ -47,8 +47,10 @@ Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): Donev's
 motions, k = ``shift`` times |K| / |A A^T|, by scipy.sparse.linalg.eigsh in shift-invert mode
 about a small negative sigma. For large k it is positive iff K_V is positive definite (and then
 also says whether there are nontrivial floppy modes: the smallest eigenvalue of A A^T + P_T).
-N_stresses is then not computed (stored as -1), so a negative eigenvalue gives *undetermined*
-unless M <= n - t + 1 ... see :func:`_decide_sparse`.
+The sign is certified by the inertia of an LDL^T factorisation (Sylvester's law; Donev used a
+Cholesky factorisation, Sec. 5.6), and the eigenvalue is computed with the shift below the
+spectrum. N_stresses and N_floppy are not computed (stored as -1), so a negative eigenvalue gives
+*undetermined* (with a unique self-stress it would be *not jammed*; use the dense method).
 """
 
 from __future__ import annotations
@@ -82,6 +84,8 @@ __all__ = ["EllipsoidJammingResult", "Decision", "verify_ellipsoids", "DEFAULT_D
 DEFAULT_DELTA = 1e-9
 #: reduced dof above which method="auto" uses the sparse shifted form
 DENSE_LIMIT = 3000
+#: sparse path: matrices up to this size get a dense eigh instead of eigsh
+SMALL_EIGH = 50
 #: symmetric semiaxes: equal to this relative tolerance
 SYMMETRY_RTOL = 1e-12
 #: codes of the order that decided a test, as stored in datasets
@@ -351,11 +355,9 @@ def _best_stress(at, stiffness, quadratic, null, forces, w, x, tol):
 def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, stress_tol: float = 1e-9,
                   eig_tol: float = 1e-9, shift: float = 1e3) -> Decision:
     """Donev's shifted form (Sec. 5.6) for large packings: the smallest eigenvalues of
-    A A^T + P_T (floppy modes?) and of k (A A^T + P_T) + K (second order), by eigsh in
-    shift-invert mode. N_stresses and N_floppy are not computed (-1); a negative eigenvalue is
-    reported as not jammed only when the packing has M <= n - t + 1 (then a strict self-stress
-    is unique unless A is rank deficient, which the LP's uniqueness cannot show: recorded in
-    the reason)."""
+    A A^T + P_T (are there floppy modes?) and of k (A A^T + P_T) + K (second order), by eigsh in
+    shift-invert mode (module docstring). N_stresses and N_floppy are not computed (-1), so a
+    non-positive eigenvalue gives *undetermined*."""
     m, n = at.shape
     t = trivial.shape[1]
     common = dict(n_stresses=-1, n_floppy=-1, n_dof=n - t, n_constraints=m)
@@ -389,13 +391,33 @@ def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, stress_tol
                     "(use method='dense')", forces, **common)
 
 
-def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
-    """(smallest eigenvalue of a sparse symmetric matrix by shift-invert about -1e-3 (its scale is
-    1), whether eigsh failed and a dense eigh gave it)."""
-    if mat.shape[0] <= 200:
-        return float(np.linalg.eigvalsh(mat.toarray())[0]), False
+def _negative_pivots(mat: sp.csc_matrix) -> int | None:
+    """Number of negative eigenvalues of a symmetric sparse matrix by Sylvester's law of inertia:
+    the negative pivots of its LU factorisation with a symmetric permutation and no pivoting
+    (P M P^T = L D L^T, U = D L^T). None when the factorisation failed or pivoted."""
     try:
-        w = spla.eigsh(mat, k=1, sigma=-1e-3, which="LM", return_eigenvectors=False)
+        lu = spla.splu(mat.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:  # exactly singular
+        return None
+    if not np.array_equal(lu.perm_r, lu.perm_c):
+        return None
+    return int((lu.U.diagonal() < 0).sum())
+
+
+def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
+    """(smallest eigenvalue of a sparse symmetric matrix of scale 1, whether a dense eigh gave it
+    after the sparse path failed). eigsh in shift-invert mode returns the eigenvalues nearest the
+    shift, so the shift must lie below the spectrum: just below 0 when the inertia (an LDL^T
+    factorisation) shows no negative eigenvalue, else below the Gershgorin bound."""
+    if mat.shape[0] <= SMALL_EIGH:
+        return float(np.linalg.eigvalsh(mat.toarray())[0]), False
+    negative = _negative_pivots(mat)
+    if negative is None:
+        return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
+    sigma = -1e-3 if negative == 0 else -float(abs(mat).sum(axis=1).max()) - 1e-3
+    try:
+        w = spla.eigsh(mat, k=1, sigma=sigma, which="LM", return_eigenvectors=False)
         return float(w.min()), False
     except (spla.ArpackNoConvergence, RuntimeError):
         return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
