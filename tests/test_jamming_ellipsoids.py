@@ -309,3 +309,27 @@ def test_refuses_spheres_and_bad_arguments():
         verify_ellipsoids(p, method="fast")
     with pytest.raises(InvalidInputError, match="delta"):
         verify_ellipsoids(p, delta=2.0)
+
+
+def test_refuses_overlapping_ellipses():
+    """Overlaps are found with the Perram-Wertheim function, not the bounding spheres."""
+    p = stretched_triangular(1, 1.5, 0.0)
+    fat = Packing(p.positions, lattice=p.lattice, allow_overlap=True,
+                  shape=Ellipsoids(p.shape.semiaxes * 1.01, p.shape.orientations))
+    with pytest.raises(InvalidInputError, match="overlap"):
+        verify_ellipsoids(fat)
+
+
+def test_cli_dispatches_ellipses(tmp_path, capsys):
+    """``hardpack verify`` sends an ellipse packing to verify_ellipsoids and stores its dataset."""
+    from hardpack.cli import main
+    from hardpack.io import load_dataset, save_packing
+
+    path = tmp_path / "trap.nc"
+    save_packing(stretched_triangular(2, 1.5, np.pi / 2), path)
+    out = tmp_path / "verdict.nc"
+    assert main(["verify", str(path), "--out", str(out)]) == 0
+    ds = load_dataset(out)
+    assert ds.attrs["hardpack_kind"] == "ellipsoid_jamming"
+    assert ds.attrs["verdict"] == int(Verdict.JAMMED) and ds.attrs["order"] == "second"
+    assert "second-order jammed" in capsys.readouterr().out

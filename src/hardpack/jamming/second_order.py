@@ -579,7 +579,8 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     Raises
     ------
     InvalidInputError
-        For a packing that is not a periodic ellipsoid packing, a bad ``delta``, ``frozen`` of
+        For a packing that is not a periodic ellipsoid packing, overlaps (mu - 1 below
+        -packing.overlap_tol, by the Perram-Wertheim function), a bad ``delta``, ``frozen`` of
         the wrong shape, an unknown ``method`` or non-positive tolerances.
     """
     check_ellipsoid_packing(packing)
@@ -596,6 +597,13 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     seconds = {}
     t0 = time.perf_counter()
     net = ellipsoid_contacts(packing, delta)
+    overlap = net.gap < -packing.overlap_tol
+    if overlap.any():
+        worst = int(np.argmin(net.gap))
+        raise InvalidInputError(
+            f"{int(overlap.sum())} pairs overlap beyond the tolerance {packing.overlap_tol:g} (mu - 1 "
+            f"down to {net.gap[worst]:.3g}, particles {net.i[worst]} and {net.j[worst]}); jamming "
+            "tests need a packing of hard particles: finish or repair it first")
     at_full = rigidity_transpose_full(net)
     hess = contact_hessians(net)
     t_full, dof = dof_basis(net, ~frozen)
