@@ -333,3 +333,69 @@ def test_cli_dispatches_ellipses(tmp_path, capsys):
     assert ds.attrs["hardpack_kind"] == "ellipsoid_jamming"
     assert ds.attrs["verdict"] == int(Verdict.JAMMED) and ds.attrs["order"] == "second"
     assert "second-order jammed" in capsys.readouterr().out
+
+
+# ------------------------------------------------------------------------------- 3D
+def _quaternion(rot):
+    """The orientation quaternion (s, p) of hardpack.geometry.shapes whose Q is rot^T (body axes =
+    the columns of rot): scipy's quaternion of rot, scalar first."""
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(rot).as_quat()
+    return np.array([w, x, y, z])
+
+
+def stretched_fcc(reps, semiaxes, rot) -> Packing:
+    """The FCC sphere crystal (diameter 1) stretched by diag(semiaxes) / 0.5 in the frame rot, with
+    aligned ellipsoids of those semiaxes: an affine image, every contact stays."""
+    p = lattice_packing("fcc", reps)
+    stretch = rot @ np.diag(np.asarray(semiaxes) / 0.5) @ rot.T
+    n = p.n_particles
+    return Packing(p.positions @ stretch.T, lattice=stretch @ p.lattice, allow_overlap=True,
+                   shape=Ellipsoids(np.tile(semiaxes, (n, 1)), np.tile(_quaternion(rot), (n, 1))))
+
+
+ROT = sla.expm(np.tensordot([0.3, -0.5, 0.7], generators(3), 1))
+
+
+def test_quaternion_helper_matches_the_shape_convention():
+    out = np.empty((3, 3))
+    shape_inverse(np.array([1.0, 2.0, 3.0]), _quaternion(ROT), out)
+    assert np.abs(out - ROT @ np.diag([1.0, 4.0, 9.0]) @ ROT.T).max() < 1e-14
+
+
+def test_spheroid_spin_is_trivial_and_removed():
+    """A spheroid's rotation about its symmetry axis leaves X unchanged: that combination of the
+    rotation columns of A^T vanishes to round-off, and the reduced dof are 5 per spheroid, 6 per
+    general ellipsoid, 3 per sphere (translations only)."""
+    spheroids = stretched_fcc(1, (0.5, 0.5, 0.75), ROT)
+    at = rigidity_transpose_full(ellipsoid_contacts(spheroids, 1e-9)).toarray().reshape(-1, 4, 6)
+    axis = ROT[:, 2]
+    assert np.abs(at[:, :, 3:] @ axis).max() < 1e-14
+    assert np.abs(at[:, :, 3:] @ ROT[:, 0]).max() > 1e-2
+    for axes, dof in (((0.5, 0.5, 0.75), 5), ((0.5, 0.6, 0.75), 6), ((0.5, 0.5, 0.5), 3)):
+        res = verify_ellipsoids(stretched_fcc(1, axes, ROT))
+        assert set(res.dof) == {dof}
+        assert res.collective.n_dof == 4 * dof - 3
+
+
+def test_fcc_spheres_as_ellipsoids_match_the_sphere_verifier():
+    """Equal semiaxes: the FCC crystal is collectively jammed (Donev 2006, Table 4.1), first order."""
+    spheres = verify(lattice_packing("fcc", 2), tests=("local", "collective"))
+    res = verify_ellipsoids(stretched_fcc(2, (0.5, 0.5, 0.5), np.eye(3)))
+    assert spheres.collective and res.verdict == Verdict.JAMMED and res.order == "first"
+    assert res.collective.n_constraints == spheres.statics.n_contacts == 192
+
+
+@pytest.mark.parametrize("semiaxes, order", [((0.5, 0.5, 0.75), "first"), ((0.5, 0.6, 0.75), "second")])
+def test_stretched_fcc_is_jammed(semiaxes, order):
+    """Aligned spheroids / ellipsoids on the affinely stretched FCC lattice (Z = 12 > 2 d_f):
+    translations are rigid as for spheres (the gap rows are the sphere rows in the coordinates
+    v' = S v), so only rotations can be floppy; N_stresses - N_floppy = M - N_f (Maxwell).
+    The orders are what this code finds (not derived independently): the spheroids are
+    first-order rigid, the general ellipsoids have floppy rotation modes that the stress matrix
+    blocks."""
+    res = verify_ellipsoids(stretched_fcc(2, semiaxes, ROT))
+    c = res.collective
+    assert res.verdict == Verdict.JAMMED and res.order == order
+    assert c.n_stresses - c.n_floppy == c.n_constraints - c.n_dof
