@@ -18,7 +18,10 @@ Degrees of freedom. The columns are the particles' translations and rotations, r
 - global translations: with no frozen particle in a periodic cell the d uniform translations of
   the backbone are trivial floppy modes; they are projected out of the floppy space.
 
-Procedure (Donev 2006, Sec. 5.5.3, on the rattler-free backbone; dense linear algebra):
+Procedure (Donev 2006, Sec. 5.5.3, on the rattler-free backbone; dense linear algebra). A
+first-order flex is Qdot != 0 (nontrivial) with A^T Qdot >= 0; first-order rigid = none exists,
+which holds iff a strict self-stress exists (every flex is then a null flex, Eqs. 5.6-5.11) and
+null(A^T) holds only trivial motions:
 
 1. rank r of A^T (SVD, relative tolerance ``rank_tol``): N_stresses = M - r,
    N_floppy = n - r - t (n reduced dof, t trivial motions);
@@ -34,8 +37,12 @@ Procedure (Donev 2006, Sec. 5.5.3, on the rattler-free backbone; dense linear al
    :mod:`hardpack.jamming.ellipsoids`). lambda_min(K_V) > tol: *jammed* at second order
    (pre-stress stable with the LP's self-stress F, Eq. 5.17); lambda_min < -tol with a unique
    self-stress: *not jammed* (second-order flexible: V x_min extends to an unjamming motion,
-   Eq. 5.14); otherwise (several self-stresses, for which a semidefinite program would be needed,
-   or |lambda_min| <= tol) *undetermined*. tol = ``eig_tol`` times the largest |K| entry.
+   Eq. 5.14). With several self-stresses (Donev: a semidefinite program would be needed) we
+   maximise lambda_min(K_V(F)), a concave function, over the self-stresses F >= 0 by Kelley's
+   cutting planes (one LP per iteration, :func:`_best_stress`): a positive maximum is *jammed*
+   (pre-stress stable); a floppy mode x with max_F x^T K_V(F) x < -tol (the dual LP 5.15 of a
+   strict second-order flex) is *not jammed*; else, or when |lambda_min| <= tol,
+   *undetermined*. tol = ``eig_tol`` times the largest |K| entry.
 
 Local test: each particle among its neighbours, which are fixed (its own columns only, no
 trivial motion); the same procedure, so a particle held only at second order (Fig. 5.5) is
@@ -47,9 +54,9 @@ Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): Donev's
 motions, k = ``shift`` times |K| / |A A^T|, by scipy.sparse.linalg.eigsh in shift-invert mode
 about a small negative sigma. For large k it is positive iff K_V is positive definite (and then
 also says whether there are nontrivial floppy modes: the smallest eigenvalue of A A^T + P_T).
-The sign is certified by the inertia of an LDL^T factorisation (Sylvester's law; Donev used a
-Cholesky factorisation, Sec. 5.6), and the eigenvalue is computed with the shift below the
-spectrum. N_stresses and N_floppy are not computed (stored as -1), so a negative eigenvalue gives
+The inertia of an LDL^T factorisation (Sylvester's law; Donev used a Cholesky factorisation as
+a certificate, Sec. 5.6) says whether a negative eigenvalue exists, so that the eigsh shift can
+be put below the spectrum (shift-invert returns the eigenvalues nearest the shift). N_stresses and N_floppy are not computed (stored as -1), so a negative eigenvalue gives
 *undetermined* (with a unique self-stress it would be *not jammed*; use the dense method).
 """
 
