@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from test_jamming_support import jammed_disks
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.contact import pw_contact, shape_inverse
@@ -31,7 +32,6 @@ from hardpack.jamming.ellipsoids import (
 )
 from hardpack.jamming.result import Verdict
 from hardpack.jamming.second_order import verify_ellipsoids
-from test_jamming_support import jammed_disks
 
 
 # ------------------------------------------------------------------------------- derivatives
@@ -148,7 +148,7 @@ def test_fig_5_5_jammed_at_second_order():
     c = res.collective
     assert res.network.n_contacts == 3 and np.abs(res.network.gap).max() < 1e-12
     assert (c.n_constraints, c.n_dof, c.n_stresses, c.n_floppy) == (3, 3, 1, 1)
-    assert not c.first_order_rigid
+    assert not c.first_order_rigid and c.lp_flex  # the randomised LP finds the null flex
     assert res.verdict == Verdict.JAMMED and res.order == "second"
     assert res.local[0] == Verdict.JAMMED and not res.rattler.any()
     expected = osculating_stiffness(params, point, c.forces)
@@ -184,6 +184,7 @@ def test_three_contacts_without_common_point_are_first_order():
     params[2] = np.pi - 0.2
     res = verify_ellipsoids(trap(params), frozen=FROZEN, local=False)
     assert res.verdict == Verdict.NOT_JAMMED and res.order == "first"
+    assert res.collective.lp_flex  # a strict flex, found by the LP with B = A e
     assert res.collective.stress_margin < 0 or not np.isfinite(res.collective.stress_margin)
 
 
@@ -209,6 +210,7 @@ def test_disks_as_ellipses_match_the_sphere_verifier():
     assert set(res.dof[res.backbone]) == {2}
     assert res.collective.n_dof == 2 * (spheres.statics.n_backbone - 1)
     assert res.collective.n_floppy == 0 and res.collective.n_stresses == 1
+    assert res.collective.lp_flex is False
     # the self-stress is the sphere one (unique up to normalisation)
     used = res.network.subset(res.contacts_used)
     key = {(i, j, tuple(s)): f for i, j, s, f in zip(used.i, used.j, used.shift, res.collective.forces)}
@@ -271,6 +273,7 @@ def test_stretched_triangular_cell_is_first_order_rigid(alpha, psi):
     assert at[:, 2] == pytest.approx(expected, abs=1e-14)
     res = verify_ellipsoids(p)
     assert res.verdict == Verdict.JAMMED and res.order == "first" and res.collective.first_order_rigid
+    assert res.collective.lp_flex is False
     assert abs(res.collective.forces @ at[:, 2]) < 1e-12 and res.collective.forces.min() > 0
 
 
@@ -286,7 +289,7 @@ def test_stretched_triangular_supercells_are_jammed(reps, psi):
     n = p.n_particles
     assert c.n_constraints == 3 * n and c.n_dof == 3 * n - 2
     assert c.n_stresses - c.n_floppy == 2
-    assert c.n_floppy > 0
+    assert c.n_floppy > 0 and c.lp_flex
     assert res.verdict == Verdict.JAMMED and res.order == "second"
     assert c.lambda_min > 0
 

@@ -446,7 +446,7 @@ def stiffness_matrix_full(net: EllipsoidContacts, forces: np.ndarray,
     scipy.sparse.csr_matrix
         The stiffness (negative stress matrix), symmetric.
     """
-    d, n, m = net.dim, net.n_particles, net.n_contacts
+    d, n = net.dim, net.n_particles
     f = dof_per_particle(d)
     hs = contact_hessians(net) if hessians is None else hessians
     w = -np.asarray(forces, float) / net.scale

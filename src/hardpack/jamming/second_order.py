@@ -44,6 +44,10 @@ null(A^T) holds only trivial motions:
    strict second-order flex) is *not jammed*; else, or when |lambda_min| <= tol,
    *undetermined*. tol = ``eig_tol`` times the largest |K| entry.
 
+Cross-check of the first-order verdict on the backbone by the randomised displacement LP of the
+sphere code (:func:`first_order_lp`): ``lp_flex`` says whether it found a first-order flex; it
+must equal ``not first_order_rigid``.
+
 Local test: each particle among its neighbours, which are fixed (its own columns only, no
 trivial motion); the same procedure, so a particle held only at second order (Fig. 5.5) is
 locally jammed. Particles that are not locally jammed are rattlers and are removed iteratively
@@ -52,12 +56,14 @@ locally jammed. Particles that are not locally jammed are rattlers and are remov
 Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): Donev's shifted form
 (Sec. 5.6): the smallest eigenvalue of k A A^T + k P_T + K, P_T the projector on the trivial
 motions, k = ``shift`` times |K| / |A A^T|, by scipy.sparse.linalg.eigsh in shift-invert mode
-about a small negative sigma. For large k it is positive iff K_V is positive definite (and then
-also says whether there are nontrivial floppy modes: the smallest eigenvalue of A A^T + P_T).
-The inertia of an LDL^T factorisation (Sylvester's law; Donev used a Cholesky factorisation as
-a certificate, Sec. 5.6) says whether a negative eigenvalue exists, so that the eigsh shift can
-be put below the spectrum (shift-invert returns the eigenvalues nearest the shift). N_stresses and N_floppy are not computed (stored as -1), so a negative eigenvalue gives
-*undetermined* (with a unique self-stress it would be *not jammed*; use the dense method).
+below the spectrum. For large k it is positive iff K_V is positive definite; whether there are
+nontrivial floppy modes at all comes first, from the smallest eigenvalue of A A^T + P_T. The
+inertia of an LDL^T factorisation (Sylvester's law; Donev used a Cholesky factorisation as a
+certificate, Sec. 5.6) says whether a negative eigenvalue exists, so that the eigsh shift can be
+put below the spectrum (shift-invert returns the eigenvalues nearest the shift). N_stresses and
+N_floppy are not computed (stored as -1), so a negative eigenvalue gives *undetermined* (with a
+unique self-stress it would be *not jammed*; use the dense method). The search over several
+self-stresses is dense-only.
 """
 
 from __future__ import annotations
@@ -85,7 +91,8 @@ from hardpack.jamming.ellipsoids import (
 from hardpack.jamming.highs import LPFailure, recording_fallbacks, solve_lp
 from hardpack.jamming.result import Verdict
 
-__all__ = ["EllipsoidJammingResult", "Decision", "verify_ellipsoids", "DEFAULT_DELTA", "DENSE_LIMIT"]
+__all__ = ["EllipsoidJammingResult", "Decision", "verify_ellipsoids", "first_order_lp", "self_stress_lp",
+           "DEFAULT_DELTA", "DENSE_LIMIT"]
 
 #: contact tolerance mu - 1 of exact (ideal) packings
 DEFAULT_DELTA = 1e-9
@@ -186,6 +193,7 @@ class Decision:
     lambda_min: float = float("nan")
     stiffness_scale: float = float("nan")
     motion: np.ndarray | None = None
+    lp_flex: bool | None = None  # the randomised LP's answer (first_order_lp), collective test only
     fallbacks: int = 0  # dense eigh after eigsh failed (sparse path)
 
 
@@ -208,6 +216,32 @@ def self_stress_lp(a: sp.spmatrix) -> tuple[float, np.ndarray]:
     except LPFailure:
         return float("-inf"), np.zeros(m)
     return float(res.x[-1]), np.asarray(res.x[:m])
+
+
+def first_order_lp(at: sp.spmatrix, trivial: np.ndarray, rng: np.random.Generator,
+                   tol: float = 1e-9) -> tuple[bool, float, float]:
+    """Randomised LP test for a first-order flex (Donev 2006, Eqs. 5.6 and 5.10, in the displacement
+    form of the sphere code, Eq. 4.10 with h = 0), independent of the self-stress procedure:
+
+        max B^T Qdot  s.t.  A^T Qdot >= 0,  |Qdot_k| <= 1,
+
+    once with B = A e (the flexes strict on some contact: exact, by LP duality Eq. 5.7) and once
+    with a Gaussian B orthogonal to the trivial motions (null flexes: found with probability 1).
+    Returns (a nontrivial first-order flex exists, the two optima) with optima relative to |B|_1."""
+    m, n = at.shape
+    at = sp.csr_matrix(at)
+    load_random = rng.standard_normal(n)
+    if trivial.shape[1]:
+        load_random -= trivial @ (trivial.T @ load_random)
+    optima = []
+    for load in (np.asarray(at.sum(axis=0)).ravel(), load_random):
+        norm = np.abs(load).sum()
+        if norm == 0:
+            optima.append(0.0)
+            continue
+        res = solve_lp(-load, A_ub=-at, b_ub=np.zeros(m), bounds=(-1.0, 1.0))
+        optima.append(float(-res.fun) / norm)
+    return bool(max(optima) > tol), optima[0], optima[1]
 
 
 def _first_order(at: sp.spmatrix, stress_tol: float) -> tuple[float, np.ndarray, str | None]:
@@ -344,7 +378,8 @@ def _best_stress(at, stiffness, quadratic, null, forces, w, x, tol):
         for col in range(q.shape[1]):
             if q[:, col] @ forces <= tol:
                 # a mode this stress does not block: is it blocked by any self-stress?
-                res = solve_lp(-np.concatenate([q[:, col], [0.0]]), A_eq=a_eq, b_eq=b_eq, bounds=bounds[:m] + [(0.0, 0.0)])
+                res = solve_lp(-np.concatenate([q[:, col], [0.0]]), A_eq=a_eq, b_eq=b_eq,
+                               bounds=bounds[:m] + [(0.0, 0.0)])
                 if -res.fun < -tol:
                     return best[2], best[0], best[1], (float(-res.fun), use[:, col])
             cuts.append(q[:, col])
@@ -490,7 +525,8 @@ class EllipsoidJammingResult:
              f"{int(self.rattler.sum())}, backbone={nb}, contacts M_b={c.n_constraints}, Z={self.z_mean:.4f}"),
             (f"dof N_f={c.n_dof} (per particle: {np.unique(self.dof[self.backbone]).tolist()}), "
              f"M_b - N_f = {self.isostaticity_gap}, self-stresses {c.n_stresses}, nontrivial floppy "
-             f"modes {c.n_floppy}, lambda_min(K_V) = {c.lambda_min:.4g}"),
+             f"modes {c.n_floppy}, lambda_min(K_V) = {c.lambda_min:.4g}; first-order LP found a flex: "
+             f"{'-' if c.lp_flex is None else 'yes' if c.lp_flex else 'no'}"),
         ]
         for name, count in self.fallbacks.items():
             if count:
@@ -520,6 +556,7 @@ class EllipsoidJammingResult:
         attrs = dict(
             hardpack_kind="ellipsoid_jamming", verdict=int(self.verdict), order=self.order,
             reason=c.reason, first_order_rigid=int(c.first_order_rigid),
+            first_order_lp_flex=-1 if c.lp_flex is None else int(c.lp_flex),
             N=net.n_particles, d=net.dim, n_contacts=net.n_contacts, n_frozen=int(self.frozen.sum()),
             n_rattlers=int(self.rattler.sum()), n_backbone=int(self.backbone.sum()),
             n_backbone_contacts=c.n_constraints, n_dof=c.n_dof, z_mean=self.z_mean,
@@ -561,7 +598,7 @@ def _submatrices(net, at_full, hess, t_full, owner, contacts, moving):
 
 def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
                       method: str = "auto", local: bool = True, rank_tol: float = 1e-9,
-                      stress_tol: float = 1e-9, eig_tol: float = 1e-9) -> EllipsoidJammingResult:
+                      stress_tol: float = 1e-9, eig_tol: float = 1e-9, seed: int = 0) -> EllipsoidJammingResult:
     """Jamming test of a periodic packing of ellipses or ellipsoids (module docstring).
 
     Parameters
@@ -578,6 +615,8 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
         Run the iterated local test (rattler removal) before the collective test.
     rank_tol, stress_tol, eig_tol : float
         Relative tolerances of the rank of A, of the self-stress LP's margin, of lambda_min.
+    seed : int, default 0
+        Seed of the random load of the first-order LP cross-check (:func:`first_order_lp`).
 
     Returns
     -------
@@ -597,6 +636,8 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     for name, value in (("rank_tol", rank_tol), ("stress_tol", stress_tol), ("eig_tol", eig_tol)):
         if not (np.isfinite(value) and 0 < value < 1):
             raise InvalidInputError(f"{name} must be in (0, 1), got {value!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
     frozen = np.zeros(n, dtype=bool) if frozen is None else np.asarray(frozen)
     if frozen.shape != (n,) or frozen.dtype != bool:
         raise InvalidInputError(f"frozen must be a boolean array of shape ({n},), got {frozen.dtype} {frozen.shape}")
@@ -658,8 +699,10 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
             dec = decide_dense(at, stiff, quad, trivial, rank_tol=rank_tol, **tols)
         else:
             dec = decide_sparse(at, stiff_sparse, trivial, **tols)
+        if active.any():
+            dec.lp_flex = first_order_lp(at, trivial, np.random.default_rng(seed))[0]
         seconds["collective"] = time.perf_counter() - t0
-    params = dict(delta=float(delta), method="dense" if dense else "sparse", rank_tol=rank_tol,
+    params = dict(delta=float(delta), method="dense" if dense else "sparse", seed=int(seed), rank_tol=rank_tol,
                   stress_tol=stress_tol, eig_tol=eig_tol)
     rattler = ~frozen & ~active
     return EllipsoidJammingResult(
