@@ -124,6 +124,7 @@ def test_torque_balanced_ellipses_are_second_order_jammed():
     assert res.network.n_contacts == len(f)  # no pair beyond the disk contacts closes
     assert res.verdict == Verdict.JAMMED and res.order == "second"
     assert res.isostaticity_gap < 0 and res.collective.n_floppy > 0
+    assert not res.collective.first_order_rigid and res.collective.lp_flex  # hypostatic
     assert not res.rattler.any()
 
 
@@ -180,20 +181,24 @@ def test_sparse_shifted_form_agrees_with_the_dense_test():
     assert sparse.order == dense.order == "second"
     assert sparse.collective.lambda_min == pytest.approx(dense.collective.lambda_min, rel=1e-2)
     assert sparse.fallbacks["sparse_eigsh_dense"] == 0
+    # the counts from the inertia of LDL^T factorisations
+    assert (sparse.collective.n_stresses, sparse.collective.n_floppy) == (dense.collective.n_stresses,
+                                                                         dense.collective.n_floppy)
 
 
 @pytest.mark.slow
 def test_sparse_shifted_form_finds_a_negative_mode():
     """The 2 x 2 supercell of that packing (N = 248): its floppy modes of the supercell's wave
     vectors are not all blocked (dense: second-order flexible with a unique self-stress); the
-    sparse path sees the negative eigenvalue (shift below the spectrum, the inertia of LDL^T)
-    and says undetermined, since it does not count self-stresses."""
+    sparse path sees the negative eigenvalue (the shift put below it by bisection on the inertia
+    of LDL^T factorisations, which also count the self-stresses and floppy modes)."""
     packing, *_ = jamming_point(EPS, disk_backbone()[5].angles)
     big = packing.tiled(2)
     dense = verify_ellipsoids(big, method="dense", local=False)
     sparse = verify_ellipsoids(big, method="sparse", local=False)
     assert dense.verdict == Verdict.NOT_JAMMED and dense.order == "second"
     assert dense.collective.n_stresses == 1
-    assert sparse.verdict == Verdict.UNDETERMINED
+    assert sparse.verdict == Verdict.NOT_JAMMED and sparse.order == "second"
+    assert (sparse.collective.n_stresses, sparse.collective.n_floppy) == (1, dense.collective.n_floppy)
     assert sparse.collective.lambda_min < 0
     assert sparse.collective.lambda_min == pytest.approx(dense.collective.lambda_min, rel=0.2)

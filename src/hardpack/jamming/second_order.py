@@ -60,10 +60,11 @@ below the spectrum. For large k it is positive iff K_V is positive definite; whe
 nontrivial floppy modes at all comes first, from the smallest eigenvalue of A A^T + P_T. The
 inertia of an LDL^T factorisation (Sylvester's law; Donev used a Cholesky factorisation as a
 certificate, Sec. 5.6) says whether a negative eigenvalue exists, so that the eigsh shift can be
-put below the spectrum (shift-invert returns the eigenvalues nearest the shift). N_stresses and
-N_floppy are not computed (stored as -1), so a negative eigenvalue gives *undetermined* (with a
-unique self-stress it would be *not jammed*; use the dense method). The search over several
-self-stresses is dense-only.
+put below the spectrum (shift-invert returns the eigenvalues nearest the shift); bisection on the
+inertia of the shifted matrix brackets a negative smallest eigenvalue first. N_floppy and
+N_stresses are the numbers of eigenvalues of A A^T + P_T and A^T A below ``rank_tol`` (relative),
+again from the inertia (-1 when a factorisation fails). The search over several self-stresses is
+dense-only, so there a negative eigenvalue gives *undetermined*.
 """
 
 from __future__ import annotations
@@ -394,51 +395,67 @@ def _best_stress(at, stiffness, quadratic, null, forces, w, x, tol):
     return best[2], best[0], best[1], None
 
 
-def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, stress_tol: float = 1e-9,
-                  eig_tol: float = 1e-9, shift: float = 1e3) -> Decision:
-    """Donev's shifted form (Sec. 5.6) for large packings: the smallest eigenvalues of
-    A A^T + P_T (are there floppy modes?) and of k (A A^T + P_T) + K (second order), by eigsh in
-    shift-invert mode (module docstring). N_stresses and N_floppy are not computed (-1), so a
-    non-positive eigenvalue gives *undetermined*."""
+def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: float = 1e-9,
+                  stress_tol: float = 1e-9, eig_tol: float = 1e-9, shift: float = 1e3) -> Decision:
+    """Donev's shifted form (Sec. 5.6) for large packings (module docstring). The counts come from
+    the inertia of LDL^T factorisations: N_floppy = the eigenvalues of A A^T + P_T below rank_tol
+    (relative), N_stresses = those of A^T A; the smallest eigenvalue of k (A A^T + P_T) + K decides
+    the second order."""
     m, n = at.shape
     t = trivial.shape[1]
     common = dict(n_stresses=-1, n_floppy=-1, n_dof=n - t, n_constraints=m)
     eps, forces, why = _first_order(at, stress_tol)
+    gram = (at.T @ at).tocsc()
+    if t:
+        gram = gram + sp.csc_matrix(trivial @ trivial.T)
+    gscale = max(abs(gram).max(), 1e-300)
+    n_floppy = _count_below(gram / gscale, rank_tol)
+    stresses = (at @ at.T).tocsc()
+    n_stresses = _count_below(stresses / max(abs(stresses).max(), 1e-300), rank_tol)
+    common.update(n_floppy=-1 if n_floppy is None else n_floppy,
+                  n_stresses=-1 if n_stresses is None else n_stresses)
     if why is not None:
         verdict = Verdict.NOT_JAMMED if eps < -stress_tol else Verdict.UNDETERMINED
         return Decision(verdict, "first" if verdict == Verdict.NOT_JAMMED else "undetermined",
                         False, why, forces, stress_margin=eps, **common)
-    gram = (at.T @ at).tocsc()
-    if t:
-        gram = gram + sp.csc_matrix(trivial @ trivial.T)
-    k = sp.csc_matrix(stiffness(forces))
-    gscale = max(abs(gram).max(), 1e-300)
-    kscale = max(abs(k).max(), 1e-300)
-    g_min, fell1 = _smallest_eigenvalue(gram / gscale)
-    if g_min > eig_tol:
+    fell = 0
+    if n_floppy is None:
+        g_min, fell1 = _smallest_eigenvalue(gram / gscale)
+        fell += int(fell1)
+        floppy = g_min <= rank_tol
+    else:
+        floppy = n_floppy > 0
+    if not floppy:
         return Decision(Verdict.JAMMED, "first", True,
                         "strict self-stress and no nontrivial floppy mode: first-order rigid",
-                        forces, stress_margin=eps, fallbacks=int(fell1), **common)
-    k_shift = shift * kscale / gscale
-    lam, fell2 = _smallest_eigenvalue((k_shift * gram + k) / kscale)
-    common["fallbacks"] = int(fell1) + int(fell2)
-    common.update(stress_margin=eps, lambda_min=lam * kscale, stiffness_scale=kscale)
+                        forces, stress_margin=eps, fallbacks=fell, **common)
+    k = sp.csc_matrix(stiffness(forces))
+    kscale = max(abs(k).max(), 1e-300)
+    lam, fell2 = _smallest_eigenvalue((shift * kscale / gscale * gram + k) / kscale)
+    common.update(stress_margin=eps, lambda_min=lam * kscale, stiffness_scale=kscale,
+                  fallbacks=fell + int(fell2))
     if lam > eig_tol:
         return Decision(Verdict.JAMMED, "second", False,
                         f"floppy modes blocked by the stress matrix (smallest eigenvalue of the "
                         f"shifted form {lam:.3g} of max |K|): second-order jammed", forces, **common)
+    if lam < -eig_tol and n_stresses == 1:
+        return Decision(Verdict.NOT_JAMMED, "second", False,
+                        "the shifted form has a negative eigenvalue and the self-stress is unique: "
+                        "second-order flexible", forces, **common)
     return Decision(Verdict.UNDETERMINED, "undetermined", False,
-                    "the shifted form has a non-positive eigenvalue; the sparse path does not count "
-                    "self-stresses, so it cannot tell second-order flexible from undetermined "
-                    "(use method='dense')", forces, **common)
+                    "the shifted form has a non-positive eigenvalue and the self-stress is not "
+                    "unique (or its count failed); the search over several self-stresses is in "
+                    "the dense method", forces, **common)
 
 
-def _negative_pivots(mat: sp.csc_matrix) -> int | None:
-    """Number of negative eigenvalues of a symmetric sparse matrix by Sylvester's law of inertia:
-    the negative pivots of its LU factorisation with a symmetric permutation and no pivoting
-    (P M P^T = L D L^T, U = D L^T). None when the factorisation failed or pivoted."""
+def _count_below(mat: sp.csc_matrix, tau: float) -> int | None:
+    """Number of eigenvalues of a symmetric sparse matrix below ``tau`` (Sylvester's law of
+    inertia: the negative pivots of the LU factorisation of mat - tau I with a symmetric
+    permutation and no pivoting, P M P^T = L D L^T, U = D L^T). None when the factorisation
+    failed or pivoted."""
+    shifted = (mat - tau * sp.identity(mat.shape[0], format="csc")).tocsc()
     try:
-        lu = spla.splu(mat.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+        lu = spla.splu(shifted, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                        options={"SymmetricMode": True})
     except RuntimeError:  # exactly singular
         return None
@@ -450,14 +467,25 @@ def _negative_pivots(mat: sp.csc_matrix) -> int | None:
 def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
     """(smallest eigenvalue of a sparse symmetric matrix of scale 1, whether a dense eigh gave it
     after the sparse path failed). eigsh in shift-invert mode returns the eigenvalues nearest the
-    shift, so the shift must lie below the spectrum: just below 0 when the inertia (an LDL^T
-    factorisation) shows no negative eigenvalue, else below the Gershgorin bound."""
+    shift, so the shift must lie just below the spectrum: at -1e-3 when the inertia (an LDL^T
+    factorisation) shows no negative eigenvalue, else just below the bracket [lo, hi) of the
+    smallest eigenvalue that bisection on the inertia of mat - sigma I finds (spectrum slicing,
+    down to 1% of |lo|)."""
     if mat.shape[0] <= SMALL_EIGH:
         return float(np.linalg.eigvalsh(mat.toarray())[0]), False
-    negative = _negative_pivots(mat)
+    negative = _count_below(mat, 0.0)
     if negative is None:
         return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
-    sigma = -1e-3 if negative == 0 else -float(abs(mat).sum(axis=1).max()) - 1e-3
+    sigma = -1e-3
+    if negative:
+        lo, hi = -float(abs(mat).sum(axis=1).max()) - 1e-3, 0.0
+        while hi - lo > 0.01 * abs(lo):
+            mid = 0.5 * (lo + hi) if hi - lo > 0.5 * abs(lo) or hi == 0.0 else -np.sqrt(lo * hi)
+            count = _count_below(mat, mid)
+            if count is None:
+                return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
+            lo, hi = (lo, mid) if count else (mid, hi)
+        sigma = lo - 0.01 * abs(lo)
     try:
         w = spla.eigsh(mat, k=1, sigma=sigma, which="LM", return_eigenvectors=False)
         return float(w.min()), False
@@ -698,7 +726,7 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
         elif dense:
             dec = decide_dense(at, stiff, quad, trivial, rank_tol=rank_tol, **tols)
         else:
-            dec = decide_sparse(at, stiff_sparse, trivial, **tols)
+            dec = decide_sparse(at, stiff_sparse, trivial, rank_tol=rank_tol, **tols)
         if active.any():
             dec.lp_flex = first_order_lp(at, trivial, np.random.default_rng(seed))[0]
         seconds["collective"] = time.perf_counter() - t0
