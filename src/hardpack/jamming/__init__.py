@@ -7,6 +7,9 @@ Building blocks: :func:`contact_network`, :func:`rigidity_matrix` (scipy.sparse)
 isostaticity, pressure). :mod:`hardpack.jamming.isostatic` solves the LPs exactly through the
 self-stress space of rigid, nearly isostatic backbones (the common case for LS packings), HiGHS
 (scipy ``linprog``) does the rest. CLI: ``hardpack verify`` (:mod:`hardpack.jamming.cli`).
+Ellipses and ellipsoids (Donev 2006, ch. 5): :func:`verify_ellipsoids` (first- and second-order
+tests, :mod:`hardpack.jamming.second_order`, on the contacts and stress matrix of
+:mod:`hardpack.jamming.ellipsoids`).
 """
 
 from hardpack.jamming.contacts import ContactNetwork, contact_network
@@ -15,11 +18,13 @@ from hardpack.jamming.ideal import ideal_test
 from hardpack.jamming.rattlers import remove_rattlers
 from hardpack.jamming.result import JammingResult
 from hardpack.jamming.rigidity import rigidity_matrix, strain_pairs
+from hardpack.jamming.second_order import EllipsoidJammingResult, verify_ellipsoids
 from hardpack.jamming.sequential import sequential_test
 from hardpack.jamming.verify import verify
 
 __all__ = [
     "ContactNetwork",
+    "EllipsoidJammingResult",
     "JammingResult",
     "contact_network",
     "ideal_test",
@@ -30,4 +35,5 @@ __all__ = [
     "statics",
     "strain_pairs",
     "verify",
+    "verify_ellipsoids",
 ]

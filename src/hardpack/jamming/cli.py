@@ -1,6 +1,8 @@
 """``hardpack verify PACKING.nc --out VERDICT.nc``: jamming verdict of a stored packing.
 
-Prints :meth:`JammingResult.summary` and writes :meth:`JammingResult.to_dataset` with
+Ellipse and ellipsoid packings go to :func:`hardpack.jamming.second_order.verify_ellipsoids`
+(first- and second-order tests, contacts within mu - 1 <= delta, default 1e-9). Sphere packings:
+prints :meth:`JammingResult.summary` and writes :meth:`JammingResult.to_dataset` with
 :func:`hardpack.io.write_dataset` (provenance attributes, atomic write). The generator's
 reduced pressure, when the packing file carries one (attribute ``pressure``,
 ``reduced_pressure`` or ``final_pressure``), is compared with the free-volume pressure from the
@@ -50,10 +52,28 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_verify)
 
 
+def _verify_ellipsoids(packing, args) -> int:
+    """Ellipses and ellipsoids: the first- and second-order tests of
+    :func:`hardpack.jamming.second_order.verify_ellipsoids` (the sphere options do not apply)."""
+    from hardpack.io import write_dataset
+    from hardpack.jamming.second_order import verify_ellipsoids
+
+    result = verify_ellipsoids(packing, delta=args.delta)
+    out = result.to_dataset()
+    out.attrs["source"] = str(args.packing)
+    write_dataset(out, args.out, seed=args.seed)
+    print(result.summary())
+    print(f"written {args.out}")
+    return 0
+
+
 def cmd_verify(args) -> int:
     from hardpack.io import dataset_to_packing, load_dataset, write_dataset
 
     ds = load_dataset(args.packing, kind="packing")
+    if ds.attrs.get("shape_kind") == "ellipsoid":
+        # verify_ellipsoids checks the overlaps itself (with the Perram-Wertheim function)
+        return _verify_ellipsoids(dataset_to_packing(ds, source=str(args.packing), allow_overlap=True), args)
     packing = dataset_to_packing(ds, source=str(args.packing))
     pressure = next((float(ds.attrs[k]) for k in PRESSURE_ATTRS if k in ds.attrs), None)
     if pressure is not None and not (math.isfinite(pressure) and pressure > 0):

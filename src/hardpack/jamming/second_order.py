@@ -1,0 +1,743 @@
+"""First- and second-order jamming tests of packings of ellipses and ellipsoids.
+
+Donev 2006, dissertation Secs. 5.5.1-5.5.3 (first-order flexes, self-stresses, the stress matrix
+and the test for ideal packings) and Sec. 5.6 (the shifted form for large packings). Contacts,
+rigidity and stress matrices are those of :mod:`hardpack.jamming.ellipsoids`.
+
+Degrees of freedom. The columns are the particles' translations and rotations, reduced by:
+
+- frozen particles (argument ``frozen``): all their columns are removed; they are fixed obstacles
+  (Donev 2006, Fig. 5.5 and Sec. 5.5.4: fixed ellipses);
+- trivial spins: a particle symmetric about an axis (a spheroid: two equal semiaxes; an ellipse
+  with equal semiaxes, i.e. a disk; a sphere: all three rotations) does not change its shape under
+  a rotation about that axis, so that column of A^T and of the stress matrix vanishes identically.
+  We remove it from the basis (exact, decided from the semiaxes to a relative 1e-12, not from
+  the numbers of A): the rotational basis of a spheroid is the two directions orthogonal to its
+  symmetry axis (Donev 2006, Sec. 5.6 penalises the same spin with k u u^T instead). The dof per
+  particle are then 3 (ellipses), 2 (disks), 6 (general ellipsoids), 5 (spheroids), 3 (spheres);
+- global translations: with no frozen particle in a periodic cell the d uniform translations of
+  the backbone are trivial floppy modes; they are projected out of the floppy space.
+
+Procedure (Donev 2006, Sec. 5.5.3, on the rattler-free backbone; dense linear algebra). A
+first-order flex is Qdot != 0 (nontrivial) with A^T Qdot >= 0; first-order rigid = none exists,
+which holds iff a strict self-stress exists (every flex is then a null flex, Eqs. 5.6-5.11) and
+null(A^T) holds only trivial motions:
+
+1. rank r of A^T (SVD, relative tolerance ``rank_tol``): N_stresses = M - r,
+   N_floppy = n - r - t (n reduced dof, t trivial motions);
+2. self-stress LP (Eq. 5.9): max eps s.t. A F = 0, F >= eps, sum F = M. No self-stress
+   (infeasible or eps < 0): *not jammed*, decided at first order (a strict first-order flex
+   exists, Eqs. 5.6-5.7). eps = 0 (a self-stress, but none strict): *undetermined* (Donev: the
+   test is inconclusive); the packing is not first-order rigid;
+3. strict self-stress and N_floppy = 0: *jammed* at first order (first-order rigid). Hypostatic
+   packings (M < n - t) always have N_floppy > 0 and go on;
+4. the projected stiffness K_V = V^T K V, V an orthonormal basis of the nontrivial floppy space
+   (null(A^T) orthogonal to the trivial motions) and K = -sum_c (F_c / s_c) Hess zeta_c the
+   negative of Donev's stress matrix (Eq. 5.16; sign convention in
+   :mod:`hardpack.jamming.ellipsoids`). lambda_min(K_V) > tol: *jammed* at second order
+   (pre-stress stable with the LP's self-stress F, Eq. 5.17); lambda_min < -tol with a unique
+   self-stress: *not jammed* (second-order flexible: V x_min extends to an unjamming motion,
+   Eq. 5.14). With several self-stresses (Donev: a semidefinite program would be needed) we
+   maximise lambda_min(K_V(F)), a concave function, over the self-stresses F >= 0 by Kelley's
+   cutting planes (one LP per iteration, :func:`_best_stress`): a positive maximum is *jammed*
+   (pre-stress stable); a floppy mode x with max_F x^T K_V(F) x < -tol (the dual LP 5.15 of a
+   strict second-order flex) is *not jammed*; else, or when |lambda_min| <= tol,
+   *undetermined*. tol = ``eig_tol`` times the largest |K| entry.
+
+Cross-check of the first-order verdict on the backbone by the randomised displacement LP of the
+sphere code (:func:`first_order_lp`): ``lp_flex`` says whether it found a first-order flex; it
+must equal ``not first_order_rigid``.
+
+Local test: each particle among its neighbours, which are fixed (its own columns only, no
+trivial motion); the same procedure, so a particle held only at second order (Fig. 5.5) is
+locally jammed. Particles that are not locally jammed are rattlers and are removed iteratively
+(their contacts dropped), as in the sphere code (Donev 2006, Sec. 4.2.4.1).
+
+Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): Donev's shifted form
+(Sec. 5.6): the smallest eigenvalue of k A A^T + k P_T + K, P_T the projector on the trivial
+motions, k = ``shift`` times |K| / |A A^T|, by scipy.sparse.linalg.eigsh in shift-invert mode
+below the spectrum. For large k it is positive iff K_V is positive definite; whether there are
+nontrivial floppy modes at all comes first, from the smallest eigenvalue of A A^T + P_T. The
+inertia of an LDL^T factorisation (Sylvester's law; Donev used a Cholesky factorisation as a
+certificate, Sec. 5.6) says whether a negative eigenvalue exists, so that the eigsh shift can be
+put below the spectrum (shift-invert returns the eigenvalues nearest the shift); bisection on the
+inertia of the shifted matrix brackets a negative smallest eigenvalue first. N_floppy and
+N_stresses are the numbers of eigenvalues of A A^T + P_T and A^T A below ``rank_tol`` (relative),
+again from the inertia (-1 when a factorisation fails). The search over several self-stresses is
+dense-only, so there a negative eigenvalue gives *undetermined*.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.packing import Packing
+from hardpack.jamming.ellipsoids import (
+    EllipsoidContacts,
+    check_ellipsoid_packing,
+    contact_hessians,
+    dof_per_particle,
+    ellipsoid_contacts,
+    rigidity_transpose_full,
+    stiffness_matrix_full,
+)
+from hardpack.jamming.highs import LPFailure, recording_fallbacks, solve_lp
+from hardpack.jamming.result import Verdict
+
+__all__ = ["EllipsoidJammingResult", "Decision", "verify_ellipsoids", "first_order_lp", "self_stress_lp",
+           "DEFAULT_DELTA", "DENSE_LIMIT"]
+
+#: contact tolerance mu - 1 of exact (ideal) packings
+DEFAULT_DELTA = 1e-9
+#: reduced dof above which method="auto" uses the sparse shifted form (measured on this 2-core
+#: machine: the dense SVD takes ~8 s at 750 dof, the sparse path 1 s)
+DENSE_LIMIT = 600
+#: sparse path: matrices up to this size get a dense eigh instead of eigsh
+SMALL_EIGH = 50
+#: symmetric semiaxes: equal to this relative tolerance
+SYMMETRY_RTOL = 1e-12
+#: codes of the order that decided a test, as stored in datasets
+ORDER_CODES = {"undetermined": 0, "first": 1, "second": 2}
+#: numerical fallbacks recorded in the result
+FALLBACKS = {
+    "sparse_eigsh_dense": "eigsh did not converge on the shifted matrix; a dense eigh was used",
+}
+
+
+# ------------------------------------------------------------------------------------- dof basis
+def rotation_basis(semiaxes: np.ndarray, shape_inv: np.ndarray) -> list[np.ndarray]:
+    """Per particle, an orthonormal basis (k, r_i) of its nontrivial rotations (module docstring)."""
+    d = semiaxes.shape[1]
+    out = []
+    for axes, inv in zip(semiaxes, shape_inv):
+        s = np.sort(axes)
+        close = np.isclose(s[1:], s[:-1], rtol=SYMMETRY_RTOL, atol=0.0)
+        if d == 2:
+            out.append(np.zeros((1, 0)) if close[0] else np.ones((1, 1)))
+            continue
+        if close.all():
+            out.append(np.zeros((3, 0)))
+        elif not close.any():
+            out.append(np.eye(3))
+        else:
+            w, vecs = np.linalg.eigh(inv)  # eigenvalues a_k^2, ascending
+            axis = vecs[:, 2] if close[0] else vecs[:, 0]  # the distinct semiaxis
+            q, _ = np.linalg.qr(np.column_stack([axis, np.eye(3)]))
+            out.append(q[:, 1:3])
+    return out
+
+
+def dof_basis(net: EllipsoidContacts, moving: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
+    """(T, dof per particle): T maps the reduced dof of the ``moving`` particles to all N d_f
+    columns (frozen particles and trivial spins removed)."""
+    d, n = net.dim, net.n_particles
+    f = dof_per_particle(d)
+    rot = rotation_basis(net.semiaxes, net.shape_inv)
+    rows, cols, vals = [], [], []
+    counts = np.zeros(n, dtype=np.int64)
+    col = 0
+    for p in np.flatnonzero(moving):
+        for k in range(d):
+            rows.append(p * f + k), cols.append(col), vals.append(1.0)
+            col += 1
+        basis = rot[p]
+        for b in range(basis.shape[1]):
+            for a in range(basis.shape[0]):
+                rows.append(p * f + d + a), cols.append(col), vals.append(basis[a, b])
+            col += 1
+        counts[p] = d + basis.shape[1]
+    t = sp.csr_matrix((vals, (rows, cols)), shape=(n * f, col))
+    return t, counts
+
+
+def trivial_translations(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray) -> np.ndarray:
+    """Orthonormal (n_red, d) uniform translations of the ``moving`` particles in reduced dof."""
+    d, n = net.dim, net.n_particles
+    f = dof_per_particle(d)
+    full = np.zeros((n * f, d))
+    for k in range(d):
+        full[np.flatnonzero(moving) * f + k, k] = 1.0
+    red = t.T @ full
+    return red / np.linalg.norm(red, axis=0)
+
+
+# ------------------------------------------------------------------------------------- decisions
+@dataclass
+class Decision:
+    """Outcome of the procedure of the module docstring on one (sub)packing.
+
+    ``verdict``: :class:`Verdict` code; ``order``: "first", "second" or "undetermined";
+    ``first_order_rigid``: no nontrivial first-order flex; ``lambda_min``: smallest eigenvalue of
+    the projected stiffness K_V (sparse path: of the shifted form; NaN when not computed), in the
+    units of K, whose largest |entry| is ``stiffness_scale``; ``forces``: the LP self-stress (zeros when
+    none); ``n_stresses`` (-1: not computed), ``n_floppy`` (nontrivial; -1: not computed),
+    ``n_dof`` (reduced, minus trivial), ``n_constraints`` (M); ``reason``: why, in words.
+    """
+
+    verdict: Verdict
+    order: str
+    first_order_rigid: bool
+    reason: str
+    forces: np.ndarray
+    n_stresses: int
+    n_floppy: int
+    n_dof: int
+    n_constraints: int
+    stress_margin: float = float("nan")
+    lambda_min: float = float("nan")
+    stiffness_scale: float = float("nan")
+    motion: np.ndarray | None = None
+    lp_flex: bool | None = None  # the randomised LP's answer (first_order_lp), collective test only
+    fallbacks: int = 0  # dense eigh after eigsh failed (sparse path)
+
+
+def self_stress_lp(a: sp.spmatrix) -> tuple[float, np.ndarray]:
+    """Donev 2006, Eq. 5.9: max eps s.t. A F = 0, F >= eps, sum F = M. Returns (eps*, F); eps* is
+    -inf (and F zeros) when no F with A F = 0 and sum F = M exists."""
+    nrow, m = a.shape
+    if m == 0:
+        return float("-inf"), np.zeros(0)
+    a = sp.csr_matrix(a)
+    a_eq = sp.vstack([sp.hstack([a, sp.csr_matrix((nrow, 1))]),
+                      sp.csr_matrix(np.concatenate([np.ones(m), [0.0]])[None, :])], format="csr")
+    b_eq = np.concatenate([np.zeros(nrow), [float(m)]])
+    a_ub = sp.hstack([-sp.identity(m, format="csr"), sp.csr_matrix(np.ones((m, 1)))], format="csr")
+    cost = np.zeros(m + 1)
+    cost[-1] = -1.0
+    bounds = [(None, None)] * m + [(None, 1.0)]
+    try:
+        res = solve_lp(cost, A_ub=a_ub, b_ub=np.zeros(m), A_eq=a_eq, b_eq=b_eq, bounds=bounds)
+    except LPFailure:
+        return float("-inf"), np.zeros(m)
+    return float(res.x[-1]), np.asarray(res.x[:m])
+
+
+def first_order_lp(at: sp.spmatrix, trivial: np.ndarray, rng: np.random.Generator,
+                   tol: float = 1e-9) -> tuple[bool, float, float]:
+    """Randomised LP test for a first-order flex (Donev 2006, Eqs. 5.6 and 5.10, in the displacement
+    form of the sphere code, Eq. 4.10 with h = 0), independent of the self-stress procedure:
+
+        max B^T Qdot  s.t.  A^T Qdot >= 0,  |Qdot_k| <= 1,
+
+    once with B = A e (the flexes strict on some contact: exact, by LP duality Eq. 5.7) and once
+    with a Gaussian B orthogonal to the trivial motions (null flexes: found with probability 1).
+    Returns (a nontrivial first-order flex exists, the two optima) with optima relative to |B|_1."""
+    m, n = at.shape
+    at = sp.csr_matrix(at)
+    load_random = rng.standard_normal(n)
+    if trivial.shape[1]:
+        load_random -= trivial @ (trivial.T @ load_random)
+    optima = []
+    for load in (np.asarray(at.sum(axis=0)).ravel(), load_random):
+        norm = np.abs(load).sum()
+        if norm == 0:
+            optima.append(0.0)
+            continue
+        res = solve_lp(-load, A_ub=-at, b_ub=np.zeros(m), bounds=(-1.0, 1.0))
+        optima.append(float(-res.fun) / norm)
+    return bool(max(optima) > tol), optima[0], optima[1]
+
+
+def _first_order(at: sp.spmatrix, stress_tol: float) -> tuple[float, np.ndarray, str | None]:
+    """Self-stress step (2. of the module docstring): (eps*, F, reason if not strict)."""
+    eps, forces = self_stress_lp(at.T)
+    if eps < -stress_tol:
+        return eps, np.zeros(at.shape[0]), (
+            "no self-stress (force and torque balance with F >= 0 fails; LP 5.9 optimum "
+            f"{eps:.3g}): a strict first-order flex exists")
+    if eps <= stress_tol:
+        return eps, np.clip(forces, 0.0, None), (
+            "a self-stress exists but none is strict (LP 5.9 optimum 0): some contact carries no "
+            "force, the first-order test is inconclusive (Donev 2006, Sec. 5.5.3)")
+    return eps, forces, None
+
+
+def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, rank_tol: float = 1e-9,
+                 stress_tol: float = 1e-9, eig_tol: float = 1e-9) -> Decision:
+    """The procedure of the module docstring with dense linear algebra.
+
+    Parameters
+    ----------
+    at : sparse matrix, shape (M, n)
+        A^T in reduced dof.
+    stiffness : callable
+        forces (M,) -> dense (n, n) stiffness K in reduced dof.
+    quadratic : callable
+        y (n, k) -> (M, k): y_k^T K_c y_k per contact (K = sum_c F_c K_c), for several stresses.
+    trivial : ndarray, shape (n, t)
+        Orthonormal trivial motions (translations), t may be 0.
+    rank_tol, stress_tol, eig_tol : float
+        Relative tolerances of the rank, of the LP's eps*, of lambda_min.
+
+    Returns
+    -------
+    Decision
+    """
+    m, n = at.shape
+    t = trivial.shape[1]
+    dense = at.toarray()
+    if m:
+        u, s, vh = np.linalg.svd(dense, full_matrices=True)
+        rank = int((s > rank_tol * s.max()).sum()) if s.size and s.max() > 0 else 0
+    else:
+        vh, rank = np.eye(n), 0
+    n_stresses, n_floppy = m - rank, n - rank - t
+    common = dict(n_stresses=n_stresses, n_floppy=n_floppy, n_dof=n - t, n_constraints=m)
+    if n - t == 0:
+        return Decision(Verdict.JAMMED, "first", True, "no nontrivial degree of freedom",
+                        np.zeros(m), **common)
+    if m == 0:
+        return Decision(Verdict.NOT_JAMMED, "first", False, "no contacts", np.zeros(0), **common)
+    eps, forces, why = _first_order(at, stress_tol)
+    if why is not None:
+        verdict = Verdict.NOT_JAMMED if eps < -stress_tol else Verdict.UNDETERMINED
+        return Decision(verdict, "first" if verdict == Verdict.NOT_JAMMED else "undetermined",
+                        False, why, forces, stress_margin=eps, **common)
+    if n_floppy <= 0:
+        return Decision(Verdict.JAMMED, "first", True,
+                        "strict self-stress and no nontrivial floppy mode: first-order rigid",
+                        forces, stress_margin=eps, **common)
+    null = vh[rank:].T  # (n, n - rank)
+    if t:
+        null = null - trivial @ (trivial.T @ null)  # spans the nontrivial floppy space, rank n_floppy
+        q, r, piv = sla.qr(null, mode="economic", pivoting=True)
+        null = q[:, :n_floppy]
+    k = stiffness(forces)
+    scale = max(np.abs(k).max(), 1e-300)
+    w, x = _projected_eigh(k, null)
+    note = ""
+    if w[0] <= eig_tol * scale and n_stresses > 1:
+        forces, w, x, flex = _best_stress(at, stiffness, quadratic, null, forces, w, x, eig_tol * scale)
+        k = stiffness(forces)
+        scale = max(np.abs(k).max(), 1e-300)
+        note = (" (the self-stress that maximises lambda_min(K_V) among the "
+                f"{n_stresses}-dimensional space of self-stresses)")
+    else:
+        flex = None
+    lam = float(w[0])
+    common.update(stress_margin=eps, lambda_min=lam, stiffness_scale=scale)
+    if lam > eig_tol * scale:
+        return Decision(Verdict.JAMMED, "second", False,
+                        f"{n_floppy} floppy mode(s), all blocked by the stress matrix "
+                        f"(lambda_min(K_V) = {lam / scale:.3g} of max |K|){note}: second-order jammed",
+                        forces, **common)
+    motion = null @ x[:, 0]
+    if lam < -eig_tol * scale and n_stresses == 1:
+        return Decision(Verdict.NOT_JAMMED, "second", False,
+                        "a floppy mode with negative stiffness and a unique self-stress: "
+                        "second-order flexible", forces, motion=motion, **common)
+    if flex is not None:
+        return Decision(Verdict.NOT_JAMMED, "second", False,
+                        f"a floppy mode on which every self-stress has negative stiffness (LP 5.15 "
+                        f"optimum {flex[0]:.3g}): second-order flexible", forces, motion=null @ flex[1],
+                        **common)
+    why = ("several self-stresses and none blocks every floppy mode, while each mode tried is "
+           "blocked by some self-stress (Donev 2006, Sec. 5.5.2.1: the general case)" if lam < 0 else
+           "lambda_min(K_V) is zero within the tolerance: higher orders would decide")
+    return Decision(Verdict.UNDETERMINED, "undetermined", False, why, forces, motion=motion, **common)
+
+
+def _projected_eigh(k: np.ndarray, null: np.ndarray):
+    kv = null.T @ k @ null
+    return np.linalg.eigh(0.5 * (kv + kv.T))
+
+
+#: iterations of the cutting-plane search of :func:`_best_stress`
+MAX_CUTS = 100
+
+
+def _best_stress(at, stiffness, quadratic, null, forces, w, x, tol):
+    """Maximise lambda_min(K_V(F)) over the self-stresses F >= 0, sum F = M (concave in F) by
+    Kelley's cutting planes: each eigenvector x of K_V(F) gives the linear cut
+    t <= sum_c F_c x^T V^T K_c V x. Stops when lambda_min > tol (pre-stress stable), when the
+    LP's bound t <= tol (no self-stress blocks all floppy modes), or after MAX_CUTS LPs.
+
+    Returns (F, eigenvalues, eigenvectors, flex) with flex = (optimum, x) when a floppy mode x
+    was found on which every self-stress has negative stiffness (max_F x^T K_V(F) x < -tol, the
+    dual LP 5.15 of a strict second-order flex), else None."""
+    m = at.shape[0]
+    a = sp.csr_matrix(at.T)
+    nrow = a.shape[0]
+    a_eq = sp.vstack([sp.hstack([a, sp.csr_matrix((nrow, 1))]),
+                      sp.csr_matrix(np.concatenate([np.ones(m), [0.0]])[None, :])], format="csr")
+    b_eq = np.concatenate([np.zeros(nrow), [float(m)]])
+    cost = np.zeros(m + 1)
+    cost[-1] = -1.0
+    bounds = [(0.0, None)] * m + [(None, None)]
+    cuts = []
+    best = (w, x, forces)
+    for _ in range(MAX_CUTS):
+        use = x[:, : max(1, int((w <= w[0] + abs(w[0]) + tol).sum()))]
+        q = quadratic(null @ use)  # (M, k)
+        for col in range(q.shape[1]):
+            if q[:, col] @ forces <= tol:
+                # a mode this stress does not block: is it blocked by any self-stress?
+                res = solve_lp(-np.concatenate([q[:, col], [0.0]]), A_eq=a_eq, b_eq=b_eq,
+                               bounds=bounds[:m] + [(0.0, 0.0)])
+                if -res.fun < -tol:
+                    return best[2], best[0], best[1], (float(-res.fun), use[:, col])
+            cuts.append(q[:, col])
+        a_ub = np.column_stack([-np.array(cuts), np.ones(len(cuts))])
+        res = solve_lp(cost, A_ub=a_ub, b_ub=np.zeros(len(cuts)), A_eq=a_eq, b_eq=b_eq, bounds=bounds)
+        forces, bound = np.clip(res.x[:m], 0.0, None), float(res.x[-1])
+        w, x = _projected_eigh(stiffness(forces), null)
+        if w[0] > best[0][0]:
+            best = (w, x, forces)
+        if best[0][0] > tol or bound <= tol or bound - best[0][0] <= tol:
+            break
+    return best[2], best[0], best[1], None
+
+
+def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: float = 1e-9,
+                  stress_tol: float = 1e-9, eig_tol: float = 1e-9, shift: float = 1e3) -> Decision:
+    """Donev's shifted form (Sec. 5.6) for large packings (module docstring). The counts come from
+    the inertia of LDL^T factorisations: N_floppy = the eigenvalues of A A^T + P_T below rank_tol
+    (relative), N_stresses = those of A^T A; the smallest eigenvalue of k (A A^T + P_T) + K decides
+    the second order."""
+    m, n = at.shape
+    t = trivial.shape[1]
+    common = dict(n_stresses=-1, n_floppy=-1, n_dof=n - t, n_constraints=m)
+    eps, forces, why = _first_order(at, stress_tol)
+    gram = (at.T @ at).tocsc()
+    if t:
+        gram = gram + sp.csc_matrix(trivial @ trivial.T)
+    gscale = max(abs(gram).max(), 1e-300)
+    n_floppy = _count_below(gram / gscale, rank_tol)
+    stresses = (at @ at.T).tocsc()
+    n_stresses = _count_below(stresses / max(abs(stresses).max(), 1e-300), rank_tol)
+    common.update(n_floppy=-1 if n_floppy is None else n_floppy,
+                  n_stresses=-1 if n_stresses is None else n_stresses)
+    if why is not None:
+        verdict = Verdict.NOT_JAMMED if eps < -stress_tol else Verdict.UNDETERMINED
+        return Decision(verdict, "first" if verdict == Verdict.NOT_JAMMED else "undetermined",
+                        False, why, forces, stress_margin=eps, **common)
+    fell = 0
+    if n_floppy is None:
+        g_min, fell1 = _smallest_eigenvalue(gram / gscale)
+        fell += int(fell1)
+        floppy = g_min <= rank_tol
+    else:
+        floppy = n_floppy > 0
+    if not floppy:
+        return Decision(Verdict.JAMMED, "first", True,
+                        "strict self-stress and no nontrivial floppy mode: first-order rigid",
+                        forces, stress_margin=eps, fallbacks=fell, **common)
+    k = sp.csc_matrix(stiffness(forces))
+    kscale = max(abs(k).max(), 1e-300)
+    lam, fell2 = _smallest_eigenvalue((shift * kscale / gscale * gram + k) / kscale)
+    common.update(stress_margin=eps, lambda_min=lam * kscale, stiffness_scale=kscale,
+                  fallbacks=fell + int(fell2))
+    if lam > eig_tol:
+        return Decision(Verdict.JAMMED, "second", False,
+                        f"floppy modes blocked by the stress matrix (smallest eigenvalue of the "
+                        f"shifted form {lam:.3g} of max |K|): second-order jammed", forces, **common)
+    if lam < -eig_tol and n_stresses == 1:
+        return Decision(Verdict.NOT_JAMMED, "second", False,
+                        "the shifted form has a negative eigenvalue and the self-stress is unique: "
+                        "second-order flexible", forces, **common)
+    return Decision(Verdict.UNDETERMINED, "undetermined", False,
+                    "the shifted form has a non-positive eigenvalue and the self-stress is not "
+                    "unique (or its count failed); the search over several self-stresses is in "
+                    "the dense method", forces, **common)
+
+
+def _count_below(mat: sp.csc_matrix, tau: float) -> int | None:
+    """Number of eigenvalues of a symmetric sparse matrix below ``tau`` (Sylvester's law of
+    inertia: the negative pivots of the LU factorisation of mat - tau I with a symmetric
+    permutation and no pivoting, P M P^T = L D L^T, U = D L^T). None when the factorisation
+    failed or pivoted."""
+    shifted = (mat - tau * sp.identity(mat.shape[0], format="csc")).tocsc()
+    try:
+        lu = spla.splu(shifted, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:  # exactly singular
+        return None
+    if not np.array_equal(lu.perm_r, lu.perm_c):
+        return None
+    return int((lu.U.diagonal() < 0).sum())
+
+
+def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
+    """(smallest eigenvalue of a sparse symmetric matrix of scale 1, whether a dense eigh gave it
+    after the sparse path failed). eigsh in shift-invert mode returns the eigenvalues nearest the
+    shift, so the shift must lie just below the spectrum: at -1e-3 when the inertia (an LDL^T
+    factorisation) shows no negative eigenvalue, else just below the bracket [lo, hi) of the
+    smallest eigenvalue that bisection on the inertia of mat - sigma I finds (spectrum slicing,
+    down to 1% of |lo|)."""
+    if mat.shape[0] <= SMALL_EIGH:
+        return float(np.linalg.eigvalsh(mat.toarray())[0]), False
+    negative = _count_below(mat, 0.0)
+    if negative is None:
+        return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
+    sigma = -1e-3
+    if negative:
+        lo, hi = -float(abs(mat).sum(axis=1).max()) - 1e-3, 0.0
+        while hi - lo > 0.01 * abs(lo):
+            mid = 0.5 * (lo + hi) if hi - lo > 0.5 * abs(lo) or hi == 0.0 else -np.sqrt(lo * hi)
+            count = _count_below(mat, mid)
+            if count is None:
+                return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
+            lo, hi = (lo, mid) if count else (mid, hi)
+        sigma = lo - 0.01 * abs(lo)
+    try:
+        w = spla.eigsh(mat, k=1, sigma=sigma, which="LM", return_eigenvectors=False)
+        return float(w.min()), False
+    except (spla.ArpackNoConvergence, RuntimeError):
+        return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
+
+
+# ------------------------------------------------------------------------------------- result
+@dataclass
+class EllipsoidJammingResult:
+    """What :func:`verify_ellipsoids` found (see the module docstring).
+
+    ``local``: Verdict per particle of the local test (NOT_RUN for frozen particles), decided at
+    ``local_order`` (:data:`ORDER_CODES`: 1 first, 2 second, 0 undetermined or not run);
+    ``rattler``: particles removed by the iterated local test; ``collective``: the
+    :class:`Decision` on the backbone; ``dof``: reduced dof per particle (0 for frozen ones).
+    """
+
+    params: dict
+    network: EllipsoidContacts
+    frozen: np.ndarray
+    local: np.ndarray
+    local_order: np.ndarray
+    rattler: np.ndarray
+    collective: Decision
+    contacts_used: np.ndarray
+    dof: np.ndarray
+    seconds: dict = field(default_factory=dict)
+    fallbacks: dict = field(default_factory=dict)
+
+    @property
+    def verdict(self) -> Verdict:
+        return self.collective.verdict
+
+    @property
+    def order(self) -> str:
+        """"first", "second" or "undetermined": the order of the test that decided."""
+        return self.collective.order
+
+    @property
+    def backbone(self) -> np.ndarray:
+        return ~self.frozen & ~self.rattler
+
+    @property
+    def z_mean(self) -> float:
+        """Mean contacts per backbone particle (contacts with frozen particles included)."""
+        nb = int(self.backbone.sum())
+        if not nb:
+            return float("nan")
+        used = self.network.subset(self.contacts_used)
+        return float(used.counts()[self.backbone].sum() / nb)
+
+    @property
+    def isostaticity_gap(self) -> int:
+        """M_b - N_f: constraints minus nontrivial dof of the backbone (0 or 1: isostatic,
+        Donev 2006, Sec. 5.4.1; negative: hypostatic)."""
+        return self.collective.n_constraints - self.collective.n_dof
+
+    def summary(self) -> str:
+        c = self.collective
+        nb = int(self.backbone.sum())
+        lines = [
+            f"verdict: {self.verdict.name.lower().replace('_', ' ')} (decided at order: {self.order}); {c.reason}",
+            (f"N={self.network.n_particles}, frozen={int(self.frozen.sum())}, rattlers="
+             f"{int(self.rattler.sum())}, backbone={nb}, contacts M_b={c.n_constraints}, Z={self.z_mean:.4f}"),
+            (f"dof N_f={c.n_dof} (per particle: {np.unique(self.dof[self.backbone]).tolist()}), "
+             f"M_b - N_f = {self.isostaticity_gap}, self-stresses {c.n_stresses}, nontrivial floppy "
+             f"modes {c.n_floppy}, lambda_min(K_V) = {c.lambda_min:.4g}; first-order LP found a flex: "
+             f"{'-' if c.lp_flex is None else 'yes' if c.lp_flex else 'no'}"),
+        ]
+        for name, count in self.fallbacks.items():
+            if count:
+                lines.append(f"numerical fallback {name}: {count}")
+        return "\n".join(lines)
+
+    def to_dataset(self) -> xr.Dataset:
+        """Per-particle and per-contact arrays and scalar attributes (verdict codes of
+        :class:`Verdict`: 1 jammed, 0 not jammed, -1 not run, -2 undetermined)."""
+        net, c = self.network, self.collective
+        forces = np.zeros(net.n_contacts)
+        forces[self.contacts_used] = c.forces
+        data = {
+            "contact_i": (("contact",), net.i),
+            "contact_j": (("contact",), net.j),
+            "contact_shift": (("contact", "dim"), net.shift),
+            "contact_gap": (("contact",), net.gap),
+            "contact_normal": (("contact", "dim"), net.normal),
+            "contact_used": (("contact",), self.contacts_used.astype(np.int8)),
+            "force": (("contact",), forces),
+            "frozen": (("particle",), self.frozen.astype(np.int8)),
+            "rattler": (("particle",), self.rattler.astype(np.int8)),
+            "local": (("particle",), self.local.astype(np.int8)),
+            "local_order": (("particle",), self.local_order.astype(np.int8)),
+            "dof": (("particle",), self.dof),
+        }
+        attrs = dict(
+            hardpack_kind="ellipsoid_jamming", verdict=int(self.verdict), order=self.order,
+            reason=c.reason, first_order_rigid=int(c.first_order_rigid),
+            first_order_lp_flex=-1 if c.lp_flex is None else int(c.lp_flex),
+            N=net.n_particles, d=net.dim, n_contacts=net.n_contacts, n_frozen=int(self.frozen.sum()),
+            n_rattlers=int(self.rattler.sum()), n_backbone=int(self.backbone.sum()),
+            n_backbone_contacts=c.n_constraints, n_dof=c.n_dof, z_mean=self.z_mean,
+            isostaticity_gap=self.isostaticity_gap, n_stresses=c.n_stresses, n_floppy=c.n_floppy,
+            lambda_min=c.lambda_min, stiffness_scale=c.stiffness_scale, stress_margin=c.stress_margin,
+            n_local_undetermined=int((self.local == Verdict.UNDETERMINED).sum()),
+            **{k: v for k, v in self.params.items() if v is not None},
+            **{f"fallback_{k}": int(v) for k, v in self.fallbacks.items()},
+            **{f"seconds_{k}": v for k, v in self.seconds.items()},
+        )
+        return xr.Dataset(data, attrs=attrs)
+
+
+# ------------------------------------------------------------------------------------- verify
+def _submatrices(net, at_full, hess, t_full, owner, contacts, moving):
+    """(A^T, dense stiffness(forces), sparse stiffness(forces), T) restricted to ``contacts`` and
+    the reduced dof of the ``moving`` particles (``owner``: the particle of each reduced column)."""
+    tm = t_full[:, np.flatnonzero(moving[owner])]
+    at = (at_full[contacts] @ tm).tocsr()
+    sub = net.subset(contacts)
+    sub_hess = hess[contacts]
+
+    def stiffness_sparse(forces):
+        return (tm.T @ stiffness_matrix_full(sub, forces, sub_hess) @ tm).tocsc()
+
+    def stiffness(forces):
+        return stiffness_sparse(forces).toarray()
+
+    f = dof_per_particle(net.dim)
+    idx = np.concatenate([sub.i[:, None] * f + np.arange(f), sub.j[:, None] * f + np.arange(f)], axis=1)
+
+    def quadratic(y):
+        """(M, k): y_k^T K_c y_k of every contact c for the columns y_k of y (n_red, k)."""
+        yc = (tm @ y)[idx]  # (M, 2 d_f, k)
+        return -np.einsum("cak,cab,cbk->ck", yc, sub_hess, yc) / sub.scale[:, None]
+
+    return at, stiffness, stiffness_sparse, quadratic, tm
+
+
+def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
+                      method: str = "auto", local: bool = True, rank_tol: float = 1e-9,
+                      stress_tol: float = 1e-9, eig_tol: float = 1e-9, seed: int = 0) -> EllipsoidJammingResult:
+    """Jamming test of a periodic packing of ellipses or ellipsoids (module docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        Ellipses or ellipsoids in a periodic cell (the contacts must be exact to ``delta``).
+    delta : float, optional
+        Contact tolerance mu - 1 (default DEFAULT_DELTA, 1e-9).
+    frozen : array_like of bool, shape (N,), optional
+        Fixed particles (obstacles): no dof, no balance equations.
+    method : {"auto", "dense", "sparse"}
+        Linear algebra of the collective test ("auto": dense up to DENSE_LIMIT reduced dof).
+    local : bool, default True
+        Run the iterated local test (rattler removal) before the collective test.
+    rank_tol, stress_tol, eig_tol : float
+        Relative tolerances of the rank of A, of the self-stress LP's margin, of lambda_min.
+    seed : int, default 0
+        Seed of the random load of the first-order LP cross-check (:func:`first_order_lp`).
+
+    Returns
+    -------
+    EllipsoidJammingResult
+
+    Raises
+    ------
+    InvalidInputError
+        For a packing that is not a periodic ellipsoid packing, overlaps (mu - 1 below
+        -packing.overlap_tol, by the Perram-Wertheim function), a bad ``delta``, ``frozen`` of
+        the wrong shape, an unknown ``method`` or non-positive tolerances.
+    """
+    check_ellipsoid_packing(packing)
+    n = packing.n_particles
+    if method not in ("auto", "dense", "sparse"):
+        raise InvalidInputError(f"method must be 'auto', 'dense' or 'sparse', got {method!r}")
+    for name, value in (("rank_tol", rank_tol), ("stress_tol", stress_tol), ("eig_tol", eig_tol)):
+        if not (np.isfinite(value) and 0 < value < 1):
+            raise InvalidInputError(f"{name} must be in (0, 1), got {value!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    frozen = np.zeros(n, dtype=bool) if frozen is None else np.asarray(frozen)
+    if frozen.shape != (n,) or frozen.dtype != bool:
+        raise InvalidInputError(f"frozen must be a boolean array of shape ({n},), got {frozen.dtype} {frozen.shape}")
+    delta = DEFAULT_DELTA if delta is None else delta
+    seconds = {}
+    t0 = time.perf_counter()
+    net = ellipsoid_contacts(packing, delta)
+    overlap = net.gap < -packing.overlap_tol
+    if overlap.any():
+        worst = int(np.argmin(net.gap))
+        raise InvalidInputError(
+            f"{int(overlap.sum())} pairs overlap beyond the tolerance {packing.overlap_tol:g} (mu - 1 "
+            f"down to {net.gap[worst]:.3g}, particles {net.i[worst]} and {net.j[worst]}); jamming "
+            "tests need a packing of hard particles: finish or repair it first")
+    at_full = rigidity_transpose_full(net)
+    hess = contact_hessians(net)
+    t_full, dof = dof_basis(net, ~frozen)
+    owner = np.repeat(np.flatnonzero(~frozen), dof[~frozen])
+    seconds["contacts"] = time.perf_counter() - t0
+    tols = dict(stress_tol=stress_tol, eig_tol=eig_tol)
+    with recording_fallbacks() as fallbacks:
+        t0 = time.perf_counter()
+        local_verdict = np.full(n, int(Verdict.NOT_RUN), dtype=np.int64)
+        local_order = np.zeros(n, dtype=np.int64)
+        active = ~frozen
+        if local:
+            changed = True
+            while changed:
+                changed = False
+                for p in np.flatnonzero(active):
+                    present = active | frozen
+                    contacts = np.flatnonzero(((net.i == p) | (net.j == p)) & present[net.i] & present[net.j])
+                    only = np.zeros(n, dtype=bool)
+                    only[p] = True
+                    at, stiff, _, quad, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only)
+                    dec = decide_dense(at, stiff, quad, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
+                    local_verdict[p] = int(dec.verdict)
+                    local_order[p] = ORDER_CODES[dec.order]
+                    if dec.verdict == Verdict.NOT_JAMMED:
+                        active[p] = False
+                        changed = True
+        seconds["local"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        present = active | frozen
+        used = present[net.i] & present[net.j] & (active[net.i] | active[net.j])
+        contacts = np.flatnonzero(used)
+        at, stiff, stiff_sparse, quad, tm = _submatrices(net, at_full, hess, t_full, owner, contacts, active)
+        trivial = (trivial_translations(tm, net, active) if not frozen.any() and active.any()
+                   else np.zeros((at.shape[1], 0)))
+        dense = method == "dense" or (method == "auto" and at.shape[1] <= DENSE_LIMIT)
+        if not active.any():
+            second = (local_order == ORDER_CODES["second"]).any()
+            dec = Decision(Verdict.NOT_JAMMED, "second" if second else "first", False,
+                           "every particle is a rattler (the local test"
+                           + (", at second order for some," if second else "")
+                           + " found an unjamming motion of each): nothing is jammed",
+                           np.zeros(len(contacts)), 0, 0, 0, len(contacts))
+        elif dense:
+            dec = decide_dense(at, stiff, quad, trivial, rank_tol=rank_tol, **tols)
+        else:
+            dec = decide_sparse(at, stiff_sparse, trivial, rank_tol=rank_tol, **tols)
+        if active.any():
+            dec.lp_flex = first_order_lp(at, trivial, np.random.default_rng(seed))[0]
+        seconds["collective"] = time.perf_counter() - t0
+    params = dict(delta=float(delta), method="dense" if dense else "sparse", seed=int(seed), rank_tol=rank_tol,
+                  stress_tol=stress_tol, eig_tol=eig_tol)
+    rattler = ~frozen & ~active
+    return EllipsoidJammingResult(
+        params=params, network=net, frozen=frozen, local=local_verdict, local_order=local_order,
+        rattler=rattler,
+        collective=dec, contacts_used=used, dof=np.where(frozen, 0, dof), seconds=seconds,
+        fallbacks={**{k: int(v) for k, v in fallbacks.items()},
+                   "sparse_eigsh_dense": dec.fallbacks},
+    )
