@@ -321,3 +321,39 @@ def test_structure_rows_on_a_bcc_crystal_fail_the_amorphous_signatures():
     rows = {r.target: r for r in structure_rows(members)}
     assert rows["donev-ch9-near-contact-exponent"].status == FAIL
     assert rows["donev-ch9-g2-peak-sqrt3"].status == FAIL
+
+
+def _ellipsoid_summary(n=1000, seeds=(1, 2), mm_phi=(0.700, 0.701), oblate_shift=0.0):
+    rows = []
+    for beta in (0.0, 0.5, 1.0):
+        for alpha in (1.0, 1.5, 2.0):
+            for seed in seeds:
+                phi = 0.64 + 0.1 * (alpha - 1) * (1 + (beta == 0.5)) / 2 + 0.001 * seed
+                phi += oblate_shift if beta == 1.0 and alpha > 1 else 0.0
+                z = 6.0 if alpha == 1 else (9.6 if beta != 0.5 else 11.4)
+                rows.append((beta, alpha, seed, phi, z, z, 0.03))
+    for seed, phi in zip(seeds, mm_phi):
+        rows.append((1.0, 1.9, seed, phi, 9.6, 9.8, 0.03))
+    beta, alpha, seed, phi, z, z_all, s = (np.array(v) for v in zip(*rows))
+    return xr.Dataset({"N": ("sample", np.full(len(rows), n)), "d": ("sample", np.full(len(rows), 3)),
+                       "phi": ("sample", phi), "z_mean": ("sample", z), "z_all": ("sample", z_all),
+                       "nematic_S": ("sample", s)},
+                      coords={"beta": ("sample", beta), "alpha": ("sample", alpha), "seed": ("sample", seed)})
+
+
+def test_ellipsoid_rows_judge_the_published_shape_dependence():
+    from hardpack.validation.ellipsoids import ellipsoid_rows
+
+    rows = {r.target: r for r in ellipsoid_rows([_ellipsoid_summary()])}
+    assert rows["donev-5.2-phij-sphere-point"].status == PASS  # 0.6415 +- 0.0002, published 0.64
+    assert rows["donev-5.2-phij-max-self-dual"].status == PASS  # 0.7415 at alpha = 2
+    assert rows["donev-5.4-z-max-non-spheroids"].status == PASS
+    assert rows["donev-5.2-z-plateau-spheroids"].status == PASS  # 9.6 within the printed 10 +- 0.5
+    assert rows["donev-5.2-prolate-oblate-duality"].status == PASS
+    assert {rows[t].status for t in ("donev-fig5.1-mm-phi", "donev-fig5.1-mm-nematic", "donev-ch7-mm-z")} == {PASS}
+    assert rows["donev-5.2-phij-max-self-dual"].reproduced == pytest.approx(0.7415)
+    shifted = {r.target: r for r in ellipsoid_rows([_ellipsoid_summary(oblate_shift=0.01, mm_phi=(0.72, 0.721))])}
+    assert shifted["donev-5.2-prolate-oblate-duality"].status == FAIL
+    assert shifted["donev-fig5.1-mm-phi"].status == FAIL
+    small = {r.target: r for r in ellipsoid_rows([_ellipsoid_summary(n=40)])}
+    assert {r.status for r in small.values()} == {NA}

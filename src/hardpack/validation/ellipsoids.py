@@ -1,0 +1,89 @@
+"""Validation rows of the LS packings of hard ellipsoids (Donev 2006, Sec. 5.2, Figs. 5.1-5.2, and
+Sec. 7.2).
+
+Input: the contact summaries of the ellipsoid study (``ellipsoids/contacts3d``: one sample per
+packing with coordinates ``beta``, ``alpha``, ``seed`` and the variables ``phi``, ``z_mean``,
+``z_all``, ``nematic_S``). A claim about a maximum over alpha takes the alpha whose mean over seeds
+is largest and judges that mean with its own standard error.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hardpack.validation.rows import Row, evaluate, seed_statistics
+from hardpack.validation.targets import load_targets
+
+#: the M&M shape of Donev 2006, Fig. 5.1: oblate spheroids (beta = 1) of aspect ratio 1.9
+MM = (1.0, 1.9)
+
+
+def _cells(summary) -> dict:
+    """{(beta, alpha): per-seed values} of every variable: ``{name: {(beta, alpha): array}}``."""
+    beta = np.round(np.asarray(summary["beta"].values, float), 12)
+    alpha = np.round(np.asarray(summary["alpha"].values, float), 12)
+    keys = sorted(set(zip(beta.tolist(), alpha.tolist())))
+    return {name: {k: np.asarray(summary[name].values, float)[(beta == k[0]) & (alpha == k[1])] for k in keys}
+            for name in ("phi", "z_mean", "z_all", "nematic_S") if name in summary}
+
+
+def _detail(cell: dict, key) -> str:
+    return f"beta = {key[0]:g}, alpha = {key[1]:g}; per seed {', '.join(f'{v:.4f}' for v in cell[key])}"
+
+
+def _largest(target, cell: dict, keys, n: int, label: str) -> Row:
+    """The row of the (beta, alpha) with the largest mean among ``keys``."""
+    keys = [k for k in keys if k in cell]
+    if not keys:
+        return evaluate(target, n=n, label=label, detail="no packing of these shapes in the study")
+    best = max(keys, key=lambda k: seed_statistics(cell[k])[0])
+    return evaluate(target, samples=cell[best], n=n, label=label, detail=_detail(cell, best))
+
+
+def ellipsoid_rows(summaries) -> list[Row]:
+    """Rows of the 3D ellipsoid summaries (module docstring); ellipse summaries have no targets."""
+    targets = load_targets()
+    out = []
+    for s in summaries:
+        if int(np.asarray(s["d"].values).ravel()[0]) != 3:
+            continue
+        n = int(np.asarray(s["N"].values).min())
+        cells = _cells(s)
+        phi, z = cells["phi"], cells["z_mean"]
+        spheres = [k for k in phi if k[1] == 1.0]
+        if spheres:
+            values = np.concatenate([phi[k] for k in spheres])
+            out.append(evaluate(targets["donev-5.2-phij-sphere-point"], samples=values, n=n, label="alpha = 1",
+                                detail=f"{len(spheres)} families; per packing {', '.join(f'{v:.4f}' for v in values)}"))
+        out.append(_largest(targets["donev-5.2-phij-max-self-dual"], phi, [k for k in phi if k[0] == 0.5], n,
+                            "beta = 1/2"))
+        out.append(_largest(targets["donev-5.2-z-plateau-spheroids"], z,
+                            [k for k in z if k[0] in (0.0, 1.0) and k[1] > 1], n, "spheroids"))
+        out.append(_largest(targets["donev-5.4-z-max-non-spheroids"], z,
+                            [k for k in z if 0 < k[0] < 1 and k[1] > 1], n, "non-spheroids"))
+        out.append(_duality(targets["donev-5.2-prolate-oblate-duality"], phi, n))
+        if MM in phi:
+            for tid, name in (("donev-fig5.1-mm-phi", "phi"), ("donev-fig5.1-mm-nematic", "nematic_S"),
+                              ("donev-ch7-mm-z", "z_all")):
+                out.append(evaluate(targets[tid], samples=cells[name][MM], n=n, label="M&M shape",
+                                    detail=_detail(cells[name], MM)))
+    return out
+
+
+def _duality(target, phi: dict, n: int) -> Row:
+    """phi_J(prolate) - phi_J(oblate) at the aspect ratio where it is largest relative to its error."""
+    pairs = sorted(k[1] for k in phi if k[0] == 0.0 and (1.0, k[1]) in phi and k[1] > 1)
+    if not pairs:
+        return evaluate(target, n=n, label="prolate - oblate", detail="no aspect ratio has both spheroids")
+    rows = []
+    for alpha in pairs:
+        p_mean, p_err, p_seeds, _ = seed_statistics(phi[(0.0, alpha)])
+        o_mean, o_err, o_seeds, _ = seed_statistics(phi[(1.0, alpha)])
+        err = math.hypot(p_err, o_err)
+        rows.append((abs(p_mean - o_mean) / err if err > 0 else math.inf, alpha, p_mean - o_mean, err,
+                     min(p_seeds, o_seeds)))
+    _, alpha, diff, err, seeds = max(rows)
+    return evaluate(target, diff, err, n=n, seeds=seeds, label="prolate - oblate",
+                    detail=f"alpha = {alpha:g}, the largest of {len(rows)} differences relative to its error")
