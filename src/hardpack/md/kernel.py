@@ -45,6 +45,18 @@ separation) the later root (B + sqrt(B^2 - AC)) / (-A) is the re-contact. C > 0:
 For shrinking spheres (kappa < 0) the squared equation also has roots with sigma(t) < 0, i.e.
 after t = 1/|kappa|; windows end before 0.5/|kappa| (engine), so such roots are never processed.
 
+Hard walls (Donev 2006, sec. 3.2.2.1 and Ch. 7; compiled only into the wall modes, see ``wmode``):
+a flat wall at x_k = 0 is hit when x_k(t) = a(t) (gap rate v_k - adot < 0), at x_k = L_k when
+L_k - x_k(t) = a(t); a spherical container of radius R about c when |x(t) - c| = R - a(t)
+(:func:`hardpack.events.roots.container_root`). The wall reverses the approach speed along its
+outward normal n, w = n.v + adot > 0: v -> v - 2 w n (the wall is infinitely massive; kinetic
+energy changes by 2 w adot), and the wall receives momentum 2 w, summed in acc[A_WALL + k]
+(flat walls of axis k) or acc[A_WALL] (container). Walled axes have no periodic images and
+positions along them are never wrapped. A wall event is stored as ep[i] = WALL with the wall in
+ec[i] (2 k or 2 k + 1), and the particle's collision counter is raised so that predictions
+against it are invalidated like after a pair collision; wall collisions count towards the
+window's collision budget.
+
 Collision law (derived here for growing spheres; Donev 2006, Algorithm 12 steps 4-5, as printed,
 with n from A to B, pushes an approaching pair together, so the sign is reversed here):
 n = r / |r| at contact, v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with
@@ -204,6 +216,14 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
         Relative skin of every particle (:meth:`hardpack.md.engine.Engine.skin_factors`).
     imgvec : numpy.ndarray of float64, shape (4**d, d), read-only
         Periodic shift L n of each image code, code = sum_k (n_k + 1) 4^k.
+    wmode : tuple
+        Boundary mode, a compile-time constant by its length: PERIODIC_MODE (), FLAT_WALLS_MODE
+        (hard walls at x_k = 0 and L_k on the axes flagged in ``walled``) or SPHERE_MODE (a hard
+        spherical container ``wspec``); the periodic specialisation contains no wall code.
+    walled : numpy.ndarray of int8, shape (d,), read-only
+        1 for the axes without periodic images (walled; all of them in a container).
+    wspec : numpy.ndarray of float64, shape (d + 1,), read-only
+        Container centre and radius R (SPHERE_MODE only).
 
     lvl : numpy.ndarray of int32, shape (N,), read-only
         Grid / cells: the grid level h of every particle.
