@@ -80,6 +80,9 @@ def test_container_time_after_reflection_is_the_next_hit():
     assert container_time(np.array([rho, 0, 0]), np.array([-1.0, 0, 0]), rho, 0.0) == pytest.approx(2 * rho)
     assert container_time(np.array([rho * (1 + 1e-16), 0, 0]), np.array([-1.0, 0, 0]), rho, 0.0) \
         == pytest.approx(2 * rho)
+    # touching from inside by one ulp, moving inward: exit_root's form cancels to 0 here
+    assert container_time(np.array([np.nextafter(rho, 0), 0, 0]), np.array([-1.0, 0, 0]), rho, 0.0) \
+        == pytest.approx(2 * rho)
     assert container_time(np.array([rho, 0, 0]), np.array([1.0, 0, 0]), rho, 0.0) == 0.0
     assert container_time(np.zeros(3), np.zeros(3), rho, 0.1) == pytest.approx(rho / 0.1)
 
