@@ -73,7 +73,6 @@ from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt
 from hardpack.md.simulation import (
-    RECORD_FIELDS,
     Simulation,
     check_packing,
     maxwell_boltzmann,

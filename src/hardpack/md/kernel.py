@@ -76,7 +76,7 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from hardpack.events.heap import heap_set
-from hardpack.events.roots import container_root, contact_root, exit_root
+from hardpack.events.roots import contact_root, container_root, exit_root
 
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
