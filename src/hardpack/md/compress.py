@@ -308,8 +308,8 @@ def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     from hardpack.geometry.neighbours import pairs_within
 
     if packing.shape.kind != "sphere":
-        raise InvalidInputError(f"the jamming backbone of an LS compression handles hard spheres only, "
-                                f"not {packing.shape.name}")
+        raise InvalidInputError(f"{packing.shape.name} are not supported by the jamming backbone of an LS "
+                                "compression yet; it handles hard spheres only")
     pairs = pairs_within(packing, rel_gap=gap)
     i, j = np.asarray(pairs.i), np.asarray(pairs.j)
     n, d = packing.n_particles, packing.dim
