@@ -5,6 +5,12 @@ placed largest first at uniformly random, non-overlapping positions in a periodi
 the target volume fraction, by the one RSA packer of the neighbour layer
 (:func:`hardpack.geometry.neighbours.random_sequential_addition`, drawing its uniforms from the same
 generator after the radii). The result depends only on (n, d, distribution, phi, box shape, seed).
+
+Finite containers (Donev 2006, Ch. 7): ``boundary="hard_walls"`` puts hard walls at 0 and L_k on
+``wall_axes`` (all axes by default) of the same box; ``boundary="spherical_container"`` places the
+spheres inside a spherical container of radius R, V_d(R) = (particle volume) / phi, centred in the
+cube [0, 2R]^d (the pseudo-box of the MD cell lists). Positions are uniform over the region each
+centre can reach (RSA restricted to the container).
 """
 
 from __future__ import annotations
@@ -13,17 +19,21 @@ import numpy as np
 
 from hardpack.distributions import Discrete, Distribution
 from hardpack.errors import InvalidInputError
-from hardpack.geometry.balls import ball_volume
+from hardpack.geometry.balls import ball_volume, unit_ball_volume
+from hardpack.geometry.boundaries import HardWalls, SphericalContainer
 from hardpack.geometry.neighbours import random_sequential_addition
 from hardpack.geometry.packing import Packing
 
 
 def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed: int,
-                   box_shape=None, max_trials: int = 100_000) -> Packing:
+                   box_shape=None, max_trials: int = 100_000, boundary: str = "periodic",
+                   wall_axes=None) -> Packing:
     """Seeded RSA packing of ``n`` spheres with radii from ``distribution`` at volume fraction ``phi``.
 
-    ``box_shape`` gives relative box lengths (default a cube). Species labels are set for
-    discrete distributions. Raises :class:`InvalidInputError` for impossible requests.
+    ``box_shape`` gives relative box lengths (default a cube; not with a spherical container).
+    ``boundary``: "periodic", "hard_walls" (walls on ``wall_axes``, default all) or
+    "spherical_container" (module docstring); phi is over the boundary's volume. Species labels
+    are set for discrete distributions. Raises :class:`InvalidInputError` for impossible requests.
     """
     if int(n) != n or n < 1:
         raise InvalidInputError(f"n must be a positive integer, got {n!r}")
@@ -41,11 +51,35 @@ def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed:
     shape = np.ones(d) if box_shape is None else np.asarray(box_shape, float)
     if shape.shape != (d,) or not (np.isfinite(shape).all() and (shape > 0).all()):
         raise InvalidInputError(f"box_shape must be {d} positive numbers, got {box_shape!r}")
-    scale = (ball_volume(radii, d).sum() / (phi * np.prod(shape))) ** (1.0 / d)
-    box = shape * scale
-    positions = random_sequential_addition(radii, box, rng, max_trials)
+    if boundary not in ("periodic", "hard_walls", "spherical_container"):
+        raise InvalidInputError(f"boundary must be 'periodic', 'hard_walls' or 'spherical_container', "
+                                f"got {boundary!r}")
+    if wall_axes is not None and boundary != "hard_walls":
+        raise InvalidInputError("wall_axes is for boundary='hard_walls' only")
     species = distribution.species_of(radii) if isinstance(distribution, Discrete) else None
-    return Packing(positions, radii, np.diag(box), species=species)
+    volume = ball_volume(radii, d).sum() / phi
+    if boundary == "spherical_container":
+        if box_shape is not None:
+            raise InvalidInputError("a spherical container sits in a cube: leave box_shape unset")
+        radius = (volume / unit_ball_volume(d)) ** (1.0 / d)
+        if radius < radii.max():
+            raise InvalidInputError(f"phi = {phi:g} leaves a container (radius {radius:.4g}) smaller than "
+                                    f"the largest sphere (radius {radii.max():.4g}): lower phi")
+        box = np.full(d, 2.0 * radius)
+        container = SphericalContainer(tuple(box / 2), radius)
+        positions = random_sequential_addition(radii, box, rng, max_trials,
+                                               container=(np.asarray(container.centre), radius))
+        return Packing(positions, radii, np.diag(box), species=species, boundary=container)
+    box = shape * (volume / np.prod(shape)) ** (1.0 / d)
+    if boundary == "periodic":
+        positions = random_sequential_addition(radii, box, rng, max_trials)
+        return Packing(positions, radii, np.diag(box), species=species)
+    walls = HardWalls(tuple(range(d)) if wall_axes is None else wall_axes)
+    walls.check(np.diag(box))
+    walled = np.zeros(d, dtype=bool)
+    walled[list(walls.axes)] = True
+    positions = random_sequential_addition(radii, box, rng, max_trials, walled=walled)
+    return Packing(positions, radii, np.diag(box), species=species, boundary=walls)
 
 
 def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=None,

@@ -5,6 +5,8 @@
   uses it with growth, the bounding-cell MD (:mod:`hardpack.freeenergy`) with g = 0.
 - :func:`exit_time`: a growing sphere touches the inside of its fixed bounding sphere (the
   near-neighbour lists of Donev 2006, sec. 3.3.2).
+- :func:`container_time`: a growing sphere hits the wall of a fixed spherical container (Donev 2006,
+  Ch. 7); flat walls need only a linear root (in :mod:`hardpack.md.kernel`).
 
 The ``*_root`` functions take the dot products and are inlined into the numba kernels' loops;
 the ``*_time`` functions take vectors.
@@ -96,4 +98,50 @@ def exit_root(dd, dv, vv, rrem, adot):
     return np.inf
 
 
-# --------------------------------------------------------------------------------- event loop
+
+@njit(cache=True)
+def container_time(dr, v, rho, adot):
+    """Time for a sphere inside a hard spherical container (centre offset dr from the container's
+    centre, velocity v, radius growing at adot) to hit the wall: |dr + v t| = rho - adot t with
+    rho = R - a the container radius less the particle's radius now (Donev 2006, Ch. 7: the wall
+    event of a spherical container). Unlike :func:`exit_time` a sphere touching the wall and
+    moving away from it (just reflected) gets its NEXT hit, not t = 0.
+    """
+    dd, dv, vv = dot_products(dr, v)
+    return container_root(dd, dv, vv, rho, adot)
+
+
+@njit(cache=True, inline="always")
+def container_root(dd, dv, vv, rho, adot):
+    """First wall time >= 0 of :func:`container_time` from dd = dr.dr, dv = dr.v, vv = v.v.
+
+    A t^2 + 2 B t + C = 0 with A = v.v - adot^2, B = dv + rho adot, C = dd - rho^2 (as in
+    :func:`exit_time`), each root in the form without cancellation. Inside (C < 0) the hit is the
+    positive root: (-B + sqrt(B^2 - AC)) / A when B < 0 (moving away from the wall, A > 0), and
+    -C / (B + sqrt(B^2 - AC)) when B >= 0 (for A < 0, a particle growing faster than it moves,
+    this is the smaller of two positive roots). :func:`exit_root` returns 0 instead when the
+    first form cancels for a sphere touching its bound and moving inward, which is harmless for a
+    neighbour-list exit but would repeat a wall event forever. On or beyond the wall (C >= 0,
+    round-off after a reflection): B >= 0 (approach speed n.v + adot >= 0) hits now; B < 0 gets
+    the later root (-B + sqrt(B^2 - AC)) / A (a reflection leaves |n.v| > adot, so A > 0).
+    Roots that cannot exist give inf (B^2 - AC < 0 for a shrinking sphere; A <= 0 with B < 0).
+    """
+    c = dd - rho * rho
+    b = dv + rho * adot
+    a = vv - adot * adot
+    if c >= 0.0 and b >= 0.0:
+        return 0.0
+    disc = b * b - a * c
+    if disc < 0.0:
+        if adot > 0.0 and c < 0.0:  # round-off: a growing sphere inside always reaches the wall
+            disc = 0.0
+        else:
+            return np.inf
+    if b < 0.0:
+        if a <= 0.0:
+            return np.inf
+        return (-b + np.sqrt(disc)) / a
+    den = b + np.sqrt(disc)
+    if den > 0.0:
+        return -c / den
+    return np.inf

@@ -67,6 +67,34 @@ class ContainmentReport:
         return f"{head}; worst: particle {self.worst} crosses {self.wall} by {self.overlap:.3e} of its radius"
 
 
+@dataclass(frozen=True)
+class WallContacts:
+    """Particle-wall contacts within a relative gap: particle ``particle[m]`` is at relative gap
+    ``gap[m]`` = h / r - 1 (h: centre-wall distance, r: radius) from a wall whose outward unit
+    normal at the contact point is ``normal[m]`` (the wall pushes the particle along -normal).
+
+    Parameters
+    ----------
+    particle : numpy.ndarray of int, shape (M,)
+    normal : numpy.ndarray of float, shape (M, d)
+    gap : numpy.ndarray of float, shape (M,)
+    """
+
+    particle: np.ndarray
+    normal: np.ndarray
+    gap: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.particle)
+
+
+def _wall_contacts(h: np.ndarray, normals: np.ndarray, radii: np.ndarray, rel_gap: float) -> WallContacts:
+    """Contacts from the centre-wall distances h (N, W) and outward normals (N, W, d) of W walls."""
+    gap = h / radii[:, None] - 1.0
+    i, w = np.nonzero(gap <= rel_gap)
+    return WallContacts(i.astype(np.int64), normals[i, w], gap[i, w])
+
+
 def _no_walls() -> ContainmentReport:
     return ContainmentReport(0, -1, "no walls", float("-inf"))
 
@@ -96,6 +124,11 @@ class Periodic:
 
     def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
         return _no_walls()
+
+    def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
+        """No walls, no contacts."""
+        d = positions.shape[1]
+        return WallContacts(np.zeros(0, np.int64), np.zeros((0, d)), np.zeros(0))
 
     def __str__(self) -> str:
         return "periodic"
@@ -172,6 +205,18 @@ class HardWalls:
         names = [f"the wall x_{k} = 0" for k in axes] + [f"the wall x_{k} = {v:.6g}" for k, v in zip(axes, length)]
         return _report(overlap, lambda i: names[nearest[i]], tol)
 
+    def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
+        """Every sphere within relative gap ``rel_gap`` of a wall (a sphere may touch several);
+        normals -e_k at x_k = 0 and +e_k at x_k = L_k."""
+        n, d = positions.shape
+        axes = list(self.axes)
+        length = np.diag(lattice)[axes]
+        h = np.concatenate([positions[:, axes], length - positions[:, axes]], axis=1)
+        normals = np.zeros((2 * len(axes), d))
+        normals[np.arange(len(axes)), axes] = -1.0
+        normals[len(axes) + np.arange(len(axes)), axes] = 1.0
+        return _wall_contacts(h, np.broadcast_to(normals, (n,) + normals.shape), radii, rel_gap)
+
     def __str__(self) -> str:
         return f"hard walls on axes {list(self.axes)}"
 
@@ -241,6 +286,17 @@ class SphericalContainer:
         dx = positions - np.array(self.centre)
         h = self.radius - np.sqrt(np.einsum("ij,ij->i", dx, dx))
         return _report(1.0 - h / radii, lambda i: "the container wall", tol)
+
+    def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
+        """Every sphere within relative gap ``rel_gap`` of the container wall; normal (x - c) / |x - c|
+        (a sphere at the centre can touch only a container of its own size and gets normal e_0)."""
+        dx = positions - np.array(self.centre)
+        dist = np.sqrt(np.einsum("ij,ij->i", dx, dx))
+        normal = np.zeros_like(dx)
+        normal[:, 0] = 1.0
+        moved = dist > 0
+        normal[moved] = dx[moved] / dist[moved, None]
+        return _wall_contacts((self.radius - dist)[:, None], normal[:, None, :], radii, rel_gap)
 
     def __str__(self) -> str:
         return f"spherical container (centre {list(self.centre)}, radius {self.radius:.6g})"

@@ -73,7 +73,6 @@ from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt, packing_to_dataset, write_dataset
 from hardpack.md.simulation import (
-    RECORD_FIELDS,
     Simulation,
     check_packing,
     maxwell_boltzmann,
@@ -252,9 +251,11 @@ def timeseries_dataset(sim: Simulation, attrs: dict) -> xr.Dataset:
         "shell": "bounding-sphere shell / radius used", "neighbours": "mean neighbour-list length",
         "wall_time": "cumulative wall-clock seconds",
         "growth_rate": "Gamma = (d<D>/dt)/sqrt(kT/m) used in the window",
+        "Z_wall": "reduced pressure on the walls p_w V/(N kT) over the window (hardpack.md.simulation)",
+        "wall_collisions": "reflections at hard walls in the window",
     }
     data = {k: ("window", np.asarray(sim.records[k], dtype=float), {"description": units[k]})
-            for k in RECORD_FIELDS}
+            for k in sim.fields}
     ds = xr.Dataset(data, coords={"window": np.arange(len(sim.records["time"]))})
     ds.attrs.update({"hardpack_kind": "md_timeseries", **attrs})
     return ds
@@ -299,7 +300,8 @@ def _check_final_stage(growth_rate: float, final_growth_rate, switch_pressure, s
 def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     """Share of the particle volume in the packing's d + 1 contact backbone.
 
-    Contacts are pairs with relative gap ``|r_ij| / (a_i + a_j) - 1 <= gap``; particles with fewer
+    Contacts are pairs with relative gap ``|r_ij| / (a_i + a_j) - 1 <= gap`` and, with hard walls,
+    particle-wall contacts with relative gap h / a_i - 1 <= gap; particles with fewer
     than d + 1 contacts (which cannot be locally jammed: d vectors do not positively span R^d,
     Donev 2006, ch. 4, local jamming) are removed repeatedly together with their contacts, and the volume of
     the particles left is returned as a fraction of the total. Near a jammed state at reduced
@@ -314,14 +316,18 @@ def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     from hardpack.geometry.balls import ball_volume
     from hardpack.geometry.neighbours import pairs_within
 
-    packing.require_periodic_spheres("the jamming backbone of an LS compression")
+    if packing.shape.kind != "sphere":
+        raise InvalidInputError(f"{packing.shape.name} are not supported by the jamming backbone of an LS "
+                                "compression yet; it handles hard spheres only")
     pairs = pairs_within(packing, rel_gap=gap)
     i, j = np.asarray(pairs.i), np.asarray(pairs.j)
     n, d = packing.n_particles, packing.dim
+    walls = packing.boundary.wall_contacts(packing.positions, packing.radii, packing.lattice, gap)
+    on_wall = np.bincount(walls.particle, minlength=n)
     alive = np.ones(n, dtype=bool)
     while True:
         keep = alive[i] & alive[j]
-        count = np.bincount(i[keep], minlength=n) + np.bincount(j[keep], minlength=n)
+        count = np.bincount(i[keep], minlength=n) + np.bincount(j[keep], minlength=n) + on_wall
         drop = alive & (count < d + 1)
         if not drop.any():
             break
@@ -396,8 +402,9 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     Parameters
     ----------
     packing : Packing
-        Start configuration: a periodic sphere packing in an orthorhombic cell, N >= 2, without
-        overlaps.
+        Start configuration: a sphere packing in an orthorhombic cell without overlaps: periodic
+        (N >= 2), with hard walls on some axes or in a spherical container (N >= 1; the walls stay
+        fixed while the spheres grow, Donev 2006, Ch. 7).
     growth_rate : float
         Gamma = (d<D>/dt) / sqrt(kT/m), finite; negative shrinks the particles (needs a
         ``target_phi`` below the start), 0 runs at fixed phi (needs a collision or time limit).
@@ -462,6 +469,10 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)
     if window is not None and not (math.isfinite(window) and window > 0):
         raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
+    if contact_forces and packing.boundary.kind != "periodic":
+        raise InvalidInputError("MD contact forces log pair collisions only; with hard walls the wall "
+                                "forces would be missing: compute forces from the packing "
+                                "(hardpack.jamming) or use a periodic cell")
     if contact_forces and (isinstance(contact_windows, bool) or int(contact_windows) != contact_windows
                            or contact_windows < 1):
         raise InvalidInputError(f"contact_windows must be a positive integer, got {contact_windows!r}")
@@ -475,7 +486,8 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
     fp = ckpt.fingerprint(packing, growth_rate=float(growth_rate), seed=int(seed), window=window,
                           overlap_tol=overlap_tol, final_growth_rate=final_growth_rate,
                           switch_pressure=float(switch_pressure) if final_growth_rate else None,
-                          contact_windows=int(contact_windows) if contact_forces else 0)
+                          contact_windows=int(contact_windows) if contact_forces else 0,
+                          **({} if packing.boundary.kind == "periodic" else {"boundary": str(packing.boundary)}))
     state = None if checkpoint is None else ckpt.load(checkpoint, fp)
     if state is not None:
         sim.restore(state)

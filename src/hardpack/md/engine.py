@@ -62,6 +62,10 @@ class WindowResult:
     max_overlap: float  # largest relative overlap 1 - r / (a_i + a_j) at the end
     n_overlapping: int  # pairs with a positive overlap at the end
     mean_neighbours: float
+    wall_collisions: int = 0  # reflections at hard walls
+    #: momentum given to the walls, sum of |J| over reflections: per walled axis k (flat walls,
+    #: both walls of the axis) or in entry 0 (spherical container); zeros without walls
+    wall_momentum: np.ndarray | None = None
 
 
 def _aligned_rows(n: int, width: int) -> np.ndarray:
@@ -90,11 +94,31 @@ def image_vectors(box: np.ndarray) -> np.ndarray:
     return image_shifts(np.arange(4**d), d) * box[None, :]
 
 
+def wall_arrays(boundary, d: int) -> tuple[tuple, np.ndarray, np.ndarray]:
+    """Kernel form of a boundary (:mod:`hardpack.geometry.boundaries`): the mode tuple
+    (:data:`hardpack.md.kernel.PERIODIC_MODE`, ``FLAT_WALLS_MODE`` or ``SPHERE_MODE``), the
+    walled-axis flags (d,) int8 and the container (centre, radius) (d + 1,) (zeros unless a
+    spherical container)."""
+    kind = "periodic" if boundary is None else boundary.kind
+    walled = np.zeros(d, dtype=np.int8)
+    spec = np.zeros(d + 1)
+    if kind == "periodic":
+        return kernel.PERIODIC_MODE, walled, spec
+    if kind == "hard_walls":
+        walled[list(boundary.axes)] = 1
+        return kernel.FLAT_WALLS_MODE, walled, spec
+    walled[:] = 1
+    spec[:d] = boundary.centre
+    spec[d] = boundary.radius
+    return kernel.SPHERE_MODE, walled, spec
+
+
 class Engine:
-    """Numba state of N spheres in an orthorhombic periodic box with side lengths ``box``."""
+    """Numba state of N spheres in an orthorhombic box with side lengths ``box``: periodic, or with
+    hard walls (``boundary``, a :mod:`hardpack.geometry.boundaries` object; None = periodic)."""
 
     def __init__(self, positions: np.ndarray, velocities: np.ndarray, radii: np.ndarray,
-                 box: np.ndarray, capacity: int = 32):
+                 box: np.ndarray, capacity: int = 32, boundary=None):
         n, d = positions.shape
         self.n, self.d = n, d
         self.box = np.ascontiguousarray(box, dtype=float)
@@ -104,6 +128,7 @@ class Engine:
         self.P[:, 2 * d + 1] = radii
         self.dims = tuple(range(d))  # its length is a compile-time constant in the kernels
         self.imgvec = image_vectors(self.box)
+        self.wmode, self.walled, self.wspec = wall_arrays(boundary, d)
         self.cnt = np.zeros(n, dtype=np.int32)  # 32-bit integers: less memory traffic
         self.ep = np.zeros(n, dtype=np.int32)
         self.ec = np.zeros(n, dtype=np.int32)
@@ -271,10 +296,12 @@ class Engine:
             if kappa < 0.0:  # end shrinking windows before radii could vanish
                 cap = min(cap, 0.5 / -kappa)
             self.cnt[:] = 0
-            acc = np.array([0.0, 0.0, 0.0, self.kinetic_energy(), 0.0])
+            acc = np.zeros(kernel.A_WALL + self.d)
+            acc[kernel.A_KE] = self.kinetic_energy()
             iacc = np.zeros(kernel.N_COUNTERS, dtype=np.int64)
             status = WindowStatus(kernel.run_events(
-                self.P, self.dims, self.box, kappa, eff_skin, self.sfac, self.imgvec, self.lvl, self.rcap,
+                self.P, self.dims, self.box, kappa, eff_skin, self.sfac, self.imgvec, self.wmode,
+                self.walled, self.wspec, self.lvl, self.rcap,
                 self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
                 self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
                 self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild, *log))
@@ -303,7 +330,8 @@ class Engine:
             collisions=int(iacc[kernel.I_COLL]), events=int(iacc[kernel.I_EVENTS]),
             stale=int(iacc[kernel.I_STALE]), exits=int(iacc[kernel.I_EXIT]),
             grazing=int(iacc[kernel.I_GRAZE]), max_overlap=float(worst), n_overlapping=int(n_over),
-            mean_neighbours=float(self.nn.mean()),
+            mean_neighbours=float(self.nn.mean()), wall_collisions=int(iacc[kernel.I_WALL]),
+            wall_momentum=acc[kernel.A_WALL:].copy(),
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:

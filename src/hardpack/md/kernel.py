@@ -45,6 +45,18 @@ separation) the later root (B + sqrt(B^2 - AC)) / (-A) is the re-contact. C > 0:
 For shrinking spheres (kappa < 0) the squared equation also has roots with sigma(t) < 0, i.e.
 after t = 1/|kappa|; windows end before 0.5/|kappa| (engine), so such roots are never processed.
 
+Hard walls (Donev 2006, sec. 3.2.2.1 and Ch. 7; compiled only into the wall modes, see ``wmode``):
+a flat wall at x_k = 0 is hit when x_k(t) = a(t) (gap rate v_k - adot < 0), at x_k = L_k when
+L_k - x_k(t) = a(t); a spherical container of radius R about c when |x(t) - c| = R - a(t)
+(:func:`hardpack.events.roots.container_root`). The wall reverses the approach speed along its
+outward normal n, w = n.v + adot > 0: v -> v - 2 w n (the wall is infinitely massive; kinetic
+energy changes by 2 w adot), and the wall receives momentum 2 w, summed in acc[A_WALL + k]
+(flat walls of axis k) or acc[A_WALL] (container). Walled axes have no periodic images and
+positions along them are never wrapped. A wall event is stored as ep[i] = WALL with the wall in
+ec[i] (2 k or 2 k + 1), and the particle's collision counter is raised so that predictions
+against it are invalidated like after a pair collision; wall collisions count towards the
+window's collision budget.
+
 Collision law (derived here for growing spheres; Donev 2006, Algorithm 12 steps 4-5, as printed,
 with n from A to B, pushes an approaching pair together, so the sign is reversed here):
 n = r / |r| at contact, v_n = n.(v_j - v_i) - (adot_i + adot_j) < 0 for an approaching pair; with
@@ -64,10 +76,17 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from hardpack.events.heap import heap_set
-from hardpack.events.roots import contact_root, exit_root
+from hardpack.events.roots import contact_root, container_root, exit_root
 
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted (event time inf)
+WALL = -3  # event: the particle hits a hard wall (which one: ``ec[i]``)
+
+#: boundary modes of :func:`run_events`, tuples whose LENGTH is a compile-time constant: numba
+#: compiles one specialisation per mode and the periodic one has no wall code at all
+PERIODIC_MODE = ()
+FLAT_WALLS_MODE = (0,)
+SPHERE_MODE = (0, 0)
 
 
 
@@ -82,11 +101,12 @@ class WindowStatus(enum.IntEnum):
     CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
 
 
-# float accumulators, acc[...]
-A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE = 0, 1, 2, 3, 4
+# float accumulators, acc[...]; acc[A_WALL + k] is the wall momentum of axis k (flat walls) or of
+# the container (A_WALL), so acc has A_WALL + d entries
+A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE, A_WALL = 0, 1, 2, 3, 4, 5
 # integer counters, iacc[...]
-I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE = 0, 1, 2, 3, 4
-N_COUNTERS = 5
+I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE, I_WALL = 0, 1, 2, 3, 4, 5
+N_COUNTERS = 6
 
 
 # --------------------------------------------------------------------------------- prefetch
@@ -143,7 +163,7 @@ def prefetch_row(typingctx, arr, idx):
 
 
 @njit(cache=True)
-def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
+def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
                coll_target, t_cap, rebuild_lists, log_pair, log_val):
     """One window: reset the schedule at t = 0, then process events in time order until
@@ -196,6 +216,14 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
         Relative skin of every particle (:meth:`hardpack.md.engine.Engine.skin_factors`).
     imgvec : numpy.ndarray of float64, shape (4**d, d), read-only
         Periodic shift L n of each image code, code = sum_k (n_k + 1) 4^k.
+    wmode : tuple
+        Boundary mode, a compile-time constant by its length: PERIODIC_MODE (), FLAT_WALLS_MODE
+        (hard walls at x_k = 0 and L_k on the axes flagged in ``walled``) or SPHERE_MODE (a hard
+        spherical container ``wspec``); the periodic specialisation contains no wall code.
+    walled : numpy.ndarray of int8, shape (d,), read-only
+        1 for the axes without periodic images (walled; all of them in a container).
+    wspec : numpy.ndarray of float64, shape (d + 1,), read-only
+        Container centre and radius R (SPHERE_MODE only).
 
     lvl : numpy.ndarray of int32, shape (N,), read-only
         Grid / cells: the grid level h of every particle.
@@ -297,6 +325,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
     while True:
         npred = 0
         rebuild = False
+        wall_hit = False
         if stage < n:  # (1) complete NNL update, one particle per step
             i = stage
             t = 0.0
@@ -320,9 +349,48 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 return WindowStatus.STUCK
             iacc[I_EVENTS] += 1
             p = ep[i]
-            if p < 0:  # leaves its bounding sphere
+            if p < 0 and (len(wmode) == 0 or p == EXIT):  # leaves its bounding sphere
                 iacc[I_EXIT] += 1
                 rebuild = True
+                upd[0] = i
+                npred = 1
+            elif len(wmode) > 0 and p == WALL:  # hits a hard wall: reflect (module docstring)
+                dti = t - P[i, 2 * d]
+                for k in range(d):
+                    P[i, k] += P[i, d + k] * dti
+                P[i, 2 * d] = t
+                adot = P[i, 2 * d + 1] * kappa
+                w = 0.0  # approach speed along the outward wall normal, growth included
+                kw = 0
+                if len(wmode) == 1:  # flat wall ec[i] = 2 k (x_k = 0) or 2 k + 1 (x_k = L_k)
+                    kw = ec[i] >> 1
+                    for k in range(d):
+                        rv[k] = 0.0
+                    rv[kw] = 1.0 if ec[i] & 1 else -1.0
+                    w = rv[kw] * P[i, d + kw] + adot
+                else:  # spherical container: outward normal (x - c) / |x - c|
+                    dist2 = 0.0
+                    for k in range(d):
+                        rv[k] = P[i, k] - wspec[k]
+                        dist2 += rv[k] * rv[k]
+                    dist = np.sqrt(dist2)
+                    if dist > 0.0:
+                        for k in range(d):
+                            rv[k] /= dist
+                            w += rv[k] * P[i, d + k]
+                        w += adot
+                if w > 0.0:
+                    for k in range(d):
+                        P[i, d + k] -= 2.0 * w * rv[k]
+                    acc[A_WALL + kw] += 2.0 * w
+                    acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+                    acc[A_TKE] = t
+                    acc[A_KE] += 2.0 * w * adot
+                    cnt[i] += 1
+                    iacc[I_WALL] += 1
+                    wall_hit = True
+                else:
+                    iacc[I_GRAZE] += 1
                 upd[0] = i
                 npred = 1
             elif ec[i] != cnt[p]:  # the partner collided since the prediction: stale
@@ -392,7 +460,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
             stride = 1
             for k in range(d):  # wrap into the box and find the new cell on i's level
                 x = P[i, k]
-                if x < 0.0 or x >= L[k]:
+                if (len(wmode) == 0 or walled[k] == 0) and (x < 0.0 or x >= L[k]):
                     x -= L[k] * np.floor(x * invL[k])
                     if x >= L[k]:
                         x -= L[k]
@@ -403,6 +471,8 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 gk = int(x * invL[k] * ncl[h, k])
                 if gk >= ncl[h, k]:
                     gk = ncl[h, k] - 1
+                if len(wmode) > 0 and gk < 0:  # a walled axis: no wrap, a round-off crossing
+                    gk = 0
                 c += gk * stride
                 stride *= ncl[h, k]
             a = P[i, 2 * d + 1] * (1.0 + kappa * t)
@@ -476,12 +546,13 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                             for k in range(d):
                                 dx = cbs[sj, k] - bs[i, k]
                                 sh = 1
-                                if dx > 0.5 * L[k]:
-                                    dx -= L[k]
-                                    sh = 0
-                                elif dx < -0.5 * L[k]:
-                                    dx += L[k]
-                                    sh = 2
+                                if len(wmode) == 0 or walled[k] == 0:  # no images along walls
+                                    if dx > 0.5 * L[k]:
+                                        dx -= L[k]
+                                        sh = 0
+                                    elif dx < -0.5 * L[k]:
+                                        dx += L[k]
+                                        sh = 2
                                 code += sh << (2 * k)
                                 d2 += dx * dx
                             s = ri + cbs[sj, d]
@@ -534,6 +605,36 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 vv += vk * vk
             best = exit_root(dd, dv, vv, rrem, adot)
             partner = EXIT if best < np.inf else NONE
+            wid = 0
+            if len(wmode) == 1:  # flat walls: gap x_k - a(t) to x_k = 0, L_k - x_k - a(t) to x_k = L_k
+                anow = ai * grow
+                for k in range(d):
+                    if walled[k]:
+                        rate = vi[k] - adot
+                        if rate < 0.0:
+                            tw = max(xi[k] - anow, 0.0) / -rate
+                            if tw < best:
+                                best = tw
+                                partner = WALL
+                                wid = 2 * k
+                        rate = -vi[k] - adot
+                        if rate < 0.0:
+                            tw = max(L[k] - xi[k] - anow, 0.0) / -rate
+                            if tw < best:
+                                best = tw
+                                partner = WALL
+                                wid = 2 * k + 1
+            elif len(wmode) == 2:  # spherical container: |x - c| = R - a(t)
+                dd = 0.0
+                dv = 0.0
+                for k in range(d):
+                    dx = xi[k] - wspec[k]
+                    dd += dx * dx
+                    dv += dx * vi[k]
+                tw = container_root(dd, dv, vv, wspec[d] - ai * grow, adot)
+                if tw < best:
+                    best = tw
+                    partner = WALL
             for m in range(nn[i]):
                 e = nb[i, m]
                 j = e >> cbits
@@ -558,6 +659,8 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
             ep[i] = partner
             if partner >= 0:
                 ec[i] = cnt[partner]
+            elif len(wmode) > 0 and partner == WALL:
+                ec[i] = wid
             hsize = heap_set(hkey, heap, hpos, hsize, i, key)
 
         if stage == 2 * n and hsize > 1:
@@ -578,6 +681,11 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccou
                 for m in range(nn[p]):
                     prefetch_row(P, nb[p, m] >> cbits)
         if iacc[I_COLL] >= coll_target and npred == 2:
+            acc[A_T] = t
+            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+            acc[A_TKE] = t
+            return WindowStatus.DONE_COLLISIONS
+        if len(wmode) > 0 and wall_hit and iacc[I_COLL] + iacc[I_WALL] >= coll_target:
             acc[A_T] = t
             acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
             acc[A_TKE] = t

@@ -10,6 +10,16 @@ Units and conventions (used throughout :mod:`hardpack.md`):
 - radii grow linearly in time in proportion to their size, a_i(t) = a_i(0) (1 + kappa t); the
   relative rate of a window is kappa = Gamma / (2 <a>) with <a> the mean radius at the window
   start, so the mean DIAMETER grows at d<D>/dt = Gamma (in units of the thermal speed) all run long.
+- boundaries: periodic, hard flat walls on some axes, or a spherical container
+  (:mod:`hardpack.geometry.boundaries`; Donev 2006, sec. 3.2.2.1 and Ch. 7). phi is over the
+  boundary's volume (the container's for a sphere). The reduced pressure ``Z`` is always the
+  collision-virial (bulk) pressure Z = 1 + virial / (2 int KE dt) of the pair collisions with
+  V = that volume (Donev 2006, sec. 3.2.4.2; Ch. 7 states no other); it diverges at jamming in a
+  container as in a periodic cell and drives the stop criteria. With walls the pressure ON THE
+  WALLS, p_w = (momentum given to the walls) / (wall area x time), is recorded as
+  ``Z_wall`` = p_w V / (N kT) (kT the window's time average): for an ideal gas of point particles
+  Z_wall = 1; finite particles see the accessible volume, and near walls the local pressure
+  differs from the bulk one, so Z_wall and Z agree only in the thermodynamic limit.
 
 State saved at a synchronisation point that precedes a spatial sort and complete neighbour-list
 rebuild (positions, velocities, radii in the engine's order, the permutation to the caller's order,
@@ -43,6 +53,8 @@ RECORD_FIELDS = (
     "time", "phi", "Z", "phi_J_est", "collisions", "kT", "kT_mean", "events", "stale", "exits",
     "grazing", "max_overlap", "shell", "neighbours", "wall_time", "growth_rate",
 )
+#: further records of runs with hard walls
+WALL_RECORD_FIELDS = ("Z_wall", "wall_collisions")
 
 
 class OverlapError(RuntimeError):
@@ -75,17 +87,24 @@ def maxwell_boltzmann(n: int, d: int, seed) -> np.ndarray:
 
 
 def check_packing(packing: Packing) -> None:
-    """Refuse packings the engine cannot run: sheared cells, fewer than 2 particles, overlaps."""
+    """Refuse packings the engine cannot run: other shapes, sheared cells, fewer than 2 particles
+    in a periodic cell (1 is enough with walls), overlaps or wall crossings."""
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
-    packing.require_periodic_spheres("the MD engine")
+    if packing.shape.kind != "sphere":
+        raise InvalidInputError(f"{packing.shape.name} are not supported by the MD engine yet; it "
+                                "handles hard spheres only")
     if not packing.is_orthorhombic:
         raise InvalidInputError(
-            "the MD engine supports orthorhombic (diagonal) periodic cells only; this lattice is "
+            "the MD engine supports orthorhombic (diagonal) cells only; this lattice is "
             "sheared. Deforming/sheared cells are not implemented yet: pass a diagonal lattice"
         )
-    if packing.n_particles < 2:
-        raise InvalidInputError("MD needs at least 2 particles")
+    if packing.n_particles < (2 if packing.boundary.kind == "periodic" else 1):
+        raise InvalidInputError("MD in a periodic cell needs at least 2 particles")
+    walls = packing.containment_report(DEFAULT_OVERLAP_TOL)
+    if walls.n_outside:
+        raise InvalidInputError(f"the start configuration crosses the boundary ({walls}); hard-sphere "
+                                "MD needs every particle inside its walls")
     report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
     if report.n_overlapping:
         raise InvalidInputError(
@@ -101,15 +120,20 @@ class Simulation:
                  overlap_tol: float = DEFAULT_OVERLAP_TOL, contact_windows: int = 0):
         """contact_windows > 0 logs every collision and keeps the per-pair impulse sums of the
         last ``contact_windows`` windows in :attr:`contacts` (:mod:`hardpack.md.contacts`)."""
-        packing.require_periodic_spheres("the MD engine")
+        check_packing(packing)
         self.lattice = np.array(packing.lattice)
+        self.boundary = packing.boundary
         self.species = packing.species
         self.box = np.diag(self.lattice).copy()
         self.n, self.d = packing.n_particles, packing.dim
+        self._periodic = self.boundary.periodic_axes(self.d)
+        self._volume = packing.volume
         self.growth_rate = float(growth_rate)
         self.overlap_tol = float(overlap_tol)
         self.perm = np.arange(self.n)
-        self.engine = Engine(packing.fractional() * self.box, velocities, packing.radii, self.box)
+        positions = packing.fractional() * self.box
+        positions[:, ~self._periodic] = packing.positions[:, ~self._periodic]
+        self.engine = Engine(positions, velocities, packing.radii, self.box, boundary=self.boundary)
         self.time = 0.0
         self.collisions = 0
         self.events = 0
@@ -117,14 +141,28 @@ class Simulation:
         self.shell = SHELL_START
         self.since_sort = SORT_EVERY  # sort (and rebuild the lists) before the first window
         self.wall_time = 0.0
-        self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
+        self.fields = RECORD_FIELDS + (WALL_RECORD_FIELDS if self.boundary.kind != "periodic" else ())
+        self.records: dict[str, list] = {k: [] for k in self.fields}
         self.contacts = ContactAccumulator(self.n, self.d, contact_windows) if contact_windows else None
         self._log = None
 
     # ----------------------------------------------------------------- derived quantities
     @property
     def volume(self) -> float:
-        return float(np.prod(self.box))
+        """The boundary's volume: the box, or the container's V_d(R)."""
+        return self._volume
+
+    def wall_area(self) -> np.ndarray:
+        """Area of the walls that :attr:`Engine.run_window`'s ``wall_momentum`` entries act on:
+        both walls of each walled axis k (2 V_box / L_k; 0 for periodic axes), or the container
+        surface d V_d(R) / R in entry 0."""
+        area = np.zeros(self.d)
+        if self.boundary.kind == "spherical_container":
+            area[0] = self.d * self._volume / self.boundary.radius
+        else:
+            walled = ~self._periodic
+            area[walled] = 2.0 * np.prod(self.box) / self.box[walled]
+        return area
 
     def phi(self) -> float:
         return unit_ball_volume(self.d) * self.engine.totals()[2] / self.volume
@@ -135,10 +173,11 @@ class Simulation:
         inv = np.empty(self.n, dtype=np.int64)
         inv[self.perm] = np.arange(self.n)
         pos = self.engine.positions[inv]
-        pos = pos - np.floor(pos / self.box) * self.box
-        pos[pos >= self.box] = 0.0
+        wrapped = pos - np.floor(pos / self.box) * self.box
+        wrapped[wrapped >= self.box] = 0.0
+        pos[:, self._periodic] = wrapped[:, self._periodic]
         return Packing(pos, self.engine.radii[inv].copy(), self.lattice, species=self.species,
-                       overlap_tol=self.overlap_tol)
+                       boundary=self.boundary, overlap_tol=self.overlap_tol)
 
     def velocities(self) -> np.ndarray:
         inv = np.empty(self.n, dtype=np.int64)
@@ -189,6 +228,13 @@ class Simulation:
         else:  # no time elapsed: every collision happened at one instant
             z = np.inf
             kt_mean = 2.0 * res.ke_end / (d * n)
+        z_wall = np.nan
+        if self.boundary.kind != "periodic":
+            self._check_walls(res)
+            if res.ke_integral > 0.0:  # p_w V / (N kT) with N kT dt = 2 int KE dt / d
+                area = self.wall_area()
+                p_dt = float(res.wall_momentum[area > 0].sum() / area.sum())
+                z_wall = p_dt * self.volume * d / (2.0 * res.ke_integral)
         phi = self.phi()
         phi_j = phi / (1.0 - d / z) if z > d else np.nan
         if self.growth_rate != 0.0:
@@ -202,10 +248,19 @@ class Simulation:
             "exits": res.exits, "grazing": res.grazing, "max_overlap": res.max_overlap, "shell": shell_used,
             "neighbours": res.mean_neighbours, "wall_time": self.wall_time,
             "growth_rate": self.growth_rate, "virial": res.virial, "ke_integral": res.ke_integral,
+            "Z_wall": z_wall, "wall_collisions": res.wall_collisions,
         }
-        for k in RECORD_FIELDS:
+        for k in self.fields:
             self.records[k].append(record[k])
         return record
+
+    def _check_walls(self, res) -> None:
+        """Raise :class:`OverlapError` when a particle crosses a wall beyond the tolerance."""
+        report = self.boundary.containment(self.engine.positions, self.engine.radii, self.lattice,
+                                           self.overlap_tol)
+        if report.n_outside:
+            raise OverlapError(f"at the end of window {self.windows - 1}: {report} > tolerance "
+                               f"{self.overlap_tol:g}")
 
     def _adapt_shell(self, res) -> None:
         """Balance list length against rebuilds: a thicker shell means longer lists (more pair
@@ -265,6 +320,6 @@ class Simulation:
         self.engine.cell_floor = int(state["cell_floor"])
         self.engine.lists_valid = False
         self.wall_time = float(state["wall_time"])
-        self.records = {k: list(np.asarray(state["rec_" + k], dtype=float)) for k in RECORD_FIELDS}
+        self.records = {k: list(np.asarray(state["rec_" + k], dtype=float)) for k in self.fields}
         if self.contacts is not None:
             self.contacts.restore(state)

@@ -10,6 +10,12 @@ from hardpack.structure.channels import (
     channel_histogram,
     channel_radii,
 )
+from hardpack.structure.containers import (
+    ball_intersection_volume,
+    extrapolate_bulk_density,
+    radial_density_profile,
+    window_fluctuations,
+)
 from hardpack.structure.order import (
     bond_harmonics,
     crystallinity,
@@ -41,6 +47,8 @@ from hardpack.structure.tessellation import (
 )
 
 __all__ = [
+    "ball_intersection_volume", "extrapolate_bulk_density", "radial_density_profile",
+    "window_fluctuations",
     "NeighbourList",
     "PowerLawFit",
     "analyse",

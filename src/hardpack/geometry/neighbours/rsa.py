@@ -63,9 +63,27 @@ def _overlaps_any(x, s, r, pos, radii, box, inv_box, level_reach, n_cells, strid
 
 
 @numba.njit(cache=True)
+def _inside(x, r, walled, lo, hi, sphere):
+    """True if a sphere of radius r at x lies inside the walls: lo_k + r <= x_k <= hi_k - r on the
+    walled axes and |x - c| <= R - r in a container (sphere = (c, R), R < 0: no container)."""
+    d = x.shape[0]
+    for k in range(d):
+        if walled[k] and (x[k] < lo[k] + r or x[k] > hi[k] - r):
+            return False
+    if sphere[d] >= 0.0:
+        dist2 = 0.0
+        for k in range(d):
+            dist2 += (x[k] - sphere[k]) ** 2
+        if dist2 > (sphere[d] - r) ** 2 or sphere[d] < r:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
 def _rsa_kernel(order, radii, box, level, level_reach, n_cells, strides, cell_offset, head, nxt, pos,
-                uniforms, start, trials_done, max_trials):
-    """Place spheres order[start:] with the uniforms in sequence; returns (next, trials of it)."""
+                uniforms, start, trials_done, max_trials, walled, wall_lo, wall_hi, sphere):
+    """Place spheres order[start:] with the uniforms in sequence; returns (next, trials of it).
+    A trial outside the walls (:func:`_inside`) is rejected like an overlapping one."""
     d = box.shape[0]
     inv_box = 1.0 / box
     x = np.empty(d)
@@ -85,8 +103,9 @@ def _rsa_kernel(order, radii, box, level, level_reach, n_cells, strides, cell_of
             s[k] = x[k] / box[k]
         used += d
         trials += 1
-        if not _overlaps_any(x, s, radii[p], pos, radii, box, inv_box, level_reach, n_cells, strides,
-                             cell_offset, head, nxt, lo, hi, c):
+        if _inside(x, radii[p], walled, wall_lo, wall_hi, sphere) and \
+                not _overlaps_any(x, s, radii[p], pos, radii, box, inv_box, level_reach, n_cells, strides,
+                                  cell_offset, head, nxt, lo, hi, c):
             h = level[p]
             flat = cell_offset[h]
             for k in range(d):
@@ -99,11 +118,16 @@ def _rsa_kernel(order, radii, box, level, level_reach, n_cells, strides, cell_of
     return i, trials
 
 
-def random_sequential_addition(radii, box, seed, max_trials: int = 100_000) -> np.ndarray:
+def random_sequential_addition(radii, box, seed, max_trials: int = 100_000, walled=None,
+                               container=None) -> np.ndarray:
     """Positions (N, d) in [0, box) for these radii, placed largest first (stable order of decreasing
     radius); deterministic in ``seed`` (an integer, or a ``numpy.random.Generator`` to draw from).
 
-    box: (d,) side lengths of the periodic orthorhombic box, each at least two largest diameters.
+    box: (d,) side lengths of the orthorhombic box, each at least two largest diameters; periodic
+    unless ``walled`` (d,) bools mark axes with hard walls at 0 and box_k, or ``container`` =
+    (centre, R) puts a hard spherical container inside the box (no axis periodic). With walls the
+    trials are drawn in a periodic box padded by two largest diameters along the walled axes (so no
+    periodic image can reach a sphere inside the walls) and rejected outside the walls.
     Raises InvalidInputError when a sphere cannot be placed in ``max_trials`` trials (the density is
     above RSA saturation for these radii).
     """
@@ -122,6 +146,17 @@ def random_sequential_addition(radii, box, seed, max_trials: int = 100_000) -> n
             f"the box (side {box.min():.3g}) is smaller than two largest diameters ({4 * r.max():.3g}) "
             f"at phi = {phi:.4g}: use more particles or a lower phi"
         )
+    walled = np.zeros(d, np.int8) if walled is None else np.asarray(walled, np.int8)
+    sphere = -np.ones(d + 1)
+    if container is not None:
+        walled[:] = 1
+        sphere[:d] = container[0]
+        sphere[d] = container[1]
+    pad = 4.0 * r.max() * walled
+    wall_lo = 0.5 * pad
+    wall_hi = 0.5 * pad + box
+    sphere[:d] += 0.5 * pad if container is not None else 0.0
+    box = box + pad
     levels = optimal_levels(r, float(np.prod(box)), d)
     level = levels.level.astype(np.int64)
     level_reach = 0.5 * levels.cell_sizes
@@ -137,7 +172,7 @@ def random_sequential_addition(radii, box, seed, max_trials: int = 100_000) -> n
     while placed < r.size:
         placed, trials = _rsa_kernel(order, r, box, level, level_reach, n_cells, c_strides(n_cells),
                                      cell_offset, head, nxt, pos, rng.random(_BATCH * d), placed, trials,
-                                     int(max_trials))
+                                     int(max_trials), walled, wall_lo, wall_hi, sphere)
         if trials >= max_trials:
             raise InvalidInputError(
                 f"random sequential addition could not place sphere {placed} of {r.size} (radius "
@@ -145,4 +180,4 @@ def random_sequential_addition(radii, box, seed, max_trials: int = 100_000) -> n
                 f"saturation for these radii (RSA saturates near {RSA_SATURATION.get(d, 'less than 0.1')} "
                 f"in d = {d} for equal spheres); choose a lower initial phi"
             )
-    return pos
+    return pos - wall_lo
