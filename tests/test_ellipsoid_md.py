@@ -209,7 +209,8 @@ def test_b2_formulas_reduce_to_spheres():
     assert _b2_2d(1.0, 1.0) == pytest.approx(2 * np.pi)
 
 
-@pytest.mark.parametrize("d,alpha", [(2, 2.0), pytest.param(3, 2.0, marks=pytest.mark.slow)])
+@pytest.mark.slow
+@pytest.mark.parametrize("d,alpha", [(2, 2.0), (3, 2.0)])
 def test_low_density_pressure_matches_the_second_virial_coefficient(d, alpha):
     """(Z - 1) / rho at three low densities, fitted by B2 + B3 rho: the intercept equals the
     Isihara-Kihara B2 within 3 standard errors of the fit (block errors of each Z)."""

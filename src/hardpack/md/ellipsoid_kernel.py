@@ -557,7 +557,10 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
             for k in range(1, d):
                 amin_j = min(amin_j, P[j, cax + k])
             s_in = amin_i + amin_j
-            horizon = min(horizon, t + contact_root(rr, ru, uu, s_in * grow, s_in * kappa, horizon - t))
+            t_ins = contact_root(rr, ru, uu, s_in * grow, s_in * kappa, horizon - t)
+            # a little beyond, so that a trace can bracket a collision exactly at t_ins (spheres)
+            # and a CHECK there always lies ahead of t
+            horizon = min(horizon, t + t_ins * (1.0 + 1e-6) + 1e-13 * (1.0 + t))
         if tin < np.inf:
             if a <= 0.0:
                 touts[m] = np.inf
