@@ -17,7 +17,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry import Packing
 from hardpack.geometry.shapes import Ellipsoids
 from hardpack.initial import random_ellipsoid_packing
-from hardpack.md import StopCriteria, compress, equilibrate, maxwell_boltzmann
+from hardpack.md import StopCriteria, equilibrate, maxwell_boltzmann
 from hardpack.md import ellipsoid_kernel as ek
 from hardpack.md.ellipsoid import EllipsoidSimulation, compress_ellipsoids, random_angular_velocities
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, moments_of_inertia

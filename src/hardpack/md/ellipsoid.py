@@ -30,12 +30,10 @@ from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.shapes import Ellipsoids
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt
-from hardpack.md.compress import StopCriteria, _check_final_stage, _stop_reason, default_window, \
-    timeseries_dataset
+from hardpack.md.compress import StopCriteria, _check_final_stage, _stop_reason, default_window, timeseries_dataset
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, rotational_dof
 from hardpack.md.ellipsoid_kernel import EPS_F
-from hardpack.md.simulation import RECORD_FIELDS, SHELL_START, SORT_EVERY, OverlapError, Simulation, \
-    maxwell_boltzmann
+from hardpack.md.simulation import RECORD_FIELDS, SHELL_START, SORT_EVERY, OverlapError, Simulation, maxwell_boltzmann
 
 log = logging.getLogger("hardpack.md")
 

@@ -45,7 +45,8 @@ m > 2 e, with m the interpolant's minimum over the step (so no dip below zero hi
 samples unless the interpolant errs by more than twice its estimated error; far from contact,
 where m is large, the steps may err by a tenth of m, which keeps them long without any risk of
 missing the zero); otherwise h is halved (the midpoint becomes the new end). The next step is
-h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= 0 brackets the collision, which a safeguarded
+h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= 0 brackets the
+collision, which a safeguarded
 Newton iteration (bisection when a Newton step leaves the bracket) locates to round-off; the
 earlier end of the final bracket (zeta >= 0, no overlap) is returned. If zeta <= 0 at t_in: a
 collision now when zeta_dot < 0; otherwise (round-off after a collision of the pair) zeta is
@@ -82,8 +83,19 @@ from numba import njit
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
 from hardpack.geometry.contact import contact_point, pw_contact, pw_rate, shape_inverse
-from hardpack.md.kernel import A_KE, A_KEINT, A_T, A_TKE, A_VIRIAL, I_COLL, I_EVENTS, I_EXIT, \
-    I_GRAZE, I_STALE, WindowStatus
+from hardpack.md.kernel import (
+    A_KE,
+    A_KEINT,
+    A_T,
+    A_TKE,
+    A_VIRIAL,
+    I_COLL,
+    I_EVENTS,
+    I_EXIT,
+    I_GRAZE,
+    I_STALE,
+    WindowStatus,
+)
 
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted
@@ -186,7 +198,8 @@ def _pose(P, i, t, kappa, shift, x, xinv, o, ax):
 def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     """(zeta, zeta_dot, lambda) of particles i and j (j shifted by ``shift``) at window time t.
 
-    ``ws`` (11, 4) (row 8 zeros, ws[10, 0] counts the evaluations) and ``wm`` (2, d, d) are scratch arrays; on return ws[0, :d],
+    ``ws`` (11, 4) (row 8 zeros, ws[10, 0] counts the evaluations) and ``wm`` (2, d, d) are
+    scratch arrays; on return ws[0, :d],
     ws[1, :d] hold the centres, ws[4, :d] the contact point, ws[5, :d] the normal n and wm[0],
     wm[1] the inverse shape matrices."""
     d = shift.shape[0]
