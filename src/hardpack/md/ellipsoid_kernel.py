@@ -111,6 +111,9 @@ A_EVAL = 5
 EPS_F = 1e-4
 #: far from contact a step may also err by this fraction of the interpolant's minimum
 RELATIVE_TOL = 0.1
+#: relative gap (squared distance over squared sum of inscribed radii, minus 1) above which a
+#: pair's inscribed-sphere contact caps the prediction horizon
+INSCRIBED_GAP = 1e-6
 #: accepted trace steps before a CHECK event (Donev 2006, Algorithm 11: 100-250)
 MAX_TRACE_STEPS = 200
 #: steps shorter than this fraction of the first step of a trace are accepted unconditionally
@@ -569,11 +572,13 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
             amin_j = P[j, cax]
             for k in range(1, d):
                 amin_j = min(amin_j, P[j, cax + k])
-            s_in = amin_i + amin_j
-            t_ins = contact_root(rr, ru, uu, s_in * grow, s_in * kappa, horizon - t)
-            # a little beyond, so that a trace can bracket a collision exactly at t_ins (spheres)
-            # and a CHECK there always lies ahead of t
-            horizon = min(horizon, t + t_ins * (1.0 + 1e-6) + 1e-13 * (1.0 + t))
+            s_in = (amin_i + amin_j) * grow
+            if rr > s_in * s_in * (1.0 + INSCRIBED_GAP):
+                # only pairs whose inscribed spheres are clearly apart now (touching ones, e.g.
+                # spheres at contact, would cap the horizon at t); a little beyond t_ins, so
+                # that a trace can bracket a collision exactly at t_ins (spheres)
+                t_ins = contact_root(rr, ru, uu, s_in, s_in * kappa / grow, horizon - t)
+                horizon = min(horizon, t + t_ins * (1.0 + 1e-6))
         if tin < np.inf:
             if a <= 0.0:
                 touts[m] = np.inf
