@@ -75,9 +75,12 @@ class EllipsoidSimulation(Simulation):
     def __init__(self, packing: Packing, velocities: np.ndarray, angular_velocities: np.ndarray,
                  growth_rate: float, overlap_tol: float = DEFAULT_OVERLAP_TOL, eps_f: float = EPS_F):
         self.lattice = np.array(packing.lattice)
+        self.boundary = packing.boundary  # periodic (check_ellipsoid_packing)
         self.species = packing.species
         self.box = np.diag(self.lattice).copy()
         self.n, self.d = packing.n_particles, packing.dim
+        self._periodic = self.boundary.periodic_axes(self.d)
+        self._volume = packing.volume
         self.growth_rate = float(growth_rate)
         self.overlap_tol = float(overlap_tol)
         self.perm = np.arange(self.n)
@@ -91,7 +94,8 @@ class EllipsoidSimulation(Simulation):
         self.shell = SHELL_START
         self.since_sort = SORT_EVERY
         self.wall_time = 0.0
-        self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
+        self.fields = RECORD_FIELDS
+        self.records: dict[str, list] = {k: [] for k in self.fields}
         self.contacts = None
         self._log = None
 
