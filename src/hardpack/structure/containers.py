@@ -34,6 +34,25 @@ def ball_intersection_volume(big, small, dist, d: int = 3) -> np.ndarray:
     d = 3: the lens V = pi (R + a - s)^2 (s^2 + 2 s a - 3 a^2 + 2 s R + 6 a R - 3 R^2) / (12 s)
     for |R - a| < s < R + a; d = 2: the sum of the two circular segments cut by the common chord.
     Disjoint balls give 0, a ball inside the other the smaller ball's volume.
+
+    Parameters
+    ----------
+    big, small : array_like
+        The radii of the two balls.
+    dist : array_like
+        The distance between their centres.
+    d : int, default 3
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    numpy.ndarray
+        The intersection volumes (areas in 2D), broadcast over the inputs.
+
+    Raises
+    ------
+    InvalidInputError
+        If d is not 2 or 3.
     """
     if d not in (2, 3):
         raise InvalidInputError(f"ball intersections are implemented for d = 2 and 3, got d = {d}")
@@ -170,12 +189,29 @@ def window_fluctuations(packing, window_radii, n_windows: int = 1000, seed: int 
     exact intersection volumes (:func:`ball_intersection_volume`) of the nearest image of each
     sphere (the only one that can reach the window, R + a_max <= L_min / 2).
 
+    Parameters
+    ----------
+    packing : Packing
+        A sphere packing in a periodic orthorhombic cell.
+    window_radii : array_like
+        Window radii R, each positive and at most L_min / 2 - a_max.
+    n_windows : int, default 1000
+        Random windows per radius.
+    seed : int, default 0
+        Seed of the window centres.
+
     Returns
     -------
     xarray.Dataset
         On dimension ``R``: ``phi_mean``, ``sigma_phi`` (standard deviation over windows) and
         ``sigma_phi_err`` (its standard error, sigma / sqrt(2 (n - 1)) for near-Gaussian
         scatter); the fit of the text for comparison is sigma_phi ~ 0.1 (2R/D)^-2.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not of spheres in a periodic orthorhombic cell, or a window radius is
+        out of range.
     """
     _sphere_check(packing, "the window fluctuations")
     if packing.boundary.kind != "periodic" or not packing.is_orthorhombic:
