@@ -85,3 +85,22 @@ def test_time_limits_cover_the_measured_jobs_of_the_full_study_twice():
         assert runtime >= 2 * minutes, f"{output}: limit {runtime} min for a job measured at {minutes} min"
     threads, _, mem_mb = _job_resources(text, "results/ls/mono3d_large/verdict/seed1.nc")
     assert threads == 2 and mem_mb >= 3000  # two ~1 GB loading-sequence workers besides the main process
+
+
+def test_no_job_group_holds_a_job_and_its_input(workflow_rules):
+    """Members of one job group must not depend on each other: the slurm profile runs a group's
+    connected members as one job step that asks for more CPUs than the cluster job has ("srun:
+    Unable to create step ... More processors requested than permitted")."""
+    import subprocess
+
+    dot = subprocess.run(["snakemake", "-n", "--forceall", "--dag", "--configfile", "config/smoke.yaml"],
+                         cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    rule_of = {int(k): v for k, v in re.findall(r'^\s*(\d+)\[label = "(\w+)', dot, re.M)}
+    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
+    # a chain of single jobs (validation: report -> gate, one component per cluster job) is fine
+    chains = {name for name, size in profile["group-components"].items() if size == 1}
+    group = {name: m.group(1) for name, text in workflow_rules.items()
+             if (m := re.search(r'^    group:\n        "(\w+)"', text, re.M)) and m.group(1) not in chains}
+    for a, b in re.findall(r"^\s*(\d+) -> (\d+)", dot, re.M):
+        ra, rb = rule_of[int(a)], rule_of[int(b)]
+        assert not (ra in group and group.get(rb) == group[ra]), f"{ra} -> {rb} inside group {group[ra]}"

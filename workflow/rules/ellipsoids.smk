@@ -17,7 +17,7 @@ rule ellipsoid_contacts:
         mem_mb=job_mem_mb("ellipsoid_contacts"),
         runtime=job_runtime("ellipsoid_contacts"),
     group:
-        "summaries"
+        "analyses"
     conda:
         "../envs/hardpack.yaml"
     log:

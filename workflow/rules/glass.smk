@@ -133,7 +133,7 @@ rule glass_eos:
         mem_mb=job_mem_mb("glass_eos"),
         runtime=job_runtime("glass_eos"),
     group:
-        "summaries"
+        "analyses"
     conda:
         "../envs/hardpack.yaml"
     log:
