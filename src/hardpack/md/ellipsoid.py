@@ -33,7 +33,7 @@ from hardpack.io import interrupt
 from hardpack.md.compress import StopCriteria, _check_final_stage, _stop_reason, default_window, timeseries_dataset
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, rotational_dof
 from hardpack.md.ellipsoid_kernel import EPS_F
-from hardpack.md.simulation import RECORD_FIELDS, SHELL_START, SORT_EVERY, OverlapError, Simulation, maxwell_boltzmann
+from hardpack.md.simulation import OverlapError, Simulation, maxwell_boltzmann
 
 log = logging.getLogger("hardpack.md")
 
@@ -74,30 +74,11 @@ class EllipsoidSimulation(Simulation):
 
     def __init__(self, packing: Packing, velocities: np.ndarray, angular_velocities: np.ndarray,
                  growth_rate: float, overlap_tol: float = DEFAULT_OVERLAP_TOL, eps_f: float = EPS_F):
-        self.lattice = np.array(packing.lattice)
-        self.boundary = packing.boundary  # periodic (check_ellipsoid_packing)
-        self.species = packing.species
-        self.box = np.diag(self.lattice).copy()
-        self.n, self.d = packing.n_particles, packing.dim
-        self._periodic = self.boundary.periodic_axes(self.d)
-        self._volume = packing.volume
-        self.growth_rate = float(growth_rate)
-        self.overlap_tol = float(overlap_tol)
-        self.perm = np.arange(self.n)
+        self._setup(packing, growth_rate, overlap_tol)  # periodic (check_ellipsoid_packing)
         shape = packing.shape
         self.engine = EllipsoidEngine(packing.fractional() * self.box, velocities, shape.semiaxes,
                                       shape.orientations, angular_velocities, self.box, eps_f=eps_f)
-        self.time = 0.0
-        self.collisions = 0
-        self.events = 0
-        self.windows = 0
-        self.shell = SHELL_START
-        self.since_sort = SORT_EVERY
-        self.wall_time = 0.0
-        self.fields = RECORD_FIELDS
-        self.records: dict[str, list] = {k: [] for k in self.fields}
         self.contacts = None
-        self._log = None
 
     def _inverse(self) -> np.ndarray:
         inv = np.empty(self.n, dtype=np.int64)

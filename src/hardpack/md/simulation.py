@@ -121,6 +121,15 @@ class Simulation:
         """contact_windows > 0 logs every collision and keeps the per-pair impulse sums of the
         last ``contact_windows`` windows in :attr:`contacts` (:mod:`hardpack.md.contacts`)."""
         check_packing(packing)
+        self._setup(packing, growth_rate, overlap_tol)
+        positions = packing.fractional() * self.box
+        positions[:, ~self._periodic] = packing.positions[:, ~self._periodic]
+        self.engine = Engine(positions, velocities, packing.radii, self.box, boundary=self.boundary)
+        self.contacts = ContactAccumulator(self.n, self.d, contact_windows) if contact_windows else None
+
+    def _setup(self, packing: Packing, growth_rate: float, overlap_tol: float) -> None:
+        """The run state every engine shares: cell, boundary, counters and records (the engine and
+        the contact accumulator are the caller's)."""
         self.lattice = np.array(packing.lattice)
         self.boundary = packing.boundary
         self.species = packing.species
@@ -131,9 +140,6 @@ class Simulation:
         self.growth_rate = float(growth_rate)
         self.overlap_tol = float(overlap_tol)
         self.perm = np.arange(self.n)
-        positions = packing.fractional() * self.box
-        positions[:, ~self._periodic] = packing.positions[:, ~self._periodic]
-        self.engine = Engine(positions, velocities, packing.radii, self.box, boundary=self.boundary)
         self.time = 0.0
         self.collisions = 0
         self.events = 0
@@ -143,7 +149,6 @@ class Simulation:
         self.wall_time = 0.0
         self.fields = RECORD_FIELDS + (WALL_RECORD_FIELDS if self.boundary.kind != "periodic" else ())
         self.records: dict[str, list] = {k: [] for k in self.fields}
-        self.contacts = ContactAccumulator(self.n, self.d, contact_windows) if contact_windows else None
         self._log = None
 
     # ----------------------------------------------------------------- derived quantities
