@@ -30,9 +30,9 @@ def main(snakemake_log: str, slurmctld_log: str) -> None:
     submissions = re.findall(submitted_as, text)
     single = Counter(name for _, kind, name in submissions if kind == "rule")
     groups = Counter(name.split("_")[0] for _, kind, name in submissions if kind == "group")
-    members = Counter()
-    for section in re.findall(r"Group job \w+ \(jobs in lexicogr\. order\):\n((?:\n|    .*\n)+)", text):
-        members.update(re.findall(r"^    (?:local)?rule (\w+):", section, re.M))
+    # the members of a group job are the only jobs printed indented; messages of the executor
+    # may be interleaved with a group's list, so the list is not parsed as one block
+    members = Counter(re.findall(r"^    (?:local)?rule (\w+):$", text, re.M))
     problems = []
     for rule, n in stats.items():
         ran = single[rule] + members[rule]

@@ -4,6 +4,8 @@ import re
 import subprocess
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -46,3 +48,36 @@ def test_ci_starts_the_smoke_dag_from_an_empty_results_directory_and_gates_it():
     common = (ROOT / "workflow" / "rules" / "common.smk").read_text()
     # `rule all` takes final_outputs(), which ends with the gate
     assert "final_outputs()" in snakefile and 'outputs.append("results/validation/gate.txt")' in common
+
+
+def _slurm_jobs_module():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("slurm_jobs", ROOT / ".ci" / "slurm_jobs.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_slurm_job_check_counts_group_members_when_executor_messages_interleave(tmp_path):
+    """The SLURM executor may print a message between the members of a group job's list (CI saw
+    "Both 'sacctmgr' and 'sshare' returned empty results ..."); the members after it still count."""
+    member = "    [Thu Nov 26 07:11:48 2026]\n    rule combine:\n        input: a.nc\n        output: {out}\n"
+    snakemake_log = (
+        "Job stats:\njob        count\n-------  -------\ncombine        3\nverify         1\ntotal          4\n\n"
+        "Job 7 has been submitted with SLURM jobid 11 (log: /x/.snakemake/slurm_logs/rule_verify/s1/11.log).\n"
+        "[Thu Nov 26 07:11:48 2026] Group job summaries (jobs in lexicogr. order):\n\n"
+        + member.format(out="s1.nc") + member.format(out="s2.nc")
+        + "Both 'sacctmgr' and 'sshare' returned empty results for account 'none'.\n"
+        + member.format(out="s3.nc")
+        + "Job abc has been submitted with SLURM jobid 12 (log: /x/.snakemake/slurm_logs/group_summaries_combine/12.log).\n"
+    )
+    ctld_log = "".join(f"_slurm_rpc_submit_batch_job: JobId={j}\n_job_complete: JobId={j} WEXITSTATUS 0\n"
+                       for j in (11, 12))
+    (tmp_path / "snakemake.log").write_text(snakemake_log)
+    (tmp_path / "ctld.log").write_text(ctld_log)
+    check = _slurm_jobs_module()
+    check.main(str(tmp_path / "snakemake.log"), str(tmp_path / "ctld.log"))  # no SystemExit
+    (tmp_path / "ctld.log").write_text(ctld_log.replace("JobId=12 WEXITSTATUS 0", "JobId=12 WEXITSTATUS 1"))
+    with pytest.raises(SystemExit, match="did not complete"):
+        check.main(str(tmp_path / "snakemake.log"), str(tmp_path / "ctld.log"))
