@@ -100,3 +100,66 @@ def test_published_stretch_gives_alpha_three():
 def test_bad_aspect_ratio_is_refused(bad):
     with pytest.raises(InvalidInputError, match="alpha"):
         laminate(bad)
+
+
+# ------------------------------------------------------------- the family of Fig. 8.2 and its rows
+def test_laminate_family_follows_fig_8_2():
+    """Fig. 8.2: FCC at alpha = 1, the maximum 0.770732 with 14 contacts at sqrt(3), the unstretched
+    laminate falling beyond it with 10 contacts (2 along the long axis, where L = 2 alpha, plus 8
+    across layers), and the stretched one keeping 0.770732 and 14 contacts."""
+    from hardpack.geometry.ellipsoid_crystals import laminate_family
+
+    ds = laminate_family([1.0, 1.5, DENSEST_ALPHA, 2.0, 3.0])
+    phi = ds["phi_laminate"].values
+    assert phi[0] == pytest.approx(FCC, rel=1e-12)
+    assert phi[2] == pytest.approx(0.770732, abs=5e-7)
+    assert np.argmax(phi) == 2 and phi[3] < phi[2] and phi[4] < phi[3]
+    assert ds["contacts_laminate"].values.tolist() == [12, 12, 14, 10, 10]
+    assert ds["contacts_densest"].values.tolist() == [12, 12, 14, 14, 14]
+    assert np.allclose(ds["phi_densest"].values[2:], 0.770732, atol=5e-7)
+    assert ds["stretch"].values[4] == pytest.approx(2.4842, abs=5e-5)  # Fig. 8.3 caption
+    assert ds["overlap_densest"].max() < 1e-9 and ds["overlap_laminate"].max() < 1e-9
+
+
+def test_laminate_family_refuses_bad_aspect_ratios():
+    from hardpack.geometry.ellipsoid_crystals import laminate_family, stretch_for
+
+    for bad in ([], [0.5], [1.0, np.nan]):
+        with pytest.raises(InvalidInputError, match="alphas must be finite numbers >= 1"):
+            laminate_family(bad)
+    with pytest.raises(InvalidInputError, match=">= sqrt"):
+        stretch_for(1.5)
+
+
+def test_crystal_rows_pass_fail_and_na():
+    from hardpack.geometry.ellipsoid_crystals import laminate_family
+    from hardpack.validation.ellipsoids import crystal_rows
+
+    ds = laminate_family([1.0, DENSEST_ALPHA, 3.0])
+    assert [r.status for r in crystal_rows([ds])] == ["pass"] * 4
+    bent = ds.copy(deep=True)
+    bent["phi_laminate"].values[1] += 1e-6  # one unit of the sixth printed digit off
+    assert crystal_rows([bent])[0].status == "fail"
+    assert [r.status for r in crystal_rows([laminate_family([1.0, 1.5])])] == ["n/a"] * 4
+
+
+def test_laminate_command_writes_the_family_with_sqrt3_and_refuses_bad_input(tmp_path, capsys):
+    from hardpack.cli import main
+    from hardpack.io import load_dataset
+
+    out = tmp_path / "family.nc"
+    assert main(["laminate", "--alpha-max", "2.5", "--alpha-step", "0.5", "--out", str(out)]) == 0
+    ds = load_dataset(out)
+    assert ds["alpha"].values.tolist() == pytest.approx([1.0, 1.5, DENSEST_ALPHA, 2.0, 2.5])
+    assert "git_commit" in ds.attrs or "hardpack_version" in ds.attrs
+    assert main(["laminate", "--alpha-step", "0", "--out", str(out)]) != 0
+    assert "--alpha-step must be a positive number" in capsys.readouterr().err
+
+
+def test_laminate_figure_renders():
+    from hardpack.geometry.ellipsoid_crystals import laminate_family
+    from hardpack.plots.ellipsoids import plot_laminate_family
+
+    fig = plot_laminate_family(laminate_family([1.0, 1.5, DENSEST_ALPHA, 2.0]))
+    ax = fig.axes[0]
+    assert ax.get_xscale() == "log" and len(ax.lines) >= 3

@@ -128,6 +128,29 @@ def cmd_lattice(args) -> int:
     return 0
 
 
+def cmd_laminate(args) -> int:
+    """The laminate crystals of spheroids vs aspect ratio (Donev 2006, Sec. 8.2, Fig. 8.2)."""
+    from hardpack.geometry.ellipsoid_crystals import DENSEST_ALPHA, laminate_family
+    from hardpack.io import write_dataset
+
+    if not (np.isfinite(args.alpha_max) and args.alpha_max >= 1):
+        raise InvalidInputError(f"--alpha-max must be a finite number >= 1, got {args.alpha_max}")
+    if not (np.isfinite(args.alpha_step) and args.alpha_step > 0):
+        raise InvalidInputError(f"--alpha-step must be a positive number, got {args.alpha_step}")
+    count = int(np.floor((args.alpha_max - 1) / args.alpha_step + 1e-9)) + 1
+    alphas = 1 + args.alpha_step * np.arange(count)
+    alphas = np.unique(np.round(np.concatenate([alphas, [args.alpha_max]]), 12))
+    if args.alpha_max >= DENSEST_ALPHA:
+        alphas = np.unique(np.concatenate([alphas[~np.isclose(alphas, DENSEST_ALPHA, rtol=0, atol=1e-9)],
+                                           [DENSEST_ALPHA]]))
+    family = laminate_family(alphas)
+    write_dataset(family, args.out, attrs={"protocol": "laminate", "alpha_max": args.alpha_max,
+                                           "alpha_step": args.alpha_step})
+    logging.info("wrote %s: %d aspect ratios, densest phi = %.6f", args.out, alphas.size,
+                 float(family["phi_densest"].max()))
+    return 0
+
+
 def cmd_combine(args) -> int:
     """Combine per-seed packings into one ensemble Dataset indexed by protocol parameters."""
     from hardpack.io import combine_ensemble, write_dataset
@@ -166,6 +189,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--reps", type=int, nargs="+", default=[1], help="unit cells along each lattice vector")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_lattice)
+
+    p = sub.add_parser("laminate", help=cmd_laminate.__doc__)
+    p.add_argument("--alpha-max", type=float, default=3.0, help="largest aspect ratio, >= 1 (default 3)")
+    p.add_argument("--alpha-step", type=float, default=0.05, help="step in alpha from 1 (default 0.05)")
+    p.add_argument("--out", required=True, help="output netCDF file")
+    p.set_defaults(func=cmd_laminate)
 
     p = sub.add_parser("info", help=cmd_info.__doc__.splitlines()[0])
     p.add_argument("file", help="a netCDF file written by hardpack")

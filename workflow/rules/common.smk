@@ -46,6 +46,7 @@ FREEENERGY = config.get("freeenergy")
 POLY = config.get("polydisperse", {})
 GLASS = config.get("glass")
 ELLIPSOIDS = config.get("ellipsoids")
+ELLIPSOID_CRYSTALS = config.get("ellipsoid_crystals")
 VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
 
@@ -574,6 +575,7 @@ def figures():
     names += ["ellipsoid_jamming"] if any(s["d"] == 3 for s in SYSTEMS["ellipsoids"].values()) else []
     names += ["ellipse_jamming"] if any(s["d"] == 2 for s in SYSTEMS["ellipsoids"].values()) else []
     names += ["ellipsoid_snapshot"] if ELLIPSOIDS and "mm" in ELLIPSOIDS else []
+    names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
     names += ["glass_eos", "glass_entropy"] if GLASS else []
     return [f"results/figures/{name}.pdf" for name in names]
 
@@ -609,6 +611,8 @@ def validation_inputs():
     ellipsoids = [summary(key) for key in COMBINED if key.startswith("ellipsoids/")]
     if ellipsoids:
         inputs["ellipsoids"] = ellipsoids
+    if ELLIPSOID_CRYSTALS:
+        inputs["ellipsoid_crystals"] = ["results/ellipsoid_crystals/laminate_family.nc"]
     return inputs
 
 

@@ -99,3 +99,51 @@ rule fig_ellipsoid_snapshot:
         "results/benchmarks/fig_ellipsoid_snapshot.tsv"
     script:
         "../scripts/plot_ellipsoid_snapshot.py"
+
+
+rule laminate_family:
+    """The laminate crystals of spheroids vs aspect ratio, with sqrt(3) and the stretched densest
+    laminate beyond it (Donev 2006, Sec. 8.2, Eqs. 8.1-8.3)."""
+    output:
+        "results/ellipsoid_crystals/laminate_family.nc",
+    params:
+        alpha_max=lambda w: ELLIPSOID_CRYSTALS["alpha_max"],
+        alpha_step=lambda w: ELLIPSOID_CRYSTALS["alpha_step"],
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("laminate_family"),
+        runtime=job_runtime("laminate_family"),
+    group:
+        "setup"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/laminate_family.log",
+    benchmark:
+        "results/benchmarks/laminate_family.tsv"
+    shell:
+        "hardpack laminate --alpha-max {params.alpha_max} --alpha-step {params.alpha_step}"
+        " --out {output} > {log} 2>&1"
+
+
+rule fig_laminate_crystals:
+    """Density of the laminate crystals vs aspect ratio (after Donev 2006, Fig. 8.2)."""
+    input:
+        "results/ellipsoid_crystals/laminate_family.nc",
+    output:
+        pdf="results/figures/laminate_crystals.pdf",
+        png=report("results/figures/laminate_crystals.png", caption="../report/laminate_crystals.rst", category="6 ellipsoids"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_laminate_crystals"),
+        runtime=job_runtime("fig_laminate_crystals"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_laminate_crystals.log",
+    benchmark:
+        "results/benchmarks/fig_laminate_crystals.tsv"
+    script:
+        "../scripts/plot_laminate_crystals.py"

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import xarray as xr
 from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
@@ -36,6 +37,9 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.contact import pw_contact, shape_inverse
 from hardpack.geometry.packing import Packing
 from hardpack.geometry.shapes import Ellipsoids
+
+#: relative gap (mu - 1 of the Perram-Wertheim scaling) within which two crystal neighbours touch
+CRYSTAL_CONTACT_TOL = 1e-9
 
 #: aspect ratio of the densest laminate, where the in-plane neighbours along the long axis touch
 DENSEST_ALPHA = math.sqrt(3.0)
@@ -155,3 +159,72 @@ def stretched_laminate(s: float) -> Packing:
         orientations.append(_quaternion(vectors.T))
     return Packing(base.positions @ f.T, lattice=f @ base.lattice,
                    shape=Ellipsoids(np.array(semiaxes), np.array(orientations)))
+
+
+def stretch_for(alpha: float) -> float:
+    """The stretch s >= 1 of the densest laminate that gives in-plane aspect ratio ``alpha`` >= sqrt(3)
+    (the inverse of :func:`stretched_alpha`, increasing in s)."""
+    if not (math.isfinite(alpha) and alpha >= DENSEST_ALPHA):
+        raise InvalidInputError(f"stretch_for: alpha must be a finite number >= sqrt(3), got {alpha!r}")
+    if alpha == DENSEST_ALPHA:
+        return 1.0
+    upper = 2.0
+    while stretched_alpha(upper) < alpha:
+        upper *= 2
+    return brentq(lambda s: stretched_alpha(s) - alpha, 1.0, upper, xtol=1e-14, rtol=4 * np.finfo(float).eps)
+
+
+def _crystal_numbers(packing) -> tuple[float, float, float]:
+    """(phi, contacts per particle, largest relative overlap 1 - mu) of a crystal packing."""
+    from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts
+
+    contacts = ellipsoid_contacts(packing, tol=CRYSTAL_CONTACT_TOL, min_contacts=1)
+    overlap = float(np.max(1 - contacts.contacts.mu)) if len(contacts.contacts.mu) else -np.inf
+    return packing.phi, float(contacts.degree.mean()), overlap
+
+
+def laminate_family(alphas) -> xr.Dataset:
+    """The laminate crystals vs in-plane aspect ratio (Donev 2006, Sec. 8.2, Fig. 8.2).
+
+    For every alpha >= 1: the unstretched laminate (:func:`laminate`; for alpha > sqrt(3) its
+    neighbours along the long axis hold it, L = 2 alpha, and its density falls) and the densest
+    known crystal of that shape ("presently maximal" curve of Fig. 8.2): the laminate up to
+    sqrt(3), the densest laminate stretched by :func:`stretch_for` beyond (:func:`stretched_laminate`,
+    phi = 0.770732 for every stretch). phi(1 / alpha) = phi(alpha): oblate shapes share the values.
+
+    Parameters
+    ----------
+    alphas : sequence of float
+        Aspect ratios, each finite and >= 1.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension ``alpha``; variables ``phi_laminate``, ``phi_densest``, ``stretch`` (1 up to
+        sqrt(3)), ``contacts_laminate`` and ``contacts_densest`` (contacts per particle within
+        relative gap :data:`CRYSTAL_CONTACT_TOL`), ``overlap_laminate`` and ``overlap_densest``
+        (largest 1 - mu over the contacts: round-off, never a real overlap).
+
+    Raises
+    ------
+    InvalidInputError
+        If an alpha is not a finite number >= 1, or ``alphas`` is empty.
+    """
+    alphas = np.asarray(alphas, dtype=float).ravel()
+    if alphas.size == 0 or not np.all(np.isfinite(alphas)) or np.any(alphas < 1):
+        raise InvalidInputError(f"laminate_family: alphas must be finite numbers >= 1, got {alphas.tolist()}")
+    columns = {name: np.empty(alphas.size) for name in
+               ("phi_laminate", "contacts_laminate", "overlap_laminate",
+                "phi_densest", "contacts_densest", "overlap_densest", "stretch")}
+    for k, alpha in enumerate(alphas):
+        base = _crystal_numbers(laminate(float(alpha)))
+        s = stretch_for(float(alpha)) if alpha > DENSEST_ALPHA else 1.0
+        densest = _crystal_numbers(stretched_laminate(s)) if alpha > DENSEST_ALPHA else base
+        for suffix, numbers in (("laminate", base), ("densest", densest)):
+            for name, value in zip(("phi", "contacts", "overlap"), numbers):
+                columns[f"{name}_{suffix}"][k] = value
+        columns["stretch"][k] = s
+    ds = xr.Dataset({name: ("alpha", values) for name, values in columns.items()}, coords={"alpha": alphas})
+    ds.attrs.update(hardpack_kind="laminate_family", contact_tol=CRYSTAL_CONTACT_TOL,
+                    densest_alpha=DENSEST_ALPHA, d=3)
+    return ds

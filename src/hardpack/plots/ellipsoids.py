@@ -130,3 +130,50 @@ def plot_snapshot(packing, slab: float | None = None):
     ax.set_yticks([])
     ax.set_title(f"{packing.shape.name}, N = {packing.n_particles}, $\\phi$ = {packing.phi:.4f}")
     return fig
+
+
+def plot_laminate_family(family):
+    """Density of the laminate crystals vs the in-plane aspect ratio (after Donev 2006, Fig. 8.2).
+
+    Both prolate (alpha) and oblate (1 / alpha) sides are drawn on a logarithmic axis (phi(alpha)
+    = phi(1 / alpha)): the unstretched laminate (dashed), the densest known crystal of each shape
+    (solid: the laminate up to sqrt(3), the stretched laminate beyond), FCC and the maximum
+    0.770732 with its 14 contacts.
+
+    Parameters
+    ----------
+    family : xarray.Dataset
+        :func:`hardpack.geometry.ellipsoid_crystals.laminate_family`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure(1, 1, figsize=(5.0, 3.4))
+    alpha = np.asarray(family["alpha"].values, float)
+    order = np.argsort(alpha)
+    alpha = alpha[order]
+    both = np.concatenate([1 / alpha[::-1], alpha])
+    for name, style, label in (("phi_densest", "-", "densest known crystal (stretched beyond $\\sqrt{3}$)"),
+                               ("phi_laminate", "--", "laminate, unstretched")):
+        values = np.asarray(family[name].values, float)[order]
+        ax.plot(both, np.concatenate([values[::-1], values]), style, color="C0" if style == "-" else "C1",
+                label=label)
+    ax.axhline(np.pi / np.sqrt(18), color="0.5", ls=":", lw=1, label=r"FCC, $\pi/\sqrt{18}$")
+    peak = float(family.attrs.get("densest_alpha", np.sqrt(3)))
+    densest = np.isclose(alpha, peak, atol=1e-12)
+    if densest.any():
+        phi = float(np.asarray(family["phi_laminate"].values, float)[order][densest][0])
+        ax.plot([1 / peak, peak], [phi, phi], "o", color="C3", ms=5,
+                label=rf"$\phi = {phi:.6f}$, 14 contacts")
+    ax.set_xscale("log")
+    ticks = [(1 / 3, "1/3"), (1 / np.sqrt(3), r"$1/\sqrt{3}$"), (1.0, "1"), (np.sqrt(3), r"$\sqrt{3}$"),
+             (3.0, "3")]
+    ticks = [(x, t) for x, t in ticks if both.min() * (1 - 1e-9) <= x <= both.max() * (1 + 1e-9)]
+    ax.set_xticks([x for x, _ in ticks], [t for _, t in ticks])
+    ax.minorticks_off()
+    ax.set_xlabel(r"aspect ratio $\alpha$ (oblate $< 1 <$ prolate)")
+    ax.set_ylabel(r"density $\phi$")
+    ax.legend(loc="lower center", fontsize="small")
+    fig.tight_layout()
+    return fig

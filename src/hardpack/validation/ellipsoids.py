@@ -87,3 +87,37 @@ def _duality(target, phi: dict, n: int) -> Row:
     _, alpha, diff, err, seeds = max(rows)
     return evaluate(target, diff, err, n=n, seeds=seeds, label="prolate - oblate",
                     detail=f"alpha = {alpha:g}, the largest of {len(rows)} differences relative to its error")
+
+
+CRYSTAL_DETAIL = "our laminate construction (contacts by the Perram-Wertheim function; the stretch by Eq. 8.3)"
+
+
+def crystal_rows(families) -> list[Row]:
+    """Rows of the laminate family (:func:`hardpack.geometry.ellipsoid_crystals.laminate_family`):
+    the densest laminate at alpha = sqrt(3) (density, contacts), the stretch that gives alpha = 3
+    and the density of the stretched laminate at the largest alpha of the family (Donev 2006, Sec.
+    8.2, Eq. 8.3, Figs. 8.2-8.3). An alpha the family lacks leaves its row n/a."""
+    targets = load_targets()
+    out = []
+    for ds in families:
+        alpha = np.asarray(ds["alpha"].values, float)
+        densest = np.isclose(alpha, math.sqrt(3.0), rtol=0, atol=1e-12)
+        three = np.isclose(alpha, 3.0, rtol=0, atol=1e-12)
+        for tid, mask, name, label in (
+                ("donev-8.2-phi-densest-laminate", densest, "phi_laminate", "alpha = sqrt(3)"),
+                ("donev-8.2-contacts-densest-laminate", densest, "contacts_laminate", "alpha = sqrt(3)"),
+                ("donev-8.3-stretch-alpha3", three, "stretch", "alpha = 3")):
+            if mask.any():
+                out.append(evaluate(targets[tid], float(ds[name].values[mask][0]), label=label, detail=CRYSTAL_DETAIL))
+            else:
+                out.append(evaluate(targets[tid], n=0, label=label, detail=f"the family has no {label}"))
+        top = int(np.argmax(alpha))
+        if alpha[top] > math.sqrt(3.0):
+            out.append(evaluate(targets["donev-8.3-phi-stretched"], float(ds["phi_densest"].values[top]),
+                                label=f"alpha = {alpha[top]:g}",
+                                detail=f"stretch {float(ds['stretch'].values[top]):.6f}, "
+                                       f"{float(ds['contacts_densest'].values[top]):g} contacts per particle"))
+        else:
+            out.append(evaluate(targets["donev-8.3-phi-stretched"], n=0, label="alpha > sqrt(3)",
+                                detail="the family has no alpha beyond sqrt(3)"))
+    return out

@@ -1,0 +1,10 @@
+"""Snakemake script: density of the laminate crystals vs aspect ratio (after Donev 2006, Fig. 8.2)."""
+
+import logging
+
+from hardpack.io import load_dataset
+from hardpack.plots.ellipsoids import plot_laminate_family
+from hardpack.plots.style import save
+
+logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+save(plot_laminate_family(load_dataset(snakemake.input[0])), snakemake.output.pdf, snakemake.output.png)
