@@ -114,7 +114,7 @@ def check_ellipsoids():
 
 
 def check_containers():
-    """The window study reads a 3D LS ensemble; the core and the fit exist at every container size."""
+    """The window study reads a 3D LS ensemble; the largest container has a core; the fit has points."""
     if not CONTAINERS:
         return
     windows = CONTAINERS["windows"]
@@ -122,9 +122,9 @@ def check_containers():
     if ens is None or ens["d"] != 3 or ens["distribution"]["kind"] != "monodisperse":
         raise ValueError(f"config: containers.windows.ensemble {windows['ensemble']!r} must be a monodisperse "
                          "3D ensemble (its LS packings are the periodic packings of Fig. 7.3)")
-    if not CONTAINERS["core_margin"] < min(CONTAINERS["N"]) ** (1 / 3):
+    if not CONTAINERS["core_margin"] < max(CONTAINERS["N"]) ** (1 / 3):
         raise ValueError(f"config: containers.core_margin = {CONTAINERS['core_margin']} a leaves no core in the "
-                         f"smallest container (N = {min(CONTAINERS['N'])}, R > N^(1/3) a): lower it")
+                         f"largest container (N = {max(CONTAINERS['N'])}, R > N^(1/3) a): lower it")
     fitted = [n for n in CONTAINERS["N"] if n >= CONTAINERS["fit_min_n"]]
     if len(fitted) < 2 or len(fitted) * len(CONTAINERS["seeds"]) < 3:
         raise ValueError("config: containers.fit_min_n leaves fewer than 2 container sizes or 3 packings for "

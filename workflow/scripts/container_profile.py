@@ -15,12 +15,14 @@ a, radius = float(packing.radii.mean()), packing.boundary.radius
 margin = snakemake.params.core_margin
 profile = radial_density_profile(packing, n_shells=math.ceil(radius / (snakemake.params.shell_width * a)))
 seed = int(snakemake.wildcards.seed)
+# a container of radius R <= margin a has no core: NaN, said in the log (the core row reads the largest N)
+phi_core = core_density(packing, margin) if radius > margin * a else float("nan")
 profile.attrs.update(
     seed=seed, N=packing.n_particles, phi=packing.phi, a_over_R=a / radius,
-    phi_core=core_density(packing, margin), core_margin=margin, shell_width=snakemake.params.shell_width,
+    phi_core=phi_core, core_margin=margin, shell_width=snakemake.params.shell_width,
     pressure=jammed.attrs["Z"], collisions=jammed.attrs["collisions"], wall_time=jammed.attrs["wall_time"],
     source=str(snakemake.input[0]),
 )
 write_dataset(profile, snakemake.output[0], seed=seed)
-logging.info("%s: N %d, a/R %.5f, phi_avg %.6f, core (r <= R - %g a) %.6f", snakemake.output[0],
+logging.info("%s: N %d, a/R %.5f, phi_avg %.6f, core (r <= R - %g a) %.6f (NaN: no core)", snakemake.output[0],
              packing.n_particles, a / radius, packing.phi, margin, profile.attrs["phi_core"])

@@ -26,9 +26,10 @@ def _bulk_rows(targets, summary) -> list[Row]:
     fitted = n[n >= summary.attrs["fit_min_n"]]
     largest = int(n.max())
     a = summary.attrs
+    sizes = ", ".join(map(str, sorted(set(fitted.tolist()))))
     fit = evaluate(targets["donev-7.3-bulk-phi0"], float(a["phi0"]), float(a["phi0_err"]), n=int(fitted.max()),
                    sizes=int(a["n_sizes_fit"]), label="Eq. 7.2 intercept",
-                   detail=f"linear fit over {a['n_fit']} packings, N = {', '.join(map(str, sorted(set(fitted.tolist()))))}; "
+                   detail=f"linear fit over {a['n_fit']} packings, N = {sizes}; "
                           f"slope {a['slope']:.3f} +- {a['slope_err']:.3f}")
     core = np.asarray(summary["phi_core"].values, float)[n == largest]
     margin = a["core_margin"]
