@@ -81,3 +81,37 @@ def test_init_refuses_semiaxes_of_the_wrong_dimension(tmp_path, capsys):
     assert main(["init", "--n", "5", "--d", "3", "--phi", "0.1", "--semiaxes", "1", "2",
                  "--seed", "1", "--out", str(tmp_path / "e.nc")]) != 0
     assert "--semiaxes needs d = 3 numbers" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("extra, boundary", [
+    (["--boundary", "spherical_container"], "spherical_container"),
+    (["--boundary", "hard_walls"], "hard_walls"),
+    (["--boundary", "hard_walls", "--wall-axes", "2"], "hard_walls"),
+])
+def test_init_in_a_container_and_compress_it_to_jamming(tmp_path, extra, boundary):
+    """Donev 2006, Sec. 7.3.1.2: spheres grown to jamming inside hard walls or a spherical container."""
+    start, out = tmp_path / "start.nc", tmp_path / "jammed.nc"
+    assert main(["init", "--n", "30", "--d", "3", "--phi", "0.2", "--seed", "2", "--out", str(start), *extra]) == 0
+    p = load_packing(start)
+    assert p.boundary.kind == boundary and p.phi == pytest.approx(0.2)
+    if "--wall-axes" in extra:
+        assert p.boundary.axes == (2,)
+    assert json.loads(load_dataset(start).attrs["config"])["boundary"] == boundary
+    assert main(["compress", "--init", str(start), "--out", str(out), "--timeseries", str(tmp_path / "ts.nc"),
+                 "--growth-rate", "0.05", "--max-pressure", "1e6", "--seed", "1"]) == 0
+    jammed = load_packing(out)
+    assert str(jammed.boundary) == str(p.boundary) and jammed.phi > 0.45
+    assert jammed.containment_report().n_outside == 0
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--wall-axes", "1"], "--wall-axes is for --boundary hard_walls only"),
+    (["--boundary", "hard_walls", "--wall-axes", "3"], "hard-wall axis 3 does not exist in 3 dimensions"),
+    (["--boundary", "spherical_container", "--semiaxes", "1", "1", "2"],
+     "--boundary spherical_container is implemented for spheres only"),
+])
+def test_init_refuses_bad_boundaries(tmp_path, capsys, extra, message):
+    out = tmp_path / "x.nc"
+    assert main(["init", "--n", "20", "--d", "3", "--phi", "0.2", "--seed", "1", "--out", str(out), *extra]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()

@@ -45,6 +45,10 @@ def test_shipped_configs_are_valid(name):
         (lambda c: c["slp"]["diluted"].pop("fraction"), "slp.diluted: 'fraction' is a required property"),
         (lambda c: c["slp"]["mrj"]["systems"]["slp_poly2d"].update(distribution={"kind": "uniform_size"}),
          "distribution: 'omega' is a required property"),
+        (lambda c: c["containers"].update(radius=3), "containers: Additional properties.*'radius'"),
+        (lambda c: c["containers"].update(N=[100]), r"containers.N: \[100\] should be non-empty|too short"),
+        (lambda c: c["containers"].pop("core_margin"), "containers: 'core_margin' is a required property"),
+        (lambda c: c["containers"]["windows"].update(n_windows=1), "containers.windows.n_windows: 1 is less than"),
     ],
 )
 def test_bad_configs_are_refused_naming_the_key(mutate, expected):
@@ -62,6 +66,12 @@ def test_snakemake_dry_run_lists_the_dag(configfile):
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert re.search(r"^init +\d+$", out.stdout, re.M) and "fig_size_distributions" in out.stdout
+    cfg = load(configfile.split("/")[1])["containers"]
+    packings = len(cfg["N"]) * len(cfg["seeds"])
+    for rule, count in (("container_init", packings), ("container_profile", packings), ("container_summary", 1),
+                        ("container_windows", 1), ("fig_container_profile", 1), ("fig_container_extrapolation", 1),
+                        ("fig_container_windows", 1)):
+        assert re.search(rf"^{rule} +{count}$", out.stdout, re.M), rule
 
 
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
@@ -123,6 +133,10 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
     (lambda c: c["slp"]["diluted"].update(seeds=[1, 7]), r"slp.diluted.seeds \[7\] are not seeds"),
     (lambda c: c["freeenergy"]["simplex"].update(ensemble="mono9d"), r"freeenergy.simplex.ensemble 'mono9d' is not one"),
     (lambda c: c["freeenergy"]["simplex"].update(seeds=[1, 7]), r"freeenergy.simplex.seeds \[7\] are not seeds"),
+    (lambda c: c["containers"]["windows"].update(ensemble="binary2d"), "must be a monodisperse 3D ensemble"),
+    (lambda c: c["containers"].update(core_margin=6), "core_margin = 6 a leaves no core"),
+    (lambda c: c["containers"].update(fit_min_n=200), "fewer than 2 container sizes"),
+    (lambda c: c["containers"]["windows"].update(fit_min_diameter=0.1), "fit_min_diameter must be >= min_diameter"),
 ])
 def test_snakemake_refuses_a_study_without_its_input_packings(tmp_path, mutate, expected):
     cfg = load("smoke.yaml")

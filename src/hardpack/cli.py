@@ -49,9 +49,19 @@ def cmd_init(args) -> int:
     dist = from_spec(args.distribution)
     attrs = dict(args.attr or [])
     config = {"n": args.n, "d": args.d, "phi": args.phi, "distribution": args.distribution, "seed": args.seed}
+    if args.wall_axes is not None and args.boundary != "hard_walls":
+        raise InvalidInputError(f"--wall-axes is for --boundary hard_walls only, got --boundary {args.boundary}")
     if args.semiaxes is None:
-        packing = random_packing(args.n, args.d, dist, args.phi, args.seed)
+        packing = random_packing(args.n, args.d, dist, args.phi, args.seed, boundary=args.boundary,
+                                 wall_axes=args.wall_axes)
+        if args.boundary != "periodic":
+            config["boundary"] = args.boundary
+            if args.wall_axes is not None:
+                config["wall_axes"] = list(args.wall_axes)
     else:
+        if args.boundary != "periodic":
+            raise InvalidInputError(f"--boundary {args.boundary} is implemented for spheres only; ellipsoid "
+                                    "start packings are periodic (drop --boundary or --semiaxes)")
         if len(args.semiaxes) != args.d:
             raise InvalidInputError(f"--semiaxes needs d = {args.d} numbers, one per body axis; got {args.semiaxes}")
         sizes = dist.sample(args.n, np.random.default_rng(args.seed))
@@ -177,6 +187,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="ellipses (d = 2) or ellipsoids (d = 3) instead of spheres: the body-frame "
                         "semiaxes of the smallest particle, the others scaled by the size distribution; "
                         "random orientations")
+    p.add_argument("--boundary", choices=("periodic", "hard_walls", "spherical_container"), default="periodic",
+                   help="periodic cube (default); hard flat walls at 0 and L on --wall-axes (all by default); "
+                        "or a hard spherical container whose volume gives --phi (Donev 2006, Ch. 7; spheres only)")
+    p.add_argument("--wall-axes", type=int, nargs="+", metavar="AXIS",
+                   help="with --boundary hard_walls: the walled axes (0 = x, 1 = y, ...), periodic along the others")
     p.add_argument("--seed", type=int, required=True, help="random seed")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",

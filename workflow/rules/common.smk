@@ -47,6 +47,7 @@ POLY = config.get("polydisperse", {})
 GLASS = config.get("glass")
 ELLIPSOIDS = config.get("ellipsoids")
 ELLIPSOID_CRYSTALS = config.get("ellipsoid_crystals")
+CONTAINERS = config.get("containers")
 VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
 
@@ -113,8 +114,29 @@ def check_ellipsoids():
                          f"ellipsoids.families {sorted(ELLIPSOIDS['families'])}")
 
 
+def check_containers():
+    """The window study reads a 3D LS ensemble; the largest container has a core; the fit has points."""
+    if not CONTAINERS:
+        return
+    windows = CONTAINERS["windows"]
+    ens = ENSEMBLES.get(windows["ensemble"])
+    if ens is None or ens["d"] != 3 or ens["distribution"]["kind"] != "monodisperse":
+        raise ValueError(f"config: containers.windows.ensemble {windows['ensemble']!r} must be a monodisperse "
+                         "3D ensemble (its LS packings are the periodic packings of Fig. 7.3)")
+    if not CONTAINERS["core_margin"] < max(CONTAINERS["N"]) ** (1 / 3):
+        raise ValueError(f"config: containers.core_margin = {CONTAINERS['core_margin']} a leaves no core in the "
+                         f"largest container (N = {max(CONTAINERS['N'])}, R > N^(1/3) a): lower it")
+    fitted = [n for n in CONTAINERS["N"] if n >= CONTAINERS["fit_min_n"]]
+    if len(fitted) < 2 or len(fitted) * len(CONTAINERS["seeds"]) < 3:
+        raise ValueError("config: containers.fit_min_n leaves fewer than 2 container sizes or 3 packings for "
+                         "the Eq. 7.2 fit")
+    if not windows["fit_min_diameter"] >= windows["min_diameter"]:
+        raise ValueError("config: containers.windows.fit_min_diameter must be >= min_diameter")
+
+
 check_config()
 check_ellipsoids()
+check_containers()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -192,7 +214,30 @@ def _systems():
             rounds=SLP_DILUTED["rounds"], slp=slp_flags(SLP_MRJ),
             dilute=f"--fraction {SLP_DILUTED['fraction']} --rounds {SLP_DILUTED['rounds']}")
     systems["ellipsoids"] = _ellipsoid_systems()
+    systems["containers"] = _container_systems()
     return systems
+
+
+def _container_systems():
+    """Spheres grown to jamming in spherical containers, one system n{N} per container size
+    (Donev 2006, Sec. 7.3): the LS ensembles' two-stage protocol without contact forces (the
+    engine logs no wall forces)."""
+    if not CONTAINERS:
+        return {}
+    c = CONTAINERS
+    compress = (f"--growth-rate {c['growth_rate']} --final-growth-rate {c['final_growth_rate']}"
+                f" --switch-pressure {c['switch_pressure']} --max-pressure {c['max_pressure']}")
+    return {f"n{n}": _system(n, 3, c["seeds"], c["init_phi"], attrs={}, compress=compress) for n in c["N"]}
+
+
+def container_files(step):
+    """Per-seed files of every container size (results/containers/n{N}/{step}/seed{seed}.nc)."""
+    return [path for name in SYSTEMS["containers"] for path in seed_files("containers", name, step)]
+
+
+def window_packings():
+    """The periodic LS packings of the window study (Donev 2006, Fig. 7.3)."""
+    return seed_files("ls", CONTAINERS["windows"]["ensemble"], "jammed")
 
 
 def _ellipsoid_shapes():
@@ -577,6 +622,7 @@ def figures():
     names += ["ellipsoid_snapshot"] if ELLIPSOIDS and "mm" in ELLIPSOIDS else []
     names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
     names += ["glass_eos", "glass_entropy"] if GLASS else []
+    names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []
     return [f"results/figures/{name}.pdf" for name in names]
 
 
@@ -613,6 +659,8 @@ def validation_inputs():
         inputs["ellipsoids"] = ellipsoids
     if ELLIPSOID_CRYSTALS:
         inputs["ellipsoid_crystals"] = ["results/ellipsoid_crystals/laminate_family.nc"]
+    if CONTAINERS:
+        inputs["containers"] = ["results/containers/profile_summary.nc", "results/containers/windows_summary.nc"]
     return inputs
 
 
@@ -719,6 +767,7 @@ PARTICLES = {
     "poly_fluid": lambda w: POLY_FLUID["N"],
     **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd"),
                     lambda w: GLASS["N"]),
+    **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
 }
 
 

@@ -37,8 +37,8 @@ rule init:
 
 rule compress:
     """LS compression of one start configuration to the system's reduced pressure: the LS ensembles'
-    two-stage protocol (with contact forces), one growth rate of the rate scan, or the ellipsoid
-    study's two-stage protocol."""
+    two-stage protocol (with contact forces), one growth rate of the rate scan, the ellipsoid
+    study's two-stage protocol, or spheres in a spherical container."""
     input:
         start_packing,
     output:
@@ -48,7 +48,7 @@ rule compress:
         options=lambda w: system(w)["compress"],
         checkpoint=checkpoint_beside,
     wildcard_constraints:
-        study="ls|ls_rates|ellipsoids",
+        study="ls|ls_rates|ellipsoids|containers",
     threads: 1
     resources:
         mem_mb=job_mem_mb("compress"),

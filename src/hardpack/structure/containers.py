@@ -8,6 +8,11 @@
   and its value at delta -> 0 with a standard error (Eq. 7.2, Fig. 7.6).
 - :func:`window_fluctuations`: sigma_phi(R), the standard deviation of the volume fraction inside
   spherical windows of radius R placed uniformly at random in a periodic packing (Fig. 7.3).
+- :func:`core_density`, :func:`container_summary`: the per-packing numbers of a container study
+  (average density, delta = a / R, the density of the core away from the wall) over (N, seed),
+  with the Eq. 7.2 extrapolation.
+- :func:`window_study`, :func:`fit_window_power_law`: sigma_phi against the window diameter 2R/D
+  over several periodic packings and the log-log fit of the text, sigma_phi ~ 0.1 (2R/D)^-2.
 
 Eq. 7.2 (derived again here from phi_avg = 3 R^-3 int_0^R r^2 phi(r) dr with Eq. 7.1,
 phi(r) = phi_0 - Dphi((R - r) / a)): phi_avg(delta) = phi_0 - 3 m_0 delta + 6 m_1 delta^2
@@ -172,13 +177,18 @@ def extrapolate_bulk_density(delta, phi_avg) -> BulkExtrapolation:
     if len(x) < 3 or not (np.isfinite(x).all() and np.isfinite(y).all()) or np.ptp(x) == 0:
         raise InvalidInputError("the extrapolation needs at least 3 finite points with different a/R "
                                 "(the scatter about the line gives the error)")
+    return BulkExtrapolation(*_line_fit(x, y), len(x))
+
+
+def _line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
+    """Ordinary least-squares line y = c0 + c1 x: c0, its standard error, c1, its standard error
+    (the residual variance estimates the scatter; at least 3 points)."""
     design = np.column_stack([np.ones_like(x), x])
     coef, *_ = np.linalg.lstsq(design, y, rcond=None)
     resid = y - design @ coef
     s2 = float(resid @ resid) / (len(x) - 2)
     cov = s2 * np.linalg.inv(design.T @ design)
-    return BulkExtrapolation(float(coef[0]), float(np.sqrt(cov[0, 0])), float(coef[1]),
-                             float(np.sqrt(cov[1, 1])), len(x))
+    return float(coef[0]), float(np.sqrt(cov[0, 0])), float(coef[1]), float(np.sqrt(cov[1, 1]))
 
 
 def window_fluctuations(packing, window_radii, n_windows: int = 1000, seed: int = 0) -> xr.Dataset:
@@ -251,3 +261,213 @@ def window_fluctuations(packing, window_radii, n_windows: int = 1000, seed: int 
                "N": packing.n_particles, "d": d, "phi": float(packing.phi),
                "source": "Donev 2006, Ch. 7, Fig. 7.3 (fit sigma_phi ~ 0.1 (2R/D)^-2)"},
     )
+
+
+def core_density(packing, margin: float) -> float:
+    """Fraction of the ball of radius R - margin a about the container centre covered by spheres.
+
+    Donev 2006, Sec. 7.3.1.2 (Fig. 7.5): the density profile reaches the core density "of about
+    0.64" only after several layers near the wall are removed; ``margin`` is that distance from
+    the wall in units of a (the mean radius, Donev's a = D/2).
+
+    Parameters
+    ----------
+    packing : Packing
+        Spheres (d = 2 or 3) in a spherical container.
+    margin : float
+        Distance of the core from the wall in units of a, 0 <= margin < R / a.
+
+    Returns
+    -------
+    float
+        The covered fraction of the core ball (exact sphere-ball intersections).
+
+    Raises
+    ------
+    InvalidInputError
+        Without a spherical container, or when the margin leaves no core.
+    """
+    _sphere_check(packing, "the core density")
+    if packing.boundary.kind != "spherical_container":
+        raise InvalidInputError("the core density needs a packing in a spherical container")
+    a = float(packing.radii.mean())
+    radius = packing.boundary.radius - float(margin) * a
+    if not (np.isfinite(margin) and margin >= 0 and radius > 0):
+        raise InvalidInputError(f"core margin {margin!r} (in units of a = {a:.4g}) must be >= 0 and leave a "
+                                f"core inside the container of radius {packing.boundary.radius:.4g}")
+    dist = np.linalg.norm(packing.positions - np.asarray(packing.boundary.centre), axis=1)
+    covered = ball_intersection_volume(radius, packing.radii, dist, packing.dim).sum()
+    return float(covered / ball_volume(radius, packing.dim))
+
+
+def container_summary(profiles, fit_min_n: int = 1) -> xr.Dataset:
+    """The packings of a container study over (N, seed) and the Eq. 7.2 bulk extrapolation.
+
+    Parameters
+    ----------
+    profiles : sequence of xarray.Dataset
+        Radial profiles (:func:`radial_density_profile`) with the attributes ``N``, ``seed``,
+        ``phi`` (the average density N V_particle / V_container), ``a_over_R`` and ``phi_core``
+        (:func:`core_density`) and ``core_margin``.
+    fit_min_n : int, default 1
+        The extrapolation uses the packings with N >= fit_min_n (Donev: "a range of (sufficiently
+        large) container sizes").
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension ``sample`` with coordinates ``N`` and ``seed`` and variables ``a_over_R``,
+        ``phi_avg``, ``phi_core``; attributes ``phi0``, ``phi0_err``, ``slope``, ``slope_err``
+        (:func:`extrapolate_bulk_density` over every packing with N >= fit_min_n, NaN when fewer
+        than 3 such packings or only one a/R), ``n_fit``, ``n_sizes_fit``, ``fit_min_n``,
+        ``core_margin``.
+
+    Raises
+    ------
+    InvalidInputError
+        If there are no profiles, a profile lacks an attribute, (N, seed) repeats, or the
+        profiles have different core margins.
+    """
+    profiles = list(profiles)
+    if not profiles:
+        raise InvalidInputError("a container summary needs at least one radial profile")
+    keys = ("N", "seed", "phi", "a_over_R", "phi_core", "core_margin")
+    for p in profiles:
+        missing = [k for k in keys if k not in p.attrs]
+        if missing:
+            raise InvalidInputError(f"radial profile {p.attrs.get('source', '?')} lacks the attributes {missing}")
+    rows = sorted((int(p.attrs["N"]), int(p.attrs["seed"]), float(p.attrs["a_over_R"]), float(p.attrs["phi"]),
+                   float(p.attrs["phi_core"])) for p in profiles)
+    pairs = [r[:2] for r in rows]
+    if len(set(pairs)) != len(pairs):
+        raise InvalidInputError(f"a (N, seed) pair repeats among the profiles: {pairs}")
+    margins = {float(p.attrs["core_margin"]) for p in profiles}
+    if len(margins) != 1:
+        raise InvalidInputError(f"the profiles have different core margins {sorted(margins)}")
+    n, seed, delta, phi, core = (np.array(c) for c in zip(*rows))
+    use = n >= fit_min_n
+    fit = {"phi0": np.nan, "phi0_err": np.nan, "slope": np.nan, "slope_err": np.nan}
+    if use.sum() >= 3 and np.ptp(delta[use]) > 0:
+        f = extrapolate_bulk_density(delta[use], phi[use])
+        fit = {"phi0": f.phi0, "phi0_err": f.phi0_err, "slope": f.slope, "slope_err": f.slope_err}
+    return xr.Dataset(
+        {"a_over_R": ("sample", delta), "phi_avg": ("sample", phi), "phi_core": ("sample", core)},
+        coords={"N": ("sample", n), "seed": ("sample", seed)},
+        attrs={"hardpack_kind": "container_summary", **fit, "n_fit": int(use.sum()),
+               "n_sizes_fit": len(set(n[use].tolist())), "fit_min_n": int(fit_min_n),
+               "core_margin": margins.pop(), "index": '["N", "seed"]',
+               "source": "Donev 2006, Sec. 7.3.2.1, Eq. 7.2 and Fig. 7.6 (linear fit in a/R)"},
+    )
+
+
+def window_study(packings, n_radii: int = 12, min_diameter: float = 1.0, n_windows: int = 1000,
+                 seed: int = 0) -> xr.Dataset:
+    """sigma_phi against the window diameter 2R/D over periodic sphere packings (Donev 2006, Fig. 7.3).
+
+    The window diameters 2R/D are ``n_radii`` values spaced evenly in log from ``min_diameter``
+    to the largest that every packing allows (2R/D <= L_min / D - 1, one image per sphere);
+    D is each packing's mean diameter. Each packing gets :func:`window_fluctuations` with
+    ``n_windows`` windows per radius.
+
+    Parameters
+    ----------
+    packings : sequence of Packing
+        Sphere packings in periodic orthorhombic cells.
+    n_radii : int, default 12
+        Window sizes, >= 2.
+    min_diameter : float, default 1.0
+        Smallest 2R/D, positive and below the largest allowed.
+    n_windows : int, default 1000
+        Windows per radius and packing.
+    seed : int, default 0
+        Seed of the window centres (the same for every packing).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``sigma_phi``, ``sigma_phi_err`` and ``phi_mean`` on (``sample``, ``x``) with x = 2R/D,
+        ``N`` and ``phi`` per sample.
+
+    Raises
+    ------
+    InvalidInputError
+        Without packings, for bad counts, or when ``min_diameter`` is not below the largest
+        allowed window.
+    """
+    packings = list(packings)
+    if not packings:
+        raise InvalidInputError("the window study needs at least one packing")
+    if int(n_radii) != n_radii or n_radii < 2:
+        raise InvalidInputError(f"n_radii must be an integer >= 2, got {n_radii!r}")
+    for p in packings:
+        _sphere_check(p, "the window study")
+        if p.boundary.kind != "periodic" or not p.is_orthorhombic:
+            raise InvalidInputError("the window study needs packings in periodic orthorhombic cells")
+    diameters = [2.0 * float(p.radii.mean()) for p in packings]
+    largest = min((np.diag(p.lattice).min() / 2 - p.radii.max()) * 2 / dia for p, dia in zip(packings, diameters))
+    if not (np.isfinite(min_diameter) and 0 < min_diameter < largest):
+        raise InvalidInputError(f"min_diameter must be in (0, {largest:.4g}) (the largest window 2R/D the "
+                                f"cells allow), got {min_diameter!r}")
+    x = np.geomspace(min_diameter, largest, int(n_radii))
+    runs = [window_fluctuations(p, x * dia / 2 * (1 - 1e-12), n_windows, seed) for p, dia in zip(packings, diameters)]
+    stack = {name: (("sample", "x"), np.array([r[name].values for r in runs]))
+             for name in ("sigma_phi", "sigma_phi_err", "phi_mean")}
+    return xr.Dataset(
+        {**stack, "N": ("sample", np.array([p.n_particles for p in packings])),
+         "phi": ("sample", np.array([p.phi for p in packings]))},
+        coords={"x": x},
+        attrs={"hardpack_kind": "window_study", "n_windows": int(n_windows), "seed": int(seed),
+               "x_description": "window diameter over sphere diameter, 2R/D",
+               "source": "Donev 2006, Sec. 7.3.1.1 and Fig. 7.3 (fit sigma_phi ~ 0.1 (2R/D)^-2)"},
+    )
+
+
+@dataclass(frozen=True)
+class PowerLaw:
+    """sigma_phi = prefactor (2R/D)^exponent fitted in log-log (ordinary least squares, standard
+    errors from the scatter about the line), and the prefactor with the exponent fixed at -2 of
+    Donev 2006, Fig. 7.3 (mean of sigma_phi (2R/D)^2 with its standard error); ``n`` points."""
+
+    exponent: float
+    exponent_err: float
+    prefactor: float
+    prefactor_err: float
+    prefactor_fixed: float
+    prefactor_fixed_err: float
+    n: int
+
+
+def fit_window_power_law(x, sigma, x_min: float = 0.0) -> PowerLaw:
+    """Fit sigma_phi(2R/D) by a power law over 2R/D >= ``x_min`` (Donev 2006, Fig. 7.3).
+
+    Parameters
+    ----------
+    x : array_like
+        Window diameters 2R/D.
+    sigma : array_like
+        sigma_phi at each (one value per x: average the packings first).
+    x_min : float, default 0
+        Smallest window of the fit (small windows see single spheres, not the R^-2 regime).
+
+    Returns
+    -------
+    PowerLaw
+        Exponent and prefactor with standard errors.
+
+    Raises
+    ------
+    InvalidInputError
+        With fewer than 3 finite positive points in the range.
+    """
+    x = np.asarray(x, float)
+    y = np.asarray(sigma, float)
+    if x.shape != y.shape or x.ndim != 1:
+        raise InvalidInputError(f"x and sigma must be 1-d arrays of one length, got {x.shape} and {y.shape}")
+    use = (x >= x_min) & np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    if use.sum() < 3:
+        raise InvalidInputError(f"the power-law fit needs at least 3 positive points with 2R/D >= {x_min:g}, "
+                                f"got {int(use.sum())}")
+    log_a, log_a_err, exponent, exponent_err = _line_fit(np.log(x[use]), np.log(y[use]))
+    scaled = y[use] * x[use] ** 2
+    return PowerLaw(exponent, exponent_err, float(np.exp(log_a)), float(np.exp(log_a) * log_a_err),
+                    float(scaled.mean()), float(scaled.std(ddof=1) / np.sqrt(scaled.size)), int(use.sum()))

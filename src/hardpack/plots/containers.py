@@ -1,0 +1,116 @@
+"""Figures of the finite-container study of spheres (Donev 2006, Sec. 7.3): the radial density
+profile near the wall (after Fig. 7.5), the average density against a/R with the Eq. 7.2 linear
+extrapolation (after Fig. 7.6) and the window fluctuations sigma_phi(2R/D) of periodic packings
+(after Fig. 7.3)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hardpack.plots.style import figure
+from hardpack.structure.containers import fit_window_power_law
+from hardpack.validation.rows import seed_statistics
+
+#: Donev 2006, Sec. 7.3.2.1: the extrapolated bulk density of jammed spheres, 0.642 +- 0.002
+DONEV_PHI0 = (0.642, 0.002)
+#: Donev 2006, Fig. 7.5: the core density far from the wall, about 0.64
+DONEV_CORE = 0.64
+
+
+def plot_radial_profile(profiles):
+    """phi(r) against the distance from the wall (R - r) / a of packings in spherical containers,
+    with the core density 0.64 of Donev 2006, Fig. 7.5 (dashed) and each packing's core density
+    (dotted, the covered fraction of the ball r <= R - core_margin a).
+
+    Parameters
+    ----------
+    profiles : sequence of xarray.Dataset
+        Radial profiles (:func:`hardpack.structure.containers.radial_density_profile`) with the
+        attributes ``N``, ``seed``, ``a``, ``radius``, ``phi_core`` and ``core_margin``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure(figsize=(6.0, 3.2))
+    for k, p in enumerate(profiles):
+        a, radius = p.attrs["a"], p.attrs["radius"]
+        ax.plot((radius - p["r"].values) / a, p["phi"].values, lw=0.8, color=f"C{k}",
+                label=f"N = {p.attrs['N']}, seed {p.attrs['seed']}")
+        ax.axhline(p.attrs["phi_core"], color=f"C{k}", ls=":", lw=0.8)
+    ax.axhline(DONEV_CORE, color="k", ls="--", lw=1, label=r"Donev 2006: $\phi_0 \approx 0.64$")
+    margin = profiles[0].attrs["core_margin"] if profiles else 0
+    ax.axvline(margin, color="0.5", lw=0.6)
+    ax.set_xlabel(r"distance from the wall $(R - r)/a$")
+    ax.set_ylabel(r"$\phi(r)$")
+    ax.set_ylim(0, 1)
+    ax.legend(fontsize=7, loc="lower right")
+    return fig
+
+
+def plot_extrapolation(summary):
+    """The average density phi_avg against delta = a/R of every packing, the mean per N, and the
+    linear fit of Eq. 7.2 extended to delta = 0 with its intercept phi_0 +- s.e., beside Donev's
+    0.642 +- 0.002 (Donev 2006, Sec. 7.3.2.1, Fig. 7.6).
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        :func:`hardpack.structure.containers.container_summary` output.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure(figsize=(5.0, 3.4))
+    n = np.asarray(summary["N"].values)
+    delta = np.asarray(summary["a_over_R"].values, float)
+    phi = np.asarray(summary["phi_avg"].values, float)
+    ax.plot(delta, phi, "o", ms=3, mfc="none", color="C0", label="packings")
+    for size in np.unique(n):
+        mean, sem, _, _ = seed_statistics(phi[n == size])
+        ax.errorbar(delta[n == size].mean(), mean, 0 if not np.isfinite(sem) else sem, fmt="s", ms=4, color="C0")
+    phi0, err, slope = (summary.attrs[k] for k in ("phi0", "phi0_err", "slope"))
+    if np.isfinite(phi0):
+        grid = np.linspace(0, delta.max() * 1.05, 50)
+        ax.plot(grid, phi0 + slope * grid, "-", color="C1",
+                label=rf"fit (N $\geq$ {summary.attrs['fit_min_n']}): $\phi_0$ = {phi0:.4f} $\pm$ {err:.4f}")
+        ax.errorbar([0], [phi0], [err], fmt="o", color="C1", capsize=3)
+    ax.errorbar([0], [DONEV_PHI0[0]], [DONEV_PHI0[1]], fmt="*", ms=8, color="k", capsize=3,
+                label=r"Donev 2006: $\phi_0$ = 0.642 $\pm$ 0.002")
+    ax.set_xlim(left=-0.005)
+    ax.set_xlabel(r"$\delta = a/R$")
+    ax.set_ylabel(r"$\phi_{avg}$")
+    ax.legend(fontsize=7)
+    return fig
+
+
+def plot_window_fluctuations(windows):
+    """sigma_phi of random spherical windows against 2R/D (log-log), per packing and the mean,
+    with the fitted power law and Donev's 0.1 (2R/D)^-2 (Donev 2006, Fig. 7.3).
+
+    Parameters
+    ----------
+    windows : xarray.Dataset
+        :func:`hardpack.structure.containers.window_study` output (attribute
+        ``fit_min_diameter``: the smallest window of the fit).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure(figsize=(5.0, 3.4))
+    x = windows["x"].values
+    sigma = windows["sigma_phi"].values
+    for row in sigma:
+        ax.loglog(x, row, "-", lw=0.6, color="0.6")
+    mean = sigma.mean(axis=0)
+    ax.loglog(x, mean, "o", ms=4, color="C0", label=f"{sigma.shape[0]} packing(s), N = {int(windows['N'][0])}")
+    fit = fit_window_power_law(x, mean, windows.attrs.get("fit_min_diameter", 0.0))
+    ax.loglog(x, fit.prefactor * x**fit.exponent, "-", color="C1",
+              label=rf"fit: {fit.prefactor:.3f} $(2R/D)^{{{fit.exponent:.2f} \pm {fit.exponent_err:.2f}}}$")
+    ax.loglog(x, 0.1 * x**-2.0, "--", color="k", label=r"Donev 2006: $0.1\,(2R/D)^{-2}$")
+    ax.set_xlabel(r"window diameter $2R/D$")
+    ax.set_ylabel(r"$\sigma_\phi(R)$")
+    ax.legend(fontsize=7)
+    return fig

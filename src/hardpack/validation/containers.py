@@ -1,0 +1,64 @@
+"""Validation rows of the finite-container study of spheres (Donev 2006, Sec. 7.3).
+
+Inputs (the pipeline's ``containers`` summaries, told apart by ``hardpack_kind``):
+
+- ``container_summary`` (:func:`hardpack.structure.containers.container_summary`): the Eq. 7.2
+  intercept phi_0 +- its standard error against 0.642 +- 0.002 (Sec. 7.3.2.1), judged at the
+  largest N of the fit with its number of sizes; the core density r <= R - core_margin a of the
+  packings of the largest container against "about 0.64" (Fig. 7.5), over seeds.
+- ``window_study`` (:func:`hardpack.structure.containers.window_study`): sigma_phi averaged over
+  the packings, fitted by a power law over 2R/D >= fit_min_diameter
+  (:func:`~hardpack.structure.containers.fit_window_power_law`): the exponent against -2 and the
+  prefactor at exponent -2 against 0.1 (Fig. 7.3).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hardpack.structure.containers import fit_window_power_law
+from hardpack.validation.rows import Row, evaluate
+from hardpack.validation.targets import load_targets
+
+
+def _bulk_rows(targets, summary) -> list[Row]:
+    n = np.asarray(summary["N"].values)
+    fitted = n[n >= summary.attrs["fit_min_n"]]
+    largest = int(n.max())
+    a = summary.attrs
+    sizes = ", ".join(map(str, sorted(set(fitted.tolist()))))
+    fit = evaluate(targets["donev-7.3-bulk-phi0"], float(a["phi0"]), float(a["phi0_err"]), n=int(fitted.max()),
+                   sizes=int(a["n_sizes_fit"]), label="Eq. 7.2 intercept",
+                   detail=f"linear fit over {a['n_fit']} packings, N = {sizes}; "
+                          f"slope {a['slope']:.3f} +- {a['slope_err']:.3f}")
+    core = np.asarray(summary["phi_core"].values, float)[n == largest]
+    margin = a["core_margin"]
+    return [fit, evaluate(targets["donev-fig7.5-core-phi"], samples=core, n=largest, label=f"N = {largest}",
+                          detail=f"r <= R - {margin:g} a; per seed {', '.join(f'{v:.4f}' for v in core)}")]
+
+
+def _window_rows(targets, windows) -> list[Row]:
+    x = windows["x"].values
+    sigma = windows["sigma_phi"].values.mean(axis=0)
+    x_min = float(windows.attrs.get("fit_min_diameter", 0.0))
+    fit = fit_window_power_law(x, sigma, x_min)
+    n = int(np.asarray(windows["N"].values).min())
+    detail = (f"{windows.sizes['sample']} packing(s), {windows.attrs['n_windows']} windows per size, "
+              f"{fit.n} sizes 2R/D = {x[x >= x_min].min():.3g}..{x.max():.3g}")
+    return [evaluate(targets["donev-fig7.3-window-exponent"], fit.exponent, fit.exponent_err, n=n,
+                     label="sigma_phi ~ (2R/D)^k", detail=detail),
+            evaluate(targets["donev-fig7.3-window-prefactor"], fit.prefactor_fixed, fit.prefactor_fixed_err,
+                     n=n, label="sigma_phi (2R/D)^2", detail=detail)]
+
+
+def container_rows(datasets) -> list[Row]:
+    """Rows of the container and window summaries (module docstring), in input order."""
+    targets = load_targets()
+    out = []
+    for ds in datasets:
+        kind = ds.attrs.get("hardpack_kind")
+        if kind == "container_summary":
+            out += _bulk_rows(targets, ds)
+        elif kind == "window_study":
+            out += _window_rows(targets, ds)
+    return out

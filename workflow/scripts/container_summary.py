@@ -1,0 +1,12 @@
+"""Snakemake script: the container packings over (N, seed) and the Eq. 7.2 bulk extrapolation."""
+
+import logging
+
+from hardpack.io import load_dataset, write_dataset
+from hardpack.structure.containers import container_summary
+
+logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+ds = container_summary([load_dataset(path) for path in snakemake.input], fit_min_n=snakemake.params.fit_min_n)
+write_dataset(ds, snakemake.output[0])
+logging.info("%s: %d packings; phi_0 = %.4f +- %.4f over %d packings of %d sizes", snakemake.output[0],
+             ds.sizes["sample"], ds.attrs["phi0"], ds.attrs["phi0_err"], ds.attrs["n_fit"], ds.attrs["n_sizes_fit"])
