@@ -227,3 +227,22 @@ def test_wall_contacts_of_the_network():
     np.testing.assert_allclose(net.normal[0], [0.0, -1.0])
     assert net.gap[0] == pytest.approx(1e-7, rel=1e-6)
     assert contact_network(p, 1e-8).n_contacts == 0
+
+
+def test_cli_init_with_walls_and_verify_writes_wall_contacts(tmp_path):
+    """``hardpack init --boundary`` starts walled packings (for ``hardpack compress``), and
+    ``hardpack verify`` of a walled packing stores its wall contacts and reactions: the closed
+    slot of two disks (7 contacts, 6 with walls, all forces 1) of the test above."""
+    from hardpack.cli import main
+    from hardpack.io import load_dataset, load_packing, save_packing
+
+    assert main(["init", "--n", "5", "--d", "2", "--phi", "0.1", "--seed", "1", "--boundary",
+                 "spherical_container", "--out", str(tmp_path / "init.nc")]) == 0
+    assert load_packing(tmp_path / "init.nc").boundary.kind == "spherical_container"
+    slot = Packing([[0.5, 0.5], [1.5, 0.5]], [0.5, 0.5], np.diag([2.0, 1.0]), boundary=HardWalls([0, 1]))
+    save_packing(slot, tmp_path / "slot.nc")
+    assert main(["verify", str(tmp_path / "slot.nc"), "--out", str(tmp_path / "v.nc")]) == 0
+    ds = load_dataset(tmp_path / "v.nc")
+    assert ds.attrs["collective"] == 1 and ds.attrs["n_wall_contacts"] == 6
+    assert ds.attrs["wall_force"] == pytest.approx(6.0)
+    np.testing.assert_allclose(ds["force"].values[ds["contact_wall"].values >= 0], 1.0, rtol=1e-9)

@@ -49,8 +49,12 @@ def cmd_init(args) -> int:
     dist = from_spec(args.distribution)
     attrs = dict(args.attr or [])
     config = {"n": args.n, "d": args.d, "phi": args.phi, "distribution": args.distribution, "seed": args.seed}
+    if args.boundary != "periodic":
+        if args.semiaxes is not None:
+            raise InvalidInputError("--boundary is for spheres only; ellipsoid starts are periodic")
+        config["boundary"] = args.boundary
     if args.semiaxes is None:
-        packing = random_packing(args.n, args.d, dist, args.phi, args.seed)
+        packing = random_packing(args.n, args.d, dist, args.phi, args.seed, boundary=args.boundary)
     else:
         if len(args.semiaxes) != args.d:
             raise InvalidInputError(f"--semiaxes needs d = {args.d} numbers, one per body axis; got {args.semiaxes}")
@@ -155,6 +159,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "semiaxes of the smallest particle, the others scaled by the size distribution; "
                         "random orientations")
     p.add_argument("--seed", type=int, required=True, help="random seed")
+    p.add_argument("--boundary", choices=("periodic", "hard_walls", "spherical_container"), default="periodic",
+                   help="periodic cell (default), hard walls on every axis of the box, or a spherical "
+                        "container (phi over its volume)")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",
                    help="extra attribute stored in the file (repeatable), e.g. ensemble=mono3d")
