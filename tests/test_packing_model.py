@@ -488,7 +488,7 @@ def _refusals():
 
 
 #: modules that run spheres with hard walls and in containers (tested in tests/test_walls.py)
-WALLED_SPHERES_SUPPORTED = ("the MD engine", "the jamming backbone of an LS compression")
+WALLED_SPHERES_SUPPORTED = ("the MD engine", "the jamming backbone of an LS compression", "the jamming tests")
 
 
 @pytest.mark.parametrize("user", list(_refusals()))

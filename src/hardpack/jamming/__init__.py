@@ -1,4 +1,5 @@
-"""Rigorous jamming tests for periodic sphere packings (Donev dissertation ch. 4).
+"""Rigorous jamming tests for sphere packings (Donev dissertation ch. 4): periodic cells, hard
+walls and spherical containers (wall contacts with fixed wall points, sec. 4.4.3).
 
 Entry point :func:`verify` -> :class:`JammingResult` (``.summary()``, ``.to_dataset()``).
 Building blocks: :func:`contact_network`, :func:`rigidity_matrix` (scipy.sparse),

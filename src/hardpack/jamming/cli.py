@@ -88,7 +88,8 @@ def cmd_verify(args) -> int:
     if "md_contact_force" in ds and result.forces.exists:
         from hardpack.jamming.md_forces import compare_md_forces
 
-        cmp = compare_md_forces(result.network, result.forces.forces, result.network.among(~result.rattler), ds)
+        pairs = result.network.among(~result.rattler) & ~result.network.is_wall  # the MD records pairs
+        cmp = compare_md_forces(result.network, result.forces.forces, pairs, ds)
         out.attrs.update(cmp.as_attrs())
         print(f"MD contact forces: LP virial / MD collisional pressure = {cmp.pressure_ratio:.4f}, "
               f"rms force difference {cmp.rms_relative:.3g} of the mean ({cmp.n_matched} of "

@@ -35,6 +35,18 @@ Statics (each checked by the tests):
 - isostaticity counts (Eqs. 4.8, 4.9, sec. 4.3.1.1): N_f = d(N_b - 1) in a fixed cell and
   N_f + d(d+1)/2 - 1 with a deformable cell; an isostatic backbone has M_b = N_f + 1, and
   ``gap = M_b - N_f - 1`` is 0 (isostatic), > 0 (hyperstatic) or < 0 (hypostatic).
+  Hard walls (sec. 4.3.1.1: "if hard wall boundary conditions are employed then N_f = N d and
+  one should also count contacts with the hard walls among the M constraints"): N_f = d N_b
+  less the translations along periodic axes (for a spherical container less its d(d-1)/2
+  rotations), the wall contacts count in M_b, and the walls stay fixed, so the strict count is
+  the collective one.
+- walls: a wall contact is a contact with a fixed point of the wall (Donev 2006, sec. 4.4.3), so
+  its force is the wall's reaction and enters the force balance A f = 0 of its particle only;
+  the virial sum over all contacts, wall contacts with their centre-wall distance, is the
+  boundary integral of x . t, i.e. d P V for a uniform wall pressure P (derived here from
+  sum_i x_i . F_i = 0).
+- free-volume pressure with walls: p = N_f / (d N mu*), which is (N_b - 1) / (N mu*) in a
+  periodic cell.
 """
 
 from __future__ import annotations
@@ -267,14 +279,16 @@ class Statics:
     n_backbone: int
     n_contacts: int  # M_b, self-image contacts once
     z_mean: float  # 2 M_b / N_b
-    n_dof_collective: int  # d (N_b - 1)
-    n_dof_strict: int  # d (N_b - 1) + d(d+1)/2 - 1
+    n_dof_collective: int  # d (N_b - 1); with walls d N_b less the trivial motions
+    n_dof_strict: int  # d (N_b - 1) + d(d+1)/2 - 1; with walls (fixed) as collective
     isostaticity_gap: int  # M_b - n_dof_collective - 1  (0 = isostatic in a fixed cell)
     isostaticity_gap_strict: int  # M_b - n_dof_strict - 1
     pressure_virial: float  # sum f |r| / (d V), forces normalised to mean 1
     stress: np.ndarray  # (d, d) virial stress tensor, same units
     jamming_gap: float  # mu* = sum f h / sum f D
-    pressure_free_volume: float  # (N_b - 1) / (N mu*), reduced pressure PV/(NkT)
+    pressure_free_volume: float  # N_f / (d N mu*) = (N_b - 1) / (N mu*) periodic, PV/(NkT)
+    n_wall_contacts: int = 0  # backbone contacts with walls, among the M_b
+    wall_force: float = 0.0  # sum of the wall reactions (forces of mean 1 over the M_b contacts)
 
 
 def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: float,
@@ -311,18 +325,22 @@ def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: f
     d, n = net.dim, net.n_particles
     contacts = net.among(backbone)
     nb = int(backbone.sum())
-    mb = int((contacts if counted is None else contacts & counted).sum())
-    nf = d * (nb - 1) if nb else 0
-    nf_strict = nf + d * (d + 1) // 2 - 1 if nb else 0
+    mb_mask = contacts if counted is None else contacts & counted
+    mb = int(mb_mask.sum())
+    nf = max(d * nb - net.n_trivial, 0) if nb else 0
+    nf_strict = nf + d * (d + 1) // 2 - 1 if nb and net.is_periodic else nf
     f = forces.forces[contacts]
     r, u = net.distance[contacts], net.normal[contacts]
     stress = np.einsum("k,kp,kq->pq", f * r, u, u) / volume if forces.exists else np.full((d, d), np.nan)
     p_vir = float(np.trace(stress) / d)
     mu = forces.jamming_gap
-    p_fv = (nb - 1) / (n * mu) if forces.exists and mu > 0 else np.inf if forces.exists else np.nan
+    p_fv = nf / (d * n * mu) if forces.exists and mu > 0 else np.inf if forces.exists else np.nan
+    wall = contacts & net.is_wall
     return Statics(
         n_backbone=nb, n_contacts=mb, z_mean=2.0 * mb / nb if nb else np.nan,
         n_dof_collective=nf, n_dof_strict=nf_strict,
         isostaticity_gap=mb - nf - 1 if nb else 0, isostaticity_gap_strict=mb - nf_strict - 1 if nb else 0,
         pressure_virial=p_vir, stress=stress, jamming_gap=mu, pressure_free_volume=float(p_fv),
+        n_wall_contacts=int((mb_mask & net.is_wall).sum()),
+        wall_force=float(forces.forces[wall].sum()) if forces.exists else np.nan,
     )

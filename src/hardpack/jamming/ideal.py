@@ -14,7 +14,9 @@ Donev 2006, dissertation sec. 4.6.1 (Algorithm 13):
 
 Displacements are measured *relative to the bulk*: the LP pins the mean displacement, and the
 componentwise median over the tested particles is then subtracted (translations are trivial
-motions, sec. 4.3.2). The median is used instead of the mean so that a large rattling cluster
+motions, sec. 4.3.2); with hard walls only along the periodic axes, and in a spherical container
+the least-squares rotation about its centre is subtracted instead (its rotations are the
+trivial motions). The median is used instead of the mean so that a large rattling cluster
 does not make the whole backbone look displaced. In the strict test the measured displacement
 is the non-affine part dr_i - eps x_i (gauge independent: a different choice of the periodic
 image of particle i shifts both terms by eps Lambda m). A strain with
@@ -35,6 +37,7 @@ from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.isostatic import RigidBackbone
 from hardpack.jamming.lp import VolumeIncrease, random_strain_load, solve_motion
 from hardpack.jamming.rattlers import neighbours_of, remove_rattlers
+from hardpack.jamming.rigidity import rotation_velocities
 
 log = logging.getLogger(__name__)
 
@@ -74,11 +77,23 @@ def cell_length(lattice: np.ndarray) -> float:
 
 def relative_displacement(net: ContactNetwork, moving: np.ndarray, disp: np.ndarray,
                           eps: np.ndarray | None) -> np.ndarray:
-    """Non-affine displacement dr_i - eps x_i minus its componentwise median over ``moving``."""
+    """Non-affine displacement dr_i - eps x_i less its trivial part over ``moving``: the
+    componentwise median along the periodic axes (translations), or in a spherical container
+    the least-squares rotation about its centre."""
     rel = disp - (net.positions @ eps.T if eps is not None else 0.0)
     rel = np.where(moving[:, None], rel, 0.0)
-    if moving.any():
+    if not moving.any():
+        return rel
+    if net.centre is not None:
+        gens = rotation_velocities(net.positions[moving] - net.centre)
+        if gens.size:
+            omega = np.linalg.lstsq(gens.T, rel[moving].ravel(), rcond=None)[0]
+            rel[moving] -= (omega @ gens).reshape(-1, net.dim)
+    elif net.is_periodic:
         rel[moving] -= np.median(rel[moving], axis=0)
+    else:
+        axes = np.flatnonzero(net.periodic)
+        rel[np.ix_(moving, axes)] -= np.median(rel[np.ix_(moving, axes)], axis=0)
     return rel
 
 

@@ -2,9 +2,10 @@
 
 Generic disordered packings from LS / MD have, after rattler removal, a backbone that is rigid
 (rank A' = N_f = d(N_b - 1); A' is A without one "anchor" particle's rows, which fixes the
-translation) with M = N_f + K contacts, K small (K = 1: isostatic, Donev 2006, Eq. 4.8; a few
-more with near contacts inside delta). Then every LP the tests need reduces, through one sparse
-LU factorisation, to an LP in K unknowns. Derivations (ours):
+translation; with walls A' drops the coordinates of
+:func:`hardpack.jamming.rigidity.gauge_dofs`) with M = N_f + K contacts, K small (K = 1:
+isostatic, Donev 2006, Eq. 4.8; a few more with near contacts inside delta). Then every LP
+the tests need reduces, through one sparse LU factorisation, to an LP in K unknowns. Derivations (ours):
 
 - Self-stress space. Remove K columns R from A' so that the square A'_{-R} is regular (LU).
   For each removed column c, n_c = e_c - A'_{-R}^{-1} a'_c (on the kept columns) solves
@@ -52,7 +53,7 @@ MAX_SELF_STRESSES = 12
 class RigidBackbone:
     """LU factorisation and self-stress basis of a rigid backbone (module docstring)."""
 
-    moving: np.ndarray  # (N,) particles with variables (backbone minus the anchor)
+    free: np.ndarray  # (N d,) coordinates with variables (backbone less the gauge, rigidity.gauge_dofs)
     contacts: np.ndarray  # (N_contacts,) mask of the backbone contacts
     a: object  # A' (csc), (N_f, M)
     lu: object  # splu of A'_{-R}
@@ -66,11 +67,13 @@ class RigidBackbone:
         d = net.dim
         contacts = net.among(backbone)
         m, nb = int(contacts.sum()), int(backbone.sum())
-        nf = d * (nb - 1)
+        nf = d * nb - net.n_trivial if nb else 0  # with the gauge of rigidity.gauge_dofs
         k = m - nf
-        if nb < 2 or not 1 <= k <= MAX_SELF_STRESSES:
+        if nf <= 0 or not 1 <= k <= MAX_SELF_STRESSES:
             return None
-        moving, at = anchored_transpose(net, backbone, contacts)
+        free, at = anchored_transpose(net, backbone, contacts)
+        if at.shape[1] != nf:  # a container backbone on which not every rotation acts
+            return None
         a = at.T.tocsc()
         rng = np.random.default_rng(0)
         norms = np.asarray(abs(a).sum(axis=0)).ravel()
@@ -98,7 +101,7 @@ class RigidBackbone:
         f0 = _uniform_self_stress(null)
         if f0 is None:
             return None
-        return cls(moving, contacts, a, lu, removed, null, f0, net.gap[contacts])
+        return cls(free, contacts, a, lu, removed, null, f0, net.gap[contacts])
 
     @property
     def n_self_stresses(self) -> int:
@@ -110,7 +113,7 @@ class RigidBackbone:
         m = self.f0.size
         y = np.zeros(m)
         rest = np.setdiff1d(np.arange(m), self.removed)
-        y[rest] = self.lu.solve(-load[self.moving].ravel())
+        y[rest] = self.lu.solve(-np.asarray(load, dtype=float).reshape(-1)[self.free])
         if self.n_self_stresses == 1:  # closed form: the contact with the smallest y / f0 opens
             n0 = self.null[:, 0] if self.null[:, 0].sum() > 0 else -self.null[:, 0]
             ratio = y / n0
@@ -130,8 +133,9 @@ class RigidBackbone:
             return None
         if np.abs(x).max() > box:
             return None
-        disp = np.zeros((self.moving.size, d))
-        disp[self.moving] = x.reshape(-1, d)
+        disp = np.zeros(self.free.size)
+        disp[self.free] = x
+        disp = disp.reshape(-1, d)
         return disp, np.maximum(forces, 0.0)
 
     def _closed_vertex(self, open_set: np.ndarray, rest: np.ndarray) -> np.ndarray | None:
@@ -175,8 +179,9 @@ class RigidBackbone:
         rhs = -coef @ eps_hat
         rest = np.setdiff1d(np.arange(self.f0.size), self.removed)
         x = self.lu.solve(rhs[rest], trans="T")
-        disp = np.zeros((self.moving.size, d))
-        disp[self.moving] = x.reshape(-1, d)
+        disp = np.zeros(self.free.size)
+        disp[self.free] = x
+        disp = disp.reshape(-1, d)
         return disp, strain_tensor(eps_hat, d)
 
 

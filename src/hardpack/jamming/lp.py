@@ -8,7 +8,11 @@
 
 (Donev 2006, dissertation secs. 4.3.2 and 4.4.5). Only the ``moving`` particles carry
 displacement variables; particles in ``fixed`` stay put but still constrain their moving
-neighbours (Donev 2006, sec. 4.4.3). One moving particle is anchored (fixed), which removes
+neighbours (Donev 2006, sec. 4.4.3), and so do wall contacts, whose wall end is fixed. With
+hard walls or a container the trivial motions are removed by fixing the coordinates of
+:func:`hardpack.jamming.rigidity.gauge_dofs` instead (the periodic axes' coordinates of one
+particle, or the coordinates the container's rotations act on). In a periodic cell one moving
+particle is anchored (fixed), which removes
 the translations (sec. 4.3.2, the text's alternative of fixing one sphere; fixed particles such as
 rattlers alone would leave them to the rattlers' cages); the solution differs from a mean-pinned
 one only by a translation, which the callers remove (componentwise median), and no dense pinning
@@ -39,9 +43,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from hardpack.errors import InvalidInputError
 from hardpack.jamming.contacts import ContactNetwork
 from hardpack.jamming.highs import HIGHS_OPTIONS, LPFailure, note_fallback, solve_lp
 from hardpack.jamming.rigidity import (
+    gauge_dofs,
     n_strain,
     rigidity_transpose,
     strain_pairs,
@@ -104,20 +110,26 @@ def solve_motion(
     """
     t0 = time.perf_counter()
     n, d = net.n_particles, net.dim
+    strict = strain_load is not None
+    if strict and not net.is_periodic:
+        raise InvalidInputError("the strict LP deforms a periodic cell; with hard walls or a container "
+                                "the walls stay fixed and only the collective LP applies")
     fixed = np.zeros(n, dtype=bool) if fixed is None else fixed & ~moving
-    if moving.any():  # anchor: fix one particle against translations
+    gauge = np.zeros(n * d, dtype=bool)
+    if moving.any() and net.is_periodic:  # anchor: fix one particle against translations
         anchor = int(np.flatnonzero(moving)[0])
         moving, fixed = moving.copy(), fixed.copy()
         moving[anchor], fixed[anchor] = False, True
+    elif moving.any():  # walls: fix the coordinates the trivial motions act on (rigidity.gauge_dofs)
+        gauge = gauge_dofs(net, moving)
     present = moving | fixed
-    strict = strain_load is not None
     use = net.among(present) & (moving[net.i] | moving[net.j])
     if strict:  # self-image and fixed-fixed contacts constrain the strain only
         use |= net.among(present) & np.any(net.shift != 0, axis=1)
     at = rigidity_transpose(net, strain=strict)[use]
     h = net.gap[use]
 
-    dof_moving = np.repeat(moving, d)
+    dof_moving = np.repeat(moving, d) & ~gauge
     ns = n_strain(d) if strict else 0
     keep_cols = np.flatnonzero(np.concatenate([dof_moving, np.ones(ns, bool)]))
     g = at[:, keep_cols].T.tocsc()  # columns a_c: constraint a_c^T x >= -h_c
@@ -134,7 +146,8 @@ def solve_motion(
         trace[n_pos:n_pos + d] = -1.0  # -Tr eps >= 0; diagonal components come first (strain_pairs)
         g = sp.hstack([g, sp.csc_matrix(trace)], format="csc")
         h = np.append(h, 0.0)
-    keys = np.column_stack([net.i[use], net.j[use], net.shift[use]])
+    # a wall contact's key has j = -(wall + 2): a particle may touch several walls
+    keys = np.column_stack([net.i[use], np.where(net.is_wall, -(net.wall + 2), net.j)[use], net.shift[use]])
     if strict:
         keys = np.vstack([keys, np.full((1, keys.shape[1]), -1)])  # the trace column
     sol = None
@@ -151,8 +164,9 @@ def solve_motion(
     else:
         x, f, objective, basis = _highs_motion(g, h, c, upper)
         warm = WarmStart.from_columns(basis, np.zeros(0, dtype=np.int64), keys, nvar)
-    disp = np.zeros((n, d))
-    disp[moving] = x[:n_pos].reshape(-1, d)
+    disp = np.zeros(n * d)
+    disp[dof_moving] = x[:n_pos]
+    disp = disp.reshape(n, d)
     eps = _volume_checked(strain_tensor(x[n_pos:], d), box, solver) if strict else None
     forces = np.zeros(net.n_contacts)
     forces[use] = f[: int(use.sum())]

@@ -1,8 +1,8 @@
 """Local jamming and iterative rattler removal (Donev Alg. 13 step 4, LP 4.15).
 
 Source: Donev 2006, dissertation secs. 4.4.3.1 (LP 4.15) and 4.6.1 (Algorithm 13). A particle is locally jammed
-when it cannot move while every other particle (including its own periodic images) stays
-fixed. For sphere i with contact normals u_k (towards the neighbours) and gaps h_k the local
+when it cannot move while every other particle (including its own periodic images) and the
+walls stay fixed. For sphere i with contact normals u_k (towards the neighbours) and gaps h_k the local
 LP (4.15) is
 
     max b_i^T dr_i   s.t.  u_k^T dr_i <= h_k for every contact k,   |dr_i| <= box,
@@ -47,10 +47,12 @@ def local_displacements(
     keep = net.among(active)
     i, j, u, h = net.i[keep], net.j[keep], net.normal[keep], net.gap[keep]
     # one inequality u^T dr_p <= h for each (particle p, contact) with p tested:
-    # particle i sees +u, particle j sees -u (a self-image contact gives both)
-    owner = np.concatenate([i, j])
-    coef = np.concatenate([u, -u])
-    rhs = np.concatenate([h, h])
+    # particle i sees +u, particle j sees -u (a self-image contact gives both, a wall contact
+    # only the first: its other end is the fixed wall)
+    pair = net.wall[keep] < 0
+    owner = np.concatenate([i, j[pair]])
+    coef = np.concatenate([u, -u[pair]])
+    rhs = np.concatenate([h, h[pair]])
     sel = tested[owner]
     owner, coef, rhs = owner[sel], coef[sel], rhs[sel]
     index = -np.ones(n, dtype=np.int64)

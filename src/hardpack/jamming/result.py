@@ -143,7 +143,7 @@ class JammingResult:
 
     def summary(self) -> str:
         """A few human-readable lines."""
-        p, s = self.params, self.statics
+        p, s, net = self.params, self.statics, self.network
         lines = [
             (f"verdict: {self.category}  (local={_yn(self.local)}, collective={_yn(self.collective)}, "
              f"strict={_yn(self.strict)}; method={p['method']}, delta={p['delta']:g}, "
@@ -152,9 +152,13 @@ class JammingResult:
             (f"N={self.network.n_particles}, contacts={self.network.n_contacts}, "
              f"rattlers={int(self.rattler.sum())} ({100 * self.rattler_fraction:.2f}%), "
              f"backbone N_b={s.n_backbone}, M_b={s.n_contacts}, Z={s.z_mean:.4f}"),
-            (f"isostaticity: M_b - d(N_b-1) - 1 = {s.isostaticity_gap} (collective), "
-             f"M_b - [d(N_b-1) + d(d+1)/2] = {s.isostaticity_gap_strict} (strict)"),
+            (f"isostaticity: M_b - N_f - 1 = {s.isostaticity_gap} (collective, N_f = {s.n_dof_collective}), "
+             f"{s.isostaticity_gap_strict} (strict, N_f = {s.n_dof_strict})"),
         ]
+        if net.n_wall_contacts:
+            reaction = f" with total reaction {s.wall_force:.4g} (forces of mean 1)" if self.forces.exists else ""
+            lines.append(f"{self.params.get('boundary', 'walls')}: {net.n_wall_contacts} wall contacts, "
+                         f"{s.n_wall_contacts} of them in the backbone (among M_b){reaction}")
         if not self.local:
             lines.append(f"no backbone: all {self.network.n_particles} particles are rattlers, so "
                          "nothing is jammed (no collective or strict LP was needed)")
@@ -190,6 +194,10 @@ class JammingResult:
     def to_dataset(self) -> xr.Dataset:
         """Per-particle, per-contact and scalar results (dims 'particle', 'contact', 'dim').
 
+        Wall contacts (hard walls, container) have ``contact_wall`` >= 0 (the wall's number, -1 for a
+        pair; :mod:`hardpack.jamming.contacts`), ``contact_j`` = ``contact_i`` and ``contact_gap``
+        h / r - 1; their ``force`` is the wall's reaction; attributes ``n_wall_contacts``,
+        ``n_backbone_wall_contacts``, ``wall_force`` (sum of the reactions) and ``boundary``.
         Verdict attributes ``local``, ``collective``, ``strict``: the codes of :class:`Verdict` (1 jammed,
         0 not jammed, -1 not run, -2 undetermined, the reason in ``<test>_undetermined``); ``fallback_<name>``: the
         count of each numerical fallback (:data:`FALLBACKS`), 0 when it did not happen."""
@@ -198,7 +206,8 @@ class JammingResult:
             "contact_i": (("contact",), net.i),
             "contact_j": (("contact",), net.j),
             "contact_shift": (("contact", "dim"), net.shift),
-            "contact_gap": (("contact",), net.distance / net.contact_distance - 1.0),
+            "contact_wall": (("contact",), net.wall),
+            "contact_gap": (("contact",), net.distance / net.contact_distance - 1.0),  # h/r - 1 for walls
             "force": (("contact",), self.forces.forces),
             "rattler": (("particle",), self.rattler.astype(np.int8)),
             "local_rattler": (("particle",), self.local_rattler.astype(np.int8)),
@@ -222,7 +231,9 @@ class JammingResult:
             **{f"{k}_undetermined": reason for k, reason in self.undetermined.items()},
             **{f"fallback_{k}": int(v) for k, v in self.fallbacks.items()},
             **{k: v for k, v in self.params.items() if v is not None},
-            N=net.n_particles, d=d, n_contacts=net.n_contacts, n_rattlers=int(self.rattler.sum()),
+            N=net.n_particles, d=d, n_contacts=net.n_contacts, n_wall_contacts=net.n_wall_contacts,
+            n_backbone_wall_contacts=s.n_wall_contacts, wall_force=s.wall_force,
+            n_rattlers=int(self.rattler.sum()),
             rattler_fraction=self.rattler_fraction, n_backbone=s.n_backbone,
             n_backbone_contacts=s.n_contacts, z_mean=s.z_mean,
             isostaticity_gap=s.isostaticity_gap, isostaticity_gap_strict=s.isostaticity_gap_strict,

@@ -1,4 +1,4 @@
-"""The rigidity matrix A of a periodic contact network, as a scipy.sparse matrix.
+"""The rigidity matrix A of a contact network (periodic, hard walls, container), as scipy.sparse.
 
 Donev 2006, dissertation sec. 4.4.3 (the rigidity matrix of sec. 4.3.1, periodic boundaries in
 sec. 4.4.3, the strain in secs. 4.4.5.1-4.4.5.2). A has one column per contact and one row per
@@ -14,7 +14,7 @@ degree of freedom:
   with respect to the tensor component: ``u_p w_p`` on the diagonal and ``u_p w_q + u_q w_p``
   off the diagonal, with w = Lambda n_ij (Eqs. 4.20-4.21; the text's factor 1/2 goes with the
   engineering strain 2 eps_pq, which we do not use). Only boundary-crossing contacts
-  (n_ij != 0) have strain entries.
+  (n_ij != 0) have strain entries; wall contacts have none (the walls stay fixed).
 
 With ``dQ = (dR, eps)``, the linearised impenetrability constraint is ``A^T dQ >= -h``
 (Eq. 4.7) and equilibrium under a load B is ``A f = -B`` with f >= 0 (Eq. 4.12). The trace
@@ -77,7 +77,7 @@ def rigidity_transpose(net: ContactNetwork, strain: bool = False) -> sp.csr_matr
     cols = np.concatenate(
         [net.i[:, None] * d + dofs, net.j[:, None] * d + dofs], axis=1
     ).ravel()
-    vals = np.concatenate([-u, u], axis=1).ravel()
+    vals = np.concatenate([-u, u * (net.wall < 0)[:, None]], axis=1).ravel()
     ncols = n * d
     if strain:
         s = n_strain(d)
@@ -91,14 +91,56 @@ def rigidity_transpose(net: ContactNetwork, strain: bool = False) -> sp.csr_matr
     return at
 
 
+def gauge_dofs(net: ContactNetwork, moving: np.ndarray) -> np.ndarray:
+    """The degrees of freedom of the ``moving`` particles held fixed to remove the trivial
+    motions (:mod:`hardpack.jamming.contacts`), as a boolean (N d,) mask.
+
+    Periodic cell: the d coordinates of the first moving particle (Donev 2006, sec. 4.4.2: "the
+    trivial translations can be most easily eliminated by fixing (freezing) the position of one
+    of the particles"). Hard walls: its coordinates along the periodic axes only. Spherical
+    container: d(d-1)/2 coordinates on which the rotations about the centre act regularly,
+    chosen by a pivoted QR of the rotation velocities; every motion is one of these coordinates
+    left at zero plus a rotation, so fixing them removes exactly the rotations.
+    """
+    d, n = net.dim, net.n_particles
+    fixed = np.zeros(n * d, dtype=bool)
+    idx = np.flatnonzero(moving)
+    if idx.size == 0:
+        return fixed
+    if net.centre is None:
+        fixed[idx[0] * d + np.flatnonzero(net.periodic)] = True
+        return fixed
+    import scipy.linalg
+
+    t = rotation_velocities(net.positions[idx] - net.centre)
+    _, r, piv = scipy.linalg.qr(t, pivoting=True, mode="economic")
+    diag = np.abs(np.diag(r))
+    rank = int(np.count_nonzero(diag > 1e-12 * max(diag.max(initial=0.0), 1e-300)))
+    dofs = (idx[:, None] * d + np.arange(d)).ravel()
+    fixed[dofs[piv[:rank]]] = True
+    return fixed
+
+
+def rotation_velocities(rel: np.ndarray) -> np.ndarray:
+    """(d(d-1)/2, K d) velocities of K points at ``rel`` (K, d) from the centre under the unit
+    rotations in the planes (p, q), p < q: x_p e_q - x_q e_p."""
+    d = rel.shape[1]
+    gens = []
+    for p in range(d):
+        for q in range(p + 1, d):
+            v = np.zeros_like(rel)
+            v[:, q], v[:, p] = rel[:, p], -rel[:, q]
+            gens.append(v.ravel())
+    return np.array(gens).reshape(-1, rel.size)
+
+
 def anchored_transpose(net: ContactNetwork, backbone: np.ndarray,
                        contacts: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
-    """(moving, rows ``contacts`` of A^T restricted to the positions of the ``moving`` particles):
-    the ``backbone`` particles except the first one, which stays fixed (removes the d
-    translations of a periodic backbone)."""
-    moving = backbone.copy()
-    moving[np.flatnonzero(backbone)[0]] = False
-    return moving, rigidity_transpose(net)[contacts][:, np.flatnonzero(np.repeat(moving, net.dim))]
+    """(free, rows ``contacts`` of A^T restricted to the ``free`` degrees of freedom): the (N d,)
+    mask of the coordinates of the ``backbone`` particles less those :func:`gauge_dofs` holds
+    fixed (the first particle in a periodic cell)."""
+    free = np.repeat(backbone, net.dim) & ~gauge_dofs(net, backbone)
+    return free, rigidity_transpose(net)[contacts][:, np.flatnonzero(free)]
 
 
 def rigidity_matrix(net: ContactNetwork, strain: bool = False) -> sp.csc_matrix:

@@ -1,8 +1,9 @@
-"""verify(packing): the full jamming verdict of a periodic sphere packing.
+"""verify(packing): the full jamming verdict of a sphere packing (periodic, hard walls, container).
 
 Steps (Donev 2006, dissertation ch. 4):
 1. contact network within the relative gap ``delta`` (Eq. 4.5; sequential method:
-   ``contact_delta``), all periodic images;
+   ``contact_delta``), all periodic images, and the contacts with hard walls or the container
+   wall (sec. 4.4.3: a contact with a fixed point of the wall; :mod:`hardpack.jamming.contacts`);
 2. local test and iterative rattler removal (LP 4.15, Alg. 13 step 4) -- always run, since
    the other tests need a rattler-free packing;
 3. collective test (strain fixed) and strict test (strain with Tr eps <= 0), either with
@@ -11,7 +12,10 @@ Steps (Donev 2006, dissertation ch. 4):
    finite-rate packings with gaps; the verdict thresholds the mean displacement). The
    strict test starts from the collectively jammed backbone when there is one; with the ideal
    method, a packing without one is not strictly jammed either (strict implies collective,
-   sec. 4.2.2) and no strict LP is solved;
+   sec. 4.2.2) and no strict LP is solved. With hard walls the walls stay fixed: a closed
+   container's strict test is its collective test, and one with periodic axes between walls is
+   undetermined when collectively jammed (:func:`_fixed_walls_strict`); the sequential method
+   handles periodic cells only;
 4. self-stress forces, contact number, isostaticity and pressure of the backbone
    (:mod:`hardpack.jamming.forces`); a backbone without a self-stress gets the forces of the
    nearest jamming point (near contacts within ``force_delta`` that close there carry force).
@@ -33,7 +37,7 @@ import numpy as np
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
-from hardpack.jamming.contacts import check_delta, contact_network
+from hardpack.jamming.contacts import check_delta, contact_network, require_spheres
 from hardpack.jamming.forces import jamming_point_forces, self_stress, statics
 from hardpack.jamming.highs import FALLBACKS, recording_fallbacks
 from hardpack.jamming.ideal import ideal_test
@@ -126,7 +130,8 @@ def verify(
     Parameters
     ----------
     packing : Packing
-        A periodic sphere packing without overlaps.
+        A sphere packing without overlaps: periodic, between hard walls or in a spherical
+        container (wall contacts are constraints and their forces the walls' reactions).
     delta : float, optional
         Relative gap tolerance for contacts, 0 < delta < 1; default DEFAULT_DELTA (1e-6)
         for the ideal method and SEQUENTIAL_DELTA (0.1) for the sequential one, whose
@@ -181,9 +186,10 @@ def verify(
     Raises
     ------
     InvalidInputError
-        If ``packing`` is not a periodic sphere Packing or overlaps; ``method`` or a test name
-        is unknown; ``delta``, ``contact_delta`` or ``force_delta`` is not in (0, 1); ``seed``
-        is not a non-negative integer; ``dr_large``, ``box``, ``threshold``, ``beta`` or
+        If ``packing`` is not a sphere Packing or overlaps; ``method`` or a test name is
+        unknown; the sequential method is asked for a packing with walls; ``delta``,
+        ``contact_delta`` or ``force_delta`` is not in (0, 1); ``seed`` is not a non-negative
+        integer; ``dr_large``, ``box``, ``threshold``, ``beta`` or
         ``md_pressure`` is not a positive finite number; ``n_loads``, ``max_steps`` or
         ``workers`` is not a positive integer; dr_large >= box; the sequential test could never
         reach ``threshold`` (max_steps * delta * r_min < threshold D); or ``checkpoint`` is
@@ -193,9 +199,13 @@ def verify(
         raise InvalidInputError(
             f"verify expects a hardpack Packing, got {type(packing).__name__}"
         )
-    packing.require_periodic_spheres("the jamming tests")
+    require_spheres(packing)
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
+    if method == "sequential" and packing.boundary.kind != "periodic":
+        raise InvalidInputError(f"the sequential method handles periodic cells only, not {packing.boundary.name} "
+                                "(its loading sequences move the packing and deform the cell); use "
+                                "method='ideal', which handles wall contacts")
     delta = check_delta((SEQUENTIAL_DELTA if method == "sequential" else DEFAULT_DELTA) if delta is None else delta)
     tests = _check_tests(tests)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -272,7 +282,10 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
         if "collective" in tests:
             collective = ideal_test(net, local_active, strict=False, dr_large=dr_large, **common)
             seconds["collective"] = collective.seconds
-        if "strict" in tests and collective is not None and not collective.jammed:
+        if "strict" in tests and not net.is_periodic:
+            strict = _fixed_walls_strict(net, local_active, collective, dr_large=dr_large, **common)
+            seconds["strict"] = strict.seconds
+        elif "strict" in tests and collective is not None and not collective.jammed:
             # strict jamming implies collective jamming (Donev 2006, sec. 4.2.2): no LP needed
             strict = replace(collective, test="strict", method="implied by the collective test",
                              n_lp=0, seconds=0.0, loads=[])
@@ -302,7 +315,7 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
     d, nb = packing.dim, int(backbone.sum())
     # hypostatic by count: straight to the nearest jamming point, whose LP also finds a
     # self-stress of the contacts themselves if there is one (their gaps cost least)
-    hypostatic = int(net.among(backbone).sum()) < d * (nb - 1) + 1
+    hypostatic = int(net.among(backbone).sum()) < d * nb - net.n_trivial + 1
     forces = None if hypostatic else self_stress(net, backbone)
     counted, near = None, {}
     if (forces is None or not forces.exists) and backbone.any():  # the nearest jamming point
@@ -316,13 +329,14 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
         forces = self_stress(net, backbone)
     stat = statics(net, backbone, forces, packing.volume, counted)
     slope = None
-    if d == 2 and forces.exists:
+    if d == 2 and forces.exists and net.is_periodic:
         slope = ellipse_slope(net.separation, net.i, net.j, forces.forces, packing.radii).slope
     seconds["forces"] = time.perf_counter() - t0
 
     if checkpoint is not None:
         ckpt.remove(checkpoint)
     params = {
+        "boundary": str(packing.boundary),
         "method": method, "delta": delta, "dr_large": dr_large, "box": box, "seed": seed,
         "tests": list(tests), "mean_diameter": diameter,
         "threshold": threshold if sequential else None,
@@ -339,3 +353,25 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
         forces=forces, statics=stat, volume=packing.volume, md_pressure=md_pressure,
         ellipse_slope=slope, seconds=seconds,
     )
+
+
+def _fixed_walls_strict(net, local_active, collective, *, dr_large, box, rng):
+    """The strict test of a packing with hard walls or in a container. Strict jamming also allows
+    volume-nonincreasing deformations of the boundary (Donev 2006, sec. 4.2.2); the text makes
+    them concrete for the lattice of a periodic cell only (sec. 4.4.5) and treats hard walls as
+    fixed (sec. 4.4.2). Here the walls stay fixed too, so a closed container (walls on every
+    axis, or a spherical container) has no boundary deformation and its strict test is the
+    collective test (run here if it was not). Walls on some axes with periodic others would need
+    the strain of the periodic lattice vectors between fixed walls, which is not implemented:
+    that strict test is undetermined, with the reason."""
+    if not net.periodic.any():
+        out = collective if collective is not None else ideal_test(
+            net, local_active, strict=False, dr_large=dr_large, box=box, rng=rng)
+        return replace(out, test="strict", method="walls fixed: the collective test")
+    out = replace(collective if collective is not None else ideal_test(
+        net, local_active, strict=False, dr_large=dr_large, box=box, rng=rng), test="strict",
+        method="not implemented", n_lp=0, seconds=0.0, loads=[])
+    if out.jammed:
+        out.undetermined = ("strict jamming between hard walls with periodic axes (a periodic cell "
+                            "deforming between fixed walls) is not implemented")
+    return out

@@ -139,11 +139,12 @@ class WarmStart:
         """The same columns after the particles were wrapped back into the cell by the integer
         lattice vectors ``wraps`` (N, d): x_i -> x_i - lattice @ w_i. A contact key (i, j, n)
         (``keys`` of :func:`hardpack.jamming.lp.solve_motion`: separation x_j + lattice @ n - x_i)
-        becomes (i, j, n + w_j - w_i); keys with i < 0 (the trace column) stay."""
+        becomes (i, j, n + w_j - w_i); keys with i < 0 (the trace column) or j < 0 (a wall
+        contact) stay."""
 
         def moved(keys):
             keys = keys.copy()
-            real = keys[:, 0] >= 0
+            real = (keys[:, 0] >= 0) & (keys[:, 1] >= 0)
             i, j = keys[real, 0], keys[real, 1]
             keys[real, 2:] += wraps[j] - wraps[i]
             return keys
