@@ -383,12 +383,11 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
     _, _, cr, _, _, _, _, _ = columns(d)
     advance(P, i, t, scratch)
     nold = nn[i]
-    for m in range(nold):
+    for m in range(nold):  # remember the old neighbours, marked with their image code + 1
         j = nb[i, m] >> cbits
         oldnb[m] = j
-        mark[j] = 1
+        mark[j] = (nb[i, m] & cmask) + 1
     nn[i] = 0
-    wrapped = False
     h = lvl[i]
     c = coff[h]
     stride = 1
@@ -400,7 +399,6 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
                 x -= L[k]
             x = max(x, 0.0)
             P[i, k] = x
-            wrapped = True
         bs[i, k] = x
         gk = int(x * invL[k] * ncl[h, k])
         if gk >= ncl[h, k]:
@@ -495,15 +493,19 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
                             nb[j, nn[j]] = back
                             nn[j] += 1
                         else:
+                            # a kept neighbour: j's entry changes with the image, which a wrap
+                            # of i changes, and so can a move of the bounding centres across half
+                            # the box (a small box: L < 2 (R_i + R_j) + the moves of both centres)
+                            changed = mark[j] != code + 1
                             mark[j] = 0
-                            if wrapped:
+                            if changed:
                                 for q2 in range(nn[j]):
                                     if nb[j, q2] >> cbits == i:
                                         nb[j, q2] = back
                                         break
     for m in range(nold):
         j = oldnb[m]
-        if mark[j] == 1:
+        if mark[j] != 0:
             mark[j] = 0
             last = nn[j] - 1
             for q2 in range(last + 1):
