@@ -102,6 +102,7 @@ class WindowStatus(enum.IntEnum):
     STUCK = 3  # no event can ever happen (nothing moves)
     BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
     CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
+    STALLED = 6  # events repeat without advancing the time (ellipsoid engine: an engine failure)
 
 
 # float accumulators, acc[...]; acc[A_WALL + k] is the wall momentum of axis k (flat walls) or of
