@@ -243,16 +243,27 @@ def test_b2_formulas_reduce_to_spheres():
     assert _b2_2d(1.0, 1.0) == pytest.approx(2 * np.pi)
 
 
+def _boublik_curvature(a, b, rho):
+    """(Z - 1) / rho of Boublik's equation of state of hard convex bodies (Boublik 1975),
+    Z = [1 + (3 al - 2) eta + (al^2 + al - 1) eta^2 - al (5 al - 4) eta^3] / (1 - eta)^3 with
+    al = R S / (3 V), beyond its first two virial terms B2 + B3 rho (B2 = V (1 + 3 al) exact,
+    B3 = V^2 (al^2 + 10 al - 1) from the series): the curvature from B4 on, for spheroids
+    (a, b, b)."""
+    vol = 4 / 3 * np.pi * a * b * b
+    al = (_b2_3d_spheroid(a, b) / vol - 1) / 3
+    eta = rho * vol
+    z = (1 + (3 * al - 2) * eta + (al**2 + al - 1) * eta**2 - al * (5 * al - 4) * eta**3) / (1 - eta) ** 3
+    return vol * ((z - 1) / eta - (1 + 3 * al) - (al**2 + 10 * al - 1) * eta)
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("d,alpha", [
-    (2, 2.0),
-    pytest.param(3, 2.0, marks=pytest.mark.xfail(
-        strict=True, reason="open: prolate spheroids 1:1:2 give an intercept 4.57 +- 0.04 against the "
-                            "Isihara-Kihara B2 = 4.75 (4 sigma); not yet known whether the engine or the fit")),
-])
+@pytest.mark.parametrize("d,alpha", [(2, 2.0), (3, 2.0)])
 def test_low_density_pressure_matches_the_second_virial_coefficient(d, alpha):
     """(Z - 1) / rho at three low densities, fitted by B2 + B3 rho: the intercept equals the
-    Isihara-Kihara B2 within 3 standard errors of the fit (block errors of each Z)."""
+    Isihara-Kihara B2 within 3 standard errors of the fit (block errors of each Z). In 3D the
+    curvature from B4 on would bias the intercept of the line by -0.083 (2 standard errors; -0.079
+    with the Parsons-Lee equation of state instead): it is subtracted with Boublik's equation of
+    state first (:func:`_boublik_curvature`), which leaves B2 and B3 to the fit."""
     n = 400 if d == 2 else 343
     ax = np.array([alpha, 1.0, 1.0][:d]) * 0.5
     b2 = _b2_2d(*ax) if d == 2 else _b2_3d_spheroid(ax[0], ax[1])
@@ -265,13 +276,22 @@ def test_low_density_pressure_matches_the_second_virial_coefficient(d, alpha):
         zm, ze = _block_mean(z)
         rho = phi / vol
         rhos.append(rho)
-        ys.append((zm - 1) / rho)
+        ys.append((zm - 1) / rho - (_boublik_curvature(ax[0], ax[1], rho) if d == 3 else 0.0))
         errs.append(ze / rho)
     rhos, ys, errs = map(np.asarray, (rhos, ys, errs))
     coef, cov = np.polyfit(rhos, ys, 1, w=1 / errs, cov="unscaled")
     intercept, sigma = coef[1], np.sqrt(cov[1, 1])
     assert abs(intercept - b2) < 3 * sigma, (intercept, sigma, b2)
     assert sigma < 0.05 * b2  # the test has the power to see a wrong B2
+
+
+def test_boublik_curvature_is_that_of_carnahan_starling_for_spheres():
+    """For spheres Boublik's equation of state is Carnahan-Starling's (al = 1), whose B2, B3 are
+    the exact 4 V and 10 V^2: the curvature is (Z_CS - 1) / rho - 4 V - 10 V^2 rho."""
+    vol, rho = 4 / 3 * np.pi, 0.05
+    eta = vol * rho
+    z_cs = (1 + eta + eta**2 - eta**3) / (1 - eta) ** 3
+    assert _boublik_curvature(1.0, 1.0, rho) == pytest.approx((z_cs - 1) / rho - 4 * vol - 10 * vol**2 * rho)
 
 
 def test_resume_after_checkpoint_is_bit_identical(tmp_path):
