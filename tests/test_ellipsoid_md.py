@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from scipy import integrate, special
 
+from hardpack.eos.theory import csk
 from hardpack.errors import InvalidInputError
 from hardpack.geometry import Packing
 from hardpack.geometry.shapes import Ellipsoids
@@ -261,9 +262,9 @@ def _boublik_curvature(a, b, rho):
 def test_low_density_pressure_matches_the_second_virial_coefficient(d, alpha):
     """(Z - 1) / rho at three low densities, fitted by B2 + B3 rho: the intercept equals the
     Isihara-Kihara B2 within 3 standard errors of the fit (block errors of each Z). In 3D the
-    curvature from B4 on would bias the intercept of the line by -0.083 (2 standard errors; -0.079
-    with the Parsons-Lee equation of state instead): it is subtracted with Boublik's equation of
-    state first (:func:`_boublik_curvature`), which leaves B2 and B3 to the fit."""
+    curvature from B4 on would bias the intercept of the line by -0.083 (2 standard errors): it is
+    subtracted with Boublik's equation of state first (:func:`_boublik_curvature`), which leaves
+    B2 and B3 to the fit."""
     n = 400 if d == 2 else 343
     ax = np.array([alpha, 1.0, 1.0][:d]) * 0.5
     b2 = _b2_2d(*ax) if d == 2 else _b2_3d_spheroid(ax[0], ax[1])
@@ -311,19 +312,18 @@ def test_resume_after_checkpoint_is_bit_identical(tmp_path):
     assert again.stats["collisions"] == ref.stats["collisions"]
 
 
-def test_spheres_as_ellipsoids_give_the_carnahan_starling_pressure():
+def test_spheres_as_ellipsoids_give_the_hard_sphere_pressure():
     """alpha = 1 in 3D: the reduced pressure of hard spheres at phi = 0.3 equals the
-    Carnahan-Starling Z = (1 + phi + phi^2 - phi^3) / (1 - phi)^3 (Carnahan & Starling 1969; exact
-    to < 0.1 % here) within 3 standard errors (block means of 40 windows)."""
+    Carnahan-Starling-Kolafa Z (:func:`hardpack.eos.theory.csk`; Ogarko 2014, sec. 3.1.2; exact to
+    < 0.1 % at this density) within 3 standard errors (block means of 40 windows)."""
     n, phi = 256, 0.3
     sim = _simulation(random_ellipsoid_packing(n, [0.5, 0.5, 0.5], phi, seed=3), 4)
     sim.run_window(20 * n)
     recs = [sim.run_window(10 * n) for _ in range(40)]
     assert max(r["max_overlap"] for r in recs) <= 1e-12
     z, z_err = _block_mean([r["Z"] for r in recs])
-    cs = (1 + phi + phi**2 - phi**3) / (1 - phi) ** 3
-    assert abs(z - cs) < 3 * z_err, (z, z_err, cs)
-    assert z_err < 0.01 * cs
+    assert abs(z - csk(phi)) < 3 * z_err, (z, z_err, csk(phi))
+    assert z_err < 0.01 * csk(phi)
 
 
 def _assert_neighbour_lists_exact(eng):
