@@ -112,25 +112,27 @@ def test_periodic_image_collision():
     np.testing.assert_allclose(eng.velocities[:, 0], [1.0, -1.0], rtol=1e-14)
 
 
-@pytest.mark.parametrize("d, kappa, omega", [(2, 0.05, 1.0), (3, 0.0, 1.0), (3, 0.02, 10.0),
-                                             pytest.param(4, 0.02, 1.0, marks=pytest.mark.slow)])
-def test_neighbour_lists_match_brute_force_after_many_partial_updates(d, kappa, omega):
+@pytest.mark.parametrize("d, kappa, omega, n, phi, skin", [
+    (2, 0.05, 1.0, 150, 0.25, 0.3), (3, 0.0, 1.0, 150, 0.25, 0.3), (3, 0.02, 10.0, 600, 0.25, 0.3),
+    (3, 0.0, 1.0, 20, 0.15, 0.5), pytest.param(4, 0.02, 1.0, 150, 0.15, 0.3, marks=pytest.mark.slow)])
+def test_neighbour_lists_match_brute_force_after_many_partial_updates(d, kappa, omega, n, phi, skin):
     """Invariants of the bounding-sphere lists (Donev sec. 2.9): every particle lies inside its
     bounding sphere, and i lists j (with the minimum-image shift) exactly when their bounding
     spheres overlap. Checked by brute force after windows full of partial updates; omega = 10
-    (radii uniform in volume over a factor 10) puts the spheres on several grid levels."""
+    (radii uniform in volume over a factor 10) puts the spheres on several grid levels. The box of
+    n = 20 at phi = 0.15 (L = 4.1) is smaller than 2 (R_i + R_j) plus the moves of two bounding
+    centres (R = 1, skin 0.5): a kept pair of neighbours changes periodic image without a wrap."""
     from hardpack.distributions import monodisperse, uniform_volume
     from hardpack.initial import random_packing
     from hardpack.md.simulation import maxwell_boltzmann
 
     dist = monodisperse(0.5) if omega == 1.0 else uniform_volume(omega)
-    n = 150 if omega == 1.0 else 600
-    packing = random_packing(n, d, dist, 0.25 if d < 4 else 0.15, seed=d)
+    packing = random_packing(n, d, dist, phi, seed=d)
     eng = Engine(packing.fractional() * np.diag(packing.lattice),
                  maxwell_boltzmann(n, d, 1), packing.radii, np.diag(packing.lattice))
     exits = 0
-    for w in range(6):
-        res = eng.run_window(kappa, 0.3, 300, np.inf, rebuild=(w == 0))
+    for w in range(10):
+        res = eng.run_window(kappa, skin, 300, np.inf, rebuild=(w == 0))
         exits += res.exits
         box = eng.box
         bc, br, x, a = eng.bs[:, :d], eng.bs[:, d], eng.positions, eng.radii

@@ -16,6 +16,10 @@ from hardpack.md.engine import SKIN_SLACK, Engine, WindowResult, _aligned_rows
 from hardpack.md.kernel import WindowStatus
 
 
+class EngineStalledError(RuntimeError):
+    """The event loop stopped advancing the time (an engine failure, never valid input's fault)."""
+
+
 def moments_of_inertia(semiaxes: np.ndarray) -> np.ndarray:
     """Spherically symmetric moment of inertia of unit-mass ellipsoids (N, 3) or ellipses (N, 2):
     (2/15)(a^2 + b^2 + c^2), the mean principal moment (exact for spheres), or (a^2 + b^2)/4
@@ -159,6 +163,16 @@ class EllipsoidEngine(Engine):
                 continue
             if status == WindowStatus.STUCK:
                 raise RuntimeError("no event can ever happen: no particle moves and none grows")
+            if status == WindowStatus.STALLED:
+                t, i, p = float(acc[0]), int(iacc[ek.I_STALL_PARTICLE]), int(iacc[ek.I_STALL_PARTNER])
+                self.P[:] = start
+                self.lists_valid = False
+                what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
+                raise EngineStalledError(
+                    f"the ellipsoid event loop stalled at window time {t!r}: more than "
+                    f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time (the last one of "
+                    f"particle {i} with {what}, engine order); the state is back at the window start. "
+                    "This is an engine failure: report it with the start packing, seed and options")
             break
         self.lists_valid = True
         duration = float(acc[0])

@@ -45,19 +45,31 @@ m > 2 e, with m the interpolant's minimum over the step (so no dip below zero hi
 samples unless the interpolant errs by more than twice its estimated error; far from contact,
 where m is large, the steps may err by a tenth of m, which keeps them long without any risk of
 missing the zero); otherwise h is halved (the midpoint becomes the new end). The next step is
-h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= 0 brackets the
-collision, which a safeguarded
-Newton iteration (bisection when a Newton step leaves the bracket) locates to round-off; the
-earlier end of the final bracket (zeta >= 0, no overlap) is returned. If zeta <= 0 at t_in: a
-collision now when zeta_dot < 0; otherwise (round-off after a collision of the pair) zeta is
-taken as 0 and traced on (Algorithm 11 step d). After MAX_TRACE_STEPS accepted steps the trace
-stops with a CHECK event at the time reached: the particle re-predicts from there (a "safe time",
-Algorithm 11 step e). Steps shorter than ``MIN_STEP_FRACTION`` of the first one are accepted
-unconditionally, so every trace advances. The neighbours are traced in the order of their t_in and
-the search stops at the first t_in after the earliest event found. The horizon of every trace
-is also capped by the first contact time of the inscribed spheres (radius the smallest semiaxis)
-of any listed pair: the particle collides by then at the latest (if no collision is located
-before it, which round-off alone could cause, a CHECK is scheduled there).
+h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= zc (the contact
+level, 0 unless the trace started in contact) after one with zeta > zc brackets a crossing,
+which a safeguarded Newton iteration (bisection when a Newton step leaves the bracket) locates
+to round-off; the earlier end of the final bracket (zeta >= zc, no deeper overlap) is returned.
+
+*Progress.* Every predicted collision approaches: its zeta_dot is below -GRAZE_RATE times the
+pair's rate scale (a bound on the relative speed of the surfaces over the smallest semiaxis),
+far above round-off, so the collision law (which skips v_n >= 0) never skips it and the pair
+separates after it. A crossing with a smaller rate is a graze: the trace goes on from just past
+it. If zeta <= 0 at t_in: a collision now when the pair approaches; otherwise (round-off after a
+collision of the pair, or a pair in contact since a graze) the pair is *touching* at the level
+zc = zeta(t_in) (Algorithm 11 step d): samples at or below zc that do not approach move the
+trace on (no bracket can start from a non-positive sample), and the first one that approaches is
+the collision (the step halved to the time resolution to find it). Steps are at least a few ulps
+of the time and at least ``MIN_STEP_FRACTION`` of the first one (such steps are accepted
+unconditionally), and a rest of the interval shorter than that holds no event; after
+MAX_TRACE_STEPS accepted steps the trace stops with a CHECK event at the time reached, later than
+the start: the particle re-predicts from there (a "safe time", Algorithm 11 step e). The
+neighbours are traced in the order of their t_in and the search stops at the first t_in after
+the earliest event found. The horizon of every trace is also capped by the first contact time of
+the inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are
+apart: the particle collides by then at the latest (if no collision is located before it, a
+CHECK is scheduled there). So every event but a collision advances the time; the event loop
+still stops a window as STALLED (an engine failure the driver reports) after a long run of
+events at one time.
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
 here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
@@ -101,9 +113,14 @@ EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted
 CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
 
-#: extra counter (after the sphere engine's): CHECK events
+#: extra counters (after the sphere engine's): CHECK events; the particle and partner of the
+#: last event of a STALLED window
 I_CHECK = 5
-N_COUNTERS = 6
+I_STALL_PARTICLE = 6
+I_STALL_PARTNER = 7
+N_COUNTERS = 8
+#: a window stops as STALLED after this many consecutive events at one time, plus 10 per particle
+STALL_EVENTS = 1000
 #: extra accumulator: contact-function evaluations
 A_EVAL = 5
 
@@ -120,6 +137,10 @@ MAX_TRACE_STEPS = 200
 MIN_STEP_FRACTION = 1e-9
 #: first trace step: this fraction of the smallest semiaxis of the pair over its relative speed
 FIRST_STEP = 0.25
+#: approach rates zeta_dot above -GRAZE_RATE times the pair's rate scale (relative surface speed
+#: bound over the smallest semiaxis) are grazing: no collision is predicted there
+GRAZE_RATE = 1e-9
+EPS = np.finfo(np.float64).eps
 
 
 @njit(cache=True, inline="always")
@@ -269,21 +290,23 @@ def _hermite_min(z0, z1, d0, d1):
 
 
 @njit(cache=True)
-def _refine(P, i, j, shift, t, kappa, lo, hi, guess, lam, ws, wm):
-    """Collision time in the bracket [lo, hi] (zeta(lo) >= 0 >= zeta(hi)) by safeguarded Newton
-    from ``guess`` (bisection when a step leaves the bracket); ends at a time with zeta >= 0 whose
-    Newton step is below round-off of the time, or at the earlier end of a bracket narrowed to
-    round-off (no overlap either way)."""
+def _refine(P, i, j, shift, t, kappa, zc, lo, dlo, hi, zhi, dhi, lamhi, guess, lam, ws, wm):
+    """First crossing of zeta = zc in the bracket [lo, hi] (zeta(lo) >= zc >= zeta(hi); ``dlo``,
+    ``dhi`` the rates at the ends) by safeguarded Newton from ``guess`` (bisection when a step
+    leaves the bracket). Returns (t_c, rate at t_c, hi, zeta(hi), rate at hi, lambda at hi) for
+    the final bracket: t_c is a time with zeta >= zc whose Newton step is below round-off of the
+    time, or the earlier end of a bracket narrowed to round-off; hi the later end."""
     tt = guess if lo < guess < hi else 0.5 * (lo + hi)
     for _ in range(100):
         z, zd, lam = pair_zeta(P, i, j, shift, t + tt, kappa, lam, ws, wm)
-        if z > 0.0:
-            lo = tt
+        f = z - zc
+        if f >= 0.0:
+            lo, dlo = tt, zd
         else:
-            hi = tt
-        nt = tt - z / zd if zd != 0.0 else -1.0
-        if z >= 0.0 and abs(nt - tt) <= 4e-16 * (t + tt):
-            return tt
+            hi, zhi, dhi, lamhi = tt, z, zd, lam
+        nt = tt - f / zd if zd != 0.0 else -1.0
+        if f >= 0.0 and abs(nt - tt) <= 4e-16 * (t + tt):
+            break
         if hi - lo <= 4e-16 * (t + hi) + 1e-300:
             break
         if not (lo < nt < hi):
@@ -291,25 +314,23 @@ def _refine(P, i, j, shift, t, kappa, lo, hi, guess, lam, ws, wm):
         if nt == tt:
             break
         tt = nt
-    return lo
+    return lo, dlo, hi, zhi, dhi, lamhi
 
 
 @njit(cache=True)
 def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
     """Earliest collision of i and j (shifted) in window time [t + tin, min(t + tout, tmax)) by
     trace event location (module docstring). Returns (time, kind) with kind 0 collision, 1 CHECK,
-    and time inf when nothing happens before the end."""
+    and time inf when nothing happens before the end. A returned collision always approaches:
+    its rate zeta_dot is below -GRAZE_RATE times the pair's rate scale (the relative surface speed
+    bound over the smallest semiaxis), so the collision law never skips it for round-off."""
     d = shift.shape[0]
     cv, _, cr, cax, _, cw, _, _ = columns(d)
     end = min(tout, tmax - t)
     lam = P[i, cr] / (P[i, cr] + P[j, cr])
     t0 = tin
     z0, d0, lam = pair_zeta(P, i, j, shift, t + t0, kappa, lam, ws, wm)
-    if z0 <= 0.0:
-        if d0 < 0.0:
-            return t + t0, 0
-        z0 = 0.0
-    # first step from the relative speed of the surfaces
+    # rate scale: bound on the relative speed of the surfaces over the smallest semiaxis
     amin = P[i, cax]
     for k in range(1, d):
         amin = min(amin, P[i, cax + k])
@@ -328,29 +349,70 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
         ww_j += P[j, cw + k] ** 2
     speed = np.sqrt(uu) + (np.sqrt(ww_i) + abs(kappa)) * P[i, cr] * (1.0 + kappa * (t + t0)) \
         + (np.sqrt(ww_j) + abs(kappa)) * P[j, cr] * (1.0 + kappa * (t + t0))
+    rate_tol = GRAZE_RATE * speed / amin
+    # zc: the contact level. A pair that starts in contact or overlapping (round-off after its
+    # collision, or a missed collision) without approaching is "touching": it collides only when
+    # it approaches (rate below -rate_tol) at or below this level (Donev 2006, Algorithm 11 step d)
+    zc = 0.0
+    touching = False
+    if z0 <= 0.0:
+        if d0 < -rate_tol:
+            return t + t0, 0
+        zc = z0
+        touching = True
     h = FIRST_STEP * amin / speed if speed > 0.0 else end - t0
     hmin_step = MIN_STEP_FRACTION * h
     steps = 0
-    while t0 < end:
+    while True:
+        # the shortest step moves the time by a few ulps: a rest of the interval shorter than
+        # that holds no event the time can resolve, and every CHECK advances the time
+        hfloor = max(hmin_step, 8.0 * EPS * abs(t + t0))
+        if end - t0 <= hfloor:
+            return np.inf, 0
         if steps >= MAX_TRACE_STEPS:
             return t + t0, 1
-        h = min(h, end - t0)
+        h = min(max(h, hfloor), end - t0)
         t1 = t0 + h
         z1, d1, lam1 = pair_zeta(P, i, j, shift, t + t1, kappa, lam, ws, wm)
+        accepted = False  # a step past a crossing of zc (a graze) or a touching stretch
         while True:
-            zm, dm, lamm = pair_zeta(P, i, j, shift, t + t0 + 0.5 * h, kappa, lam, ws, wm)
-            if zm <= 0.0:  # bracket [t0, t0 + h/2]
-                hm, root = _hermite_min(z0, zm, d0 * 0.5 * h, dm * 0.5 * h)
-                return _refine(P, i, j, shift, t, kappa, t0, t0 + 0.5 * h,
-                               t0 + 0.5 * h * min(root, 1.0), lam, ws, wm) + t, 0
-            if z1 <= 0.0:  # bracket [t0 + h/2, t1]
-                hm, root = _hermite_min(zm, z1, dm * 0.5 * h, d1 * 0.5 * h)
-                return _refine(P, i, j, shift, t, kappa, t0 + 0.5 * h, t1,
-                               t0 + 0.5 * h * (1.0 + min(root, 1.0)), lamm, ws, wm) + t, 0
+            tm = t0 + 0.5 * h
+            zm, dm, lamm = pair_zeta(P, i, j, shift, t + tm, kappa, lam, ws, wm)
+            if zm <= zc and touching:  # still in contact at the midpoint
+                if dm < -rate_tol:  # approaching: the collision is at the latest here
+                    if h <= hfloor:
+                        return t + tm, 0
+                    h *= 0.5
+                    t1, z1, d1, lam1 = tm, zm, dm, lamm
+                    continue
+                t1, z1, d1, lam1 = tm, zm, dm, lamm  # touching, not approaching: move on
+                zc = min(zc, zm)
+                accepted = True
+                break
+            if zm <= zc or z1 <= zc:  # a crossing of zc from above
+                if zm <= zc:
+                    _, root = _hermite_min(z0 - zc, zm - zc, d0 * 0.5 * h, dm * 0.5 * h)
+                    tc, dc, thi, zhi, dhi, lamhi = _refine(
+                        P, i, j, shift, t, kappa, zc, t0, d0, tm, zm, dm, lamm,
+                        t0 + 0.5 * h * min(root, 1.0), lam, ws, wm)
+                else:
+                    _, root = _hermite_min(zm - zc, z1 - zc, dm * 0.5 * h, d1 * 0.5 * h)
+                    tc, dc, thi, zhi, dhi, lamhi = _refine(
+                        P, i, j, shift, t, kappa, zc, tm, dm, t1, z1, d1, lam1,
+                        t0 + 0.5 * h * (1.0 + min(root, 1.0)), lamm, ws, wm)
+                if dc < -rate_tol:
+                    return t + tc, 0
+                # a grazing touch: the pair is touching from just past it on
+                t1, z1, d1, lam1 = thi, zhi, dhi, lamhi
+                zc = min(zc, z1)
+                touching = True
+                accepted = True
+                break
             err = abs(0.5 * (z0 + z1) + 0.125 * h * (d0 - d1) - zm)
-            hmin, root = _hermite_min(z0, z1, d0 * h, d1 * h)
+            hmin, root = _hermite_min(z0 - zc, z1 - zc, d0 * h, d1 * h)
             tol = max(eps_f, RELATIVE_TOL * hmin)
-            if (err <= tol and hmin > 2.0 * err) or h <= hmin_step:
+            if (err <= tol and hmin > 2.0 * err) or h <= hfloor:
+                touching = False
                 break
             # halve: the midpoint becomes the end
             h *= 0.5
@@ -359,12 +421,13 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
         steps += 1
         t0 = t1
         z0, d0, lam = z1, d1, lam1
+        if accepted:
+            continue
         if err > 0.0:
             fac = 0.8 * (max(min(tol, 0.5 * hmin), 0.0) / err) ** 0.25
             h *= min(max(fac, 0.5), 4.0)
         else:
             h *= 4.0
-    return np.inf, 0
 
 
 @njit(cache=True)
@@ -383,12 +446,11 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
     _, _, cr, _, _, _, _, _ = columns(d)
     advance(P, i, t, scratch)
     nold = nn[i]
-    for m in range(nold):
+    for m in range(nold):  # remember the old neighbours, marked with their image code + 1
         j = nb[i, m] >> cbits
         oldnb[m] = j
-        mark[j] = 1
+        mark[j] = (nb[i, m] & cmask) + 1
     nn[i] = 0
-    wrapped = False
     h = lvl[i]
     c = coff[h]
     stride = 1
@@ -400,7 +462,6 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
                 x -= L[k]
             x = max(x, 0.0)
             P[i, k] = x
-            wrapped = True
         bs[i, k] = x
         gk = int(x * invL[k] * ncl[h, k])
         if gk >= ncl[h, k]:
@@ -495,15 +556,19 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
                             nb[j, nn[j]] = back
                             nn[j] += 1
                         else:
+                            # a kept neighbour: j's entry changes with the image, which a wrap
+                            # of i changes, and so can a move of the bounding centres across half
+                            # the box (a small box: L < 2 (R_i + R_j) + the moves of both centres)
+                            changed = mark[j] != code + 1
                             mark[j] = 0
-                            if wrapped:
+                            if changed:
                                 for q2 in range(nn[j]):
                                     if nb[j, q2] >> cbits == i:
                                         nb[j, q2] = back
                                         break
     for m in range(nold):
         j = oldnb[m]
-        if mark[j] == 1:
+        if mark[j] != 0:
             mark[j] = 0
             last = nn[j] - 1
             for q2 in range(last + 1):
@@ -686,7 +751,9 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
                coll_target, t_cap, rebuild_lists):
     """One window of ellipsoid MD; arguments, accumulators and return codes as in
     :func:`hardpack.md.kernel.run_events` (no ``dims``: d is the length of ``L``; ``eps_f`` the
-    trace tolerance; ``iacc`` has N_COUNTERS entries, the last counting CHECK events; acc[A_KE]
+    trace tolerance; ``iacc`` has N_COUNTERS entries: after the sphere engine's, I_CHECK counts
+    CHECK events and I_STALL_PARTICLE, I_STALL_PARTNER name the last event of a STALLED window (its
+    time in acc[A_T]); acc[A_KE]
     enters the current translational kinetic energy; ``acc`` has a sixth entry, A_EVAL, that
     receives the number of contact-function evaluations)."""
     ws = np.zeros((11, 4))
@@ -734,6 +801,9 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         if partner >= 0:
             ec[i] = cnt[partner]
         hsize = heap_set(hkey, heap, hpos, hsize, i, key)
+    t_last = -1.0
+    same = 0
+    max_same = STALL_EVENTS + 10 * n
     while True:
         i = heap[0]
         t = hkey[0]
@@ -744,8 +814,20 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             return WindowStatus.DONE_TIME
         if t == np.inf:
             return WindowStatus.STUCK
-        iacc[I_EVENTS] += 1
         p = ep[i]
+        # progress guard: every event advances the time, except chains of collisions of distinct
+        # pairs at one instant, which are short; a long run of events at one time is a failure
+        if t == t_last:
+            same += 1
+            if same > max_same:
+                acc[A_T] = t
+                iacc[I_STALL_PARTICLE] = i
+                iacc[I_STALL_PARTNER] = p
+                return WindowStatus.STALLED
+        else:
+            t_last = t
+            same = 0
+        iacc[I_EVENTS] += 1
         npred = 1
         upd[0] = i
         if p == EXIT:

@@ -26,8 +26,11 @@ particle, lazy invalidation" form:
   locates a particle's slot), so the scan reads plain arrays instead of chasing linked lists
   (it was latency bound). Each list entry packs the neighbour j and its periodic image as
   j << 2d | code, code = sum_k (n_k + 1) 4^k indexing ``imgvec`` (shifts n in {-1, 0, 1}^d; bit
-  operations instead of an integer division in the innermost loop); the image stays valid
-  because a position is re-wrapped into the box only when its own list is rebuilt.
+  operations instead of an integer division in the innermost loop); the image changes only when
+  the list of i or j is rebuilt (a position is re-wrapped into the box only then, and the
+  bounding centres move only then; in a small box, L < 2 (R_i + R_j) plus the moves of both
+  centres, a kept neighbour can change image without a wrap), and the rebuild updates the other
+  particle's entry whenever it does.
 - Time is measured from the last synchronisation (Alg. 3); radii are a_i(t) = a_i (1 + kappa t)
   with ONE relative growth rate kappa (radii grow in proportion to their size).
 
@@ -99,6 +102,7 @@ class WindowStatus(enum.IntEnum):
     STUCK = 3  # no event can ever happen (nothing moves)
     BOUND_TOO_SMALL = 4  # a particle grew to the bounding-radius cap (window too long)
     CELL_OVERFLOW = 5  # a grid cell is full: enlarge the cell capacity and redo the window
+    STALLED = 6  # events repeat without advancing the time (ellipsoid engine: an engine failure)
 
 
 # float accumulators, acc[...]; acc[A_WALL + k] is the wall momentum of axis k (flat walls) or of
@@ -177,8 +181,9 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
     bounding radius is
     min(a_i(t) + skin sfac_i, rcap_h) on grid level h = lvl[i] (size-dependent skin factors, see
     :meth:`hardpack.md.engine.Engine.skin_factors`). A partial update edits only the
-    lists of neighbours gained or lost (``mark`` flags the old ones), plus those of kept ones if the
-    particle was wrapped back into the box (their image code changes). Without ``rebuild_lists``
+    lists of neighbours gained or lost (``mark`` holds the old ones' image codes + 1), plus those of
+    kept ones whose image code changed (a wrap back into the box, or a move of a bounding centre
+    across half of a small box). Without ``rebuild_lists``
     the lists, bounding spheres and grid of the previous window are kept (they stay valid across
     a synchronisation); (2) N predictions inserted into the heap (schedule reset, Alg. 4);
     (3) events: stale collision -> re-predict; valid collision -> advance both, collide,
@@ -252,7 +257,8 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
     nn : numpy.ndarray of int32, shape (N,)
         Neighbour lists: length of each list (reset on a rebuild).
     mark : numpy.ndarray of int8, shape (N,)
-        Neighbour lists: scratch flags of a partial update (reset at entry).
+        Neighbour lists: scratch of a partial update, image code + 1 of the old neighbours
+        (reset at entry).
 
     cnt : numpy.ndarray of int32, shape (N,)
         Heap / events: collision counter of every particle (lazy invalidation).
@@ -449,12 +455,11 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
                 P[i, k] += P[i, d + k] * dt
             P[i, 2 * d] = t
             nold = nn[i]
-            for m in range(nold):  # remember (and mark) the old neighbours
+            for m in range(nold):  # remember the old neighbours, marked with their image code + 1
                 j = nb[i, m] >> cbits
                 oldnb[m] = j
-                mark[j] = 1
+                mark[j] = (nb[i, m] & cmask) + 1
             nn[i] = 0
-            wrapped = False
             h = lvl[i]
             c = coff[h]
             stride = 1
@@ -466,7 +471,6 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
                         x -= L[k]
                     x = max(x, 0.0)
                     P[i, k] = x
-                    wrapped = True
                 bs[i, k] = x
                 gk = int(x * invL[k] * ncl[h, k])
                 if gk >= ncl[h, k]:
@@ -566,16 +570,17 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
                                 if mark[j] == 0:  # new neighbour
                                     nb[j, nn[j]] = back
                                     nn[j] += 1
-                                else:  # still a neighbour: j's entry changes only if i wrapped
+                                else:  # still a neighbour: j's entry changes with the image
+                                    changed = mark[j] != code + 1
                                     mark[j] = 0
-                                    if wrapped:
+                                    if changed:
                                         for q2 in range(nn[j]):
                                             if nb[j, q2] >> cbits == i:
                                                 nb[j, q2] = back
                                                 break
             for m in range(nold):  # drop i from the lists of former neighbours
                 j = oldnb[m]
-                if mark[j] == 1:
+                if mark[j] != 0:
                     mark[j] = 0
                     last = nn[j] - 1
                     for q2 in range(last + 1):
