@@ -696,7 +696,8 @@ SLP_MINUTES_PER_N2 = 1.6e-5  # SLP to convergence, 3D: 1.6 min at N = 500, 6-24 
 #: SLP cost against 3D at the same N (2D N = 500: 12 s; 4D N = 250: 1.5 min; 5D N = 243: 6 min; 6D N = 250: 25 min)
 SLP_DIMENSION_COST = {2: 0.05, 3: 1.0, 4: 1.5, 5: 6.5, 6: 25.0}
 #: cost of an LS compression of ellipsoids against spheres at the same N, d and growth rate
-ELLIPSOID_MD_COST = 10.0
+#: (N = 1000, Gamma = 0.01: spheres 1.1e6 collisions/s, spheroids 1:1:1.5 9.5e3 /s)
+ELLIPSOID_MD_COST = 100.0
 #: rules that never take long: they run as one cluster job per group (--group-components in the
 #: slurm profile), with these expected minutes
 TINY_MINUTES = 0.3
