@@ -33,43 +33,50 @@ of inertia is kept at its window-start value within a window (it is recomputed a
 synchronisation, where the growing runs rescale the velocities anyway); with kappa = 0 the
 dynamics is exactly energy conserving.
 
-**Pair prediction** (Donev 2006, sec. 3.5.1, Algorithm 11). The Perram-Wertheim potential
-zeta(t) (> 0 disjoint; :func:`hardpack.geometry.contact.pw_contact`) and its rate (Eq. 2.21,
+**Pair prediction** (Donev 2006, sec. 3.5.1, Algorithm 11). The Perram-Wertheim potential zeta(t)
+(> 0 disjoint; :func:`hardpack.geometry.contact.pw_contact`) and its rate (Eq. 2.21,
 :func:`hardpack.geometry.contact.pw_rate`) are followed only while the bounding spheres overlap:
 the overlap interval [t_in, t_out] of the two growing bounding spheres comes from the same
 quadratic as a sphere collision (:func:`hardpack.events.roots.contact_root` for t_in, the other
-root for t_out). On it, trace event location: steps [t0, t0 + h] with zeta and zeta_dot at both
-ends define a cubic Hermite interpolant, whose error is estimated at the midpoint,
-e = |H(1/2) - zeta(t0 + h/2)|. A step is accepted when e <= max(eps_F, RELATIVE_TOL m) and
-m > 2 e, with m the interpolant's minimum over the step (so no dip below zero hides between the
-samples unless the interpolant errs by more than twice its estimated error; far from contact,
-where m is large, the steps may err by a tenth of m, which keeps them long without any risk of
-missing the zero); otherwise h is halved (the midpoint becomes the new end). The next step is
-h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= zc (the contact
-level, 0 unless the trace started in contact) after one with zeta > zc brackets a crossing,
-which a safeguarded Newton iteration (bisection when a Newton step leaves the bracket) locates
-to round-off; the earlier end of the final bracket (zeta >= zc, no deeper overlap) is returned.
+root for t_out). On it, trace event location. *Safe steps* first (Donev 2006, sec. 3.5.1: jump
+ahead with a bound on the rate): every evaluation also gives the width of the slab between the
+particles' support planes normal to the contact normal n, r . n^ (1 - 1 / sqrt(1 + zeta)), a lower
+bound on the distance of the surfaces; along that fixed n^ the width changes at the rate n^ . (v_j
+- v_i) of the centres less the rates of the two support functions (at most c |w| each for a spin w,
+:func:`support_rate_bound`) and the growth, so no contact happens before the safe time
+:func:`_safe_time`, and the trace jumps there with one evaluation (no midpoint). When the safe time
+is shorter than the step below, an ordinary step: [t0, t0 + h] with zeta and zeta_dot at both ends
+define a cubic Hermite interpolant, whose error is estimated at the midpoint, e = |H(1/2) - zeta(t0
++ h/2)|. A step is accepted when e <= max(eps_F, RELATIVE_TOL m) and m > 2 e, with m the
+interpolant's minimum over the step (so no dip below zero hides between the samples unless the
+interpolant errs by more than twice its estimated error; far from contact, where m is large, the
+steps may err by a tenth of m, which keeps them long without any risk of missing the zero);
+otherwise h is halved (the midpoint becomes the new end). The next step is h (tol / e)^(1/4) times
+0.8, within [h / 2, 4 h]. The first sample with zeta <= zc (the contact level, 0 unless the trace
+started in contact) after one with zeta > zc brackets a crossing, which a safeguarded Newton
+iteration (bisection when a Newton step leaves the bracket) locates to the round-off of zeta
+(|zeta - zc| <= ZETA_TOL, 64 ulps).
 
 *Progress.* Every predicted collision approaches: its zeta_dot is below -GRAZE_RATE times the
-pair's rate scale (a bound on the relative speed of the surfaces over the smallest semiaxis),
-far above round-off, so the collision law (which skips v_n >= 0) never skips it and the pair
-separates after it. A crossing with a smaller rate is a graze: the trace goes on from just past
-it. If zeta <= 0 at t_in: a collision now when the pair approaches; otherwise (round-off after a
-collision of the pair, or a pair in contact since a graze) the pair is *touching* at the level
-zc = zeta(t_in) (Algorithm 11 step d): samples at or below zc that do not approach move the
-trace on (no bracket can start from a non-positive sample), and the first one that approaches is
-the collision (the step halved to the time resolution to find it). Steps are at least a few ulps
-of the time and at least ``MIN_STEP_FRACTION`` of the first one (such steps are accepted
-unconditionally), and a rest of the interval shorter than that holds no event; after
-MAX_TRACE_STEPS accepted steps the trace stops with a CHECK event at the time reached, later than
-the start: the particle re-predicts from there (a "safe time", Algorithm 11 step e). The
-neighbours are traced in the order of their t_in and the search stops at the first t_in after
-the earliest event found. The horizon of every trace is also capped by the first contact time of
-the inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are
-apart: the particle collides by then at the latest (if no collision is located before it, a
-CHECK is scheduled there). So every event but a collision advances the time; the event loop
-still stops a window as STALLED (an engine failure the driver reports) after a long run of
-events at one time.
+pair's rate scale (a bound on the relative speed of the surfaces over the smallest semiaxis), far
+above round-off, so the collision law (which skips v_n >= 0) never skips it and the pair separates
+after it. A crossing with a smaller rate is a graze: the trace goes on from just past it. If zeta
+<= 0 at t_in: a collision now when the pair approaches; otherwise (round-off after a collision of
+the pair, or a pair in contact since a graze) the pair is *touching* at the level zc = zeta(t_in)
+(Algorithm 11 step d): samples at or below zc that do not approach move the trace on (no bracket
+can start from a non-positive sample), and the first one that approaches is the collision (the step
+halved to the time resolution to find it). Steps are at least a few ulps of the time and at least
+``MIN_STEP_FRACTION`` of the first one (such steps are accepted unconditionally), and a rest of the
+interval shorter than that holds no event; after MAX_TRACE_STEPS accepted steps the trace stops
+with a CHECK event at the time reached, later than the start: the particle re-predicts from there
+(a "safe time", Algorithm 11 step e). The neighbours are searched best first (:func:`_predict`):
+each has a lower bound on its collision time, t_in, then t_in plus its safe time once zeta at t_in
+is known; the pair with the smallest bound is started or traced until that bound is after the
+earliest event found. The horizon of every trace is also capped by the first contact time of the
+inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are apart: the
+particle collides by then at the latest (if no collision is located before it, a CHECK is scheduled
+there). So every event but a collision advances the time; the event loop still stops a window as
+STALLED (an engine failure the driver reports) after a long run of events at one time.
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
 here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
