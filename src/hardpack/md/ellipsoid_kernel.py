@@ -42,7 +42,7 @@ root for t_out). On it, trace event location. *Safe steps* first (Donev 2006, se
 ahead with a bound on the rate): every evaluation also gives the width of the slab between the
 particles' support planes normal to the contact normal n, r . n^ (1 - 1 / sqrt(1 + zeta)), a lower
 bound on the distance of the surfaces; along that fixed n^ the width changes at the rate n^ . (v_j
-- v_i) of the centres less the rates of the two support functions (at most c |w| each for a spin w,
+- v_i) of the centres less the rates of the two support functions (at most c |w x n^| each for a spin w,
 :func:`support_rate_bound`) and the growth, so no contact happens before the safe time
 :func:`_safe_time`, and the trace jumps there with one evaluation (no midpoint). When the safe time
 is shorter than the step below, an ordinary step: [t0, t0 + h] with zeta and zeta_dot at both ends
@@ -244,8 +244,10 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     ws[1, :d] hold the centres, ws[4, :d] the contact point, ws[5, :d] the normal n, wm[0],
     wm[1] the inverse shape matrices, ws[10, 1] the width of the slab between the particles'
     support planes normal to n, r . n / |n| (1 - 1 / sqrt(1 + zeta)), a lower bound on the distance
-    of the surfaces (0 unless zeta > 0), and ws[10, 2] the rate n . (v_j - v_i) / |n| at which the
-    centres separate along n (:func:`predict_pair`)."""
+    of the surfaces (0 unless zeta > 0), ws[10, 2] the rate n . (v_j - v_i) / |n| at which the
+    centres separate along n and ws[10, 3] the bound c_i |w_i x n^| + c_j |w_j x n^| on the rate of
+    the support functions along n^ from the spins (:func:`support_rate_bound`; for
+    :func:`_safe_time`)."""
     d = shift.shape[0]
     cv, _, _, _, _, cw, _, _ = columns(d)
     xa, xb, oa, ob, rc = ws[0, :d], ws[1, :d], ws[2], ws[3], ws[4, :d]
@@ -269,6 +271,8 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     nn = np.sqrt(nn)
     ws[10, 1] = rn / nn * (1.0 - 1.0 / np.sqrt(1.0 + zeta)) if zeta > 0.0 else 0.0
     ws[10, 2] = nv / nn
+    ws[10, 3] = support_rate_bound(P, i, d) * _spin_across(P, i, n, nn) \
+        + support_rate_bound(P, j, d) * _spin_across(P, j, n, nn)
     nw = 3 if d == 3 else 1
     g = kappa / (1.0 + kappa * t)
     zdot = pw_rate(lam, n, xa, xb, rc, P[i, cv:cv + d], P[j, cv:cv + d], P[i, cw:cw + nw],
@@ -355,9 +359,9 @@ def _safe_time(gap, sep_rate, spin, grow_speed, kappa, t):
     between the particles' support planes normal to a fixed unit vector u is a lower bound on the
     distance of the surfaces at all times; it grows at the rate ``sep_rate`` = u . (v_j - v_i) of
     the centres less the rates of the support functions h(u) = sqrt(u^T X^-1 u), each at most
-    c |w| (1 + kappa t') for a spin w (``spin`` = c_i |w_i| + c_j |w_j|, c = min(R, (a_max^2 -
-    a_min^2) / (2 a_min)) at the window start: derived in :func:`support_rate_bound`) plus
-    |kappa| R for the growth (``grow_speed``). The first root of
+    c |w x u| (1 + kappa t') for a spin w (``spin`` = c_i |w_i x u| + c_j |w_j x u|, c = min(R,
+    (a_max^2 - a_min^2) / (2 a_min)) at the window start: derived in :func:`support_rate_bound`)
+    plus |kappa| R for the growth (``grow_speed``). The first root of
     gap - (grow_speed + spin (1 + kappa t) - sep_rate) s - spin kappa s^2 / 2 = 0, or inf."""
     if gap <= 0.0:
         return 0.0
@@ -372,16 +376,42 @@ def _safe_time(gap, sep_rate, spin, grow_speed, kappa, t):
 
 
 @njit(cache=True, inline="always")
+def _back_safe_time(gap, sep_rate, spin, grow_speed, kappa, t0, t1):
+    """Time before window time t1 (back to t0 at most) during which a pair whose slab width at t1
+    is ``gap`` cannot have touched: :func:`_safe_time` run backwards, with the largest rate on
+    [t0, t1]."""
+    if gap <= 0.0:
+        return 0.0
+    s = grow_speed + spin * max(1.0 + kappa * t0, 1.0 + kappa * t1) + sep_rate
+    return gap / s if s > 0.0 else np.inf
+
+
+@njit(cache=True, inline="always")
+def _spin_across(P, i, n, nn):
+    """|w_i x n| / nn: the part of the spin of i that turns the direction n (norm nn); |w_i| in 2D."""
+    d = n.shape[0]
+    _, _, _, _, _, cw, _, _ = columns(d)
+    if d == 2:
+        return abs(P[i, cw])
+    w0, w1, w2 = P[i, cw], P[i, cw + 1], P[i, cw + 2]
+    c0 = w1 * n[2] - w2 * n[1]
+    c1 = w2 * n[0] - w0 * n[2]
+    c2 = w0 * n[1] - w1 * n[0]
+    return np.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / nn
+
+
+@njit(cache=True, inline="always")
 def support_rate_bound(P, i, d):
     """c_i = min(R_i, (a_max^2 - a_min^2) / (2 a_min)) with the window-start semiaxes: |dh/dt| <=
-    c_i |w_i| for the support function h(u) = sqrt(u^T X^-1 u) of particle i along a fixed unit
-    vector u while it spins at w_i.
+    c_i |w_i x u| for the support function h(u) = sqrt(u^T X^-1 u) of particle i along a fixed
+    unit vector u while it spins at w_i.
 
     Derived here: with M = X^-1, dM/dt = W M - M W, so d(u^T M u)/dt = -2 (w x u) . (M u) and
     dh/dt = -(w x u) . (M u) / h, the speed along u of the support point M u / h turning about the
-    centre; |dh/dt| <= |w| |M u|_perp / h, where the part of M u normal to u is at most
-    (a_max^2 - a_min^2) / 2 (eigenvalues of M between a_min^2 and a_max^2) and h >= a_min, and also
-    <= |w| R (the support point is within R of the centre)."""
+    centre; w x u is normal to u, so |dh/dt| <= |w x u| |M u|_perp / h, where the part of M u
+    normal to u is at most (a_max^2 - a_min^2) / 2 (eigenvalues of M between a_min^2 and
+    a_max^2) and h >= a_min, and also <= |w x u| R (the support point is within R of the
+    centre). A spin about u does not change h(u)."""
     _, _, cr, cax, _, _, _, _ = columns(d)
     amin = P[i, cax]
     amax = P[i, cax]
@@ -409,7 +439,7 @@ def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
     cv, _, cr, cax, _, cw, _, _ = columns(d)
     lam = P[i, cr] / (P[i, cr] + P[j, cr])
     z0, d0, lam = pair_zeta(P, i, j, shift, t + tin, kappa, lam, ws, wm)
-    gap0, sep0 = ws[10, 1], ws[10, 2]
+    gap0, sep0, spin0 = ws[10, 1], ws[10, 2], ws[10, 3]
     # rate scale: bound on the relative speed of the surfaces over the smallest semiaxis
     amin = P[i, cax]
     for k in range(1, d):
@@ -427,7 +457,6 @@ def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
     for k in range(nw):
         ww_i += P[i, cw + k] ** 2
         ww_j += P[j, cw + k] ** 2
-    spin = np.sqrt(ww_i) * support_rate_bound(P, i, d) + np.sqrt(ww_j) * support_rate_bound(P, j, d)
     grow_speed = abs(kappa) * (P[i, cr] + P[j, cr])
     speed = np.sqrt(uu) + (np.sqrt(ww_i) * P[i, cr] + np.sqrt(ww_j) * P[j, cr] + grow_speed) \
         * (1.0 + kappa * (t + tin))
@@ -441,12 +470,12 @@ def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
         touching = 1.0
     h = FIRST_STEP * amin / speed if speed > 0.0 else np.inf
     st[0], st[1], st[2], st[3], st[4], st[5], st[6] = tin, z0, d0, lam, gap0, sep0, zc
-    st[7], st[8], st[9], st[10], st[11], st[12] = touching, spin, grow_speed, rate_tol, h, MIN_STEP_FRACTION * h
+    st[7], st[8], st[9], st[10], st[11], st[12] = touching, spin0, grow_speed, rate_tol, h, MIN_STEP_FRACTION * h
     if speed == 0.0:  # nothing moves: zeta is constant
         return np.inf, False
     if touching:
         return tin, False
-    return tin + _safe_time(gap0, sep0, spin, grow_speed, kappa, t + tin), False
+    return tin + _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + tin), False
 
 
 @njit(cache=True)
@@ -473,7 +502,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
     end = min(tout, tmax - t)
     t0, z0, d0, lam, gap0, sep0, zc = st[0], st[1], st[2], st[3], st[4], st[5], st[6]
     touching = st[7] != 0.0
-    spin, grow_speed, rate_tol, h, hmin_step = st[8], st[9], st[10], st[11], st[12]
+    spin0, grow_speed, rate_tol, h, hmin_step = st[8], st[9], st[10], st[11], st[12]
     if h == np.inf:  # nothing moves
         return np.inf, 0
     steps = 0
@@ -486,7 +515,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
         if steps >= MAX_TRACE_STEPS:
             return t + t0, 1
         # a safe step: no contact before the distance bound is used up (Donev 2006, sec. 3.5.1)
-        safe = _safe_time(gap0, sep0, spin, grow_speed, kappa, t + t0)
+        safe = _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + t0)
         if t0 + safe >= end:
             return np.inf, 0
         h = min(max(h, hfloor), end - t0)
@@ -495,27 +524,34 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
             z1, d1, lam1 = pair_zeta(P, i, j, shift, t + t1, kappa, lam, ws, wm)
             if z1 > zc:
                 steps += 1
-                t0, z0, d0, lam, gap0, sep0 = t1, z1, d1, lam1, ws[10, 1], ws[10, 2]
+                t0, z0, d0, lam, gap0, sep0, spin0 = t1, z1, d1, lam1, ws[10, 1], ws[10, 2], ws[10, 3]
                 continue
             h = safe  # round-off of the bound: an ordinary step over the same interval
         else:
             t1 = t0 + h
             z1, d1, lam1 = pair_zeta(P, i, j, shift, t + t1, kappa, lam, ws, wm)
-        gap1, sep1 = ws[10, 1], ws[10, 2]
+            # the safe times forwards from t0 and backwards from t1 cover the step: no midpoint
+            if z1 > zc and not touching and \
+                    safe + _back_safe_time(ws[10, 1], ws[10, 2], ws[10, 3], grow_speed, kappa, t + t0, t + t1) >= h:
+                steps += 1
+                t0, z0, d0, lam, gap0, sep0, spin0 = t1, z1, d1, lam1, ws[10, 1], ws[10, 2], ws[10, 3]
+                h *= 2.0
+                continue
+        gap1, sep1, spin1 = ws[10, 1], ws[10, 2], ws[10, 3]
         accepted = False  # a step past a crossing of zc (a graze) or a touching stretch
         while True:
             tm = t0 + 0.5 * h
             zm, dm, lamm = pair_zeta(P, i, j, shift, t + tm, kappa, lam, ws, wm)
-            gapm, sepm = ws[10, 1], ws[10, 2]
+            gapm, sepm, spinm = ws[10, 1], ws[10, 2], ws[10, 3]
             if zm <= zc and touching:  # still in contact at the midpoint
                 if dm < -rate_tol:  # approaching: the collision is at the latest here
                     if h <= hfloor:
                         return t + tm, 0
                     h *= 0.5
-                    t1, z1, d1, lam1, gap1, sep1 = tm, zm, dm, lamm, gapm, sepm
+                    t1, z1, d1, lam1, gap1, sep1, spin1 = tm, zm, dm, lamm, gapm, sepm, spinm
                     continue
                 # touching, not approaching: move on
-                t1, z1, d1, lam1, gap1, sep1 = tm, zm, dm, lamm, gapm, sepm
+                t1, z1, d1, lam1, gap1, sep1, spin1 = tm, zm, dm, lamm, gapm, sepm, spinm
                 zc = min(zc, zm)
                 accepted = True
                 break
@@ -533,7 +569,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
                 if dc < -rate_tol:
                     return t + tc, 0
                 # a grazing touch: the pair is touching from just past it on
-                t1, z1, d1, lam1, gap1, sep1 = thi, zhi, dhi, lamhi, 0.0, 0.0
+                t1, z1, d1, lam1, gap1, sep1, spin1 = thi, zhi, dhi, lamhi, 0.0, 0.0, 0.0
                 zc = min(zc, z1)
                 touching = True
                 accepted = True
@@ -547,10 +583,10 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
             # halve: the midpoint becomes the end
             h *= 0.5
             t1 = t0 + h
-            z1, d1, lam1, gap1, sep1 = zm, dm, lamm, gapm, sepm
+            z1, d1, lam1, gap1, sep1, spin1 = zm, dm, lamm, gapm, sepm, spinm
         steps += 1
         t0 = t1
-        z0, d0, lam, gap0, sep0 = z1, d1, lam1, gap1, sep1
+        z0, d0, lam, gap0, sep0, spin0 = z1, d1, lam1, gap1, sep1, spin1
         if accepted:
             continue
         if err > 0.0:
