@@ -101,7 +101,7 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
-from hardpack.geometry.contact import contact_point, pw_contact_into, pw_rate, shape_inverse_into
+from hardpack.geometry.contact import _inverse_sym, contact_point, pw_contact_into, pw_rate, shape_inverse_into
 from hardpack.md.kernel import (
     A_KE,
     A_KEINT,
@@ -373,6 +373,63 @@ def _safe_time(gap, sep_rate, spin, grow_speed, kappa, t):
     if s0 <= 0.0:
         return np.inf
     return gap / s0
+
+
+@njit(cache=True)
+def _screen_time(P, i, j, shift, t, kappa, ws, wm):
+    """A lower bound on the time from window time t to the first contact of i and j (shifted),
+    without the Perram-Wertheim maximisation: the slab between the support planes normal to
+    u = Y(lam)^-1 r for the guess lam = h_i / (h_i + h_j) (h the support functions along r, exact
+    for spheres) bounds their distance from below (any u does; this one is nearly the contact
+    normal), and :func:`_safe_time` turns its width into a time. 0 when the slab is empty. The
+    pose of i at t is in ws[0], wm[0] (:func:`_pose`); ws[1], ws[3], ws[5:8], wm[1:] are
+    overwritten."""
+    d = shift.shape[0]
+    cv, _, cr, _, _, _, _, _ = columns(d)
+    xi, mi, xj, mj = ws[0, :d], wm[0], ws[1, :d], wm[1]
+    _pose(P, j, t, kappa, shift, xj, mj, ws[3], ws[6, :d], wm[2])
+    r = ws[7, :d]
+    for k in range(d):
+        r[k] = xj[k] - xi[k]
+    hi = np.sqrt(_quad(mi, r))
+    hj = np.sqrt(_quad(mj, r))
+    lam = hi / (hi + hj)
+    y = wm[3]
+    for a in range(d):
+        for b in range(d):
+            y[a, b] = lam * mj[a, b] + (1.0 - lam) * mi[a, b]
+    _inverse_sym(y, wm[2])
+    u = ws[5, :d]
+    uu = 0.0
+    for a in range(d):
+        acc = 0.0
+        for b in range(d):
+            acc += wm[2, a, b] * r[b]
+        u[a] = acc
+        uu += acc * acc
+    uu = np.sqrt(uu)
+    ur = 0.0
+    sep = 0.0
+    for a in range(d):
+        u[a] /= uu
+        ur += u[a] * r[a]
+        sep += u[a] * (P[j, cv + a] - P[i, cv + a])
+    width = ur - np.sqrt(_quad(mi, u)) - np.sqrt(_quad(mj, u))
+    if width <= 0.0:
+        return 0.0
+    spin = support_rate_bound(P, i, d) * _spin_across(P, i, u, 1.0) \
+        + support_rate_bound(P, j, d) * _spin_across(P, j, u, 1.0)
+    return _safe_time(width, sep, spin, abs(kappa) * (P[i, cr] + P[j, cr]), kappa, t)
+
+
+@njit(cache=True, inline="always")
+def _quad(m, x):
+    """x^T m x."""
+    acc = 0.0
+    for a in range(x.shape[0]):
+        for b in range(x.shape[0]):
+            acc += x[a] * m[a, b] * x[b]
+    return acc
 
 
 @njit(cache=True, inline="always")
@@ -749,11 +806,12 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
 def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm):
     """Next event of particle i from window time t: (time, partner), partner EXIT, CHECK or a
     particle index (Algorithm 5 with NNLs). The pairs are searched best first: each has a key, a
-    lower bound on its collision time, first the start t_in of its bounding-sphere overlap, then,
-    once :func:`pair_start` has evaluated zeta there, t_in plus its safe time; the pair of the
-    smallest key is started or, if started, traced (:func:`pair_trace`), until the smallest key
-    is after the earliest event found (``done``: 0 new, 1 started, 2 finished; ``pst`` the
-    states of the started pairs)."""
+    lower bound on its collision time, first the start t_in of its bounding-sphere overlap (or,
+    for the pairs whose bounding spheres overlap now, the cheap bound of :func:`_screen_time`),
+    then, once :func:`pair_start` has evaluated zeta at t_in, t_in plus its safe time; the pair
+    of the smallest key is started or, if started, traced (:func:`pair_trace`), until the
+    smallest key is after the earliest event found (``done``: 0 new, 3 screened, 1 started,
+    2 finished; ``pst`` the states of the started pairs)."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 2 * d
@@ -825,11 +883,25 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
                     den = b + np.sqrt(disc)
                     touts[m] = -c / den if den > 0.0 else 0.0
     sh = ws[9, :d]
-    for _ in range(2 * m_n):  # best first: each pair is started, then traced
+    # screen the pairs whose bounding spheres overlap now with a cheap bound (_screen_time)
+    posed = False
+    for m in range(m_n):
+        if tins[m] == 0.0 and t < min(best, horizon):
+            if not posed:
+                _pose(P, i, t, kappa, ws[8, :d], ws[0, :d], wm[0], ws[2], ws[6, :d], wm[2])
+                posed = True
+            e = nb[i, m]
+            for k in range(d):
+                sh[k] = imgvec[e & cmask, k]
+            lower = _screen_time(P, i, e >> cbits, sh, t, kappa, ws, wm)
+            if lower > 0.0:
+                tins[m] = lower
+                done[m] = 3
+    for _ in range(3 * m_n):  # best first: each pair is (screened,) started, then traced
         q = -1
         tq = np.inf
         for m in range(m_n):
-            if done[m] < 2 and tins[m] < tq:
+            if done[m] != 2 and tins[m] < tq:
                 tq = tins[m]
                 q = m
         if q < 0 or t + tq >= min(best, horizon):
@@ -839,14 +911,16 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
         im = e & cmask
         for k in range(d):
             sh[k] = imgvec[im, k]
-        if done[q] == 0:
-            lower, now = pair_start(P, i, j, sh, t, tq, kappa, ws, wm, pst[q])
+        if done[q] == 0 or done[q] == 3:
+            tstart = 0.0 if done[q] == 3 else tq
+            lower, now = pair_start(P, i, j, sh, t, tstart, kappa, ws, wm, pst[q])
             if now:
                 done[q] = 2
-                if t + tq < best:
-                    best = t + tq
+                if t + tstart < best:
+                    best = t + tstart
                     partner = j
             else:
+                lower = max(lower, tq)
                 done[q] = 1 if lower < touts[q] else 2
                 tins[q] = lower
             continue
