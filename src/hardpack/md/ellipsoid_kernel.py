@@ -76,7 +76,7 @@ earliest event found. The horizon of every trace is also capped by the first con
 inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are apart: the
 particle collides by then at the latest (if no collision is located before it, a CHECK is scheduled
 there). So every event but a collision advances the time; the event loop still stops a window as
-STALLED (an engine failure the driver reports) after a long run of events at one time.
+STALLED (an engine failure the driver reports) after a long run of other events at one time.
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
 here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
@@ -126,7 +126,8 @@ I_CHECK = 5
 I_STALL_PARTICLE = 6
 I_STALL_PARTNER = 7
 N_COUNTERS = 8
-#: a window stops as STALLED after this many consecutive events at one time, plus 10 per particle
+#: a window stops as STALLED after this many consecutive events at one time without a collision,
+#: plus 10 per particle
 STALL_EVENTS = 1000
 #: extra accumulator: contact-function evaluations
 A_EVAL = 5
@@ -1070,8 +1071,8 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         if t == np.inf:
             return WindowStatus.STUCK
         p = ep[i]
-        # progress guard: every event advances the time, except chains of collisions of distinct
-        # pairs at one instant, which are short; a long run of events at one time is a failure
+        # progress guard: every event but a collision advances the time (collisions at one
+        # instant change the velocities); a long run of other events at one time is a failure
         if t == t_last:
             same += 1
             if same > max_same:
@@ -1100,6 +1101,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             j = p
             jimp, vir, dke = collide(P, i, j, t, L, kappa, ws, wm)
             if jimp > 0.0:
+                same = 0
                 acc[A_VIRIAL] += vir
                 acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
                 acc[A_TKE] = t
