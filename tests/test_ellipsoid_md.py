@@ -1,10 +1,13 @@
 """Physics of the hard-ellipsoid / hard-ellipse event-driven MD (hardpack.md.ellipsoid*).
 
 Free rotation against Donev 2006 Eq. 2.9; the collision law's conservation laws (Donev 2006,
-Algorithm 12, signs derived in the kernel); NVE conservation and no overlaps over many collisions;
-spheres run as ellipsoids against the sphere engine; the low-density equation of state against the
-second virial coefficient of convex bodies B2 = V + S R (3D) and A + P^2 / (4 pi) (2D)
-(Isihara 1950; Kihara 1953); bit-identical resume.
+Algorithm 12, signs derived in the kernel); the pair prediction (pairs in contact to round-off
+collide at once only when they approach; the distance and safe-time bounds hold); NVE
+conservation and no overlaps over many collisions; spheres run as ellipsoids against the sphere
+engine and the hard-sphere equation of state; small boxes (exact neighbour lists, no stall, jamming
+of the two starts that used to hang); the low-density equation of state against the second virial
+coefficient of convex bodies B2 = V + S R (3D) and A + P^2 / (4 pi) (2D) (Isihara 1950; Kihara
+1953); bit-identical resume.
 """
 
 from __future__ import annotations
