@@ -49,7 +49,8 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
-__all__ = ["shape_inverse", "pw_contact", "contact_point", "pw_rate", "inverse_shapes", "pair_potentials"]
+__all__ = ["shape_inverse", "shape_inverse_into", "pw_contact", "pw_contact_into", "contact_point", "pw_rate",
+           "inverse_shapes", "pair_potentials"]
 
 _EPS = np.finfo(np.float64).eps
 _NOISE = 1e-9  # relative Newton step below which a step that stops shrinking is round-off
@@ -75,8 +76,14 @@ def shape_inverse(semiaxes, orientation_row, out):
     None
         The result is written to ``out``.
     """
+    shape_inverse_into(semiaxes, orientation_row, out, np.empty((semiaxes.shape[0], semiaxes.shape[0])))
+
+
+@numba.njit(cache=True)
+def shape_inverse_into(semiaxes, orientation_row, out, q):
+    """:func:`shape_inverse` with a (d, d) scratch array ``q`` for the rotation (no allocation:
+    the event-driven MD calls it in its innermost loop)."""
     d = semiaxes.shape[0]
-    q = np.empty((d, d))
     if d == 2:
         c, s = np.cos(orientation_row[0]), np.sin(orientation_row[0])
         q[0, 0], q[0, 1], q[1, 0], q[1, 1] = c, s, -s, c
@@ -155,6 +162,17 @@ def pw_contact(r_ab, a_inv, b_inv, lam0):
 def _pw_maximise(r_ab, a_inv, b_inv, lam0):
     """:func:`pw_contact` and the number of Newton/bisection iterations it took."""
     d = r_ab.shape[0]
+    n = np.zeros(d)
+    zeta, lam, iterations = pw_contact_into(r_ab, a_inv, b_inv, lam0, n, np.empty((d, d)), np.empty((d, d)),
+                                            np.empty(d))
+    return zeta, lam, n, iterations
+
+
+@numba.njit(cache=True)
+def pw_contact_into(r_ab, a_inv, b_inv, lam0, n, y, y_inv, dn):
+    """:func:`pw_contact` without allocation: the normal goes into ``n`` (d,), ``y``, ``y_inv``
+    (d, d) and ``dn`` (d,) are scratch. Returns (zeta, lam, number of iterations)."""
+    d = r_ab.shape[0]
     if not (lam0 >= 0.0 and lam0 <= 1.0):
         raise ValueError("pw_contact: the initial guess lam0 must be in [0, 1]")
     rr = 0.0
@@ -162,12 +180,10 @@ def _pw_maximise(r_ab, a_inv, b_inv, lam0):
         rr += r_ab[i] * r_ab[i]
     if not np.isfinite(rr):
         raise ValueError("pw_contact: the separation r_ab must be finite")
-    n = np.zeros(d)
     if rr == 0.0:
-        return -1.0, lam0, n, 0
-    y = np.empty((d, d))
-    y_inv = np.empty((d, d))
-    dn = np.empty(d)
+        for i in range(d):
+            n[i] = 0.0
+        return -1.0, lam0, 0
     lam = lam0 if 0.0 < lam0 < 1.0 else 0.5
     lo, hi = 0.0, 1.0
     last_step = 1.0
@@ -219,7 +235,7 @@ def _pw_maximise(r_ab, a_inv, b_inv, lam0):
             step = abs(new - lam)
         last_step = step
         lam = new
-    return lam * (1.0 - lam) * rn - 1.0, lam, n, iterations
+    return lam * (1.0 - lam) * rn - 1.0, lam, iterations
 
 
 @numba.njit(cache=True)
@@ -255,22 +271,25 @@ def contact_point(r_a, a_inv, lam, n, out):
         out[i] = r_a[i] + (1.0 - lam) * acc
 
 
-def _spin_dot(w, x, n):
-    """n . (w x x); in 2D w is the scalar angular velocity (or a (1,) array)."""
+def _spin_dot(w, p, c, n):
+    """n . (w x (p - c)); in 2D w is the scalar angular velocity (or a (1,) array)."""
 
 
 @overload(_spin_dot)
-def _spin_dot_impl(w, x, n):
+def _spin_dot_impl(w, p, c, n):
     if isinstance(w, (types.Float, types.Integer)):
-        def scalar(w, x, n):
-            return w * (x[0] * n[1] - x[1] * n[0])
+        def scalar(w, p, c, n):
+            return w * ((p[0] - c[0]) * n[1] - (p[1] - c[1]) * n[0])
         return scalar
 
-    def vector(w, x, n):
+    def vector(w, p, c, n):
+        x0 = p[0] - c[0]
+        x1 = p[1] - c[1]
         if w.shape[0] == 1:
-            return w[0] * (x[0] * n[1] - x[1] * n[0])
-        return (n[0] * (w[1] * x[2] - w[2] * x[1]) + n[1] * (w[2] * x[0] - w[0] * x[2])
-                + n[2] * (w[0] * x[1] - w[1] * x[0]))
+            return w[0] * (x0 * n[1] - x1 * n[0])
+        x2 = p[2] - c[2]
+        return (n[0] * (w[1] * x2 - w[2] * x1) + n[1] * (w[2] * x0 - w[0] * x2)
+                + n[2] * (w[0] * x1 - w[1] * x0))
     return vector
 
 
@@ -304,11 +323,9 @@ def pw_rate(lam, n, r_a, r_b, r_c, v_a, v_b, w_a, w_b, g_a, g_b):
         d zeta / dt.
     """
     d = n.shape[0]
-    xa = r_c - r_a
-    xb = r_c - r_b
-    nv = _spin_dot(w_b, xb, n) - _spin_dot(w_a, xa, n)
+    nv = _spin_dot(w_b, r_c, r_b, n) - _spin_dot(w_a, r_c, r_a, n)
     for i in range(d):
-        nv += n[i] * (v_b[i] - v_a[i] + g_b * xb[i] - g_a * xa[i])
+        nv += n[i] * (v_b[i] - v_a[i] + g_b * (r_c[i] - r_b[i]) - g_a * (r_c[i] - r_a[i]))
     return 2.0 * lam * (1.0 - lam) * nv
 
 

@@ -170,7 +170,8 @@ class EllipsoidEngine(Engine):
                 what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
                 raise EngineStalledError(
                     f"the ellipsoid event loop stalled at window time {t!r}: more than "
-                    f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time (the last one of "
+                    f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time without a "
+                    f"collision (the last one of "
                     f"particle {i} with {what}, engine order); the state is back at the window start. "
                     "This is an engine failure: report it with the start packing, seed and options")
             break

@@ -33,43 +33,50 @@ of inertia is kept at its window-start value within a window (it is recomputed a
 synchronisation, where the growing runs rescale the velocities anyway); with kappa = 0 the
 dynamics is exactly energy conserving.
 
-**Pair prediction** (Donev 2006, sec. 3.5.1, Algorithm 11). The Perram-Wertheim potential
-zeta(t) (> 0 disjoint; :func:`hardpack.geometry.contact.pw_contact`) and its rate (Eq. 2.21,
+**Pair prediction** (Donev 2006, sec. 3.5.1, Algorithm 11). The Perram-Wertheim potential zeta(t)
+(> 0 disjoint; :func:`hardpack.geometry.contact.pw_contact`) and its rate (Eq. 2.21,
 :func:`hardpack.geometry.contact.pw_rate`) are followed only while the bounding spheres overlap:
 the overlap interval [t_in, t_out] of the two growing bounding spheres comes from the same
 quadratic as a sphere collision (:func:`hardpack.events.roots.contact_root` for t_in, the other
-root for t_out). On it, trace event location: steps [t0, t0 + h] with zeta and zeta_dot at both
-ends define a cubic Hermite interpolant, whose error is estimated at the midpoint,
-e = |H(1/2) - zeta(t0 + h/2)|. A step is accepted when e <= max(eps_F, RELATIVE_TOL m) and
-m > 2 e, with m the interpolant's minimum over the step (so no dip below zero hides between the
-samples unless the interpolant errs by more than twice its estimated error; far from contact,
-where m is large, the steps may err by a tenth of m, which keeps them long without any risk of
-missing the zero); otherwise h is halved (the midpoint becomes the new end). The next step is
-h (tol / e)^(1/4) times 0.8, within [h / 2, 4 h]. The first sample with zeta <= zc (the contact
-level, 0 unless the trace started in contact) after one with zeta > zc brackets a crossing,
-which a safeguarded Newton iteration (bisection when a Newton step leaves the bracket) locates
-to round-off; the earlier end of the final bracket (zeta >= zc, no deeper overlap) is returned.
+root for t_out). On it, trace event location. *Safe steps* first (Donev 2006, sec. 3.5.1: jump
+ahead with a bound on the rate): every evaluation also gives the width of the slab between the
+particles' support planes normal to the contact normal n, r . n^ (1 - 1 / sqrt(1 + zeta)), a lower
+bound on the distance of the surfaces; along that fixed n^ the width changes at the rate n^ . (v_j
+- v_i) of the centres less the rates of the two support functions (at most c |w x n^| each for a spin w,
+:func:`support_rate_bound`) and the growth, so no contact happens before the safe time
+:func:`_safe_time`, and the trace jumps there with one evaluation (no midpoint). When the safe time
+is shorter than the step below, an ordinary step: [t0, t0 + h] with zeta and zeta_dot at both ends
+define a cubic Hermite interpolant, whose error is estimated at the midpoint, e = |H(1/2) - zeta(t0
++ h/2)|. A step is accepted when e <= max(eps_F, RELATIVE_TOL m) and m > 2 e, with m the
+interpolant's minimum over the step (so no dip below zero hides between the samples unless the
+interpolant errs by more than twice its estimated error; far from contact, where m is large, the
+steps may err by a tenth of m, which keeps them long without any risk of missing the zero);
+otherwise h is halved (the midpoint becomes the new end). The next step is h (tol / e)^(1/4) times
+0.8, within [h / 2, 4 h]. The first sample with zeta <= zc (the contact level, 0 unless the trace
+started in contact) after one with zeta > zc brackets a crossing, which a safeguarded Newton
+iteration (bisection when a Newton step leaves the bracket) locates to the round-off of zeta
+(|zeta - zc| <= ZETA_TOL, 64 ulps).
 
 *Progress.* Every predicted collision approaches: its zeta_dot is below -GRAZE_RATE times the
-pair's rate scale (a bound on the relative speed of the surfaces over the smallest semiaxis),
-far above round-off, so the collision law (which skips v_n >= 0) never skips it and the pair
-separates after it. A crossing with a smaller rate is a graze: the trace goes on from just past
-it. If zeta <= 0 at t_in: a collision now when the pair approaches; otherwise (round-off after a
-collision of the pair, or a pair in contact since a graze) the pair is *touching* at the level
-zc = zeta(t_in) (Algorithm 11 step d): samples at or below zc that do not approach move the
-trace on (no bracket can start from a non-positive sample), and the first one that approaches is
-the collision (the step halved to the time resolution to find it). Steps are at least a few ulps
-of the time and at least ``MIN_STEP_FRACTION`` of the first one (such steps are accepted
-unconditionally), and a rest of the interval shorter than that holds no event; after
-MAX_TRACE_STEPS accepted steps the trace stops with a CHECK event at the time reached, later than
-the start: the particle re-predicts from there (a "safe time", Algorithm 11 step e). The
-neighbours are traced in the order of their t_in and the search stops at the first t_in after
-the earliest event found. The horizon of every trace is also capped by the first contact time of
-the inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are
-apart: the particle collides by then at the latest (if no collision is located before it, a
-CHECK is scheduled there). So every event but a collision advances the time; the event loop
-still stops a window as STALLED (an engine failure the driver reports) after a long run of
-events at one time.
+pair's rate scale (a bound on the relative speed of the surfaces over the smallest semiaxis), far
+above round-off, so the collision law (which skips v_n >= 0) never skips it and the pair separates
+after it. A crossing with a smaller rate is a graze: the trace goes on from just past it. If zeta
+<= 0 at t_in: a collision now when the pair approaches; otherwise (round-off after a collision of
+the pair, or a pair in contact since a graze) the pair is *touching* at the level zc = zeta(t_in)
+(Algorithm 11 step d): samples at or below zc that do not approach move the trace on (no bracket
+can start from a non-positive sample), and the first one that approaches is the collision (the step
+halved to the time resolution to find it). Steps are at least a few ulps of the time and at least
+``MIN_STEP_FRACTION`` of the first one (such steps are accepted unconditionally), and a rest of the
+interval shorter than that holds no event; after MAX_TRACE_STEPS accepted steps the trace stops
+with a CHECK event at the time reached, later than the start: the particle re-predicts from there
+(a "safe time", Algorithm 11 step e). The neighbours are searched best first (:func:`_predict`):
+each has a lower bound on its collision time, t_in, then t_in plus its safe time once zeta at t_in
+is known; the pair with the smallest bound is started or traced until that bound is after the
+earliest event found. The horizon of every trace is also capped by the first contact time of the
+inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are apart: the
+particle collides by then at the latest (if no collision is located before it, a CHECK is scheduled
+there). So every event but a collision advances the time; the event loop still stops a window as
+STALLED (an engine failure the driver reports) after a long run of other events at one time.
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
 here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
@@ -94,7 +101,7 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
-from hardpack.geometry.contact import contact_point, pw_contact, pw_rate, shape_inverse
+from hardpack.geometry.contact import _inverse_sym, contact_point, pw_contact_into, pw_rate, shape_inverse_into
 from hardpack.md.kernel import (
     A_KE,
     A_KEINT,
@@ -119,7 +126,8 @@ I_CHECK = 5
 I_STALL_PARTICLE = 6
 I_STALL_PARTNER = 7
 N_COUNTERS = 8
-#: a window stops as STALLED after this many consecutive events at one time, plus 10 per particle
+#: a window stops as STALLED after this many consecutive events at one time without a collision,
+#: plus 10 per particle
 STALL_EVENTS = 1000
 #: extra accumulator: contact-function evaluations
 A_EVAL = 5
@@ -137,6 +145,8 @@ MAX_TRACE_STEPS = 200
 MIN_STEP_FRACTION = 1e-9
 #: first trace step: this fraction of the smallest semiaxis of the pair over its relative speed
 FIRST_STEP = 0.25
+#: a collision time is located when |zeta| is below this (64 ulps; the round-off of zeta is a few)
+ZETA_TOL = 64.0 * np.finfo(np.float64).eps
 #: approach rates zeta_dot above -GRAZE_RATE times the pair's rate scale (relative surface speed
 #: bound over the smallest semiaxis) are grazing: no collision is predicted there
 GRAZE_RATE = 1e-9
@@ -205,8 +215,16 @@ def advance(P, i, t, scratch):
 
 
 @njit(cache=True)
-def _pose(P, i, t, kappa, shift, x, xinv, o, ax):
-    """Centre (plus ``shift``) and inverse shape matrix of particle i at window time t."""
+def work_arrays(d):
+    """Scratch arrays (ws, wm) of :func:`pair_zeta` and the kernels that call it: ws (11, 4) with
+    row 8 zeros, wm (4, d, d)."""
+    return np.zeros((11, 4)), np.empty((4, d, d))
+
+
+@njit(cache=True)
+def _pose(P, i, t, kappa, shift, x, xinv, o, ax, q):
+    """Centre (plus ``shift``) and inverse shape matrix of particle i at window time t (``q``:
+    (d, d) scratch)."""
     d = x.shape[0]
     cv, ct, _, cax, _, _, _, _ = columns(d)
     dt = t - P[i, ct]
@@ -215,31 +233,47 @@ def _pose(P, i, t, kappa, shift, x, xinv, o, ax):
         x[k] = P[i, k] + P[i, cv + k] * dt + shift[k]
         ax[k] = P[i, cax + k] * grow
     orientation_at(P, i, t, o)
-    shape_inverse(ax, o, xinv)
+    shape_inverse_into(ax, o, xinv, q)
 
 
 @njit(cache=True)
 def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     """(zeta, zeta_dot, lambda) of particles i and j (j shifted by ``shift``) at window time t.
 
-    ``ws`` (11, 4) (row 8 zeros, ws[10, 0] counts the evaluations) and ``wm`` (2, d, d) are
-    scratch arrays; on return ws[0, :d],
-    ws[1, :d] hold the centres, ws[4, :d] the contact point, ws[5, :d] the normal n and wm[0],
-    wm[1] the inverse shape matrices."""
+    ``ws`` (row 8 zeros, ws[10, 0] counts the evaluations) and ``wm`` are the scratch arrays of
+    :func:`work_arrays`; on return ws[0, :d],
+    ws[1, :d] hold the centres, ws[4, :d] the contact point, ws[5, :d] the normal n, wm[0],
+    wm[1] the inverse shape matrices, ws[10, 1] the width of the slab between the particles'
+    support planes normal to n, r . n / |n| (1 - 1 / sqrt(1 + zeta)), a lower bound on the distance
+    of the surfaces (0 unless zeta > 0), ws[10, 2] the rate n . (v_j - v_i) / |n| at which the
+    centres separate along n and ws[10, 3] the bound c_i |w_i x n^| + c_j |w_j x n^| on the rate of
+    the support functions along n^ from the spins (:func:`support_rate_bound`; for
+    :func:`_safe_time`)."""
     d = shift.shape[0]
     cv, _, _, _, _, cw, _, _ = columns(d)
     xa, xb, oa, ob, rc = ws[0, :d], ws[1, :d], ws[2], ws[3], ws[4, :d]
     ax = ws[6, :d]
-    _pose(P, i, t, kappa, ws[8, :d], xa, wm[0], oa, ax)
-    _pose(P, j, t, kappa, shift, xb, wm[1], ob, ax)
+    _pose(P, i, t, kappa, ws[8, :d], xa, wm[0], oa, ax, wm[2])
+    _pose(P, j, t, kappa, shift, xb, wm[1], ob, ax, wm[2])
     r = ws[7, :d]
     for k in range(d):
         r[k] = xb[k] - xa[k]
-    zeta, lam, n = pw_contact(r, wm[0], wm[1], lam0)
+    n = ws[5, :d]
+    zeta, lam, _ = pw_contact_into(r, wm[0], wm[1], lam0, n, wm[2], wm[3], ws[6, :d])
     ws[10, 0] += 1.0
     contact_point(xa, wm[0], lam, n, rc)
+    rn = 0.0
+    nn = 0.0
+    nv = 0.0
     for k in range(d):
-        ws[5, k] = n[k]
+        rn += r[k] * n[k]
+        nn += n[k] * n[k]
+        nv += n[k] * (P[j, cv + k] - P[i, cv + k])
+    nn = np.sqrt(nn)
+    ws[10, 1] = rn / nn * (1.0 - 1.0 / np.sqrt(1.0 + zeta)) if zeta > 0.0 else 0.0
+    ws[10, 2] = nv / nn
+    ws[10, 3] = support_rate_bound(P, i, d) * _spin_across(P, i, n, nn) \
+        + support_rate_bound(P, j, d) * _spin_across(P, j, n, nn)
     nw = 3 if d == 3 else 1
     g = kappa / (1.0 + kappa * t)
     zdot = pw_rate(lam, n, xa, xb, rc, P[i, cv:cv + d], P[j, cv:cv + d], P[i, cw:cw + nw],
@@ -294,8 +328,9 @@ def _refine(P, i, j, shift, t, kappa, zc, lo, dlo, hi, zhi, dhi, lamhi, guess, l
     """First crossing of zeta = zc in the bracket [lo, hi] (zeta(lo) >= zc >= zeta(hi); ``dlo``,
     ``dhi`` the rates at the ends) by safeguarded Newton from ``guess`` (bisection when a step
     leaves the bracket). Returns (t_c, rate at t_c, hi, zeta(hi), rate at hi, lambda at hi) for
-    the final bracket: t_c is a time with zeta >= zc whose Newton step is below round-off of the
-    time, or the earlier end of a bracket narrowed to round-off; hi the later end."""
+    the final bracket: t_c is a time with |zeta - zc| <= ZETA_TOL (the round-off of zeta, which
+    Newton cannot improve on), or with zeta >= zc and a Newton step below round-off of the time,
+    or the earlier end of a bracket narrowed to round-off; hi the later end."""
     tt = guess if lo < guess < hi else 0.5 * (lo + hi)
     for _ in range(100):
         z, zd, lam = pair_zeta(P, i, j, shift, t + tt, kappa, lam, ws, wm)
@@ -304,6 +339,8 @@ def _refine(P, i, j, shift, t, kappa, zc, lo, dlo, hi, zhi, dhi, lamhi, guess, l
             lo, dlo = tt, zd
         else:
             hi, zhi, dhi, lamhi = tt, z, zd, lam
+        if abs(f) <= ZETA_TOL:
+            return tt, zd, hi, zhi, dhi, lamhi
         nt = tt - f / zd if zd != 0.0 else -1.0
         if f >= 0.0 and abs(nt - tt) <= 4e-16 * (t + tt):
             break
@@ -317,26 +354,157 @@ def _refine(P, i, j, shift, t, kappa, zc, lo, dlo, hi, zhi, dhi, lamhi, guess, l
     return lo, dlo, hi, zhi, dhi, lamhi
 
 
+@njit(cache=True, inline="always")
+def _safe_time(gap, sep_rate, spin, grow_speed, kappa, t):
+    """Time from window time t during which a pair cannot touch: the width ``gap`` of the slab
+    between the particles' support planes normal to a fixed unit vector u is a lower bound on the
+    distance of the surfaces at all times; it grows at the rate ``sep_rate`` = u . (v_j - v_i) of
+    the centres less the rates of the support functions h(u) = sqrt(u^T X^-1 u), each at most
+    c |w x u| (1 + kappa t') for a spin w (``spin`` = c_i |w_i x u| + c_j |w_j x u|, c = min(R,
+    (a_max^2 - a_min^2) / (2 a_min)) at the window start: derived in :func:`support_rate_bound`)
+    plus |kappa| R for the growth (``grow_speed``). The first root of
+    gap - (grow_speed + spin (1 + kappa t) - sep_rate) s - spin kappa s^2 / 2 = 0, or inf."""
+    if gap <= 0.0:
+        return 0.0
+    s0 = grow_speed + spin * (1.0 + kappa * t) - sep_rate
+    a = 0.5 * spin * kappa
+    if a > 0.0:  # the positive root, each form without cancellation
+        sq = np.sqrt(s0 * s0 + 4.0 * a * gap)
+        return 2.0 * gap / (s0 + sq) if s0 >= 0.0 else (sq - s0) / (2.0 * a)
+    if s0 <= 0.0:
+        return np.inf
+    return gap / s0
+
+
 @njit(cache=True)
-def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
-    """Earliest collision of i and j (shifted) in window time [t + tin, min(t + tout, tmax)) by
-    trace event location (module docstring). Returns (time, kind) with kind 0 collision, 1 CHECK,
-    and time inf when nothing happens before the end. A returned collision always approaches:
-    its rate zeta_dot is below -GRAZE_RATE times the pair's rate scale (the relative surface speed
-    bound over the smallest semiaxis), so the collision law never skips it for round-off."""
+def _screen_time(P, i, j, shift, t, kappa, ws, wm):
+    """A lower bound on the time from window time t to the first contact of i and j (shifted),
+    without the Perram-Wertheim maximisation: the slab between the support planes normal to
+    u = Y(lam)^-1 r for the guess lam = h_i / (h_i + h_j) (h the support functions along r, exact
+    for spheres) bounds their distance from below (any u does; this one is nearly the contact
+    normal), and :func:`_safe_time` turns its width into a time. 0 when the slab is empty. The
+    pose of i at t is in ws[0], wm[0] (:func:`_pose`); ws[1], ws[3], ws[5:8], wm[1:] are
+    overwritten."""
+    d = shift.shape[0]
+    cv, _, cr, _, _, _, _, _ = columns(d)
+    xi, mi, xj, mj = ws[0, :d], wm[0], ws[1, :d], wm[1]
+    _pose(P, j, t, kappa, shift, xj, mj, ws[3], ws[6, :d], wm[2])
+    r = ws[7, :d]
+    for k in range(d):
+        r[k] = xj[k] - xi[k]
+    hi = np.sqrt(_quad(mi, r))
+    hj = np.sqrt(_quad(mj, r))
+    lam = hi / (hi + hj)
+    y = wm[3]
+    for a in range(d):
+        for b in range(d):
+            y[a, b] = lam * mj[a, b] + (1.0 - lam) * mi[a, b]
+    _inverse_sym(y, wm[2])
+    u = ws[5, :d]
+    uu = 0.0
+    for a in range(d):
+        acc = 0.0
+        for b in range(d):
+            acc += wm[2, a, b] * r[b]
+        u[a] = acc
+        uu += acc * acc
+    uu = np.sqrt(uu)
+    ur = 0.0
+    sep = 0.0
+    for a in range(d):
+        u[a] /= uu
+        ur += u[a] * r[a]
+        sep += u[a] * (P[j, cv + a] - P[i, cv + a])
+    width = ur - np.sqrt(_quad(mi, u)) - np.sqrt(_quad(mj, u))
+    if width <= 0.0:
+        return 0.0
+    spin = support_rate_bound(P, i, d) * _spin_across(P, i, u, 1.0) \
+        + support_rate_bound(P, j, d) * _spin_across(P, j, u, 1.0)
+    return _safe_time(width, sep, spin, abs(kappa) * (P[i, cr] + P[j, cr]), kappa, t)
+
+
+@njit(cache=True, inline="always")
+def _quad(m, x):
+    """x^T m x."""
+    acc = 0.0
+    for a in range(x.shape[0]):
+        for b in range(x.shape[0]):
+            acc += x[a] * m[a, b] * x[b]
+    return acc
+
+
+@njit(cache=True, inline="always")
+def _back_safe_time(gap, sep_rate, spin, grow_speed, kappa, t0, t1):
+    """Time before window time t1 (back to t0 at most) during which a pair whose slab width at t1
+    is ``gap`` cannot have touched: :func:`_safe_time` run backwards, with the largest rate on
+    [t0, t1]."""
+    if gap <= 0.0:
+        return 0.0
+    s = grow_speed + spin * max(1.0 + kappa * t0, 1.0 + kappa * t1) + sep_rate
+    return gap / s if s > 0.0 else np.inf
+
+
+@njit(cache=True, inline="always")
+def _spin_across(P, i, n, nn):
+    """|w_i x n| / nn: the part of the spin of i that turns the direction n (norm nn); |w_i| in 2D."""
+    d = n.shape[0]
+    _, _, _, _, _, cw, _, _ = columns(d)
+    if d == 2:
+        return abs(P[i, cw])
+    w0, w1, w2 = P[i, cw], P[i, cw + 1], P[i, cw + 2]
+    c0 = w1 * n[2] - w2 * n[1]
+    c1 = w2 * n[0] - w0 * n[2]
+    c2 = w0 * n[1] - w1 * n[0]
+    return np.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / nn
+
+
+@njit(cache=True, inline="always")
+def support_rate_bound(P, i, d):
+    """c_i = min(R_i, (a_max^2 - a_min^2) / (2 a_min)) with the window-start semiaxes: |dh/dt| <=
+    c_i |w_i x u| for the support function h(u) = sqrt(u^T X^-1 u) of particle i along a fixed
+    unit vector u while it spins at w_i.
+
+    Derived here: with M = X^-1, dM/dt = W M - M W, so d(u^T M u)/dt = -2 (w x u) . (M u) and
+    dh/dt = -(w x u) . (M u) / h, the speed along u of the support point M u / h turning about the
+    centre; w x u is normal to u, so |dh/dt| <= |w x u| |M u|_perp / h, where the part of M u
+    normal to u is at most (a_max^2 - a_min^2) / 2 (eigenvalues of M between a_min^2 and
+    a_max^2) and h >= a_min, and also <= |w x u| R (the support point is within R of the
+    centre). A spin about u does not change h(u)."""
+    _, _, cr, cax, _, _, _, _ = columns(d)
+    amin = P[i, cax]
+    amax = P[i, cax]
+    for k in range(1, d):
+        amin = min(amin, P[i, cax + k])
+        amax = max(amax, P[i, cax + k])
+    return min(P[i, cr], 0.5 * (amax * amax - amin * amin) / amin)
+
+
+#: length of a pair's trace state (:func:`pair_start`)
+PAIR_STATE = 13
+
+
+@njit(cache=True)
+def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
+    """Start of the trace of i and j (shifted) at window time t + tin: zeta there and the pair's
+    constants into the state row ``st`` (PAIR_STATE entries) that :func:`pair_trace` continues.
+    Returns (lower bound on the collision time, relative to t; True for a collision now). The
+    bound is t_in plus the safe time of the distance bound (:func:`_safe_time`), or t_in for a
+    touching pair. A pair that starts in contact or overlapping (round-off after its collision,
+    or a missed collision) collides now if it approaches (rate below -rate_tol); otherwise it is
+    "touching" at the contact level zc = zeta(t_in): it collides only when it approaches at or
+    below that level (Donev 2006, Algorithm 11 step d)."""
     d = shift.shape[0]
     cv, _, cr, cax, _, cw, _, _ = columns(d)
-    end = min(tout, tmax - t)
     lam = P[i, cr] / (P[i, cr] + P[j, cr])
-    t0 = tin
-    z0, d0, lam = pair_zeta(P, i, j, shift, t + t0, kappa, lam, ws, wm)
+    z0, d0, lam = pair_zeta(P, i, j, shift, t + tin, kappa, lam, ws, wm)
+    gap0, sep0, spin0 = ws[10, 1], ws[10, 2], ws[10, 3]
     # rate scale: bound on the relative speed of the surfaces over the smallest semiaxis
     amin = P[i, cax]
     for k in range(1, d):
         amin = min(amin, P[i, cax + k])
     for k in range(d):
         amin = min(amin, P[j, cax + k])
-    amin *= 1.0 + kappa * (t + t0)
+    amin *= 1.0 + kappa * (t + tin)
     uu = 0.0
     for k in range(d):
         du = P[j, cv + k] - P[i, cv + k]
@@ -347,21 +515,54 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
     for k in range(nw):
         ww_i += P[i, cw + k] ** 2
         ww_j += P[j, cw + k] ** 2
-    speed = np.sqrt(uu) + (np.sqrt(ww_i) + abs(kappa)) * P[i, cr] * (1.0 + kappa * (t + t0)) \
-        + (np.sqrt(ww_j) + abs(kappa)) * P[j, cr] * (1.0 + kappa * (t + t0))
+    grow_speed = abs(kappa) * (P[i, cr] + P[j, cr])
+    speed = np.sqrt(uu) + (np.sqrt(ww_i) * P[i, cr] + np.sqrt(ww_j) * P[j, cr] + grow_speed) \
+        * (1.0 + kappa * (t + tin))
     rate_tol = GRAZE_RATE * speed / amin
-    # zc: the contact level. A pair that starts in contact or overlapping (round-off after its
-    # collision, or a missed collision) without approaching is "touching": it collides only when
-    # it approaches (rate below -rate_tol) at or below this level (Donev 2006, Algorithm 11 step d)
     zc = 0.0
-    touching = False
+    touching = 0.0
     if z0 <= 0.0:
         if d0 < -rate_tol:
-            return t + t0, 0
+            return tin, True
         zc = z0
-        touching = True
-    h = FIRST_STEP * amin / speed if speed > 0.0 else end - t0
-    hmin_step = MIN_STEP_FRACTION * h
+        touching = 1.0
+    h = FIRST_STEP * amin / speed if speed > 0.0 else np.inf
+    st[0], st[1], st[2], st[3], st[4], st[5], st[6] = tin, z0, d0, lam, gap0, sep0, zc
+    st[7], st[8], st[9], st[10], st[11], st[12] = touching, spin0, grow_speed, rate_tol, h, MIN_STEP_FRACTION * h
+    if speed == 0.0:  # nothing moves: zeta is constant
+        return np.inf, False
+    if touching:
+        return tin, False
+    return tin + _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + tin), False
+
+
+@njit(cache=True)
+def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
+    """Earliest collision of i and j (shifted) in window time [t + tin, min(t + tout, tmax)) by
+    trace event location (module docstring): :func:`pair_start` and :func:`pair_trace`. Returns
+    (time, kind) with kind 0 collision, 1 CHECK, and time inf when nothing happens before the end.
+    A returned collision always approaches: its rate zeta_dot is below -GRAZE_RATE times the
+    pair's rate scale (the relative surface speed bound over the smallest semiaxis), so the
+    collision law never skips it for round-off."""
+    st = np.empty(PAIR_STATE)
+    lower, now = pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st)
+    if now:
+        return t + tin, 0
+    if lower >= min(tout, tmax - t):
+        return np.inf, 0
+    return pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st)
+
+
+@njit(cache=True)
+def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
+    """Trace of i and j (shifted) from the state ``st`` of :func:`pair_start` to
+    min(t + tout, tmax): (time, kind) as :func:`predict_pair`."""
+    end = min(tout, tmax - t)
+    t0, z0, d0, lam, gap0, sep0, zc = st[0], st[1], st[2], st[3], st[4], st[5], st[6]
+    touching = st[7] != 0.0
+    spin0, grow_speed, rate_tol, h, hmin_step = st[8], st[9], st[10], st[11], st[12]
+    if h == np.inf:  # nothing moves
+        return np.inf, 0
     steps = 0
     while True:
         # the shortest step moves the time by a few ulps: a rest of the interval shorter than
@@ -371,21 +572,44 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
             return np.inf, 0
         if steps >= MAX_TRACE_STEPS:
             return t + t0, 1
+        # a safe step: no contact before the distance bound is used up (Donev 2006, sec. 3.5.1)
+        safe = _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + t0)
+        if t0 + safe >= end:
+            return np.inf, 0
         h = min(max(h, hfloor), end - t0)
-        t1 = t0 + h
-        z1, d1, lam1 = pair_zeta(P, i, j, shift, t + t1, kappa, lam, ws, wm)
+        if safe > h:
+            t1 = t0 + safe
+            z1, d1, lam1 = pair_zeta(P, i, j, shift, t + t1, kappa, lam, ws, wm)
+            if z1 > zc:
+                steps += 1
+                t0, z0, d0, lam, gap0, sep0, spin0 = t1, z1, d1, lam1, ws[10, 1], ws[10, 2], ws[10, 3]
+                continue
+            h = safe  # round-off of the bound: an ordinary step over the same interval
+        else:
+            t1 = t0 + h
+            z1, d1, lam1 = pair_zeta(P, i, j, shift, t + t1, kappa, lam, ws, wm)
+            # the safe times forwards from t0 and backwards from t1 cover the step: no midpoint
+            if z1 > zc and not touching and \
+                    safe + _back_safe_time(ws[10, 1], ws[10, 2], ws[10, 3], grow_speed, kappa, t + t0, t + t1) >= h:
+                steps += 1
+                t0, z0, d0, lam, gap0, sep0, spin0 = t1, z1, d1, lam1, ws[10, 1], ws[10, 2], ws[10, 3]
+                h *= 2.0
+                continue
+        gap1, sep1, spin1 = ws[10, 1], ws[10, 2], ws[10, 3]
         accepted = False  # a step past a crossing of zc (a graze) or a touching stretch
         while True:
             tm = t0 + 0.5 * h
             zm, dm, lamm = pair_zeta(P, i, j, shift, t + tm, kappa, lam, ws, wm)
+            gapm, sepm, spinm = ws[10, 1], ws[10, 2], ws[10, 3]
             if zm <= zc and touching:  # still in contact at the midpoint
                 if dm < -rate_tol:  # approaching: the collision is at the latest here
                     if h <= hfloor:
                         return t + tm, 0
                     h *= 0.5
-                    t1, z1, d1, lam1 = tm, zm, dm, lamm
+                    t1, z1, d1, lam1, gap1, sep1, spin1 = tm, zm, dm, lamm, gapm, sepm, spinm
                     continue
-                t1, z1, d1, lam1 = tm, zm, dm, lamm  # touching, not approaching: move on
+                # touching, not approaching: move on
+                t1, z1, d1, lam1, gap1, sep1, spin1 = tm, zm, dm, lamm, gapm, sepm, spinm
                 zc = min(zc, zm)
                 accepted = True
                 break
@@ -403,7 +627,7 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
                 if dc < -rate_tol:
                     return t + tc, 0
                 # a grazing touch: the pair is touching from just past it on
-                t1, z1, d1, lam1 = thi, zhi, dhi, lamhi
+                t1, z1, d1, lam1, gap1, sep1, spin1 = thi, zhi, dhi, lamhi, 0.0, 0.0, 0.0
                 zc = min(zc, z1)
                 touching = True
                 accepted = True
@@ -417,10 +641,10 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
             # halve: the midpoint becomes the end
             h *= 0.5
             t1 = t0 + h
-            z1, d1, lam1 = zm, dm, lamm
+            z1, d1, lam1, gap1, sep1, spin1 = zm, dm, lamm, gapm, sepm, spinm
         steps += 1
         t0 = t1
-        z0, d0, lam = z1, d1, lam1
+        z0, d0, lam, gap0, sep0, spin0 = z1, d1, lam1, gap1, sep1, spin1
         if accepted:
             continue
         if err > 0.0:
@@ -580,10 +804,15 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
 
 
 @njit(cache=True)
-def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, wm):
+def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm):
     """Next event of particle i from window time t: (time, partner), partner EXIT, CHECK or a
-    particle index (Algorithm 5 with NNLs; pairs by :func:`predict_pair` in the order of their
-    bounding-sphere contact times)."""
+    particle index (Algorithm 5 with NNLs). The pairs are searched best first: each has a key, a
+    lower bound on its collision time, first the start t_in of its bounding-sphere overlap (or,
+    for the pairs whose bounding spheres overlap now, the cheap bound of :func:`_screen_time`),
+    then, once :func:`pair_start` has evaluated zeta at t_in, t_in plus its safe time; the pair
+    of the smallest key is started or, if started, traced (:func:`pair_trace`), until the
+    smallest key is after the earliest event found (``done``: 0 new, 3 screened, 1 started,
+    2 finished; ``pst`` the states of the started pairs)."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 2 * d
@@ -655,22 +884,49 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, w
                     den = b + np.sqrt(disc)
                     touts[m] = -c / den if den > 0.0 else 0.0
     sh = ws[9, :d]
-    for _ in range(m_n):  # trace in the order of the overlap starts
+    # screen the pairs whose bounding spheres overlap now with a cheap bound (_screen_time)
+    posed = False
+    for m in range(m_n):
+        if tins[m] == 0.0 and t < min(best, horizon):
+            if not posed:
+                _pose(P, i, t, kappa, ws[8, :d], ws[0, :d], wm[0], ws[2], ws[6, :d], wm[2])
+                posed = True
+            e = nb[i, m]
+            for k in range(d):
+                sh[k] = imgvec[e & cmask, k]
+            lower = _screen_time(P, i, e >> cbits, sh, t, kappa, ws, wm)
+            if lower > 0.0:
+                tins[m] = lower
+                done[m] = 3
+    for _ in range(3 * m_n):  # best first: each pair is (screened,) started, then traced
         q = -1
         tq = np.inf
         for m in range(m_n):
-            if done[m] == 0 and tins[m] < tq:
+            if done[m] != 2 and tins[m] < tq:
                 tq = tins[m]
                 q = m
         if q < 0 or t + tq >= min(best, horizon):
             break
-        done[q] = 1
         e = nb[i, q]
         j = e >> cbits
         im = e & cmask
         for k in range(d):
             sh[k] = imgvec[im, k]
-        tc, kind = predict_pair(P, i, j, sh, t, min(best, horizon), tq, touts[q], kappa, eps_f, ws, wm)
+        if done[q] == 0 or done[q] == 3:
+            tstart = 0.0 if done[q] == 3 else tq
+            lower, now = pair_start(P, i, j, sh, t, tstart, kappa, ws, wm, pst[q])
+            if now:
+                done[q] = 2
+                if t + tstart < best:
+                    best = t + tstart
+                    partner = j
+            else:
+                lower = max(lower, tq)
+                done[q] = 1 if lower < touts[q] else 2
+                tins[q] = lower
+            continue
+        done[q] = 2
+        tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q])
         if tc < best:
             best = tc
             partner = j if kind == 0 else CHECK
@@ -756,10 +1012,10 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     time in acc[A_T]); acc[A_KE]
     enters the current translational kinetic energy; ``acc`` has a sixth entry, A_EVAL, that
     receives the number of contact-function evaluations)."""
-    ws = np.zeros((11, 4))
+    ws, wm = work_arrays(L.shape[0])
     status = _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                   slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
-                  coll_target, t_cap, rebuild_lists, ws)
+                  coll_target, t_cap, rebuild_lists, ws, wm)
     acc[A_EVAL] = ws[10, 0]
     return status
 
@@ -767,7 +1023,7 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
 @njit(cache=True)
 def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
          slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
-         coll_target, t_cap, rebuild_lists, ws):
+         coll_target, t_cap, rebuild_lists, ws, wm):
     d = L.shape[0]
     n = P.shape[0]
     cap = nb.shape[1]
@@ -778,8 +1034,8 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
     codo = np.empty(d, dtype=np.int64)
     tins = np.empty(cap)
     touts = np.empty(cap)
+    pst = np.empty((cap, PAIR_STATE))
     done = np.empty(cap, dtype=np.int8)
-    wm = np.empty((2, d, d))
     scratch = np.empty(4)
     upd = np.empty(2, dtype=np.int64)
     mark[:] = 0
@@ -796,7 +1052,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
                 acc[A_T] = 0.0
                 return status
     for i in range(n):
-        key, partner = _predict(i, 0.0, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, ws, wm)
+        key, partner = _predict(i, 0.0, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm)
         ep[i] = partner
         if partner >= 0:
             ec[i] = cnt[partner]
@@ -815,8 +1071,8 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         if t == np.inf:
             return WindowStatus.STUCK
         p = ep[i]
-        # progress guard: every event advances the time, except chains of collisions of distinct
-        # pairs at one instant, which are short; a long run of events at one time is a failure
+        # progress guard: every event but a collision advances the time (collisions at one
+        # instant change the velocities); a long run of other events at one time is a failure
         if t == t_last:
             same += 1
             if same > max_same:
@@ -845,6 +1101,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             j = p
             jimp, vir, dke = collide(P, i, j, t, L, kappa, ws, wm)
             if jimp > 0.0:
+                same = 0
                 acc[A_VIRIAL] += vir
                 acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
                 acc[A_TKE] = t
@@ -859,7 +1116,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         for q in range(npred):
             k = upd[q]
             key, partner = _predict(k, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done,
-                                    ws, wm)
+                                    pst, ws, wm)
             ep[k] = partner
             if partner >= 0:
                 ec[k] = cnt[partner]
@@ -932,8 +1189,7 @@ def max_overlap(P, imgvec, nb, nn):
     the number of pairs with a positive one. Every touching pair is listed."""
     d = imgvec.shape[1]
     cbits = 2 * d
-    ws = np.zeros((11, 4))
-    wm = np.empty((2, d, d))
+    ws, wm = work_arrays(d)
     worst = -np.inf
     count = 0
     _, _, cr, _, _, _, _, _ = columns(d)
