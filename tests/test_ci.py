@@ -81,3 +81,24 @@ def test_slurm_job_check_counts_group_members_when_executor_messages_interleave(
     (tmp_path / "ctld.log").write_text(ctld_log.replace("JobId=12 WEXITSTATUS 0", "JobId=12 WEXITSTATUS 1"))
     with pytest.raises(SystemExit, match="did not complete"):
         check.main(str(tmp_path / "snakemake.log"), str(tmp_path / "ctld.log"))
+
+
+def test_slurm_subset_deletes_one_output_per_rule_and_the_validation(tmp_path):
+    summary = tmp_path / "summary.tsv"
+    summary.write_text(
+        "output_file\tdate\trule\tlog-file(s)\tstatus\tplan\n"
+        "results/a/init/seed1.nc\tThu Nov 26 09:17:07 2026\tinit\t-\tok\tno update\n"
+        "results/a/init/seed2.nc\tThu Nov 26 09:17:08 2026\tinit\t-\tok\tno update\n"
+        "results/a/jammed/seed1.nc\tThu Nov 26 09:18:00 2026\tcompress\t-\tok\tno update\n"
+        "results/validation/gate.txt\tThu Nov 26 09:19:00 2026\tvalidation\t-\tok\tno update\n")
+    run = tmp_path / "run"
+    for name in ("a/init/seed1.nc", "a/init/seed2.nc", "a/jammed/seed1.nc", "validation/gate.txt",
+                 "validation/report.md"):
+        (run / "results" / name).parent.mkdir(parents=True, exist_ok=True)
+        (run / "results" / name).write_text("x")
+    out = subprocess.run(["python", str(ROOT / ".ci" / "slurm_subset.py"), str(summary), str(run)],
+                         capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["results/a/init/seed1.nc", "results/a/jammed/seed1.nc", "results/validation/gate.txt"]
+    assert not (run / "results" / "validation").exists()
+    assert not (run / "results/a/init/seed1.nc").exists() and not (run / "results/a/jammed/seed1.nc").exists()
+    assert (run / "results/a/init/seed2.nc").exists()
