@@ -17,6 +17,7 @@ from hardpack.structure.containers import (
     core_density,
     fit_window_power_law,
     radial_density_profile,
+    wall_layer_density,
     window_study,
 )
 from hardpack.validation.containers import container_rows
@@ -51,13 +52,23 @@ def test_core_density_needs_a_container():
 
 
 # ----------------------------------------------------------------------------- summary and Eq. 7.2
-def _profile(n, seed, delta, phi, core, margin=10.0):
-    return xr.Dataset(attrs={"N": n, "seed": seed, "a_over_R": delta, "phi": phi, "phi_core": core,
-                             "core_margin": margin})
+def _profile(n, seed, delta, phi, core, margin=10.0, wall_layer=0.5):
+    """A radial profile in shells of a / 4 (a = 1, R = 1 / delta): wall_layer in the last a, phi inside."""
+    radius = 1.0 / delta
+    edges = np.linspace(0.0, radius, int(round(4 * radius)) + 1)
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    return xr.Dataset({"phi": ("r", np.where(mid > radius - 1.0, wall_layer, phi)),
+                       "r_inner": ("r", edges[:-1]), "r_outer": ("r", edges[1:])}, coords={"r": mid},
+                      attrs={"N": n, "seed": seed, "a_over_R": delta, "phi": phi, "phi_core": core,
+                             "core_margin": margin, "radius": radius, "a": 1.0})
+
+
+def _bulk(phis=(0.6412, 0.6428, 0.6416), n=1000):
+    return [xr.Dataset(attrs={"N": n, "seed": k + 1, "phi": v}) for k, v in enumerate(phis)]
 
 
 def _summary(phi0=0.642, slope=-0.55, sizes=(1000, 2000, 5000), seeds=(1, 2, 3), core=(0.641, 0.639, 0.640),
-             noise=0.0005, fit_min_n=1):
+             noise=0.0005, fit_min_n=1, bulk=()):
     rng = np.random.default_rng(3)
     profiles = []
     for n in sizes:
@@ -65,7 +76,7 @@ def _summary(phi0=0.642, slope=-0.55, sizes=(1000, 2000, 5000), seeds=(1, 2, 3),
         for k, seed in enumerate(seeds):
             profiles.append(_profile(n, seed, delta, phi0 + slope * delta + noise * rng.standard_normal(),
                                      core[k % len(core)] if n == max(sizes) else np.nan))
-    return container_summary(profiles, fit_min_n=fit_min_n)
+    return container_summary(profiles, fit_min_n=fit_min_n, bulk=bulk)
 
 
 def test_container_summary_recovers_an_exact_line_and_orders_by_n_and_seed():
@@ -76,6 +87,36 @@ def test_container_summary_recovers_an_exact_line_and_orders_by_n_and_seed():
     assert ds.attrs["phi0_err"] < 1e-12 and ds.attrs["n_sizes_fit"] == 3
     few = container_summary(profiles, fit_min_n=1000)  # two points: no fit, NaN
     assert np.isnan(few.attrs["phi0"]) and few.attrs["n_fit"] == 2
+
+
+def test_wall_layer_density_weights_the_shells_cut_by_the_layer_edge():
+    """R = 10.3 a in shells of a / 4: the layer edge R - a cuts a shell; a uniform profile gives its
+    own density, a step at r = R - a gives the step's value, at any shell alignment."""
+    prof = _profile(100, 1, 1 / 10.3, 0.3, 0.3, wall_layer=0.3)
+    assert wall_layer_density(prof) == pytest.approx(0.3, rel=1e-12)
+    edges = np.linspace(0, 10.3, 42)
+    cut = np.flatnonzero((edges[:-1] < 9.3) & (edges[1:] > 9.3))[0]  # the shell across the layer edge
+    phi = np.where(np.arange(41) > cut, 0.5, 0.9)
+    phi[cut] = 0.6
+    step = xr.Dataset({"phi": ("r", phi), "r_inner": ("r", edges[:-1]), "r_outer": ("r", edges[1:])},
+                      coords={"r": 0.5 * (edges[1:] + edges[:-1])}, attrs={"radius": 10.3, "a": 1.0})
+    expected = (0.5 * (10.3**3 - edges[cut + 1] ** 3) + 0.6 * (edges[cut + 1] ** 3 - 9.3**3)) / (10.3**3 - 9.3**3)
+    assert wall_layer_density(step) == pytest.approx(expected, rel=1e-12)
+    with pytest.raises(InvalidInputError, match="radius"):
+        wall_layer_density(xr.Dataset(attrs={"a": 1.0}))
+
+
+def test_container_summary_keeps_the_periodic_packings_of_the_protocol():
+    ds = _summary(bulk=_bulk())
+    assert ds.attrs["phi_bulk"] == pytest.approx(np.mean([0.6412, 0.6428, 0.6416]), rel=1e-12)
+    assert ds.attrs["phi_bulk_err"] == pytest.approx(np.std([0.6412, 0.6428, 0.6416], ddof=1) / np.sqrt(3))
+    assert ds.attrs["n_bulk"] == 3 and ds.attrs["bulk_N"] == 1000 and ds.bulk_seed.values.tolist() == [1, 2, 3]
+    assert np.isnan(_summary(bulk=_bulk((0.64,))).attrs["phi_bulk_err"])
+    assert "phi_bulk" not in _summary().attrs
+    for bad, message in ((_bulk() + _bulk((0.64,), n=500), "different N"), (_bulk() + _bulk((0.64,)), "repeats"),
+                         ([xr.Dataset(attrs={"N": 10})], "lacks the attributes")):
+        with pytest.raises(InvalidInputError, match=message):
+            _summary(bulk=bad)
 
 
 @pytest.mark.parametrize("profiles, message", [
@@ -138,6 +179,14 @@ def test_container_rows_pass_on_donevs_numbers():
     assert rows["donev-fig7.3-window-exponent"].reproduced == pytest.approx(-2, abs=0.02)
 
 
+def test_bulk_row_judges_the_periodic_packings_of_the_protocol():
+    row = _rows(_summary(bulk=_bulk()))["donev-7.3-bulk-phi-periodic"]
+    assert row.status == PASS and row.reproduced == pytest.approx(0.64187, abs=1e-5)
+    assert _rows(_summary(bulk=_bulk((0.6485, 0.6490, 0.6480))))["donev-7.3-bulk-phi-periodic"].status == FAIL
+    assert _rows(_summary(bulk=_bulk(n=100)))["donev-7.3-bulk-phi-periodic"].status == NA
+    assert _rows(_summary(bulk=_bulk((0.642, 0.642))))["donev-7.3-bulk-phi-periodic"].status == NA  # 2 seeds
+
+
 def test_container_rows_fail_when_the_numbers_differ():
     rows = _rows(_summary(phi0=0.652, core=(0.625, 0.627, 0.626)), _windows(prefactor=0.2, exponent=-1.2))
     assert {r.status for r in rows.values()} == {FAIL}
@@ -171,5 +220,6 @@ def test_figures_are_written(tmp_path):
         profiles.append(prof)
     save(plot_radial_profile(profiles), tmp_path / "profile.pdf")
     save(plot_extrapolation(_summary()), tmp_path / "extrapolation.pdf", tmp_path / "extrapolation.png")
+    save(plot_extrapolation(_summary(bulk=_bulk())), tmp_path / "extrapolation_bulk.pdf")
     save(plot_window_fluctuations(_windows()), tmp_path / "windows.pdf")
     assert all((tmp_path / f).stat().st_size > 1000 for f in ("profile.pdf", "extrapolation.png", "windows.pdf"))

@@ -227,12 +227,22 @@ def _container_systems():
     c = CONTAINERS
     compress = (f"--growth-rate {c['growth_rate']} --final-growth-rate {c['final_growth_rate']}"
                 f" --switch-pressure {c['switch_pressure']} --max-pressure {c['max_pressure']}")
-    return {f"n{n}": _system(n, 3, c["seeds"], c["init_phi"], attrs={}, compress=compress) for n in c["N"]}
+    systems = {f"n{n}": _system(n, 3, c["seeds"], c["init_phi"], attrs={}, compress=compress,
+                                boundary="spherical_container") for n in c["N"]}
+    systems["bulk"] = _system(c["bulk"]["N"], 3, c["bulk"]["seeds"], c["init_phi"], attrs={}, compress=compress,
+                              boundary="periodic")
+    return systems
 
 
 def container_files(step):
     """Per-seed files of every container size (results/containers/n{N}/{step}/seed{seed}.nc)."""
-    return [path for name in SYSTEMS["containers"] for path in seed_files("containers", name, step)]
+    return [path for name, s in SYSTEMS["containers"].items() if s["boundary"] == "spherical_container"
+            for path in seed_files("containers", name, step)]
+
+
+def container_bulk_packings():
+    """The periodic packings of the containers' protocol (results/containers/bulk/jammed/seed{seed}.nc)."""
+    return seed_files("containers", "bulk", "jammed")
 
 
 def window_packings():

@@ -5,12 +5,14 @@
 
 
 rule container_init:
-    """Random sequential addition start of one container size and seed, inside a spherical container."""
+    """Random sequential addition start of one container size and seed, inside a spherical container
+    (or, for the system ``bulk``, in a periodic cube)."""
     output:
         "results/containers/{name}/init/seed{seed}.nc",
     params:
         n=lambda w: SYSTEMS["containers"][w.name]["N"],
         phi=lambda w: SYSTEMS["containers"][w.name]["init_phi"],
+        boundary=lambda w: SYSTEMS["containers"][w.name]["boundary"],
     threads: 1
     resources:
         mem_mb=job_mem_mb("container_init"),
@@ -24,7 +26,7 @@ rule container_init:
     benchmark:
         "results/benchmarks/container_init/{name}/seed{seed}.tsv"
     shell:
-        "hardpack init --n {params.n} --d 3 --phi {params.phi} --boundary spherical_container"
+        "hardpack init --n {params.n} --d 3 --phi {params.phi} --boundary {params.boundary}"
         " --seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
@@ -55,10 +57,12 @@ rule container_profile:
 
 
 rule container_summary:
-    """The container packings over (N, seed) and the Eq. 7.2 extrapolation of phi_avg to a/R -> 0
-    over the sizes N >= fit_min_n, with its standard error."""
+    """The container packings over (N, seed), the Eq. 7.2 extrapolation of phi_avg to a/R -> 0
+    over the sizes N >= fit_min_n with its standard error, and the density of periodic packings
+    made with the same protocol (the bulk value the extrapolation estimates)."""
     input:
-        container_files("profile") if CONTAINERS else [],
+        profiles=container_files("profile") if CONTAINERS else [],
+        bulk=container_bulk_packings() if CONTAINERS else [],
     output:
         "results/containers/profile_summary.nc",
     params:

@@ -1,4 +1,5 @@
-"""Snakemake script: the container packings over (N, seed) and the Eq. 7.2 bulk extrapolation."""
+"""Snakemake script: the container packings over (N, seed), the Eq. 7.2 bulk extrapolation and the
+periodic packings of the same protocol."""
 
 import logging
 
@@ -6,7 +7,10 @@ from hardpack.io import load_dataset, write_dataset
 from hardpack.structure.containers import container_summary
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
-ds = container_summary([load_dataset(path) for path in snakemake.input], fit_min_n=snakemake.params.fit_min_n)
+ds = container_summary([load_dataset(path) for path in snakemake.input.profiles], fit_min_n=snakemake.params.fit_min_n,
+                       bulk=[load_dataset(path) for path in snakemake.input.bulk])
 write_dataset(ds, snakemake.output[0])
 logging.info("%s: %d packings; phi_0 = %.4f +- %.4f over %d packings of %d sizes", snakemake.output[0],
              ds.sizes["sample"], ds.attrs["phi0"], ds.attrs["phi0_err"], ds.attrs["n_fit"], ds.attrs["n_sizes_fit"])
+logging.info("periodic packings of the protocol: phi = %.4f +- %.4f (%d)", ds.attrs["phi_bulk"],
+             ds.attrs["phi_bulk_err"], ds.attrs["n_bulk"])

@@ -51,7 +51,8 @@ def plot_radial_profile(profiles):
 def plot_extrapolation(summary):
     """The average density phi_avg against delta = a/R of every packing, the mean per N, and the
     linear fit of Eq. 7.2 extended to delta = 0 with its intercept phi_0 +- s.e., beside Donev's
-    0.642 +- 0.002 (Donev 2006, Sec. 7.3.2.1, Fig. 7.6).
+    0.642 +- 0.002 (Donev 2006, Sec. 7.3.2.1, Fig. 7.6) and, when the summary has them, the mean
+    density of periodic packings made with the same protocol (dashed, band: s.e.).
 
     Parameters
     ----------
@@ -76,6 +77,13 @@ def plot_extrapolation(summary):
         ax.plot(grid, phi0 + slope * grid, "-", color="C1",
                 label=rf"fit (N $\geq$ {summary.attrs['fit_min_n']}): $\phi_0$ = {phi0:.4f} $\pm$ {err:.4f}")
         ax.errorbar([0], [phi0], [err], fmt="o", color="C1", capsize=3)
+    if "phi_bulk" in summary.attrs:
+        bulk, bulk_err = summary.attrs["phi_bulk"], summary.attrs["phi_bulk_err"]
+        ax.axhline(bulk, color="C2", lw=1, ls="--",
+                   label=rf"periodic, same protocol (N = {summary.attrs['bulk_N']}): {bulk:.4f}"
+                         + (rf" $\pm$ {bulk_err:.4f}" if np.isfinite(bulk_err) else ""))
+        if np.isfinite(bulk_err):
+            ax.axhspan(bulk - bulk_err, bulk + bulk_err, color="C2", alpha=0.15, lw=0)
     ax.errorbar([0], [DONEV_PHI0[0]], [DONEV_PHI0[1]], fmt="*", ms=8, color="k", capsize=3,
                 label=r"Donev 2006: $\phi_0$ = 0.642 $\pm$ 0.002")
     ax.set_xlim(left=-0.005)

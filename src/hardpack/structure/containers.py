@@ -300,8 +300,9 @@ def core_density(packing, margin: float) -> float:
     return float(covered / ball_volume(radius, packing.dim))
 
 
-def container_summary(profiles, fit_min_n: int = 1) -> xr.Dataset:
-    """The packings of a container study over (N, seed) and the Eq. 7.2 bulk extrapolation.
+def container_summary(profiles, fit_min_n: int = 1, bulk=()) -> xr.Dataset:
+    """The packings of a container study over (N, seed), the Eq. 7.2 bulk extrapolation and the
+    density of periodic packings made with the same protocol.
 
     Parameters
     ----------
@@ -312,6 +313,10 @@ def container_summary(profiles, fit_min_n: int = 1) -> xr.Dataset:
     fit_min_n : int, default 1
         The extrapolation uses the packings with N >= fit_min_n (Donev: "a range of (sufficiently
         large) container sizes").
+    bulk : sequence of xarray.Dataset, optional
+        Jammed periodic packings of the containers' compression protocol (attributes ``N``,
+        ``seed``, ``phi``): the bulk density phi_0 that the extrapolation estimates (Donev 2006,
+        Sec. 7.3.2.1: "the core density phi_0 will approach the bulk packing density").
 
     Returns
     -------
@@ -320,7 +325,10 @@ def container_summary(profiles, fit_min_n: int = 1) -> xr.Dataset:
         ``phi_avg``, ``phi_core``; attributes ``phi0``, ``phi0_err``, ``slope``, ``slope_err``
         (:func:`extrapolate_bulk_density` over every packing with N >= fit_min_n, NaN when fewer
         than 3 such packings or only one a/R), ``n_fit``, ``n_sizes_fit``, ``fit_min_n``,
-        ``core_margin``.
+        ``core_margin``. ``phi_wall_layer`` is the density of the layer within one a of the wall,
+        the part of Eq. 7.1's wall correction that wall curvature changes most. With ``bulk``:
+        dimension ``bulk_sample`` (``bulk_seed``, ``phi_bulk``) and attributes ``phi_bulk``, its
+        standard error ``phi_bulk_err`` (NaN for one packing), ``n_bulk``, ``bulk_N``.
 
     Raises
     ------
@@ -344,16 +352,21 @@ def container_summary(profiles, fit_min_n: int = 1) -> xr.Dataset:
     margins = {float(p.attrs["core_margin"]) for p in profiles}
     if len(margins) != 1:
         raise InvalidInputError(f"the profiles have different core margins {sorted(margins)}")
+    layer = {(int(p.attrs["N"]), int(p.attrs["seed"])): wall_layer_density(p) for p in profiles}
     n, seed, delta, phi, core = (np.array(c) for c in zip(*rows))
+    wall = np.array([layer[(int(a), int(b))] for a, b in zip(n, seed)])
     use = n >= fit_min_n
     fit = {"phi0": np.nan, "phi0_err": np.nan, "slope": np.nan, "slope_err": np.nan}
     if use.sum() >= 3 and np.ptp(delta[use]) > 0:
         f = extrapolate_bulk_density(delta[use], phi[use])
         fit = {"phi0": f.phi0, "phi0_err": f.phi0_err, "slope": f.slope, "slope_err": f.slope_err}
+    data = {"a_over_R": ("sample", delta), "phi_avg": ("sample", phi), "phi_core": ("sample", core),
+            "phi_wall_layer": ("sample", wall)}
+    coords = {"N": ("sample", n), "seed": ("sample", seed)}
+    extra = _bulk_density(bulk, data, coords)
     return xr.Dataset(
-        {"a_over_R": ("sample", delta), "phi_avg": ("sample", phi), "phi_core": ("sample", core)},
-        coords={"N": ("sample", n), "seed": ("sample", seed)},
-        attrs={"hardpack_kind": "container_summary", **fit, "n_fit": int(use.sum()),
+        data, coords=coords,
+        attrs={"hardpack_kind": "container_summary", **fit, **extra, "n_fit": int(use.sum()),
                "n_sizes_fit": len(set(n[use].tolist())), "fit_min_n": int(fit_min_n),
                "core_margin": margins.pop(), "index": '["N", "seed"]',
                "source": "Donev 2006, Sec. 7.3.2.1, Eq. 7.2 and Fig. 7.6 (linear fit in a/R)"},
@@ -471,3 +484,38 @@ def fit_window_power_law(x, sigma, x_min: float = 0.0) -> PowerLaw:
     scaled = y[use] * x[use] ** 2
     return PowerLaw(exponent, exponent_err, float(np.exp(log_a)), float(np.exp(log_a) * log_a_err),
                     float(scaled.mean()), float(scaled.std(ddof=1) / np.sqrt(scaled.size)), int(use.sum()))
+
+
+def wall_layer_density(profile: xr.Dataset) -> float:
+    """Volume fraction of the shell R - a < r <= R next to the wall, from a radial profile
+    (:func:`radial_density_profile`; shells cut by the layer's edge count by their overlap)."""
+    for k in ("radius", "a"):
+        if k not in profile.attrs:
+            raise InvalidInputError(f"radial profile {profile.attrs.get('source', '?')} lacks the attribute {k!r}")
+    radius, a = float(profile.attrs["radius"]), float(profile.attrs["a"])
+    inner = np.clip(profile["r_inner"].values, radius - a, radius)
+    outer = np.clip(profile["r_outer"].values, radius - a, radius)
+    vol = outer**3 - inner**3
+    return float(np.sum(profile["phi"].values * vol) / (radius**3 - (radius - a) ** 3))
+
+
+def _bulk_density(bulk, data: dict, coords: dict) -> dict:
+    """Add the periodic packings of the protocol to ``data`` / ``coords``; their attributes."""
+    bulk = list(bulk)
+    if not bulk:
+        return {}
+    for p in bulk:
+        missing = [k for k in ("N", "seed", "phi") if k not in p.attrs]
+        if missing:
+            raise InvalidInputError(f"bulk packing {p.attrs.get('source', '?')} lacks the attributes {missing}")
+    sizes = {int(p.attrs["N"]) for p in bulk}
+    if len(sizes) != 1:
+        raise InvalidInputError(f"the bulk packings have different N {sorted(sizes)}: give one ensemble")
+    seeds = [int(p.attrs["seed"]) for p in bulk]
+    if len(set(seeds)) != len(seeds):
+        raise InvalidInputError(f"a seed repeats among the bulk packings: {seeds}")
+    values = np.array([float(p.attrs["phi"]) for p in bulk])
+    data["phi_bulk"] = ("bulk_sample", values)
+    coords["bulk_seed"] = ("bulk_sample", np.array(seeds))
+    err = float(values.std(ddof=1) / np.sqrt(len(values))) if len(values) > 1 else float("nan")
+    return {"phi_bulk": float(values.mean()), "phi_bulk_err": err, "n_bulk": len(values), "bulk_N": sizes.pop()}

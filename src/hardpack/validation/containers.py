@@ -5,7 +5,9 @@ Inputs (the pipeline's ``containers`` summaries, told apart by ``hardpack_kind``
 - ``container_summary`` (:func:`hardpack.structure.containers.container_summary`): the Eq. 7.2
   intercept phi_0 +- its standard error against 0.642 +- 0.002 (Sec. 7.3.2.1), judged at the
   largest N of the fit with its number of sizes; the core density r <= R - core_margin a of the
-  packings of the largest container against "about 0.64" (Fig. 7.5), over seeds.
+  packings of the largest container against "about 0.64" (Fig. 7.5), over seeds; and, with the
+  summary's periodic packings of the same protocol, their density against the same 0.642 +- 0.002
+  (the bulk value phi_0 that the extrapolation estimates).
 - ``window_study`` (:func:`hardpack.structure.containers.window_study`): sigma_phi averaged over
   the packings, fitted by a power law over 2R/D >= fit_min_diameter
   (:func:`~hardpack.structure.containers.fit_window_power_law`): the exponent against -2 and the
@@ -30,11 +32,29 @@ def _bulk_rows(targets, summary) -> list[Row]:
     fit = evaluate(targets["donev-7.3-bulk-phi0"], float(a["phi0"]), float(a["phi0_err"]), n=int(fitted.max()),
                    sizes=int(a["n_sizes_fit"]), label="Eq. 7.2 intercept",
                    detail=f"linear fit over {a['n_fit']} packings, N = {sizes}; "
-                          f"slope {a['slope']:.3f} +- {a['slope_err']:.3f}")
+                          f"slope {a['slope']:.3f} +- {a['slope_err']:.3f}; {_wall_layer_detail(summary)}")
     core = np.asarray(summary["phi_core"].values, float)[n == largest]
     margin = a["core_margin"]
-    return [fit, evaluate(targets["donev-fig7.5-core-phi"], samples=core, n=largest, label=f"N = {largest}",
+    rows = [fit, evaluate(targets["donev-fig7.5-core-phi"], samples=core, n=largest, label=f"N = {largest}",
                           detail=f"r <= R - {margin:g} a; per seed {', '.join(f'{v:.4f}' for v in core)}")]
+    if "phi_bulk" in summary:
+        bulk = np.asarray(summary["phi_bulk"].values, float)
+        rows.append(evaluate(targets["donev-7.3-bulk-phi-periodic"], samples=bulk, n=int(a["bulk_N"]),
+                             label=f"periodic, N = {a['bulk_N']}",
+                             detail="the containers' compression protocol in a periodic cube; per seed "
+                                    + ", ".join(f"{v:.4f}" for v in bulk)))
+    return rows
+
+
+def _wall_layer_detail(summary) -> str:
+    """Mean density of the layer within one a of the wall per container size (Eq. 7.1 takes the
+    wall correction as independent of R; a trend with a/R bends phi_avg(a/R) away from a line)."""
+    if "phi_wall_layer" not in summary:
+        return "no wall-layer densities"
+    n = np.asarray(summary["N"].values)
+    parts = [f"{np.mean(summary['phi_wall_layer'].values[n == k]):.3f} at a/R = "
+             f"{np.mean(summary['a_over_R'].values[n == k]):.3f}" for k in sorted(set(n.tolist()))]
+    return "wall-layer density " + ", ".join(parts)
 
 
 def _window_rows(targets, windows) -> list[Row]:
