@@ -371,6 +371,82 @@ def _jammed_short(stop: StopCriteria, record: dict, growth_rate: float) -> None:
     )
 
 
+def run_windows(sim, stop: StopCriteria, stage_window, checkpoint, fingerprint: str, *, final_growth_rate=None,
+                switch_pressure: float = 1e3, progress=None, progress_interval: float = 10.0,
+                checkpoint_interval: float = 300.0, label: str = "") -> str:
+    """Run a simulation's event windows until a stop criterion holds (the loop of :func:`compress`).
+
+    Resumes from ``checkpoint`` when it holds a state of the same ``fingerprint``; switches to
+    ``final_growth_rate`` at the first window whose reduced pressure reaches ``switch_pressure``;
+    refuses to go on when a run towards ``stop.target_phi`` jammed short of it; logs progress,
+    writes checkpoints every ``checkpoint_interval`` seconds at points where the continuation is
+    bit-identical, and on SIGINT / SIGTERM saves and raises
+    :class:`hardpack.io.interrupt.Interrupted`.
+
+    Parameters
+    ----------
+    sim : Simulation or EllipsoidSimulation
+        Anything with ``run_window``, ``growth_rate``, ``n``, ``collisions``, ``windows``,
+        ``records``, ``checkpoint_ready``, ``state()`` and ``restore()``.
+    stop : StopCriteria
+        When to stop.
+    stage_window : callable
+        Collisions per particle of a window at a growth rate.
+    checkpoint : path or None
+        Resumable checkpoint.
+    fingerprint : str
+        :func:`hardpack.io.checkpoint.fingerprint` of the run's inputs.
+    final_growth_rate, switch_pressure, progress, progress_interval, checkpoint_interval
+        As for :func:`compress`.
+    label : str
+        Prefix of the progress log lines.
+
+    Returns
+    -------
+    str
+        The stop reason.
+    """
+    state = None if checkpoint is None else ckpt.load(checkpoint, fingerprint)
+    if state is not None:
+        sim.restore(state)
+    started = time.perf_counter()
+    last_ckpt = last_log = started
+    last_coll = sim.collisions
+    with interrupt.deferred():
+        if state is not None:  # announced once a signal can no longer stop the run before a save
+            log.info("resumed from %s at window %d (%d collisions)", checkpoint, sim.windows,
+                     sim.collisions)
+        while (reason := _stop_reason(stop, sim, started)) is None:
+            budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
+            if stop.max_collisions is not None:
+                budget = min(budget, int(stop.max_collisions) - sim.collisions)
+            record = sim.run_window(budget, stop.target_phi)
+            _jammed_short(stop, record, sim.growth_rate)
+            if final_growth_rate is not None and sim.growth_rate != final_growth_rate \
+                    and record["Z"] >= switch_pressure:
+                sim.growth_rate = float(final_growth_rate)
+                log.info("Z=%.4g >= %.4g after %d collisions: growth rate now %g", record["Z"],
+                         switch_pressure, sim.collisions, final_growth_rate)
+            if progress is not None:
+                progress(record)
+            now = time.perf_counter()
+            if now - last_log >= progress_interval:
+                log.info("%sphi=%.6f Z=%.4g phi_J_est=%.6f collisions=%d (%.3g /s)", label, record["phi"],
+                         record["Z"], record["phi_J_est"], sim.collisions,
+                         (sim.collisions - last_coll) / (now - last_log))
+                last_log, last_coll = now, sim.collisions
+            if interrupt.requested() is not None and (checkpoint is None or sim.checkpoint_ready):
+                if checkpoint is not None:
+                    ckpt.save(checkpoint, fingerprint, sim.state())
+                raise interrupt.stop(checkpoint, f"phi = {record['phi']:.6f}, Z = {record['Z']:.4g}, "
+                                                 f"{sim.collisions} collisions")
+            if checkpoint is not None and now - last_ckpt >= checkpoint_interval \
+                    and sim.checkpoint_ready and _stop_reason(stop, sim, started) is None:
+                ckpt.save(checkpoint, fingerprint, sim.state())
+                last_ckpt = time.perf_counter()
+    return reason
+
+
 def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria | None = None,
              checkpoint=None, progress=None, *, window: float | None = None,
              checkpoint_interval: float = 300.0, progress_interval: float = 10.0,
@@ -488,44 +564,9 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
                           switch_pressure=float(switch_pressure) if final_growth_rate else None,
                           contact_windows=int(contact_windows) if contact_forces else 0,
                           **({} if packing.boundary.kind == "periodic" else {"boundary": str(packing.boundary)}))
-    state = None if checkpoint is None else ckpt.load(checkpoint, fp)
-    if state is not None:
-        sim.restore(state)
-    started = time.perf_counter()
-    last_ckpt = last_log = started
-    last_coll = sim.collisions
-    with interrupt.deferred():
-        if state is not None:  # announced once a signal can no longer stop the run before a save
-            log.info("resumed from %s at window %d (%d collisions)", checkpoint, sim.windows,
-                     sim.collisions)
-        while (reason := _stop_reason(stop, sim, started)) is None:
-            budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
-            if stop.max_collisions is not None:
-                budget = min(budget, int(stop.max_collisions) - sim.collisions)
-            record = sim.run_window(budget, stop.target_phi)
-            _jammed_short(stop, record, sim.growth_rate)
-            if final_growth_rate is not None and sim.growth_rate != final_growth_rate \
-                    and record["Z"] >= switch_pressure:
-                sim.growth_rate = float(final_growth_rate)
-                log.info("Z=%.4g >= %.4g after %d collisions: growth rate now %g", record["Z"],
-                         switch_pressure, sim.collisions, final_growth_rate)
-            if progress is not None:
-                progress(record)
-            now = time.perf_counter()
-            if now - last_log >= progress_interval:
-                log.info("phi=%.6f Z=%.4g phi_J_est=%.6f collisions=%d (%.3g /s)", record["phi"],
-                         record["Z"], record["phi_J_est"], sim.collisions,
-                         (sim.collisions - last_coll) / (now - last_log))
-                last_log, last_coll = now, sim.collisions
-            if interrupt.requested() is not None and (checkpoint is None or sim.checkpoint_ready):
-                if checkpoint is not None:
-                    ckpt.save(checkpoint, fp, sim.state())
-                raise interrupt.stop(checkpoint, f"phi = {record['phi']:.6f}, Z = {record['Z']:.4g}, "
-                                                 f"{sim.collisions} collisions")
-            if checkpoint is not None and now - last_ckpt >= checkpoint_interval \
-                    and sim.checkpoint_ready and _stop_reason(stop, sim, started) is None:
-                ckpt.save(checkpoint, fp, sim.state())
-                last_ckpt = time.perf_counter()
+    reason = run_windows(sim, stop, stage_window, checkpoint, fp, final_growth_rate=final_growth_rate,
+                         switch_pressure=switch_pressure, progress=progress, progress_interval=progress_interval,
+                         checkpoint_interval=checkpoint_interval)
 
     final = sim.packing()
     report = final.overlap_report(overlap_tol)

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import logging
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,8 +28,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.shapes import Ellipsoids
 from hardpack.io import checkpoint as ckpt
-from hardpack.io import interrupt
-from hardpack.md.compress import StopCriteria, _check_final_stage, _stop_reason, default_window, timeseries_dataset
+from hardpack.md.compress import StopCriteria, _check_final_stage, default_window, run_windows, timeseries_dataset
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, rotational_dof
 from hardpack.md.ellipsoid_kernel import EPS_F
 from hardpack.md.simulation import OverlapError, Simulation, maxwell_boltzmann
@@ -240,41 +238,9 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
                       overlap_tol=overlap_tol, final_growth_rate=final_growth_rate, eps_f=float(eps_f),
                       switch_pressure=float(switch_pressure) if final_growth_rate else None,
                       kind="ellipsoid")
-    state = None if checkpoint is None else ckpt.load(checkpoint, fp)
-    if state is not None:
-        sim.restore(state)
-    started = time.perf_counter()
-    last_ckpt = last_log = started
-    last_coll = sim.collisions
-    with interrupt.deferred():
-        if state is not None:
-            log.info("resumed from %s at window %d (%d collisions)", checkpoint, sim.windows, sim.collisions)
-        while (reason := _stop_reason(stop, sim, started)) is None:
-            budget = max(1, round(stage_window(sim.growth_rate) * n))
-            if stop.max_collisions is not None:
-                budget = min(budget, int(stop.max_collisions) - sim.collisions)
-            record = sim.run_window(budget, stop.target_phi)
-            if final_growth_rate is not None and sim.growth_rate != final_growth_rate \
-                    and record["Z"] >= switch_pressure:
-                sim.growth_rate = float(final_growth_rate)
-                log.info("Z=%.4g >= %.4g after %d collisions: growth rate now %g", record["Z"],
-                         switch_pressure, sim.collisions, final_growth_rate)
-            if progress is not None:
-                progress(record)
-            now = time.perf_counter()
-            if now - last_log >= progress_interval:
-                log.info("ellipsoids: phi=%.6f Z=%.4g collisions=%d (%.3g /s)", record["phi"],
-                         record["Z"], sim.collisions, (sim.collisions - last_coll) / (now - last_log))
-                last_log, last_coll = now, sim.collisions
-            if interrupt.requested() is not None and (checkpoint is None or sim.checkpoint_ready):
-                if checkpoint is not None:
-                    ckpt.save(checkpoint, fp, sim.state())
-                raise interrupt.stop(checkpoint, f"phi = {record['phi']:.6f}, Z = {record['Z']:.4g}, "
-                                                 f"{sim.collisions} collisions")
-            if checkpoint is not None and now - last_ckpt >= checkpoint_interval \
-                    and sim.checkpoint_ready and _stop_reason(stop, sim, started) is None:
-                ckpt.save(checkpoint, fp, sim.state())
-                last_ckpt = time.perf_counter()
+    reason = run_windows(sim, stop, stage_window, checkpoint, fp, final_growth_rate=final_growth_rate,
+                         switch_pressure=switch_pressure, progress=progress, progress_interval=progress_interval,
+                         checkpoint_interval=checkpoint_interval, label="ellipsoids: ")
 
     final = sim.packing()
     report = final.overlap_report(overlap_tol)
