@@ -12,7 +12,7 @@ import pytest
 
 from hardpack import InvalidInputError, Packing
 from hardpack.geometry import Ellipsoids, HardWalls, lattice_packing
-from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts, nematic_order, symmetry_axes
+from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts, near_sphere_contact_law, nematic_order, symmetry_axes
 
 
 def stretched_crystal(name, alpha, reps=2):
@@ -195,3 +195,27 @@ def test_isotropic_ellipsoids_have_s_of_order_one_over_root_n():
         q = rng.normal(size=(n, 4))
         s, _ = nematic_order(with_orientations(q / np.linalg.norm(q, axis=1)[:, None], [1.0, 0.5, 0.5]))
         assert 0.2 < s * math.sqrt(n) < 4
+
+
+# ----------------------------------------------------------------------------- Eq. 5.30
+def test_near_sphere_law_recovers_a_square_root_law_and_tells_it_from_a_line():
+    alpha = np.array([1.0, 1.01, 1.02, 1.05, 1.1, 1.2, 1.5, 2.0])
+    z = 6 + 8.0 * np.sqrt(alpha - 1)
+    law = near_sphere_contact_law(alpha, z, dim=3, alpha_max=1.3)
+    assert law.n == 5 and law.z_alpha == pytest.approx(8.0, rel=1e-12) and law.z_alpha_err < 1e-10
+    assert law.rms_sqrt < 1e-12 < 0.1 < law.rms_linear
+    linear = near_sphere_contact_law(alpha, 4 + 20 * (alpha - 1), dim=2)
+    assert linear.rms_linear < 1e-12 < linear.rms_sqrt
+    assert near_sphere_contact_law([1.0, 2.0], [6.0, 9.0], dim=3).n == 0
+    assert np.isnan(near_sphere_contact_law([1.0, 2.0], [6.0, 9.0], dim=3).z_alpha)
+    assert np.isnan(near_sphere_contact_law([1.1], [7.0], dim=3).z_alpha_err)
+
+
+@pytest.mark.parametrize("alpha, z, dim, message", [
+    ([1.1, 1.2], [7.0], 3, "one length"),
+    ([1.1, 1.2], [7.0, np.nan], 3, "finite"),
+    ([1.1], [7.0], 4, "dim"),
+])
+def test_near_sphere_law_refuses_bad_input(alpha, z, dim, message):
+    with pytest.raises(InvalidInputError, match=message):
+        near_sphere_contact_law(alpha, z, dim)

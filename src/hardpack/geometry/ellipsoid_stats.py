@@ -192,3 +192,66 @@ def nematic_order(packing) -> tuple[float, np.ndarray]:
     q = (d * np.einsum("ni,nj->ij", u, u) / len(u) - np.eye(d)) / (d - 1)
     values, vectors = np.linalg.eigh(q)
     return float(values[-1]), vectors[:, -1]
+
+
+@dataclass(frozen=True)
+class NearSphereLaw:
+    """Fit of the contact number near the sphere point (Donev 2006, Eq. 5.30)."""
+
+    z_alpha: float        #: Z_alpha of Z = 2d + Z_alpha sqrt(alpha - 1)
+    z_alpha_err: float    #: its standard error (NaN with one point)
+    rms_sqrt: float       #: rms residual of the square-root law
+    rms_linear: float     #: rms residual of the best linear law Z = 2d + c (alpha - 1), for comparison
+    n: int                #: packings in the fit
+
+
+def near_sphere_contact_law(alpha, z, dim: int, alpha_max: float = 1.3) -> NearSphereLaw:
+    """Fit Z = 2d + Z_alpha sqrt(alpha - 1) (Donev 2006, Sec. 5.9.2, Eq. 5.30) to packings with
+    1 < alpha <= alpha_max.
+
+    Near the sphere point a jammed packing gains contacts over the 2d of spheres as the
+    square root of the asphericity; the text gives the law but no value of Z_alpha. The fit is a
+    least-squares line through the origin in sqrt(alpha - 1); the same fit in (alpha - 1) is
+    reported beside it, so that the data can tell the two laws apart.
+
+    Parameters
+    ----------
+    alpha, z : array_like
+        Aspect ratio and mean backbone contact number of each packing (same length).
+    dim : int
+        2 or 3 (2d is the contact number of jammed disks or spheres).
+    alpha_max : float, default 1.3
+        Largest aspect ratio counted as near the sphere point.
+
+    Returns
+    -------
+    NearSphereLaw
+        NaN fields when no packing has 1 < alpha <= alpha_max.
+
+    Raises
+    ------
+    InvalidInputError
+        If the arrays differ in shape, hold NaN, or ``dim`` is not 2 or 3.
+    """
+    a = np.asarray(alpha, float)
+    zz = np.asarray(z, float)
+    if a.shape != zz.shape or a.ndim != 1:
+        raise InvalidInputError(f"alpha and z must be 1-d arrays of one length, got {a.shape} and {zz.shape}")
+    if not (np.isfinite(a).all() and np.isfinite(zz).all()):
+        raise InvalidInputError("alpha and z must be finite (a packing without a contact number cannot be fitted)")
+    if dim not in (2, 3):
+        raise InvalidInputError(f"dim must be 2 or 3, got {dim!r}")
+    use = (a > 1.0) & (a <= alpha_max)
+    if not use.any():
+        return NearSphereLaw(*(float("nan"),) * 4, 0)
+    y = zz[use] - 2 * dim
+
+    def through_origin(x):
+        c = float(x @ y / (x @ x))
+        resid = y - c * x
+        err = float(np.sqrt(resid @ resid / (len(y) - 1) / (x @ x))) if len(y) > 1 else float("nan")
+        return c, err, float(np.sqrt(np.mean(resid**2)))
+
+    c_sqrt, err, rms_sqrt = through_origin(np.sqrt(a[use] - 1.0))
+    _, _, rms_linear = through_origin(a[use] - 1.0)
+    return NearSphereLaw(c_sqrt, err, rms_sqrt, rms_linear, int(use.sum()))

@@ -6,12 +6,15 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.collections import EllipseCollection
 
+from hardpack.geometry.ellipsoid_stats import near_sphere_contact_law
 from hardpack.plots.style import figure
 from hardpack.validation.rows import seed_statistics
 
 #: isostatic contact numbers 2 f (Donev 2006, Sec. 5.2): f = 3 for ellipses, 5 for spheroids
 #: (the spin about the symmetry axis is trivial), 6 for general ellipsoids
 ISOSTATIC = {"ellipses": 6, "spheroids": 10, "ellipsoids": 12}
+#: largest aspect ratio of the near-sphere fit of Eq. 5.30 drawn on the contact-number panel
+NEAR_SPHERE_ALPHA_MAX = 1.3
 
 
 def _per_alpha(summary, beta, name):
@@ -29,7 +32,8 @@ def _per_alpha(summary, beta, name):
 def plot_jamming_vs_alpha(summary, dim: int = 3):
     """phi_J (left) and the mean contact number of the rattler-free backbone (right) vs the aspect
     ratio alpha, one curve per shape family beta (semiaxes 1 : alpha^beta : alpha), mean +- s.e.
-    over seeds, with the isostatic 2 f lines.
+    over seeds, with the isostatic 2 f lines and, per family, Z = 2d + Z_alpha sqrt(alpha - 1)
+    (Donev 2006, Eq. 5.30) fitted to its packings with 1 < alpha <= 1.3 (dashed).
 
     Parameters
     ----------
@@ -49,20 +53,36 @@ def plot_jamming_vs_alpha(summary, dim: int = 3):
         for ax, name in ((left, "phi"), (right, "z_mean")):
             rows = _per_alpha(summary, beta, name)
             ax.errorbar(rows[:, 0], rows[:, 1], rows[:, 2], fmt="o-", ms=3.5, color=f"C{k}", label=label)
-    if dim == 2:
-        right.axhline(ISOSTATIC["ellipses"], color="k", ls="--", lw=1, label="isostatic 6")
-    else:
-        right.axhline(ISOSTATIC["spheroids"], color="k", ls=":", lw=1, label="isostatic, spheroids (10)")
-        right.axhline(ISOSTATIC["ellipsoids"], color="k", ls="--", lw=1, label="isostatic, ellipsoids (12)")
-        right.axhline(6, color="0.5", ls="-.", lw=1, label="spheres (6)")
+        _near_sphere_curve(right, summary, beta, dim, f"C{k}")
+    lines = [(ISOSTATIC["ellipses"], "--", "isostatic (6)")] if dim == 2 else [
+        (ISOSTATIC["spheroids"], ":", "isostatic, spheroids (10)"),
+        (ISOSTATIC["ellipsoids"], "--", "isostatic, ellipsoids (12)"), (6, "-.", "spheres (6)")]
+    for value, style, text in lines:
+        right.axhline(value, color="0.4", ls=style, lw=1)
+        right.annotate(text, (0.01, value), xycoords=("axes fraction", "data"), va="bottom", fontsize=6.5,
+                       color="0.3")
     left.set_xlabel(r"aspect ratio $\alpha$")
     left.set_ylabel(r"jamming density $\phi_J$")
     right.set_xlabel(r"aspect ratio $\alpha$")
     right.set_ylabel(r"mean contact number $\bar Z$ (rattlers removed)")
     left.legend(loc="lower right")
-    right.legend(loc="lower right")
+    right.legend(loc="lower right", fontsize=6.5)
     fig.tight_layout()
     return fig
+
+
+def _near_sphere_curve(ax, summary, beta, dim, color, alpha_max=NEAR_SPHERE_ALPHA_MAX):
+    """Eq. 5.30 fitted to one family's packings with 1 < alpha <= alpha_max, drawn to alpha_max."""
+    mask = np.isclose(np.asarray(summary["beta"].values, float), beta)
+    alpha = np.asarray(summary["alpha"].values, float)[mask]
+    z = np.asarray(summary["z_mean"].values, float)[mask]
+    keep = np.isfinite(z)
+    law = near_sphere_contact_law(alpha[keep], z[keep], dim, alpha_max)
+    if law.n == 0:
+        return
+    grid = np.linspace(1.0, alpha_max, 60)
+    ax.plot(grid, 2 * dim + law.z_alpha * np.sqrt(grid - 1.0), ls="--", lw=0.8, color=color,
+            label=rf"Eq. 5.30: $Z_\alpha$ = {law.z_alpha:.3g}")
 
 
 def _shadow(packing):
