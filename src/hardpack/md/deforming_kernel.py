@@ -151,7 +151,7 @@ def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
 
 
 @njit(cache=True)
-def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn, cnt, ep, ei, ec, tv,
+def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn, mark, cnt, ep, ei, ec, tv,
                hkey, heap, hpos, kin, vir, acc, iacc, coll_target, t_cap):
     """One window in a fixed cell H from a synchronisation point (all T = 0): build all lists,
     predict, process events until ``coll_target`` collisions or ``t_cap``.
@@ -169,6 +169,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
     kin[:, :] = 0.0
     vir[:, :] = 0.0
     nn[:] = 0
+    mark[:] = 0
     hpos[:] = -1
     cnt[:] = 0
     tv[:] = 0.0
@@ -224,8 +225,11 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                     for k in range(d):
                         a2 += H[q, k] * s_acc[k]
                     X[i, q] -= a2
-                for e in range(nn[i]):  # drop i from its old neighbours' lists
+                for e in range(nn[i]):  # drop i from its old neighbours' lists (each list once)
                     j = nb[i, e] // m
+                    if mark[j]:
+                        continue
+                    mark[j] = 1
                     q2 = 0
                     while q2 < nn[j]:
                         if nb[j, q2] // m == i:
@@ -233,6 +237,8 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                             nb[j, q2] = nb[j, nn[j]]
                         else:
                             q2 += 1
+                for e in range(nn[i]):
+                    mark[nb[i, e] // m] = 0
                 nn[i] = 0
                 for k in range(d):
                     bs[i, k] = X[i, k]
