@@ -129,3 +129,21 @@ def test_too_small_cell_and_walls_are_refused():
     walled = random_packing(10, 2, monodisperse(), 0.2, 0, boundary="hard_walls")
     with pytest.raises(InvalidInputError, match="periodic"):
         compress_deforming(walled, 0.02, 0)
+
+
+def test_cli_writes_the_deformed_cell(tmp_path):
+    from hardpack.cli import main
+    from hardpack.io import load_packing, write_dataset
+    from hardpack.io import packing_to_dataset
+
+    start = random_packing(20, 2, monodisperse(), 0.3, 0)
+    write_dataset(packing_to_dataset(start), tmp_path / "init.nc")
+    out = tmp_path / "out.nc"
+    assert main(["compress", "--init", str(tmp_path / "init.nc"), "--out", str(out), "--growth-rate",
+                 "0.02", "--seed", "0", "--max-pressure", "1e4", "--deforming-cell"]) == 0
+    final = load_packing(out)
+    assert not final.is_orthorhombic
+    assert abs(np.linalg.det(final.lattice)) == pytest.approx(start.volume, rel=1e-12)
+    assert final.overlap_report().n_overlapping == 0
+    assert main(["compress", "--init", str(tmp_path / "init.nc"), "--out", str(out), "--growth-rate",
+                 "0.02", "--seed", "0", "--applied-pressure", "2"]) == 2  # refused: no --deforming-cell

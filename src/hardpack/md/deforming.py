@@ -430,6 +430,8 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         "protocol": "lubachevsky_stillinger_deforming_cell", "growth_rate": float(growth_rate),
         "seed": int(seed), "stop_reason": reason, "Z": float(rec["Z"][-1]) if rec["Z"] else float("nan"),
         "phi": float(final.phi), "collisions": int(sim.collisions), "windows": int(sim.windows),
+        "phi_J_est": float(final.phi / (1.0 - sim.d / rec["Z"][-1])) if rec["Z"] and rec["Z"][-1] > sim.d
+        else float("nan"),
         "md_time": float(sim.time), "wall_time": float(sim.wall_time),
         "window_collisions_per_particle": stage_window(growth_rate), "overlap_tol": overlap_tol,
         "n_overlapping": int(report.n_overlapping),
