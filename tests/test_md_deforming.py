@@ -133,8 +133,7 @@ def test_too_small_cell_and_walls_are_refused():
 
 def test_cli_writes_the_deformed_cell(tmp_path):
     from hardpack.cli import main
-    from hardpack.io import load_packing, write_dataset
-    from hardpack.io import packing_to_dataset
+    from hardpack.io import load_packing, packing_to_dataset, write_dataset
 
     start = random_packing(20, 2, monodisperse(), 0.3, 0)
     write_dataset(packing_to_dataset(start), tmp_path / "init.nc")

@@ -92,7 +92,6 @@ RECORD_FIELDS = ("time", "phi", "Z", "collisions", "kT_mean", "volume", "pressur
 def shortest_vector(lattice: np.ndarray) -> float:
     """Length of the shortest non-zero lattice vector |H n| (exhaustive over the n that can beat
     the shortest basis vector: |n_k| <= l / h_k)."""
-    d = lattice.shape[0]
     best = float(np.linalg.norm(lattice, axis=0).min())
     heights = 1.0 / np.linalg.norm(np.linalg.inv(lattice), axis=1)
     ranges = [range(-int(best / h), int(best / h) + 1) for h in heights]
