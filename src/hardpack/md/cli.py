@@ -44,7 +44,14 @@ def cmd_compress(args) -> int:
                   checkpoint_interval=args.checkpoint_interval, final_growth_rate=args.final_growth_rate,
                   switch_pressure=args.switch_pressure, keep_checkpoint=True)
     ellipsoids = packing.shape.kind == "ellipsoid"
-    if ellipsoids:
+    deforming = _deforming_options(args, ellipsoids)
+    if deforming is not None:
+        from hardpack.md.deforming import compress_deforming
+
+        result = compress_deforming(packing, args.growth_rate, args.seed, stop, window=args.window,
+                                    final_growth_rate=args.final_growth_rate,
+                                    switch_pressure=args.switch_pressure, **deforming)
+    elif ellipsoids:
         if args.contact_forces:
             raise InvalidInputError("--contact-forces is implemented for spheres only; drop it for "
                                     f"{packing.shape.name}")
@@ -59,6 +66,8 @@ def cmd_compress(args) -> int:
               "switch_pressure": args.switch_pressure if args.final_growth_rate else None,
               "contact_windows": args.contact_windows if args.contact_forces else None,
               "eps_f": args.eps_f if ellipsoids else None}
+    if deforming is not None:
+        config.update(deforming_cell=True, applied_pressure=args.applied_pressure, cell_step=args.cell_step)
     result.save(args.out, args.timeseries, config=config)
     if args.checkpoint is not None:  # only now that the results are safely written
         ckpt.remove(args.checkpoint)
@@ -66,6 +75,29 @@ def cmd_compress(args) -> int:
     log.info("wrote %s: phi=%.8f Z=%.4g phi_J_est=%.8f (%s, %d collisions, %.1f s)", args.out,
              s["phi"], s["Z"], s["phi_J_est"], s["stop_reason"], s["collisions"], s["wall_time"])
     return 0
+
+
+def _deforming_options(args, ellipsoids: bool) -> dict | None:
+    """Keyword arguments of :func:`hardpack.md.deforming.compress_deforming` for
+    ``--deforming-cell`` (None without it); refuses the options it cannot combine with."""
+    from hardpack.errors import InvalidInputError
+
+    if not args.deforming_cell:
+        if args.applied_pressure is not None or args.cell_step is not None:
+            raise InvalidInputError("--applied-pressure and --cell-step need --deforming-cell")
+        return None
+    clash = [flag for flag, on in (("--checkpoint", args.checkpoint is not None),
+                                   ("--contact-forces", args.contact_forces),
+                                   ("--target-phi", args.target_phi is not None)) if on]
+    if ellipsoids:
+        raise InvalidInputError("--deforming-cell is implemented for spheres only")
+    if clash:
+        raise InvalidInputError(f"--deforming-cell cannot be combined with {', '.join(clash)} (not "
+                                "implemented for the deforming cell); drop it")
+    from hardpack.md.deforming import CELL_STEP
+
+    return {"applied_pressure": args.applied_pressure,
+            "cell_step": CELL_STEP if args.cell_step is None else args.cell_step}
 
 
 def cmd_eos(args) -> int:
@@ -122,6 +154,15 @@ def register(subparsers) -> None:
     p.add_argument("--eps-f", type=float, default=1e-4,
                    help="ellipsoids: tolerance of the collision search on the contact function "
                         "(default 1e-4, Donev 2006 sec. 3.5.1)")
+    p.add_argument("--deforming-cell", action="store_true",
+                   help="let the periodic cell deform between windows so that the stress becomes "
+                        "isotropic (Donev 2006 sec. 3.2.4.2; hardpack.md.deforming): strictly jammed "
+                        "packings; the final cell is stored as the packing's lattice")
+    p.add_argument("--applied-pressure", type=float,
+                   help="with --deforming-cell: applied pressure P0 in kT per unit volume of the "
+                        "packing's length unit (the volume changes too); default: shape only")
+    p.add_argument("--cell-step", type=float,
+                   help="with --deforming-cell: alpha of the strain rule, in (0, 1] (default 0.1)")
     p.set_defaults(func=cmd_compress)
 
     p = subparsers.add_parser("eos", help=cmd_eos.__doc__)

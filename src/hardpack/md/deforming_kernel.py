@@ -1,0 +1,445 @@
+"""Numba kernels of the deforming-cell sphere MD (:mod:`hardpack.md.deforming`).
+
+The cell is a general (sheared) lattice H whose columns are the lattice vectors (Donev's Lambda,
+Donev 2006, sec. 3.2.4 and Eq. 3.1); it stays FIXED during a window and is deformed only between
+windows by the driver, so inside a window every particle moves on a straight line and the pair
+contact time is the quadratic root of the fixed-cell engine (:func:`hardpack.events.roots.contact_root`,
+derived in :mod:`hardpack.md.kernel`), not Donev's quartic of a cell deforming during the flight
+(Donev 2006, sec. 3.2.2.2).
+
+Same event scheme as :mod:`hardpack.md.kernel` in its simplest form: one predicted event per
+particle in a 4-ary heap (:func:`hardpack.events.heap.heap_set`), lazy invalidation by collision
+counters, and neighbour lists with immobile bounding spheres (Donev 2006, sec. 3.3.2). There is no
+cell grid: a list is (re)built by scanning all N particles, so a partial update costs O(N d^2)
+and a complete one O(N^2 d^2) (meant for the small systems of strict-jamming and crystal
+searches, N up to a few thousand). The periodic images of a candidate pair are the integer
+vectors n with |H (s_j - s_i + n)| < R_i + R_j; along lattice vector k only the n_k with
+|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k are visited (h_k the cell height, 1 / |row k of H^-1|),
+so a sheared cell costs nothing more than an orthogonal one. A list entry is j * m + code, code
+the index of n in the image table ``img`` (m entries, n_k in [-M_k, M_k], lexicographic with
+axis 0 fastest, so the image -n has code m - 1 - code).
+
+A bounding-sphere exit re-wraps the particle into the cell and rebuilds its list; it also raises
+the particle's collision counter, so that predictions of others against it (whose image codes
+may have changed with the wrap) are invalidated and made again (the particle's trajectory is
+unchanged, so the re-prediction finds the same collision).
+
+Stress (Donev 2006, sec. 3.2.4.2, with the kinetic term added): the window accumulates the time
+integral of sum_i v_i v_i^T (``kin``) and the collisional virial sum_coll r_ij J_ij^T
+(``vir``; r_ij from i to j, J_ij the impulse on j, both along the contact normal, so the tensor
+is symmetric); sigma = (kin + vir) / (V dt) with m = 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from hardpack.events.heap import heap_set
+from hardpack.events.roots import contact_root, exit_root
+
+EXIT = -1
+NONE = -2
+
+# statuses
+DONE_COLLISIONS, DONE_TIME, OVERFLOW, STUCK, SELF_IMAGE = 0, 1, 2, 3, 4
+# integer counters
+I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE = 0, 1, 2, 3, 4
+N_COUNTERS = 5
+
+
+def image_ranges(lattice: np.ndarray, reach: float) -> np.ndarray:
+    """M_k = 1 + ceil(reach / h_k): the image range that holds every pair within ``reach`` when
+    both fractional coordinates lie in [0, 1)."""
+    heights = 1.0 / np.linalg.norm(np.linalg.inv(lattice), axis=1)
+    return (1 + np.ceil(reach / heights)).astype(np.int64)
+
+
+@njit(cache=True)
+def image_table(H, M):
+    """Cartesian image vectors H n for n_k in [-M_k, M_k] (axis 0 fastest), shape (m, d)."""
+    d = H.shape[0]
+    m = 1
+    for k in range(d):
+        m *= 2 * M[k] + 1
+    img = np.zeros((m, d))
+    for c in range(m):
+        rem = c
+        for k in range(d):
+            w = 2 * M[k] + 1
+            nk = rem % w - M[k]
+            rem //= w
+            for q in range(d):
+                img[c, q] += H[q, k] * nk
+    return img
+
+
+@njit(cache=True)
+def wrap_into_cell(X, H, Hinv):
+    """Move every position into the cell (fractional coordinates in [0, 1))."""
+    n, d = X.shape
+    s = np.empty(d)
+    for i in range(n):
+        for k in range(d):
+            acc = 0.0
+            for q in range(d):
+                acc += Hinv[k, q] * X[i, q]
+            s[k] = np.floor(acc)
+        for q in range(d):
+            acc = 0.0
+            for k in range(d):
+                acc += H[q, k] * s[k]
+            X[i, q] -= acc
+
+
+@njit(cache=True)
+def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
+    """List every bounding sphere j < jstop (j != i) that overlaps i's, in both lists; returns
+    OVERFLOW when a list is full, SELF_IMAGE when i's bounding sphere reaches its own image
+    (``lmin`` is the shortest lattice vector), else 0. ``cfac`` = 1 / h_k."""
+    d = X.shape[1]
+    cap = nb.shape[1]
+    ds = np.empty(d)
+    lo = np.empty(d, dtype=np.int64)
+    hi = np.empty(d, dtype=np.int64)
+    od = np.empty(d, dtype=np.int64)
+    ri = bs[i, d]
+    if 2.0 * ri >= lmin:  # i's bounding sphere would reach its own periodic image
+        return SELF_IMAGE
+    for j in range(jstop):
+        if j == i:
+            continue
+        reach = ri + bs[j, d]
+        for k in range(d):
+            acc = 0.0
+            for q in range(d):
+                acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
+            ds[k] = acc
+            c = reach * cfac[k]
+            lo[k] = int(np.ceil(-c - acc))
+            hi[k] = int(np.floor(c - acc))
+        total = 1
+        for k in range(d):
+            if hi[k] < lo[k]:
+                total = 0
+                break
+            total *= hi[k] - lo[k] + 1
+            od[k] = lo[k]
+        for _ in range(total):
+            code = 0
+            d2 = 0.0
+            for k in range(d):
+                code += (od[k] + M[k]) * strides[k]
+            for q in range(d):
+                acc = 0.0
+                for k in range(d):
+                    acc += H[q, k] * (ds[k] + od[k])
+                d2 += acc * acc
+            for k in range(d):  # odometer step
+                od[k] += 1
+                if od[k] <= hi[k]:
+                    break
+                od[k] = lo[k]
+            if d2 < reach * reach:
+                if nn[i] >= cap or nn[j] >= cap:
+                    return OVERFLOW
+                nb[i, nn[i]] = j * m + code
+                nn[i] += 1
+                nb[j, nn[j]] = i * m + (m - 1 - code)
+                nn[j] += 1
+    return 0
+
+
+@njit(cache=True)
+def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn, mark, cnt, ep, ei, ec, tv,
+               hkey, heap, hpos, kin, vir, acc, iacc, coll_target, t_cap):
+    """One window in a fixed cell H from a synchronisation point (all T = 0): build all lists,
+    predict, process events until ``coll_target`` collisions or ``t_cap``.
+
+    X, V : (N, d) positions and velocities at the particles' own times T (N,); A : (N,) radii at
+    window time 0, a_i(t) = A_i (1 + kappa t); skin: bounding-sphere skin (N,) (R_i = a_i(t) +
+    skin_i at the list's time); kin, vir : (d, d) accumulators (zeroed here); acc: (0) end time,
+    (1) time integral of the kinetic energy; iacc: counters. Returns a status.
+    """
+    n, d = X.shape
+    m = img.shape[0]
+    strides = np.ones(d, dtype=np.int64)
+    for k in range(1, d):
+        strides[k] = strides[k - 1] * (2 * M[k - 1] + 1)
+    kin[:, :] = 0.0
+    vir[:, :] = 0.0
+    nn[:] = 0
+    mark[:] = 0
+    hpos[:] = -1
+    cnt[:] = 0
+    tv[:] = 0.0
+    rv = np.empty(d)
+    xi = np.empty(d)
+    upd = np.empty(2, dtype=np.int64)
+    for i in range(n):  # complete rebuild at t = 0 (positions wrapped by the caller)
+        for k in range(d):
+            bs[i, k] = X[i, k]
+        bs[i, d] = A[i] + skin[i]
+    for i in range(n):
+        st = _list_particle(i, i, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin)
+        if st != 0:
+            return st
+    hsize = 0
+    t = 0.0
+    stage = 0
+    while True:
+        npred = 0
+        if stage < n:  # initial predictions (schedule reset)
+            upd[0] = stage
+            npred = 1
+            stage += 1
+        else:
+            if hsize == 0 or hkey[0] == np.inf:
+                if t_cap < np.inf:
+                    t = t_cap
+                    break
+                acc[0] = t
+                return STUCK
+            i = heap[0]
+            tn = hkey[0]
+            if tn > t_cap:
+                t = t_cap
+                break
+            t = tn
+            iacc[I_EVENTS] += 1
+            p = ep[i]
+            if p == EXIT:
+                iacc[I_EXIT] += 1
+                dt = t - T[i]
+                for k in range(d):
+                    X[i, k] += V[i, k] * dt
+                T[i] = t
+                s_acc = np.empty(d)  # wrap i into the cell
+                for k in range(d):
+                    a2 = 0.0
+                    for q in range(d):
+                        a2 += Hinv[k, q] * X[i, q]
+                    s_acc[k] = np.floor(a2)
+                for q in range(d):
+                    a2 = 0.0
+                    for k in range(d):
+                        a2 += H[q, k] * s_acc[k]
+                    X[i, q] -= a2
+                for e in range(nn[i]):  # drop i from its old neighbours' lists (each list once)
+                    j = nb[i, e] // m
+                    if mark[j]:
+                        continue
+                    mark[j] = 1
+                    q2 = 0
+                    while q2 < nn[j]:
+                        if nb[j, q2] // m == i:
+                            nn[j] -= 1
+                            nb[j, q2] = nb[j, nn[j]]
+                        else:
+                            q2 += 1
+                for e in range(nn[i]):
+                    mark[nb[i, e] // m] = 0
+                nn[i] = 0
+                for k in range(d):
+                    bs[i, k] = X[i, k]
+                bs[i, d] = A[i] * (1.0 + kappa * t) + skin[i]
+                st = _list_particle(i, n, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin)
+                if st != 0:
+                    acc[0] = t
+                    return st
+                cnt[i] += 1
+                upd[0] = i
+                npred = 1
+            elif p == NONE or ec[i] != cnt[p]:
+                iacc[I_STALE] += 1
+                upd[0] = i
+                npred = 1
+            else:
+                j = p
+                dti = t - T[i]
+                dtj = t - T[j]
+                dist2 = 0.0
+                code = ei[i]
+                for k in range(d):
+                    X[i, k] += V[i, k] * dti
+                    X[j, k] += V[j, k] * dtj
+                    dx = X[j, k] + img[code, k] - X[i, k]
+                    rv[k] = dx
+                    dist2 += dx * dx
+                T[i] = t
+                T[j] = t
+                dist = np.sqrt(dist2)
+                g = (A[i] + A[j]) * kappa
+                vn = 0.0
+                for k in range(d):
+                    rv[k] /= dist
+                    vn += rv[k] * (V[j, k] - V[i, k])
+                vn -= g
+                if vn < 0.0:
+                    for q in (i, j):  # close the kinetic-tensor integral of both before the kick
+                        w = t - tv[q]
+                        for a1 in range(d):
+                            for b1 in range(d):
+                                kin[a1, b1] += V[q, a1] * V[q, b1] * w
+                        tv[q] = t
+                    for k in range(d):
+                        dv = vn * rv[k]
+                        V[i, k] += dv
+                        V[j, k] -= dv
+                    for a1 in range(d):
+                        for b1 in range(d):
+                            vir[a1, b1] -= vn * dist * rv[a1] * rv[b1]
+                    cnt[i] += 1
+                    cnt[j] += 1
+                    iacc[I_COLL] += 1
+                else:
+                    iacc[I_GRAZE] += 1
+                upd[0] = i
+                upd[1] = j
+                npred = 2
+        for q in range(npred):
+            i = upd[q]
+            dt = t - T[i]
+            grow = 1.0 + kappa * t
+            ai = A[i]
+            adot = ai * kappa
+            dd = 0.0
+            dv = 0.0
+            vv = 0.0
+            for k in range(d):
+                xi[k] = X[i, k] + V[i, k] * dt
+                dx = xi[k] - bs[i, k]
+                dd += dx * dx
+                dv += dx * V[i, k]
+                vv += V[i, k] * V[i, k]
+            best = exit_root(dd, dv, vv, bs[i, d] - ai * grow, adot)
+            partner = EXIT if best < np.inf else NONE
+            pcode = 0
+            for e in range(nn[i]):
+                j = nb[i, e] // m
+                code = nb[i, e] - j * m
+                dtj = t - T[j]
+                rr = 0.0
+                ru = 0.0
+                uu = 0.0
+                for k in range(d):
+                    r = X[j, k] + V[j, k] * dtj + img[code, k] - xi[k]
+                    u = V[j, k] - V[i, k]
+                    rr += r * r
+                    ru += r * u
+                    uu += u * u
+                s = ai + A[j]
+                tc = contact_root(rr, ru, uu, s * grow, s * kappa, best)
+                if tc < best:
+                    best = tc
+                    partner = j
+                    pcode = code
+            ep[i] = partner
+            ei[i] = pcode
+            if partner >= 0:
+                ec[i] = cnt[partner]
+            hsize = heap_set(hkey, heap, hpos, hsize, i, t + best)
+        if stage >= n and npred == 2 and iacc[I_COLL] >= coll_target:
+            break
+    acc[0] = t
+    for i in range(n):  # close the kinetic-tensor integrals at the window end
+        w = t - tv[i]
+        for a1 in range(d):
+            for b1 in range(d):
+                kin[a1, b1] += V[i, a1] * V[i, b1] * w
+    acc[1] = 0.5 * np.trace(kin)
+    if stage >= n and t == t_cap:
+        return DONE_TIME
+    return DONE_COLLISIONS
+
+
+@njit(cache=True)
+def synchronise(X, V, T, A, t, kappa):
+    """Advance all particles to window time t, radii to a_i (1 + kappa t), time origin to t."""
+    n, d = X.shape
+    grow = 1.0 + kappa * t
+    for i in range(n):
+        dt = t - T[i]
+        for k in range(d):
+            X[i, k] += V[i, k] * dt
+        T[i] = 0.0
+        A[i] *= grow
+
+
+@njit(cache=True)
+def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
+    """Largest s in [0, 1] such that mapping positions and cell by (I + s strain) leaves every
+    pair within ``reach`` at least half its gap (|r| - sigma), and the smallest relative gap
+    (|r| - sigma) / sigma before the map. A particle's own images count as pairs with contact
+    distance ``self_sigma``. Positions must be wrapped into the cell.
+
+    Along the path r(s) = r + s strain r the first s with |r(s)| = sigma + gap / 2 is the
+    contact root of a pair with relative velocity strain r (:func:`hardpack.events.roots.contact_root`).
+    """
+    n, d = X.shape
+    cfac = np.empty(d)
+    for k in range(d):
+        s2 = 0.0
+        for q in range(d):
+            s2 += Hinv[k, q] * Hinv[k, q]
+        cfac[k] = np.sqrt(s2)
+    ds = np.empty(d)
+    r = np.empty(d)
+    lo = np.empty(d, dtype=np.int64)
+    hi = np.empty(d, dtype=np.int64)
+    od = np.empty(d, dtype=np.int64)
+    smax = 1.0
+    gmin = np.inf
+    for i in range(n):
+        for j in range(i, n):
+            for k in range(d):
+                acc = 0.0
+                for q in range(d):
+                    acc += Hinv[k, q] * (X[j, q] - X[i, q])
+                ds[k] = acc
+                c = reach * cfac[k]
+                lo[k] = int(np.ceil(-c - acc))
+                hi[k] = int(np.floor(c - acc))
+            total = 1
+            for k in range(d):
+                if hi[k] < lo[k]:
+                    total = 0
+                    break
+                total *= hi[k] - lo[k] + 1
+                od[k] = lo[k]
+            sigma = self_sigma if i == j else A[i] + A[j]
+            for _ in range(total):
+                skip = i == j
+                for k in range(d):
+                    if od[k] != 0:
+                        skip = False
+                rr = 0.0
+                for q in range(d):
+                    acc = 0.0
+                    for k in range(d):
+                        acc += H[q, k] * (ds[k] + od[k])
+                    r[q] = acc
+                    rr += acc * acc
+                for k in range(d):
+                    od[k] += 1
+                    if od[k] <= hi[k]:
+                        break
+                    od[k] = lo[k]
+                if skip or rr >= reach * reach:
+                    continue
+                gap = np.sqrt(rr) - sigma
+                gmin = min(gmin, gap / sigma)
+                ru = 0.0
+                uu = 0.0
+                for q in range(d):
+                    u = 0.0
+                    for k in range(d):
+                        u += strain[q, k] * r[k]
+                    ru += r[q] * u
+                    uu += u * u
+                if gap <= 0.0:  # touching (round-off): the strain must not push the pair closer
+                    if ru < 0.0:
+                        smax = 0.0
+                else:
+                    smax = min(smax, contact_root(rr, ru, uu, sigma + 0.5 * gap, 0.0, smax))
+    return smax, gmin

@@ -1,0 +1,148 @@
+"""Deforming-cell sphere MD (hardpack.md.deforming; Donev 2006, sec. 3.2.4.2).
+
+- an LS packing grown in a deforming cell (2D, N = 20) is strictly jammed (the strict LP test of
+  Donev 2006, sec. 4.2.2, lets the lattice deform), while the fixed-cell packing of the same seed
+  is collectively but not strictly jammed;
+- a dilute gas at an applied pressure P0 settles at the volume N kT Z(phi) / P0 (Carnahan-Starling
+  Z, exact to 1e-8 at phi = 0.005) within three standard errors of the window mean;
+- crystals (triangular, FCC) at their own pressure keep their cell: the time-averaged strain is
+  zero within three standard errors, in shape-only mode and at an applied pressure equal to the
+  crystal's measured pressure;
+- no pair ever overlaps (checked after every deformation and at every window end; the final
+  packings are checked independently here);
+- bad input is refused with InvalidInputError.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hardpack.distributions import monodisperse
+from hardpack.errors import InvalidInputError
+from hardpack.geometry.balls import unit_ball_volume
+from hardpack.geometry.lattices import lattice_packing
+from hardpack.initial import random_packing
+from hardpack.md import StopCriteria, compress
+from hardpack.md.deforming import compress_deforming, shortest_vector
+
+
+def _block_mean(x, n_blocks=10):
+    blocks = np.array([b.mean() for b in np.array_split(np.asarray(x), n_blocks)])
+    return blocks.mean(), blocks.std(ddof=1) / np.sqrt(n_blocks)
+
+
+def _carnahan_starling(phi):
+    return (1 + phi + phi**2 - phi**3) / (1 - phi) ** 3
+
+
+def _at_phi(packing, phi):
+    """The packing with its radii scaled to volume fraction phi."""
+    return packing.replace(radii=packing.radii * (phi / packing.phi) ** (1 / packing.dim))
+
+
+def test_shortest_vector_of_a_sheared_basis():
+    # basis (1, 0), (5, 1): the shortest vector is (0, 1) = b2 - 5 b1, much shorter than b2
+    assert shortest_vector(np.array([[1.0, 5.0], [0.0, 1.0]])) == pytest.approx(1.0)
+    assert shortest_vector(np.array([[3.0, 0.0], [0.0, 2.0]])) == pytest.approx(2.0)
+
+
+@pytest.mark.slow
+def test_dilute_gas_volume_follows_applied_pressure():
+    n, d, phi_target = 64, 3, 0.005
+    start = random_packing(n, d, monodisperse(), 0.01, 1)
+    vp = unit_ball_volume(d) * float(np.sum(start.radii ** d))
+    p0 = n * _carnahan_starling(phi_target) * phi_target / vp
+    res = compress_deforming(start, 0.0, 1, StopCriteria(max_pressure=None, max_collisions=150_000),
+                             applied_pressure=p0)
+    volume = res.timeseries.volume.values
+    v_star = vp / phi_target
+    for _ in range(50):  # self-consistent V = N kT Z(phi(V)) / P0
+        v_star = n * _carnahan_starling(vp / v_star) / p0
+    assert volume[0] < 0.6 * v_star  # it started far from the target
+    mean, err = _block_mean(volume[len(volume) // 4:])
+    assert abs(mean - v_star) < 3 * err + 1e-12 * v_star, (mean, err, v_star)
+    assert res.stats["overlap_check"] == "passed"
+
+
+@pytest.mark.parametrize("name, reps, phi", [("triangular", (4, 4), 0.8), ("fcc", 2, 0.6)])
+@pytest.mark.parametrize("isobaric", [False, True])
+def test_crystal_keeps_its_cell(name, reps, phi, isobaric):
+    crystal = _at_phi(lattice_packing(name, reps), phi)
+    h0 = crystal.lattice
+    stop = StopCriteria(max_pressure=None, max_collisions=60 * crystal.n_particles * 20)
+    p0 = None
+    if isobaric:  # the crystal's own pressure, measured at fixed volume in the shape-only mode
+        own = compress_deforming(crystal, 0.0, 7, stop)
+        p0, _ = _block_mean(own.timeseries.pressure.values[5:])
+    res = compress_deforming(crystal, 0.0, 3, stop, applied_pressure=p0)
+    assert res.stats["overlap_check"] == "passed"
+    lat = res.packing.lattice
+    # the cell may come back LLL-reduced: compare the metric-free strain F = H H0^-1 via its
+    # invariants, the volume ratio and the stretch of the lattice vectors' Gram matrix
+    strain_volume = abs(np.linalg.det(lat) / np.linalg.det(h0)) - 1.0
+    volumes = res.timeseries.volume.values[5:] / abs(np.linalg.det(h0)) - 1.0
+    mean, err = _block_mean(volumes)
+    assert abs(mean) < 3 * err + 1e-12, (mean, err)
+    assert abs(strain_volume) < 0.05
+    shear = res.timeseries.shear.values[5:]
+    mean_shear, _ = _block_mean(shear)
+    assert mean_shear < 0.2  # no systematic shear stress builds up
+
+
+@pytest.mark.slow
+def test_deforming_ls_packing_is_strictly_jammed_where_fixed_cell_is_not():
+    from hardpack.jamming import verify
+
+    start = random_packing(20, 2, monodisperse(), 0.3, 0)
+    fixed = compress(start, 0.02, 0, final_growth_rate=1e-4)
+    deformed = compress_deforming(start, 0.02, 0, final_growth_rate=1e-4)
+    vf = verify(fixed.packing)
+    vd = verify(deformed.packing)
+    assert vf.collective and not vf.strict
+    assert vd.collective and vd.strict
+    assert deformed.packing.overlap_report().n_overlapping == 0
+    assert deformed.stats["volume_ratio"] == pytest.approx(1.0, abs=1e-12)
+    assert not deformed.packing.is_orthorhombic  # the cell did shear
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"applied_pressure": -1.0}, "applied_pressure"),
+    ({"applied_pressure": float("nan")}, "applied_pressure"),
+    ({"cell_step": 0.0}, "cell_step"),
+    ({"cell_step": 2.0}, "cell_step"),
+    ({"growth_rate": -0.1}, "growth_rate"),
+    ({"stop": StopCriteria(max_pressure=None, target_phi=0.5)}, "target_phi"),
+])
+def test_bad_input_is_refused(kwargs, match):
+    start = random_packing(20, 2, monodisperse(), 0.3, 0)
+    args = {"growth_rate": 0.02, "seed": 0} | kwargs
+    with pytest.raises(InvalidInputError, match=match):
+        compress_deforming(start, **args)
+
+
+def test_too_small_cell_and_walls_are_refused():
+    # 2 disks whose cell has a lattice vector of 1.03 diameters (each nearly touches its own image)
+    tiny = _at_phi(lattice_packing("triangular", (2, 1)), 0.85)
+    with pytest.raises(InvalidInputError, match="too small"):
+        compress_deforming(tiny, 0.02, 0)
+    walled = random_packing(10, 2, monodisperse(), 0.2, 0, boundary="hard_walls")
+    with pytest.raises(InvalidInputError, match="periodic"):
+        compress_deforming(walled, 0.02, 0)
+
+
+def test_cli_writes_the_deformed_cell(tmp_path):
+    from hardpack.cli import main
+    from hardpack.io import load_packing, packing_to_dataset, write_dataset
+
+    start = random_packing(20, 2, monodisperse(), 0.3, 0)
+    write_dataset(packing_to_dataset(start), tmp_path / "init.nc")
+    out = tmp_path / "out.nc"
+    assert main(["compress", "--init", str(tmp_path / "init.nc"), "--out", str(out), "--growth-rate",
+                 "0.02", "--seed", "0", "--max-pressure", "1e4", "--deforming-cell"]) == 0
+    final = load_packing(out)
+    assert not final.is_orthorhombic
+    assert abs(np.linalg.det(final.lattice)) == pytest.approx(start.volume, rel=1e-12)
+    assert final.overlap_report().n_overlapping == 0
+    assert main(["compress", "--init", str(tmp_path / "init.nc"), "--out", str(out), "--growth-rate",
+                 "0.02", "--seed", "0", "--applied-pressure", "2"]) == 2  # refused: no --deforming-cell
