@@ -68,7 +68,8 @@ def test_snakemake_dry_run_lists_the_dag(configfile):
     assert re.search(r"^init +\d+$", out.stdout, re.M) and "fig_size_distributions" in out.stdout
     cfg = load(configfile.split("/")[1])["containers"]
     packings = len(cfg["N"]) * len(cfg["seeds"])
-    for rule, count in (("container_init", packings), ("container_profile", packings), ("container_summary", 1),
+    bulk = len(cfg["bulk"]["seeds"])  # the periodic packings of the protocol start like the containers
+    for rule, count in (("container_init", packings + bulk), ("container_profile", packings), ("container_summary", 1),
                         ("container_windows", 1), ("fig_container_profile", 1), ("fig_container_extrapolation", 1),
                         ("fig_container_windows", 1)):
         assert re.search(rf"^{rule} +{count}$", out.stdout, re.M), rule

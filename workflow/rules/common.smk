@@ -48,6 +48,7 @@ GLASS = config.get("glass")
 ELLIPSOIDS = config.get("ellipsoids")
 ELLIPSOID_CRYSTALS = config.get("ellipsoid_crystals")
 CONTAINERS = config.get("containers")
+STRICT_LS = config.get("strict_ls")
 VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
 
@@ -215,7 +216,22 @@ def _systems():
             dilute=f"--fraction {SLP_DILUTED['fraction']} --rounds {SLP_DILUTED['rounds']}")
     systems["ellipsoids"] = _ellipsoid_systems()
     systems["containers"] = _container_systems()
+    systems["strict_ls"] = _strict_ls_systems()
     return systems
+
+
+def _strict_ls_systems():
+    """Monodisperse LS packings grown in a deforming periodic cell, one system d{d} per dimension
+    (Donev 2006, Sec. 4.7.2.3 and Fig. 4.15): the LS two-stage protocol with `--deforming-cell`."""
+    if not STRICT_LS:
+        return {}
+    c = STRICT_LS
+    compress = (f"--growth-rate {c['growth_rate']} --final-growth-rate {c['final_growth_rate']}"
+                f" --switch-pressure {c['switch_pressure']} --max-pressure {c['max_pressure']} --deforming-cell")
+    return {f"d{spec['d']}": _system(spec["N"], spec["d"], spec["seeds"], c["init_phi"],
+                                     attrs={"ensemble": f"strict_ls_d{spec['d']}"}, compress=compress,
+                                     deforming=True)
+            for spec in c["systems"]}
 
 
 def _container_systems():
@@ -299,7 +315,8 @@ def init_shape(wildcards):
 
 SYSTEMS = _systems()
 #: the packing step each study's verdicts judge
-PACKED = {"ls": "jammed", "ellipsoids": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted": "slp"}
+PACKED = {"ls": "jammed", "ellipsoids": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted": "slp",
+          "strict_ls": "jammed"}
 
 
 def system(wildcards):
@@ -337,6 +354,15 @@ def checkpoint_beside(wildcards, output):
     """params function: the checkpoint of a resumable job, beside its first output (.nc -> .ckpt);
     a killed job started again resumes from it, and the job removes it when it succeeds."""
     return output[0].removesuffix(".nc") + ".ckpt"
+
+
+def checkpoint_option(wildcards, output):
+    """params function: `--checkpoint PATH` (:func:`checkpoint_beside`) for a compression that can
+    resume, nothing for a deforming-cell one (short runs of small systems; the engine has no
+    checkpoints)."""
+    if system(wildcards).get("deforming"):
+        return ""
+    return f"--checkpoint {checkpoint_beside(wildcards, output)}"
 
 
 def diluted_rounds(name):
@@ -542,6 +568,12 @@ def _combined_summaries():
         table[f"ls/{name}/jammed"] = _combined(seed_files("ls", name, "jammed"), ["seed"],
                                                ["Z", "phi_J_est", "collisions", "wall_time", "growth_rate"], attrs)
         table[f"ls/{name}/verdict"] = _combined(seed_files("ls", name, "verdict"), ["seed"], JAMMING_VARIABLES, attrs)
+    for name, spec in SYSTEMS["strict_ls"].items():
+        attrs = {"ensemble": spec["attrs"]["ensemble"], "d": spec["d"]}
+        table[f"strict_ls/{name}/jammed"] = _combined(seed_files("strict_ls", name, "jammed"), ["seed"],
+                                                      ["Z", "phi_J_est", "collisions", "wall_time"], attrs)
+        table[f"strict_ls/{name}/verdict"] = _combined(seed_files("strict_ls", name, "verdict"), ["seed"],
+                                                       JAMMING_VARIABLES, attrs)
     for name, spec in SYSTEMS["slp_mrj"].items():
         attrs = {"ensemble": name, "distribution": json.dumps(spec["distribution"])}
         table[f"slp_mrj/{name}/slp"] = _combined(seed_files("slp_mrj", name, "slp"), ["seed"],
@@ -671,6 +703,8 @@ def validation_inputs():
         inputs["ellipsoid_crystals"] = ["results/ellipsoid_crystals/laminate_family.nc"]
     if CONTAINERS:
         inputs["containers"] = ["results/containers/profile_summary.nc", "results/containers/windows_summary.nc"]
+    if STRICT_LS:
+        inputs["strict_ls"] = [summary(f"strict_ls/{name}/verdict") for name in SYSTEMS["strict_ls"]]
     return inputs
 
 

@@ -16,7 +16,7 @@ rule init:
         attrs=lambda w: attr_options(system(w)["attrs"]),
         shape=init_shape,
     wildcard_constraints:
-        study="ls|slp_mrj|slp_densest|slp_order_map|ellipsoids",
+        study="ls|slp_mrj|slp_densest|slp_order_map|ellipsoids|strict_ls",
     threads: 1
     resources:
         mem_mb=job_mem_mb("init"),
@@ -38,7 +38,7 @@ rule init:
 rule compress:
     """LS compression of one start configuration to the system's reduced pressure: the LS ensembles'
     two-stage protocol (with contact forces), one growth rate of the rate scan, the ellipsoid
-    study's two-stage protocol, or spheres in a spherical container."""
+    study's two-stage protocol, spheres in a spherical container, or spheres in a deforming cell."""
     input:
         start_packing,
     output:
@@ -46,9 +46,9 @@ rule compress:
         timeseries="results/{study}/{name}/timeseries/seed{seed}.nc",
     params:
         options=lambda w: system(w)["compress"],
-        checkpoint=checkpoint_beside,
+        checkpoint=checkpoint_option,
     wildcard_constraints:
-        study="ls|ls_rates|ellipsoids|containers",
+        study="ls|ls_rates|ellipsoids|containers|strict_ls",
     threads: 1
     resources:
         mem_mb=job_mem_mb("compress"),
@@ -61,7 +61,7 @@ rule compress:
         "results/benchmarks/compress/{study}/{name}/seed{seed}.tsv"
     shell:
         "hardpack compress --init {input} --out {output.packing} --timeseries {output.timeseries}"
-        " {params.options} --seed {wildcards.seed} --checkpoint {params.checkpoint} > {log} 2>&1"
+        " {params.options} --seed {wildcards.seed} {params.checkpoint} > {log} 2>&1"
 
 
 rule slp:

@@ -24,7 +24,7 @@ from hardpack.validation.containers import container_rows
 from hardpack.validation.ellipsoids import crystal_rows, ellipsoid_rows
 from hardpack.validation.freeenergy import bcmd_rows, density_rows, ladder_rows, simplex_rows
 from hardpack.validation.glass import entropy_rows, eos_rows, freezing_rows, smix_rows
-from hardpack.validation.jamming import jamming_rows
+from hardpack.validation.jamming import jamming_rows, strict_ls_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
 from hardpack.validation.polydisperse import polydisperse_rows
 from hardpack.validation.rows import from_dataset, gate, headline, to_dataset, to_markdown
@@ -46,6 +46,7 @@ ROW_BUILDERS = {
     "slp_order_map": lambda datasets: [row for ds in datasets for row in order_map_rows(ds)],
     "slp_diluted": lambda datasets: [row for ds in datasets for row in diluted_rows(ds)],
     "jamming": jamming_rows,
+    "strict_ls": strict_ls_rows,
     "structure": structure_rows,
     "bcmd": lambda datasets: bcmd_rows({ds.attrs["state"]: ds for ds in datasets}),
     "bcmd_density": lambda datasets: density_rows(**{ds.attrs["state"]: ds for ds in datasets}),

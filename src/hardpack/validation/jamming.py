@@ -111,3 +111,24 @@ def _slope_row(target, summary, n: int, seeds: int, label: str, size: str) -> Ro
     values = np.asarray(summary["ellipse_slope"].values, float)
     return evaluate(target, samples=values, n=n, seeds=seeds, label=label,
                     detail=f"{size}; per seed {', '.join(f'{v:.4f}' for v in values)}")
+
+
+def strict_ls_rows(summaries) -> list[Row]:
+    """The fraction of strictly jammed packings of each deforming-cell LS system (verdict
+    summaries with the attribute ``d``) against Donev 2006, Sec. 4.7.2.3 ("typically" strictly
+    jammed for small N)."""
+    targets = load_targets()
+    out = []
+    for s in summaries:
+        d = int(s.attrs["d"])
+        tid = f"donev-4.7.2.3-deforming-ls-strict-d{d}"
+        if tid not in targets:
+            continue
+        n, seeds = n_particles(s), s.sizes["sample"]
+        strict = s["strict"].values
+        detail = f"N = {n}, {seeds} seeds; strict verdicts {', '.join(map(str, strict))}"
+        if notes := verdict_notes(s):
+            detail += f"; {notes}"
+        out.append(evaluate(targets[tid], verdict_fraction(strict), n=n, seeds=seeds,
+                            label=s.attrs.get("ensemble", f"d = {d}"), detail=detail))
+    return out
