@@ -21,6 +21,7 @@ include: "workflow/rules/freeenergy.smk"    # BCMD free energies of FCC and of L
 include: "workflow/rules/polydisperse.smk"  # polydisperse vs bi- and tridisperse equivalents
 include: "workflow/rules/ellipsoids.smk"     # hard ellipsoids and ellipses: contacts, figures after Figs. 5.1-5.3
 include: "workflow/rules/containers.smk"    # spheres in spherical containers, window fluctuations (Donev 2006, Sec. 7.3)
+include: "workflow/rules/strict.smk"        # strictly jammed LS packings in a deforming cell (Donev 2006, Sec. 4.7.2.3)
 include: "workflow/rules/glass.smk"         # binary hard-disk glasses: EOS, fits, SOC free energies, s_c
 include: "workflow/rules/validation.smk"    # validation report and gate
 

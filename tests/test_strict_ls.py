@@ -24,3 +24,22 @@ def test_strict_rows_pass_when_most_packings_are_strict_and_fail_otherwise():
 
 def test_strict_rows_skip_dimensions_without_a_target():
     assert strict_ls_rows([_verdicts(5, 30, [1])]) == []
+
+
+def test_jammed_disk_figure_counts_rattlers_and_saves(tmp_path):
+    import numpy as np
+
+    from hardpack.geometry import lattice_packing
+    from hardpack.plots.jamming import plot_jammed_disks
+    from hardpack.plots.style import save
+
+    crystal = lattice_packing("triangular", [2, 2])
+    n = crystal.n_particles
+    verdict = xr.Dataset({"contact_i": ("contact", [0, 1]), "contact_j": ("contact", [1, 2]),
+                          "contact_shift": (("contact", "dim"), np.zeros((2, 2), int)),
+                          "force": ("contact", [1.0, 0.5]), "rattler": ("particle", [False] * (n - 1) + [True])},
+                         attrs={"verdict": "strictly jammed"})
+    fig = plot_jammed_disks(crystal, verdict)
+    assert "1 rattlers" in fig.axes[0].get_title()
+    save(fig, tmp_path / "disks.pdf")
+    assert (tmp_path / "disks.pdf").stat().st_size > 0

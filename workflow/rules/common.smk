@@ -665,6 +665,7 @@ def figures():
     names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
     names += ["glass_eos", "glass_entropy"] if GLASS else []
     names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []
+    names += ["strict_ls_disks"] if "d2" in SYSTEMS["strict_ls"] else []
     return [f"results/figures/{name}.pdf" for name in names]
 
 
