@@ -47,14 +47,17 @@ def _bulk_rows(targets, summary) -> list[Row]:
 
 
 def _wall_layer_detail(summary) -> str:
-    """Mean density of the layer within one a of the wall per container size (Eq. 7.1 takes the
-    wall correction as independent of R; a trend with a/R bends phi_avg(a/R) away from a line)."""
+    """Mean density of the layer within one a of the wall, and of the core, per container size
+    (Eq. 7.1 takes the wall correction as independent of R and the core as the bulk; a trend of
+    either with a/R moves the linear intercept away from the bulk density)."""
     if "phi_wall_layer" not in summary:
         return "no wall-layer densities"
     n = np.asarray(summary["N"].values)
     parts = [f"{np.mean(summary['phi_wall_layer'].values[n == k]):.3f} at a/R = "
              f"{np.mean(summary['a_over_R'].values[n == k]):.3f}" for k in sorted(set(n.tolist()))]
-    return "wall-layer density " + ", ".join(parts)
+    cores = [f"{np.nanmean(summary['phi_core'].values[n == k]):.4f} at N = {k}" for k in sorted(set(n.tolist()))
+             if np.isfinite(summary["phi_core"].values[n == k]).any()]
+    return "wall-layer density " + ", ".join(parts) + ("; core density " + ", ".join(cores) if cores else "")
 
 
 def _window_rows(targets, windows) -> list[Row]:
