@@ -278,3 +278,77 @@ def test_entropy_decreases_with_correlation_length_and_smoothness():
     assert np.all(np.diff(table, axis=1) < 0), table
     assert np.all(np.diff(table, axis=0) < 0), table
     assert np.all(table < thermo.mixing_entropy(1 / 3))
+
+
+# --- the study dataset, the labelled crystal and the command line --------------------------------
+
+def test_label_study_tables():
+    ds = seg.label_study((32, 48), 2.0, 0.4, 2 / 3, 9, count=3, window=(3, 2))
+    labels = ds["labels"].values
+    assert labels.shape == (3, 32, 48) and ds.attrs["n_windows"] == 3 * 32 * 48
+    assert ds.attrs["n_a"] == round(2 / 3 * 32 * 48)
+    assert np.all((labels == seg.LABEL_A).sum(axis=(1, 2)) == ds.attrs["n_a"])
+    S = seg.block_entropies(labels, 3, 2)
+    assert ds["block_entropy"].values == pytest.approx(S[1:, 1:], abs=1e-15)
+    assert ds["entropy_per_site"].values == pytest.approx(seg.markov_entropy(S), abs=1e-15)
+    assert ds["entropy_per_site"].sel(window_rows=1, window_cols=1) == pytest.approx(ds.attrs["s_mix"])
+    assert ds["n_configurations"].sel(window_rows=1, window_cols=1) == 2
+    assert np.all(ds["n_configurations"].values <= 2 ** np.outer(np.arange(1, 4), np.arange(1, 3)))
+    for a in range(1, 4):
+        for b in range(1, 3):
+            seen = np.unique(seg.window_codes(labels, a, b)).size
+            assert ds["n_configurations"].sel(window_rows=a, window_cols=b) == seen
+
+
+def test_labelled_crystal_carries_the_labels():
+    labels = seg.label_ensemble((8, 6), 1.5, 0.3, 2 / 3, 4)[0][0]
+    p = seg.labelled_crystal(labels, 0.8)
+    assert p.n_particles == 48 and np.all(p.radii == p.radii[0]) and p.phi == pytest.approx(0.8)
+    # site (r, c) sits at (c + (r mod 2) / 2, r sqrt(3) / 2) + 1/4 and carries labels[r, c]
+    r, c = np.indices((8, 6))
+    site = np.column_stack([c.ravel() + 0.5 * (r.ravel() % 2), r.ravel() * math.sqrt(3) / 2]) + 0.25
+    order = np.lexsort((p.positions[:, 0], np.round(p.positions[:, 1], 9)))
+    assert p.positions[order] == pytest.approx(site, abs=1e-12)
+    assert np.array_equal(p.species[order], labels.ravel())
+    with pytest.raises(InvalidInputError, match="even number"):
+        seg.labelled_crystal(labels[:7], 0.8)
+
+
+def test_cli_writes_labels_and_crystal(tmp_path, capsys):
+    from hardpack.cli import main
+    from hardpack.io import load_dataset, load_packing
+
+    out = tmp_path / "labels.nc"
+    assert main(["glass-labels", "--shape", "16", "20", "--R", "2", "--nu", "0.3", "--seed", "3",
+                 "--realisations", "2", "--window", "3", "3", "--out", str(out)]) == 0
+    ds = load_dataset(out, kind="glass_labels")
+    ref = seg.label_study((16, 20), 2.0, 0.3, 2 / 3, 3, count=2, window=(3, 3))
+    assert np.array_equal(ds["labels"].values, ref["labels"].values)
+    assert ds["entropy_per_site"].values == pytest.approx(ref["entropy_per_site"].values, abs=1e-15)
+    assert ds.attrs["seed"] == 3 and "git_commit" in ds.attrs and ds.attrs["matern_convention"]
+    crystal = tmp_path / "crystal.nc"
+    assert main(["glass-labelled-crystal", "--labels", str(out), "--realisation", "1", "--phi", "0.7",
+                 "--out", str(crystal)]) == 0
+    p = load_packing(crystal)
+    assert sorted(p.species.tolist()) == sorted(ds["labels"].values[1].ravel().tolist())
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--R", "0", "--nu", "0.3"], "correlation length R must be > 0"),
+    (["--R", "-2", "--nu", "0.3"], "correlation length R must be > 0"),
+    (["--R", "2", "--nu", "1"], "smoothness nu must be in (0, 1)"),
+    (["--R", "2", "--nu", "0"], "smoothness nu must be in (0, 1)"),
+    (["--R", "2", "--nu", "0.3", "--fraction-a", "1.5"], "fraction of A sites must be in (0, 1)"),
+    (["--R", "2", "--nu", "0.3", "--fraction-a", "0"], "fraction of A sites must be in (0, 1)"),
+    (["--R", "2", "--nu", "0.3", "--shape", "3", "64"], "a 4 x 4 window does not fit the 3 x 64 lattice"),
+    (["--R", "2", "--nu", "0.3", "--window", "0", "2"], "window sizes must be >= 1"),
+    (["--R", "2", "--nu", "0.3", "--realisations", "0"], "--realisations must be >= 1"),
+])
+def test_cli_refuses_bad_input(tmp_path, capsys, extra, message):
+    from hardpack.cli import main
+
+    out = tmp_path / "x.nc"
+    assert main(["glass-labels", "--seed", "1", "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0], err
+    assert not out.exists()

@@ -35,10 +35,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 from scipy.special import gamma, kv
 
 from hardpack.errors import InvalidInputError
+from hardpack.geometry.packing import Packing
 
+MATERN_CONVENTION = "C(r) = 2^(1-nu)/Gamma(nu) (r/R)^nu K_nu(r/R), r in lattice units (minimum image)"
 LABEL_A = 0
 LABEL_B = 1
 MAX_WINDOW_SITES = 62  # window codes are int64 bit patterns
@@ -327,14 +330,31 @@ def block_entropy(labels, n: int, m: int) -> float:
             raise InvalidInputError(f"window sizes must be >= 0, got {n} x {m}")
         _as_labels(labels)
         return 0.0
+    counts = window_counts(labels, n, m)
+    p = counts / counts.sum()
+    return float(-(p * np.log(p)).sum())
+
+
+def window_counts(labels, n: int, m: int) -> np.ndarray:
+    """How often each window configuration occurs (only the configurations that do occur).
+
+    Parameters
+    ----------
+    labels : array_like
+        0/1 labels, shape (rows, columns) or (realisations, rows, columns).
+    n, m : int
+        Window rows and columns (:func:`window_codes`).
+
+    Returns
+    -------
+    numpy.ndarray
+        Positive counts, one per distinct configuration, summing to the number of windows.
+    """
     codes = window_codes(labels, n, m).ravel()
     if int(n) * int(m) <= _BINCOUNT_SITES:
         counts = np.bincount(codes, minlength=1)
-        counts = counts[counts > 0]
-    else:
-        counts = np.unique(codes, return_counts=True)[1]
-    p = counts / codes.size
-    return float(-(p * np.log(p)).sum())
+        return counts[counts > 0]
+    return np.unique(codes, return_counts=True)[1]
 
 
 def block_entropies(labels, n: int, m: int) -> np.ndarray:
@@ -375,3 +395,120 @@ def markov_entropy(block: np.ndarray) -> np.ndarray:
     """
     S = np.asarray(block, dtype=float)
     return S[1:, 1:] - S[:-1, 1:] - S[1:, :-1] + S[:-1, :-1]
+
+
+def check_window(shape, window) -> tuple[int, int]:
+    """Refuse a window that does not fit the lattice (before any field is generated).
+
+    Parameters
+    ----------
+    shape : tuple of int
+        Lattice (rows, columns).
+    window : tuple of int
+        Largest window (rows, columns), each >= 1.
+
+    Returns
+    -------
+    tuple of int
+        The window as (rows, columns).
+    """
+    rows, cols = _check_shape(shape)
+    n, m = (int(w) for w in window)
+    if n < 1 or m < 1:
+        raise InvalidInputError(f"window sizes must be >= 1, got {n} x {m}")
+    if n > rows or m > cols:
+        raise InvalidInputError(f"a {n} x {m} window does not fit the {rows} x {cols} lattice; use a larger "
+                                "lattice or a smaller window")
+    if n * m > MAX_WINDOW_SITES:
+        raise InvalidInputError(f"windows of more than {MAX_WINDOW_SITES} sites are not supported, got {n} x {m}")
+    return n, m
+
+
+def label_study(shape, R: float, nu: float, fraction_a: float, seed: int, count: int = 1,
+                window=(4, 4)) -> xr.Dataset:
+    """Level-cut Matérn labels of one (R, nu) ensemble and their window entropies (Donev 2006,
+    sec. 13.5, Fig. 13.15).
+
+    Parameters
+    ----------
+    shape : tuple of int
+        Lattice (rows, columns); 64 x 64 in the text.
+    R, nu : float
+        Matérn correlation length (> 0) and smoothness in (0, 1).
+    fraction_a : float
+        Fraction of A sites in (0, 1) (2/3 in the text).
+    seed : int
+        Seed of the realisations (:func:`label_ensemble`).
+    count : int
+        Number of realisations; the window statistics pool all of them.
+    window : tuple of int
+        Largest window (n, m); the text uses 4 x 4.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``labels(realisation, row, col)`` (int8, 0 = A, 1 = B), ``field(realisation, row, col)``,
+        ``block_entropy(window_rows, window_cols)`` S_{a,b} and ``entropy_per_site`` s_{a,b}
+        (Markov estimate) for a = 1..n, b = 1..m (S_{0,b} = S_{a,0} = 0), ``n_configurations``
+        (distinct configurations seen: compare with 2^(a b) and ``n_windows`` to judge the
+        sampling of the plug-in estimate); attributes ``hardpack_kind`` = "glass_labels", the
+        parameters, ``n_a``, ``n_windows``, ``clipped_weight``, ``matern_convention``, ``s_mix``.
+    """
+    n, m = check_window(shape, window)
+    labels, fields, clipped = label_ensemble(shape, R, nu, fraction_a, seed, count)
+    S = block_entropies(labels, n, m)
+    configs = np.array([[window_counts(labels, a, b).size for b in range(1, m + 1)] for a in range(1, n + 1)])
+    x = count_a(labels[0].size, fraction_a) / labels[0].size
+    s_mix = -(x * math.log(x) + (1 - x) * math.log(1 - x)) if 0 < x < 1 else 0.0
+    cell = ("realisation", "row", "col")
+    win = ("window_rows", "window_cols")
+    return xr.Dataset(
+        {"labels": (cell, labels), "field": (cell, fields),
+         "block_entropy": (win, S[1:, 1:]), "entropy_per_site": (win, markov_entropy(S)),
+         "n_configurations": (win, configs)},
+        coords={"realisation": np.arange(labels.shape[0]), "window_rows": np.arange(1, n + 1),
+                "window_cols": np.arange(1, m + 1)},
+        attrs={"hardpack_kind": "glass_labels", "R": float(R), "nu": float(nu), "fraction_a": float(fraction_a),
+               "n_a": int(count_a(labels[0].size, fraction_a)), "rows": labels.shape[1], "cols": labels.shape[2],
+               "realisations": labels.shape[0], "n_windows": int(labels.size), "clipped_weight": clipped,
+               "matern_convention": MATERN_CONVENTION, "label_A": LABEL_A, "label_B": LABEL_B,
+               "s_mix": s_mix, "reference": "Donev 2006, sec. 13.5"},
+    )
+
+
+def labelled_crystal(labels, phi: float) -> Packing:
+    """The monodisperse triangular crystal whose sites carry the labels (species 0 = A, 1 = B), at
+    equal radii: the start of the micro-segregated packings before the B disks grow (Donev 2006,
+    sec. 13.5).
+
+    Lattice row r, column c is the disk at (c + (r mod 2) / 2, r sqrt(3) / 2) (+ 1/4 both ways),
+    in the orthorhombic box c_max x r_max sqrt(3) / 2 (:func:`hardpack.glass.study.triangular_crystal`
+    with nx = columns, ny = rows / 2); rows must be even for the alternate row offsets to wrap.
+
+    Parameters
+    ----------
+    labels : array_like
+        0/1 labels, shape (rows, columns), rows even.
+    phi : float
+        Volume fraction in (0, pi / sqrt(12)).
+
+    Returns
+    -------
+    Packing
+        rows x columns disks with ``species`` = the labels.
+    """
+    from hardpack.glass.study import triangular_crystal
+
+    arr = _as_labels(labels)
+    if arr.shape[0] != 1:
+        raise InvalidInputError(f"labelled_crystal takes one (rows, columns) label array, got shape "
+                                f"{np.shape(labels)}")
+    rows, cols = arr.shape[1:]
+    if rows % 2:
+        raise InvalidInputError(f"the triangular crystal needs an even number of label rows, got {rows}")
+    crystal = triangular_crystal(cols, rows // 2, phi)
+    r, c = np.indices((rows, cols))
+    index = (c * (rows // 2) + r // 2) * 2 + r % 2
+    species = np.empty(rows * cols, dtype=np.int64)
+    species[index.ravel()] = arr[0].ravel()
+    return Packing(crystal.positions, crystal.radii, crystal.lattice, species=species)
