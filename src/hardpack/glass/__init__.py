@@ -10,6 +10,9 @@ Torquato 2006).
 - :mod:`hardpack.glass.study`: the triangular start crystal, binned EOS of compressions and the
   summaries of the pipeline.
 
-Not implemented: the micro-segregated packings of sec. 13.5 (they need a constant-pressure,
-deforming-cell event-driven MD that hardpack does not have).
+- :mod:`hardpack.glass.segregated`: the micro-segregated labels of sec. 13.5 (level-cut Matérn
+  Gaussian random fields), their window entropies s_{n,m} and the labelled start crystal.
+
+Not implemented: growing the B disks of the labelled crystal at constant pressure and jamming the
+micro-segregated packings (sec. 13.5; needs the deforming-cell MD of :mod:`hardpack.md.deforming`).
 """

@@ -2,7 +2,10 @@
 ``hardpack glass-eos``: binned EOS, fits (Eqs. 13.3-13.4) and free energies of one system from its
 compression (and decompression) time series; ``hardpack glass-entropy``: s_c - s_mix of the SOC
 glasses from the EOS summary and their BCMD results; ``hardpack glass-freezing``: phi_F by
-chemical-potential matching (Eq. 13.2). Donev 2006, ch. 13 (:mod:`hardpack.glass`).
+chemical-potential matching (Eq. 13.2); ``hardpack glass-labels``: level-cut Matérn labels of the
+micro-segregated packings and their window entropies (sec. 13.5); ``hardpack glass-labelled-crystal``:
+the triangular crystal carrying one realisation of those labels. Donev 2006, ch. 13
+(:mod:`hardpack.glass`).
 """
 
 from __future__ import annotations
@@ -105,6 +108,45 @@ def cmd_glass_freezing(args) -> int:
     return 0
 
 
+def cmd_glass_labels(args) -> int:
+    """Level-cut Matérn GRF labels and their window entropies s_{n,m} (Donev 2006, sec. 13.5)."""
+    from hardpack.glass.segregated import check_window, count_a, label_study, matern
+    from hardpack.io import write_dataset
+
+    matern(0.0, args.R, args.nu)  # refuses bad R / nu before anything runs
+    count_a(1, args.fraction_a)
+    check_window(args.shape, args.window)
+    if args.realisations < 1:
+        raise InvalidInputError(f"--realisations must be >= 1, got {args.realisations}")
+    ds = label_study(args.shape, args.R, args.nu, args.fraction_a, args.seed, args.realisations, args.window)
+    config = {"shape": list(args.shape), "R": args.R, "nu": args.nu, "fraction_a": args.fraction_a,
+              "realisations": args.realisations, "window": list(args.window)}
+    write_dataset(ds, args.out, config=config, seed=args.seed)
+    s = ds["entropy_per_site"].values
+    log.info("R = %g, nu = %g: s_{n,n} = %s (s_mix = %.4f); %d windows; clipped eigenvalue weight %.3g",
+             args.R, args.nu, np.round(np.diag(s), 4).tolist(), ds.attrs["s_mix"], ds.attrs["n_windows"],
+             ds.attrs["clipped_weight"])
+    return 0
+
+
+def cmd_glass_labelled_crystal(args) -> int:
+    """Triangular crystal of equal disks carrying one realisation of glass-labels (species 0 = A, 1 = B)."""
+    from hardpack.glass.segregated import labelled_crystal
+    from hardpack.io import load_dataset, save_packing
+
+    ds = load_dataset(args.labels, kind="glass_labels")
+    k = ds.sizes["realisation"]
+    if not 0 <= args.realisation < k:
+        raise InvalidInputError(f"--realisation must be in 0..{k - 1} ({args.labels} holds {k}), "
+                                f"got {args.realisation}")
+    packing = labelled_crystal(ds["labels"].values[args.realisation], args.phi)
+    attrs = {"protocol": "labelled_triangular_crystal", "labels_source": str(args.labels),
+             "realisation": args.realisation, **{key: ds.attrs[key] for key in ("R", "nu", "fraction_a", "seed")}}
+    save_packing(packing, args.out, attrs=attrs)
+    log.info("wrote %s: %r", args.out, packing)
+    return 0
+
+
 def register(subparsers) -> None:
     p = subparsers.add_parser("glass-crystal", help=cmd_glass_crystal.__doc__)
     p.add_argument("--nx", type=int, required=True, help="rectangular 2-disk cells along x")
@@ -146,3 +188,23 @@ def register(subparsers) -> None:
                    help="monodisperse EOS: compression below, decompression from here up (default 0.70)")
     p.add_argument("--out", required=True, help="freezing netCDF")
     p.set_defaults(func=cmd_glass_freezing)
+
+    p = subparsers.add_parser("glass-labels", help=cmd_glass_labels.__doc__)
+    p.add_argument("--shape", type=int, nargs=2, default=[64, 64], metavar=("ROWS", "COLS"),
+                   help="periodic lattice (default 64 64)")
+    p.add_argument("--R", type=float, required=True, help="Matérn correlation length (> 0, lattice units)")
+    p.add_argument("--nu", type=float, required=True, help="Matérn smoothness in (0, 1)")
+    p.add_argument("--fraction-a", type=float, default=2 / 3, help="fraction of A (small) sites (default 2/3)")
+    p.add_argument("--seed", type=int, required=True, help="seed of the realisations")
+    p.add_argument("--realisations", type=int, default=1, help="independent fields pooled in the statistics")
+    p.add_argument("--window", type=int, nargs=2, default=[4, 4], metavar=("N", "M"),
+                   help="largest window for S_{n,m} and s_{n,m} (default 4 4)")
+    p.add_argument("--out", required=True, help="labels netCDF")
+    p.set_defaults(func=cmd_glass_labels)
+
+    p = subparsers.add_parser("glass-labelled-crystal", help=cmd_glass_labelled_crystal.__doc__)
+    p.add_argument("--labels", required=True, help="glass-labels netCDF")
+    p.add_argument("--realisation", type=int, default=0, help="which realisation (default 0)")
+    p.add_argument("--phi", type=float, required=True, help="volume fraction (< pi/sqrt(12))")
+    p.add_argument("--out", required=True, help="packing netCDF")
+    p.set_defaults(func=cmd_glass_labelled_crystal)
