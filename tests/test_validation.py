@@ -59,6 +59,8 @@ def test_the_packaged_table_loads_and_every_target_has_its_provenance():
             assert t.tolerance == 0 and t.min_seeds >= 2
         if t.tolerance_origin == "printed-digits":
             assert t.printed is not None
+        if t.tolerance_origin == "qualitative":  # a word of the text: the note must quote it
+            assert '"' in t.tolerance_note, t.id
 
 
 def test_printed_digits_give_half_a_unit_of_the_last_digit():
