@@ -1,0 +1,99 @@
+"""Jamming tests of ellipse and ellipsoid packings from the LS compression (Donev 2006, Secs. 5.2, 5.6).
+
+The packings in tests/data were made by ``hardpack compress`` from the RSA starts of the smoke
+study (N = 40, binary ellipses alpha = 1.5 and oblate spheroids alpha = 1.5, seed 1), growth rate
+0.03 up to Z = 1e3, then the final rate given in the name ('slow' 1e-3, 'fast' 1e-2), to the reduced
+pressure in the name. What the text says of such packings:
+
+- they are near, not at, their jamming point: A f = 0 holds only approximately, with the smallest
+  eigenvalue of A^T A 3-6 orders of magnitude below the next, its eigenvector strictly positive,
+  and the packings second-order jammed (Sec. 5.6);
+- fast particle expansion leaves packings whose torques are not balanced, translationally but not
+  rotationally jammed (Sec. 5.9);
+- contacts are defined by a tolerance on the gaps, which must separate contacts from near contacts
+  (Sec. 5.2, ch. 9).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hardpack.io import dataset_to_packing, load_dataset
+from hardpack.jamming.result import Verdict
+from hardpack.jamming.second_order import (
+    APPROX_STRESS_GAP,
+    approximate_stress,
+    contact_delta_from_gaps,
+    verify_ellipsoids,
+)
+
+DATA = Path(__file__).parent / "data"
+
+
+def _packing(name):
+    return dataset_to_packing(load_dataset(DATA / f"{name}.nc"), allow_overlap=True)
+
+
+def test_slowly_compressed_ellipses_are_second_order_jammed():
+    """p = 1e12 at the slow final rate: the gaps jump by > 8 decades above the contacts; A f = 0 has
+    no exact solution (the exact LP 5.9 is infeasible: 'not jammed' before the near self-stress of
+    Sec. 5.6 was accepted) but a strictly positive near one, |A f| ~ 1e-5; hypostatic (Z = 5.6 < 6)
+    and jammed at second order."""
+    res = verify_ellipsoids(_packing("ellipses_n40_slow_p1e12"), delta="gaps")
+    assert res.params["delta_decades"] > 8
+    c = res.collective
+    assert c.approx_stress is not None and c.approx_stress.min() > 0 and c.stress_residual < 1e-4
+    assert res.verdict == Verdict.JAMMED and res.order == "second"
+    assert res.isostaticity_gap < 0 and c.n_floppy > 0 and c.n_stresses == 1
+    assert not res.rattler.any()
+
+
+def test_slowly_compressed_spheroids_are_second_order_jammed():
+    """The same for oblate spheroids (5 dof each): Z = 9.6 < 10, jammed at second order."""
+    res = verify_ellipsoids(_packing("oblate_n40_slow_p1e12"), delta="gaps")
+    assert res.verdict == Verdict.JAMMED and res.order == "second"
+    assert res.z_mean < 10 and res.collective.approx_stress.min() > 0
+
+
+def test_fast_compressed_ellipses_have_unbalanced_torques():
+    """The fast final rate leaves no near self-stress (s_1 / s_2 of the balance-scaled A above
+    10^-1.5): not jammed, decided at first order by the flex the LP finds."""
+    packing = _packing("ellipses_n40_fast_p1e12")
+    res = verify_ellipsoids(packing, delta="gaps")
+    assert res.verdict == Verdict.NOT_JAMMED and res.order == "first"
+    assert res.collective.approx_stress is None and res.collective.lp_flex
+
+
+def test_unresolved_contacts_are_undetermined():
+    """p = 1e5: the gaps of the contacts and the near contacts overlap (no jump of 2 decades), so
+    no verdict: undetermined, with the reason."""
+    res = verify_ellipsoids(_packing("ellipses_n40_fast_p1e5"), delta="gaps")
+    assert res.params["delta_decades"] < 2
+    assert res.verdict == Verdict.UNDETERMINED and res.order == "undetermined"
+    assert "contacts not resolved" in res.collective.reason
+
+
+def test_contact_delta_from_gaps():
+    """The tolerance sits in the widest jump above the fewest contacts of a jammed packing
+    (Z >= d + 1), at its geometric middle; the search bound closes the list."""
+    gaps = np.concatenate([[1e-17], np.full(59, 1e-12), np.full(10, 1e-6)])  # N = 40, d = 2: 60 needed
+    delta, decades = contact_delta_from_gaps(gaps, 40, 2)
+    assert delta == pytest.approx(1e-9) and decades == pytest.approx(6.0)
+    delta, decades = contact_delta_from_gaps(gaps[:60], 40, 2)  # nothing above the contacts
+    assert delta == pytest.approx(1e-7) and decades == pytest.approx(10.0)
+    assert np.isnan(contact_delta_from_gaps(gaps[:50], 40, 2)[0])
+
+
+def test_near_stress_ignores_the_scale_of_the_torque_rows():
+    """A near-sphere balance: force rows O(1), a torque row O(1e-3) that no positive F balances
+    to its own scale. Unscaled, s_1 / s_2 would pass the gap; the scaled rows refuse it."""
+    a = np.array([[1.0, -1.0, 0.0], [0.0, 1.0, -1.0], [1e-3, 2e-3, 0.5e-3]])  # rows: balance eqs
+    at = a.T
+    s = np.linalg.svd(a, compute_uv=False)
+    assert s[-1] / s[-2] < APPROX_STRESS_GAP
+    assert approximate_stress(at) is None
+    near = approximate_stress(np.vstack([at[:, :2].T, [1e-3, 1e-3, -2e-3 + 1e-9]]).T)
+    assert near is not None and near[0].min() > 0
