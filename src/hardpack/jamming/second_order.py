@@ -201,7 +201,8 @@ class Decision:
     units of K, whose largest |entry| is ``stiffness_scale``; ``forces``: the LP self-stress (zeros when
     none); ``approx_stress``, ``stress_residual``: the approximate self-stress of a packing near (not
     at) its jamming point, when one was accepted (:func:`approximate_stress`); ``n_stresses`` (-1: not
-    computed), ``n_floppy`` (nontrivial; -1: not computed), ``n_dof`` (reduced, minus trivial), ``n_constraints`` (M); ``reason``: why, in words.
+    computed), ``n_floppy`` (nontrivial; -1: not computed), ``n_dof`` (reduced, minus trivial),
+    ``n_constraints`` (M); ``reason``: why, in words.
     """
 
     verdict: Verdict
