@@ -97,3 +97,22 @@ def test_near_stress_ignores_the_scale_of_the_torque_rows():
     assert approximate_stress(at) is None
     near = approximate_stress(np.vstack([at[:, :2].T, [1e-3, 1e-3, -2e-3 + 1e-9]]).T)
     assert near is not None and near[0].min() > 0
+
+
+@pytest.mark.slow
+def test_near_sphere_ellipsoids_hypostatic_and_second_order_jammed(monkeypatch):
+    """General ellipsoids near the sphere point (semiaxes 1 : 1.05^(1/2) : 1.05, N = 100, slow rate,
+    p = 1e12): Z = 7.5 < 12 = 2 d_f, hypostatic, and jammed at second order (Donev 2006, Sec. 5.6:
+    'indeed second-order jammed, even very close to the sphere point'). The local tests must see A
+    at the jamming point of the whole packing's near self-stress: with each particle's exact local
+    balance instead, every particle is a 'rattler' (near the sphere point the O(alpha - 1) torque
+    rows make the local balance need negative forces at a finite pressure)."""
+    from hardpack.jamming import second_order
+
+    packing = _packing("self_dual_a1.05_n100_slow_p1e12")
+    res = verify_ellipsoids(packing, delta="gaps")
+    assert res.verdict == Verdict.JAMMED and res.order == "second"
+    assert res.z_mean < 12 and res.isostaticity_gap < 0 and not res.rattler.any()
+    monkeypatch.setattr(second_order, "_global_near_stress", lambda *args: None)
+    res = verify_ellipsoids(packing, delta="gaps")
+    assert res.rattler.all() and res.verdict == Verdict.NOT_JAMMED

@@ -222,6 +222,7 @@ class Decision:
     fallbacks: int = 0  # dense eigh after eigsh failed (sparse path)
     approx_stress: np.ndarray | None = None  # unit approximate self-stress (see approximate_stress)
     stress_residual: float = 0.0  # s_1 / s_max of that stress (0: the self-stresses are exact)
+    stress_gap: float = float("nan")  # s_1 / s_2 of that stress (NaN: the self-stresses are exact)
 
 
 def self_stress_lp(a: sp.spmatrix) -> tuple[float, np.ndarray]:
@@ -323,6 +324,25 @@ def contact_delta_from_gaps(gaps: np.ndarray, n_particles: int, dim: int,
     return float(10 ** (0.5 * (lg[k] + lg[k + 1]))), float(lg[k + 1] - lg[k])
 
 
+def _unique_stress(stress: np.ndarray, stress_tol: float) -> tuple[float, np.ndarray, str | None]:
+    """The self-stress step for a one-dimensional space of self-stresses spanned by ``stress``: LP
+    5.9 has the optimum min(F) with F = stress scaled to sum M and the sign that makes the sum
+    positive (a stress of mixed signs has no non-negative multiple)."""
+    m = stress.size
+    total = stress.sum()
+    forces = stress * (m / total) if total != 0 else stress
+    eps = float(forces.min()) if total != 0 else float("-inf")
+    if eps < -stress_tol:
+        return eps, np.zeros(m), (
+            "no self-stress (force and torque balance with F >= 0 fails: the unique self-stress has "
+            f"mixed signs, LP 5.9 optimum {eps:.3g}): a strict first-order flex exists")
+    if eps <= stress_tol:
+        return eps, np.clip(forces, 0.0, None), (
+            "a self-stress exists but none is strict (LP 5.9 optimum 0): some contact carries no "
+            "force, the first-order test is inconclusive (Donev 2006, Sec. 5.5.3)")
+    return eps, forces, None
+
+
 def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, rank_tol: float = 1e-9,
                  stress_tol: float = 1e-9, eig_tol: float = 1e-9) -> Decision:
     """The procedure of the module docstring with dense linear algebra.
@@ -347,7 +367,7 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
     m, n = at.shape
     t = trivial.shape[1]
     dense = at.toarray()
-    approx, residual = None, 0.0
+    approx, residual, gap = None, 0.0, float("nan")
     if m:
         u, s, vh = np.linalg.svd(dense, full_matrices=True)
         rank = int((s > rank_tol * s.max()).sum()) if s.size and s.max() > 0 else 0
@@ -355,7 +375,7 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
         if near is not None:
             # no exact self-stress but a near one f (a packing near its jamming point, Sec. 5.6):
             # A at the jamming point is taken as (I - f f^T) applied to A^T, so that A f = 0
-            approx, _, residual = near
+            approx, gap, residual = near
             dense = dense - np.outer(approx, approx @ dense)
             at = sp.csr_matrix(dense)
             u, s, vh = np.linalg.svd(dense, full_matrices=True)
@@ -364,13 +384,13 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
         vh, rank = np.eye(n), 0
     n_stresses, n_floppy = m - rank, n - rank - t
     common = dict(n_stresses=n_stresses, n_floppy=n_floppy, n_dof=n - t, n_constraints=m,
-                  approx_stress=approx, stress_residual=residual)
+                  approx_stress=approx, stress_residual=residual, stress_gap=gap)
     if n - t == 0:
         return Decision(Verdict.JAMMED, "first", True, "no nontrivial degree of freedom",
                         np.zeros(m), **common)
     if m == 0:
         return Decision(Verdict.NOT_JAMMED, "first", False, "no contacts", np.zeros(0), **common)
-    eps, forces, why = _first_order(at, stress_tol)
+    eps, forces, why = _unique_stress(u[:, m - 1], stress_tol) if n_stresses == 1 else _first_order(at, stress_tol)
     if why is not None:
         verdict = Verdict.NOT_JAMMED if eps < -stress_tol else Verdict.UNDETERMINED
         return Decision(verdict, "first" if verdict == Verdict.NOT_JAMMED else "undetermined",
@@ -526,14 +546,14 @@ def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: 
     bias = 0.0
     if eps < -stress_tol and (near := approximate_stress(at)) is not None:
         # a near self-stress (Sec. 5.6): the packing is near its jamming point, where A f = 0
-        approx, _, residual = near
+        approx, gap, residual = near
         w = at.T @ approx  # A f, |w| = s_1: A at the jamming point is A - w f^T
         forces = approx * (m / approx.sum())
         eps = float(forces.min())
         n_floppy = _count_below(gram / gscale, max(rank_tol, 2.0 * float(w @ w) / gscale))
         n_stresses = 1
         common.update(n_stresses=1, n_floppy=-1 if n_floppy is None else n_floppy, approx_stress=approx,
-                      stress_residual=residual)
+                      stress_residual=residual, stress_gap=gap)
         why = None if eps > stress_tol else (
             "the near self-stress (smallest singular vector of A) is not strictly positive: a strict "
             "first-order flex exists" if eps < -stress_tol else
@@ -721,6 +741,7 @@ class EllipsoidJammingResult:
             lambda_min=c.lambda_min, stiffness_scale=c.stiffness_scale, stress_margin=c.stress_margin,
             n_local_undetermined=int((self.local == Verdict.UNDETERMINED).sum()),
             approximate_stress=int(c.approx_stress is not None), stress_residual=c.stress_residual,
+            stress_gap=c.stress_gap,
             order_code=ORDER_CODES[self.order], rattler_fraction=float(self.rattler.sum() / max(net.n_particles, 1)),
             hypostatic=int(self.isostaticity_gap < 0), jammed=int(self.verdict == Verdict.JAMMED),
             **{k: v for k, v in self.params.items() if v is not None},
@@ -731,11 +752,15 @@ class EllipsoidJammingResult:
 
 
 # ------------------------------------------------------------------------------------- verify
-def _submatrices(net, at_full, hess, t_full, owner, contacts, moving):
+def _submatrices(net, at_full, hess, t_full, owner, contacts, moving, near=None):
     """(A^T, dense stiffness(forces), sparse stiffness(forces), T) restricted to ``contacts`` and
-    the reduced dof of the ``moving`` particles (``owner``: the particle of each reduced column)."""
+    the reduced dof of the ``moving`` particles (``owner``: the particle of each reduced column).
+    ``near`` = (f, A f) of a near self-stress over all contacts: A^T is then taken at the jamming
+    point, (I - f f^T) A^T (module docstring)."""
     tm = t_full[:, np.flatnonzero(moving[owner])]
     at = (at_full[contacts] @ tm).tocsr()
+    if near is not None:
+        at = sp.csr_matrix(at.toarray() - np.outer(near[0][contacts], near[1] @ tm))
     sub = net.subset(contacts)
     sub_hess = hess[contacts]
 
@@ -754,6 +779,24 @@ def _submatrices(net, at_full, hess, t_full, owner, contacts, moving):
         return -np.einsum("cak,cab,cbk->ck", yc, sub_hess, yc) / sub.scale[:, None]
 
     return at, stiffness, stiffness_sparse, quadratic, tm
+
+
+def _global_near_stress(net, at_full, t_full, owner, frozen):
+    """(f, A f) over all contacts (zeros on those between frozen particles) of the near self-stress
+    of the whole packing (:func:`approximate_stress`), or None when it has none. The local tests
+    use A at the jamming point it defines: a particle's own balance equations alone can be far
+    more sensitive to the distance from jamming than the whole packing's (near the sphere point,
+    where the torque rows are small, an exact local balance of a packing at a finite pressure may
+    need negative forces while the whole packing has a strictly positive near self-stress)."""
+    moving = ~frozen
+    base = np.flatnonzero(moving[net.i] | moving[net.j])
+    tm = t_full[:, np.flatnonzero(moving[owner])]
+    found = approximate_stress(at_full[base] @ tm)
+    if found is None:
+        return None
+    f = np.zeros(net.n_contacts)
+    f[base] = found[0]
+    return f, np.asarray(at_full.T @ f).ravel()
 
 
 def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
@@ -832,25 +875,32 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     tols = dict(stress_tol=stress_tol, eig_tol=eig_tol)
     with recording_fallbacks() as fallbacks:
         t0 = time.perf_counter()
+        near = _global_near_stress(net, at_full, t_full, owner, frozen) if local else None
         local_verdict = np.full(n, int(Verdict.NOT_RUN), dtype=np.int64)
         local_order = np.zeros(n, dtype=np.int64)
         active = ~frozen
         if local:
-            changed = True
-            while changed:
-                changed = False
-                for p in np.flatnonzero(active):
-                    present = active | frozen
-                    contacts = np.flatnonzero(((net.i == p) | (net.j == p)) & present[net.i] & present[net.j])
-                    only = np.zeros(n, dtype=bool)
-                    only[p] = True
-                    at, stiff, _, quad, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only)
-                    dec = decide_dense(at, stiff, quad, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
-                    local_verdict[p] = int(dec.verdict)
-                    local_order[p] = ORDER_CODES[dec.order]
-                    if dec.verdict == Verdict.NOT_JAMMED:
-                        active[p] = False
-                        changed = True
+            # removing a particle can unjam only its neighbours: they are tested again
+            pending = list(np.flatnonzero(active))
+            queued = active.copy()
+            while pending:
+                p = pending.pop(0)
+                queued[p] = False
+                present = active | frozen
+                mine = (net.i == p) | (net.j == p)
+                contacts = np.flatnonzero(mine & present[net.i] & present[net.j])
+                only = np.zeros(n, dtype=bool)
+                only[p] = True
+                at, stiff, _, quad, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only, near)
+                dec = decide_dense(at, stiff, quad, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
+                local_verdict[p] = int(dec.verdict)
+                local_order[p] = ORDER_CODES[dec.order]
+                if dec.verdict == Verdict.NOT_JAMMED:
+                    active[p] = False
+                    for q in np.unique(np.concatenate([net.i[mine], net.j[mine]])):
+                        if active[q] and not queued[q]:
+                            pending.append(q)
+                            queued[q] = True
         seconds["local"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         present = active | frozen
