@@ -116,3 +116,47 @@ def test_near_sphere_ellipsoids_hypostatic_and_second_order_jammed(monkeypatch):
     monkeypatch.setattr(second_order, "_global_near_stress", lambda *args: None)
     res = verify_ellipsoids(packing, delta="gaps")
     assert res.rattler.all() and res.verdict == Verdict.NOT_JAMMED
+
+
+def test_cli_verifies_with_gaps_and_attributes(tmp_path, capsys):
+    """``hardpack verify --delta gaps --attr alpha=1.5``: the verdict file carries the order that
+    decided, the tolerance read off the gaps and the attribute; sphere packings refuse 'gaps'."""
+    from hardpack.cli import main
+    from hardpack.geometry.lattices import lattice_packing
+    from hardpack.io import save_packing
+
+    out = tmp_path / "verdict.nc"
+    assert main(["verify", str(DATA / "ellipses_n40_slow_p1e12.nc"), "--out", str(out), "--delta", "gaps",
+                 "--attr", "alpha=1.5", "--seed", "3"]) == 0
+    ds = load_dataset(out)
+    assert ds.attrs["order"] == "second" and ds.attrs["order_code"] == 2 and ds.attrs["jammed"] == 1
+    assert ds.attrs["alpha"] == 1.5 and ds.attrs["delta_decades"] > 8 and ds.attrs["seed"] == 3
+    assert "decided at order: second" in capsys.readouterr().out
+    spheres = tmp_path / "fcc.nc"
+    save_packing(lattice_packing("fcc", 2), spheres)
+    assert main(["verify", str(spheres), "--out", str(tmp_path / "v.nc"), "--delta", "gaps"]) != 0
+    assert "--delta gaps is for ellipse and ellipsoid packings" in capsys.readouterr().err
+
+
+def test_verdict_fractions_per_shape():
+    """Fractions over the packings of each (beta, alpha): jammed, decided at first / second order
+    or not at all, hypostatic; mean backbone Z with its standard error, rattler fraction."""
+    import xarray as xr
+
+    from hardpack.jamming.ellipsoid_verdicts import verdict_fractions
+
+    summary = xr.Dataset(
+        {"jammed": ("sample", [1.0, 0.0, 1.0, 1.0]), "order_code": ("sample", [2, 1, 0, 2]),
+         "hypostatic": ("sample", [1, 1, 1, 0]), "z_mean": ("sample", [9.0, 9.5, 10.0, 11.0]),
+         "rattler_fraction": ("sample", [0.0, 0.1, 0.2, 0.0])},
+        coords={"beta": ("sample", [0.0, 0.0, 0.0, 0.5]), "alpha": ("sample", [1.5, 1.5, 1.5, 2.0]),
+                "seed": ("sample", [1, 2, 3, 1])})
+    out = verdict_fractions(summary)
+    first = out.isel(shape=0)
+    assert float(first.alpha) == 1.5 and int(first.n_packings) == 3
+    assert float(first.fraction_jammed) == pytest.approx(2 / 3)
+    assert (float(first.fraction_first), float(first.fraction_second), float(first.fraction_undetermined)) == \
+        pytest.approx((1 / 3, 1 / 3, 1 / 3))
+    assert float(first.z_backbone) == pytest.approx(9.5) and float(first.z_backbone_err) == pytest.approx(0.5 / 3**0.5)
+    assert float(first.rattler_fraction) == pytest.approx(0.1)
+    assert np.isnan(float(out.isel(shape=1).z_backbone_err))

@@ -51,7 +51,15 @@ def register(subparsers) -> None:
     p.add_argument("--workers", type=int, default=1,
                    help="sequential method: loading sequences run at once, one process each "
                         "(default 1; the result does not depend on it)")
+    p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",
+                   help="extra attribute stored in the verdict (repeatable), e.g. alpha=1.5")
     p.set_defaults(func=cmd_verify)
+
+
+def _key_value(text: str):
+    from hardpack.cli import _key_value as parse
+
+    return parse(text)
 
 
 def _delta(text: str):
@@ -65,9 +73,10 @@ def _verify_ellipsoids(packing, args) -> int:
     from hardpack.io import write_dataset
     from hardpack.jamming.second_order import verify_ellipsoids
 
-    result = verify_ellipsoids(packing, delta=args.delta)
+    result = verify_ellipsoids(packing, delta=args.delta, seed=args.seed)
     out = result.to_dataset()
     out.attrs["source"] = str(args.packing)
+    out.attrs.update(dict(args.attr or []))
     write_dataset(out, args.out, seed=args.seed)
     print(result.summary())
     print(f"written {args.out}")
@@ -105,6 +114,7 @@ def cmd_verify(args) -> int:
         print(f"MD contact forces: LP virial / MD collisional pressure = {cmp.pressure_ratio:.4f}, "
               f"rms force difference {cmp.rms_relative:.3g} of the mean ({cmp.n_matched} of "
               f"{cmp.n_lp_contacts} contacts matched)")
+    out.attrs.update(dict(args.attr or []))
     write_dataset(out, args.out, seed=args.seed)
     print(result.summary())
     print(f"written {args.out}")
