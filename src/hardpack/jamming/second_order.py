@@ -52,8 +52,9 @@ the O(alpha - 1) torque rows near the sphere point count at their own scale) lie
 singular vector f is taken as the self-stress (:func:`approximate_stress`, recorded as
 ``approx_stress`` with its residual) and A^T is replaced by (I - f f^T) A^T, the nearest matrix
 with A f = 0, for everything that follows. With ``delta="gaps"`` the contact tolerance is read off
-the gap distribution (:func:`contact_delta_from_gaps`); when the widest jump spans fewer than
-GAP_DECADES decades the contacts are not resolved and the verdict is *undetermined*.
+the gap distribution (:func:`contact_delta_from_gaps`); when more than AMBIGUOUS_FRACTION of the
+contacts have a pair within a decade of it, the contacts are not resolved and the verdict is
+*undetermined*.
 
 Cross-check of the first-order verdict on the backbone by the randomised displacement LP of the
 sphere code (:func:`first_order_lp`): ``lp_flex`` says whether it found a first-order flex; it
@@ -119,8 +120,9 @@ SYMMETRY_RTOL = 1e-12
 #: the singular vector of s_1 is taken as an approximate self-stress: Donev 2006, Sec. 5.6 finds the
 #: smallest eigenvalue of A^T A 3-6 orders of magnitude below the next (s_1 / s_2 = 10^-1.5..10^-3)
 APPROX_STRESS_GAP = 10**-1.5
-#: contact tolerance from the gap distribution: the jump in log10(mu - 1) must span this many decades
-GAP_DECADES = 2.0
+#: contact tolerance from the gap distribution: contacts count as resolved when at most this
+#: fraction of them has a pair within a decade of the tolerance
+AMBIGUOUS_FRACTION = 0.01
 #: pairs within this mu - 1 are searched for the jump of the gap distribution
 GAPS_SEARCH = 1e-2
 #: gaps below this count as round-off when the contact tolerance is read off the gap distribution
@@ -291,15 +293,16 @@ def _first_order(at: sp.spmatrix, stress_tol: float) -> tuple[float, np.ndarray,
 
 
 def contact_delta_from_gaps(gaps: np.ndarray, n_particles: int, dim: int,
-                            search: float = GAPS_SEARCH) -> tuple[float, float]:
+                            search: float = GAPS_SEARCH) -> tuple[float, int]:
     """Contact tolerance of a packing near its jamming point from its gap distribution.
 
     An LS packing compressed to a high pressure p has its true contacts at gaps mu - 1 ~ 1/p and
     its near contacts orders of magnitude further (Donev 2006, Sec. 5.2 and ch. 9: Z is flat over a
-    wide range of tolerances). The tolerance is put in the widest jump of log10(mu - 1) over the
-    sorted gaps (gaps below GAP_FLOOR at GAP_FLOOR; ``search`` closes the list) whose lower side
-    holds enough contacts for Z >= d + 1 over all particles (the fewest a jammed particle can have),
-    at the geometric middle of the jump.
+    wide range of tolerances). The tolerance is where Z(delta) is flattest: the delta (on a grid of
+    0.05 decades) with the fewest pairs within a decade of it, delta / 10 < mu - 1 <= 10 delta, among
+    those with enough contacts below delta / 10 for Z >= d + 1 over all particles (the fewest a
+    jammed particle can have) and 10 delta <= ``search``; the middle of the longest run of such
+    deltas. Gaps below GAP_FLOOR count as GAP_FLOOR.
 
     Parameters
     ----------
@@ -311,17 +314,23 @@ def contact_delta_from_gaps(gaps: np.ndarray, n_particles: int, dim: int,
 
     Returns
     -------
-    (delta, decades) : (float, float)
-        The tolerance and the width of its jump in decades (NaN, 0 when no pair qualifies).
+    (delta, ambiguous) : (float, int)
+        The tolerance and the number of pairs within a decade of it (NaN, -1 when no delta
+        qualifies).
     """
-    gaps = np.asarray(gaps, float)
-    lg = np.log10(np.maximum(np.sort(np.append(gaps[gaps < search], search)), GAP_FLOOR))
-    first = int(np.ceil((dim + 1) * n_particles / 2)) - 1  # index of the last contact needed
-    if lg.size < first + 2:
-        return float("nan"), 0.0
-    jumps = np.diff(lg)[first:]
-    k = first + int(np.argmax(jumps))
-    return float(10 ** (0.5 * (lg[k] + lg[k + 1]))), float(lg[k + 1] - lg[k])
+    lg = np.sort(np.log10(np.maximum(np.asarray(gaps, float), GAP_FLOOR)))
+    lg = lg[lg <= np.log10(search)]
+    needed = int(np.ceil((dim + 1) * n_particles / 2))
+    if lg.size < needed:
+        return float("nan"), -1
+    grid = np.arange(lg[needed - 1] + 1.0, np.log10(search) - 1.0 + 1e-9, 0.05)
+    if grid.size == 0:
+        return float("nan"), -1
+    counts = np.searchsorted(lg, grid + 1.0, side="right") - np.searchsorted(lg, grid - 1.0, side="right")
+    best = counts == counts.min()
+    runs = np.split(np.flatnonzero(best), np.flatnonzero(np.diff(np.flatnonzero(best)) > 1) + 1)
+    run = max(runs, key=len)
+    return float(10 ** grid[run[len(run) // 2]]), int(counts.min())
 
 
 def _unique_stress(stress: np.ndarray, stress_tol: float) -> tuple[float, np.ndarray, str | None]:
@@ -849,12 +858,12 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     delta = DEFAULT_DELTA if delta is None else delta
     seconds = {}
     t0 = time.perf_counter()
-    decades = float("nan")
+    ambiguous = -1
     if isinstance(delta, str):
         if delta != "gaps":
             raise InvalidInputError(f"delta must be a number in (0, 1) or 'gaps', got {delta!r}")
         wide = ellipsoid_contacts(packing, GAPS_SEARCH)
-        delta, decades = contact_delta_from_gaps(wide.gap, n, packing.dim)
+        delta, ambiguous = contact_delta_from_gaps(wide.gap, n, packing.dim)
         if not np.isfinite(delta):
             raise InvalidInputError(
                 f"fewer pairs within mu - 1 <= {GAPS_SEARCH:g} than a jammed packing needs "
@@ -924,13 +933,14 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
         if active.any():
             dec.lp_flex = first_order_lp(at, trivial, np.random.default_rng(seed), stress=dec.approx_stress)[0]
         seconds["collective"] = time.perf_counter() - t0
-    if decades < GAP_DECADES:
-        dec.reason = (f"contacts not resolved: the widest jump of the gap distribution spans {decades:.2g} "
-                      f"decades (< {GAP_DECADES:g}), so no tolerance separates contacts from near contacts; "
+    if ambiguous > AMBIGUOUS_FRACTION * net.n_contacts:
+        dec.reason = (f"contacts not resolved: {ambiguous} pairs lie within a decade of the tolerance, more than "
+                      f"{AMBIGUOUS_FRACTION:g} of the {net.n_contacts} contacts, so no tolerance separates contacts "
+                      "from near contacts; "
                       f"compress to a higher pressure (the test alone said: {dec.verdict.name.lower()} at "
                       f"order {dec.order}; {dec.reason})")
         dec.verdict, dec.order = Verdict.UNDETERMINED, "undetermined"
-    params = dict(delta=float(delta), delta_decades=decades, method="dense" if dense else "sparse", seed=int(seed),
+    params = dict(delta=float(delta), delta_ambiguous=ambiguous, method="dense" if dense else "sparse", seed=int(seed),
                   rank_tol=rank_tol, stress_tol=stress_tol, eig_tol=eig_tol)
     rattler = ~frozen & ~active
     return EllipsoidJammingResult(
