@@ -754,8 +754,9 @@ def lp_minutes(n):
 
 def ellipsoid_verify_minutes(n):
     """Expected minutes of the first- and second-order tests of n ellipsoids (benchmarks/
-    bench_jamming.py: N = 1000 spheroids in XX s; N = 40: 10 s, mostly the local tests)."""
-    return 0.3 + 2.0 * (n / 1000) ** 1.5
+    bench_ellipsoid_jamming.py, CPU: N = 1000 spheroids decided at first order 9 s, N = 1080 at
+    second order 42 s; N = 100: ~20 s)."""
+    return 0.3 + 1.0 * (n / 1000) ** 1.5
 
 
 def _slowest_rate(spec):

@@ -113,6 +113,8 @@ DEFAULT_DELTA = 1e-9
 #: reduced dof above which method="auto" uses the sparse shifted form (measured on this 2-core
 #: machine: the dense SVD takes ~8 s at 750 dof, the sparse path 1 s)
 DENSE_LIMIT = 600
+#: sparse path: the smallest eigenvalue of a matrix of scale 1 is bracketed down to -this
+BRACKET_FLOOR = 1e-12
 #: sparse path: matrices up to this size get a dense eigh instead of eigsh
 SMALL_EIGH = 50
 #: symmetric semiaxes: equal to this relative tolerance
@@ -632,10 +634,11 @@ def _count_below(mat: sp.csc_matrix, tau: float) -> int | None:
 def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
     """(smallest eigenvalue of a sparse symmetric matrix of scale 1, whether a dense eigh gave it
     after the sparse path failed). eigsh in shift-invert mode returns the eigenvalues nearest the
-    shift, so the shift must lie just below the spectrum: at -1e-3 when the inertia (an LDL^T
-    factorisation) shows no negative eigenvalue, else just below the bracket [lo, hi) of the
-    smallest eigenvalue that bisection on the inertia of mat - sigma I finds (spectrum slicing,
-    down to 1% of |lo|)."""
+    shift, so the shift must lie below the spectrum: at -1e-3 when the inertia (an LDL^T
+    factorisation) shows no negative eigenvalue, else at twice the lower end of the bracket
+    [lo, hi) of the smallest eigenvalue that geometric bisection on the inertia of mat - sigma I
+    finds (spectrum slicing, to a factor of 2: any shift below the smallest eigenvalue makes it
+    the nearest, the bracket only speeds up the iteration)."""
     if mat.shape[0] <= SMALL_EIGH:
         return float(np.linalg.eigvalsh(mat.toarray())[0]), False
     negative = _count_below(mat, 0.0)
@@ -643,14 +646,19 @@ def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
         return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
     sigma = -1e-3
     if negative:
-        lo, hi = -float(abs(mat).sum(axis=1).max()) - 1e-3, 0.0
-        while hi - lo > 0.01 * abs(lo):
-            mid = 0.5 * (lo + hi) if hi - lo > 0.5 * abs(lo) or hi == 0.0 else -np.sqrt(lo * hi)
+        lo, hi = -float(abs(mat).sum(axis=1).max()) - 1e-3, -BRACKET_FLOOR
+        count = _count_below(mat, hi)
+        if count is None:
+            return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
+        if not count:
+            lo, hi = hi, 0.0
+        while hi < 0.0 and lo / hi > 2.0:  # geometric bisection to a factor of 2: shift-invert refines
+            mid = -np.sqrt(lo * hi)
             count = _count_below(mat, mid)
             if count is None:
                 return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
             lo, hi = (lo, mid) if count else (mid, hi)
-        sigma = lo - 0.01 * abs(lo)
+        sigma = 2.0 * lo
     try:
         w = spla.eigsh(mat, k=1, sigma=sigma, which="LM", return_eigenvectors=False)
         return float(w.min()), False
