@@ -530,7 +530,7 @@ def approximate_stress(at: sp.spmatrix) -> tuple[np.ndarray, float, float] | Non
         order = np.argsort(w)
         w, v = w[order], v[:, order]
     s1, s2 = np.sqrt(np.maximum(w[:2], 0.0))
-    if not s1 <= APPROX_STRESS_GAP * s2:
+    if not (s2 > 0 and s1 <= APPROX_STRESS_GAP * s2):  # s2 = 0: several exact self-stresses
         return None
     f = v[:, 0] * np.sign(v[:, 0].sum())
     return f, float(s1 / s2), float(s1 / np.sqrt(top))
