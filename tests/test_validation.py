@@ -359,3 +359,43 @@ def test_ellipsoid_rows_judge_the_published_shape_dependence():
     assert shifted["donev-fig5.1-mm-phi"].status == FAIL
     small = {r.target: r for r in ellipsoid_rows([_ellipsoid_summary(n=40)])}
     assert {r.status for r in small.values()} == {NA}
+
+
+def _ellipsoid_verdicts(n=100, jammed=(1, 1, 1, 1, 1, 1), order=(2, 2, 2, 2, 2, 2), gap=1e-2):
+    """Six 3D packings: three at alpha = 1.05 and three at 1.5 (beta = 0.5), hypostatic."""
+    k = len(jammed)
+    alpha = [1.05] * (k // 2) + [1.5] * (k - k // 2)
+    data = {"jammed": ("sample", np.asarray(jammed, float)), "order_code": ("sample", np.asarray(order)),
+            "hypostatic": ("sample", np.ones(k)), "n_stresses": ("sample", np.ones(k)),
+            "approximate_stress": ("sample", np.ones(k)), "stress_gap": ("sample", np.full(k, gap)),
+            "d": ("sample", np.full(k, 3)), "N": ("sample", np.full(k, n))}
+    return xr.Dataset(data, coords={"beta": ("sample", np.full(k, 0.5)), "alpha": ("sample", alpha),
+                                    "seed": ("sample", np.arange(k))})
+
+
+def test_ellipsoid_jamming_rows_judge_the_second_order_claims():
+    """Every packing jammed at second order and hypostatic near the sphere point: the rows of Donev
+    2006, Sec. 5.6 pass; near-sphere packings decided not jammed at first order fail both
+    fractions when no near-sphere packing is jammed; s_1 / s_2 = 1e-4 (8 orders in A^T A) fails the 3-6 orders;
+    below N = 100 the rows are n/a."""
+    from hardpack.validation.ellipsoids import ellipsoid_jamming_rows
+
+    rows = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts()])}
+    assert {r.status for r in rows.values()} == {PASS}
+    assert rows["donev-5.6-stress-eigenvalue-gap"].reproduced == pytest.approx(4.0)
+    bad = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts(jammed=(0, 0, 0, 1, 1, 1),
+                                                                             order=(1, 1, 1, 2, 2, 2), gap=1e-4)])}
+    assert bad["donev-5.6-near-sphere-hypostatic-second-order"].status == FAIL
+    assert bad["donev-5.6-stress-eigenvalue-gap"].status == FAIL
+    small = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts(n=40)])}
+    assert {r.status for r in small.values()} == {NA}
+
+
+def test_ellipsoid_jamming_rows_without_near_sphere_packings_are_na():
+    """A shape grid without alpha <= 1.1 leaves the near-sphere row n/a, not failed."""
+    from hardpack.validation.ellipsoids import ellipsoid_jamming_rows
+
+    grid = _ellipsoid_verdicts().assign_coords(alpha=("sample", np.full(6, 1.5)))
+    rows = {r.target: r for r in ellipsoid_jamming_rows([grid])}
+    assert rows["donev-5.6-near-sphere-hypostatic-second-order"].status == NA
+    assert rows["donev-5.6-ls-ellipsoids-jammed"].status == PASS

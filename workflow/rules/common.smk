@@ -109,10 +109,16 @@ def check_config():
 
 
 def check_ellipsoids():
-    """The M&M system names one of the ellipsoid families."""
-    if ELLIPSOIDS and "mm" in ELLIPSOIDS and ELLIPSOIDS["mm"]["family"] not in ELLIPSOIDS["families"]:
+    """The M&M system and the near-sphere systems name ellipsoid families."""
+    if not ELLIPSOIDS:
+        return
+    if "mm" in ELLIPSOIDS and ELLIPSOIDS["mm"]["family"] not in ELLIPSOIDS["families"]:
         raise ValueError(f"config: ellipsoids.mm.family {ELLIPSOIDS['mm']['family']!r} is not one of "
                          f"ellipsoids.families {sorted(ELLIPSOIDS['families'])}")
+    unknown = set(ELLIPSOIDS.get("near_sphere", {}).get("families", [])) - set(ELLIPSOIDS["families"])
+    if unknown:
+        raise ValueError(f"config: ellipsoids.near_sphere.families {sorted(unknown)} are not ellipsoids.families "
+                         f"{sorted(ELLIPSOIDS['families'])}")
 
 
 def check_containers():
@@ -287,6 +293,14 @@ def _ellipsoid_systems():
         systems[f"{family}_a{alpha:g}"] = _system(
             e["N"], 3, e["seeds"], e["init_phi"], attrs={"family": family, "beta": beta, "alpha": alpha},
             semiaxes=[1.0, alpha**beta, alpha], compress=compress)
+    near = e.get("near_sphere")
+    for family in near["families"] if near else []:
+        beta = e["families"][family]
+        for alpha in near["alphas"]:
+            systems[f"near_{family}_a{alpha:g}"] = _system(
+                near["N"], 3, near["seeds"], e["init_phi"],
+                attrs={"family": family, "beta": beta, "alpha": alpha, "part": "near_sphere"},
+                semiaxes=[1.0, alpha**beta, alpha], compress=compress, near_sphere=True)
     ell = e.get("ellipses")
     for alpha in ell["alphas"] if ell else []:
         sizes = {"kind": "bidisperse", "size_ratio": ell["size_ratio"], "large_fraction": ell["large_fraction"]}
@@ -296,9 +310,11 @@ def _ellipsoid_systems():
     return systems
 
 
-def ellipsoid_files(dim, step):
-    """Per-seed files of every ellipsoid (dim 3) or ellipse (dim 2) system."""
-    return [path for name, spec in SYSTEMS["ellipsoids"].items() if spec["d"] == dim
+def ellipsoid_files(dim, step, near_sphere=False):
+    """Per-seed files of every ellipsoid (dim 3) or ellipse (dim 2) system of the shape grid, or of
+    the near-sphere systems."""
+    return [path for name, spec in SYSTEMS["ellipsoids"].items()
+            if spec["d"] == dim and spec.get("near_sphere", False) == near_sphere
             for path in seed_files("ellipsoids", name, step)]
 
 
@@ -315,8 +331,7 @@ def init_shape(wildcards):
 
 SYSTEMS = _systems()
 #: the packing step each study's verdicts judge
-PACKED = {"ls": "jammed", "ellipsoids": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted": "slp",
-          "strict_ls": "jammed"}
+PACKED = {"ls": "jammed", "slp_mrj": "slp", "slp_order_map": "slp", "slp_diluted": "slp", "strict_ls": "jammed"}
 
 
 def system(wildcards):
@@ -554,6 +569,13 @@ ELLIPSOID_VARIABLES = ("z_mean", "z_all", "rattler_fraction", "nematic_S", "pres
                        "collisions", "wall_time")
 
 
+#: per-packing numbers of the ellipsoid jamming verdicts (hardpack verify --delta gaps)
+ELLIPSOID_VERDICT_VARIABLES = ("jammed", "order_code", "hypostatic", "z_mean", "rattler_fraction",
+                               "isostaticity_gap", "n_floppy", "n_stresses", "approximate_stress",
+                               "stress_residual", "stress_gap", "delta", "delta_ambiguous", "lambda_min",
+                               "stiffness_scale", "n_backbone")
+
+
 def _combined(inputs, index, variables=(), attrs=None):
     options = [f"--index {' '.join(index)}", *(f"--variable {v}" for v in variables), attr_options(attrs or {})]
     return {"inputs": inputs, "options": " ".join(o for o in options if o)}
@@ -601,6 +623,11 @@ def _combined_summaries():
         files = ellipsoid_files(dim, "contacts")
         if files:
             table[f"ellipsoids/contacts{dim}d"] = _combined(files, ["beta", "alpha", "seed"], ELLIPSOID_VARIABLES)
+            table[f"ellipsoids/verdicts{dim}d"] = _combined(ellipsoid_files(dim, "verdict"), ["beta", "alpha", "seed"],
+                                                            ELLIPSOID_VERDICT_VARIABLES)
+    near = ellipsoid_files(3, "verdict", near_sphere=True)
+    if near:
+        table["ellipsoids/verdicts_near_sphere"] = _combined(near, ["beta", "alpha", "seed"], ELLIPSOID_VERDICT_VARIABLES)
     return table
 
 
@@ -697,9 +724,10 @@ def validation_inputs():
     poly = [summary(key) for key in EOS_SUMMARIES]
     if poly:
         inputs["polydisperse"] = poly
-    ellipsoids = [summary(key) for key in COMBINED if key.startswith("ellipsoids/")]
+    ellipsoids = [summary(key) for key in COMBINED if key.startswith("ellipsoids/contacts")]
     if ellipsoids:
         inputs["ellipsoids"] = ellipsoids
+        inputs["ellipsoid_jamming"] = [summary(key) for key in COMBINED if key.startswith("ellipsoids/verdicts")]
     if ELLIPSOID_CRYSTALS:
         inputs["ellipsoid_crystals"] = ["results/ellipsoid_crystals/laminate_family.nc"]
     if CONTAINERS:
@@ -718,6 +746,8 @@ def final_outputs():
     """What `all` builds: every LS ensemble's summaries, the figures, the validation inputs and the gate."""
     outputs = [summary(f"ls/{name}/{step}") for name in SYSTEMS["ls"] for step in ("init", "jammed", "verdict")]
     outputs += figures()
+    outputs += [f"results/ellipsoids/verdict_fractions{key.removeprefix('ellipsoids/verdicts')}.nc"
+                for key in COMBINED if key.startswith("ellipsoids/verdicts")]
     outputs += [path for paths in validation_inputs().values() for path in paths]
     outputs.append("results/validation/gate.txt")
     return list(dict.fromkeys(outputs))
@@ -766,6 +796,13 @@ def lp_minutes(n):
     return 0.3 + 5.0 * (n / 1e4) ** 2
 
 
+def ellipsoid_verify_minutes(n):
+    """Expected minutes of the first- and second-order tests of n ellipsoids (benchmarks/
+    bench_ellipsoid_jamming.py, CPU: N = 1000 spheroids decided at first order 9 s, N = 1080 at
+    second order 42 s; N = 100: ~20 s)."""
+    return 0.3 + 1.0 * (n / 1000) ** 1.5
+
+
 def _slowest_rate(spec):
     rates = [float(r) for r in re.findall(r"--(?:final-)?growth-rate ([0-9.e+-]+)", spec["compress"])]
     return min(rates)
@@ -779,6 +816,7 @@ EXPECTED_MINUTES = {
     "slp": lambda w: slp_minutes(system(w)["N"], system(w)["d"]),
     "slp_dilute": lambda w: system(w)["rounds"] * slp_minutes(system(w)["N"], system(w)["d"]),
     "verify": lambda w: lp_minutes(system(w)["N"]),
+    "ellipsoid_verify": lambda w: ellipsoid_verify_minutes(SYSTEMS["ellipsoids"][w.name]["N"]),
     "structure": lambda w: 0.3 + system(w)["N"] / 2e4,
     "bcmd_fcc": lambda w: 0.3 + 4 * int(w.reps) ** 3 / 500,
     "fcc_eos": lambda w: 0.3 + FREEENERGY["density"]["eos_collisions"] / 6e7,
@@ -806,6 +844,7 @@ def job_runtime(rule):
 #: the number of particles a job holds in memory (jobs not listed: none to speak of)
 PARTICLES = {
     **dict.fromkeys(("init", "compress", "slp", "slp_dilute", "verify", "structure"), lambda w: system(w)["N"]),
+    "ellipsoid_verify": lambda w: SYSTEMS["ellipsoids"][w.name]["N"],
     "poly_jam": lambda w: poly_protocol(w)["N"],
     "bcmd_fcc": lambda w: 4 * int(w.reps) ** 3,
     "fcc_eos": lambda w: 4 * int(w.reps) ** 3,

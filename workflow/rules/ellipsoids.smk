@@ -1,5 +1,6 @@
-# Hard ellipsoids and ellipses (Donev 2006, Sec. 5.2): the contacts of the LS packings (the init
-# and compress jobs are the generic ones of packings.smk) and the figures after Figs. 5.1-5.3.
+# Hard ellipsoids and ellipses (Donev 2006, Sec. 5.2): the contacts and jamming verdicts of the LS
+# packings (the init and compress jobs are the generic ones of packings.smk) and the figures after
+# Figs. 5.1-5.3.
 
 
 rule ellipsoid_contacts:
@@ -26,6 +27,55 @@ rule ellipsoid_contacts:
         "results/benchmarks/ellipsoid_contacts/{name}/seed{seed}.tsv"
     script:
         "../scripts/ellipsoid_contacts.py"
+
+
+rule ellipsoid_verify:
+    """First- and second-order jamming tests of one jammed ellipsoid or ellipse packing (Donev 2006,
+    Secs. 5.5.3 and 5.6), contacts from the gap distribution; the verdict states the order that
+    decided it."""
+    input:
+        "results/ellipsoids/{name}/jammed/seed{seed}.nc",
+    output:
+        "results/ellipsoids/{name}/verdict/seed{seed}.nc",
+    params:
+        attrs=lambda w: attr_options(SYSTEMS["ellipsoids"][w.name]["attrs"]),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("ellipsoid_verify"),
+        runtime=job_runtime("ellipsoid_verify"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/ellipsoid_verify/{name}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/ellipsoid_verify/{name}/seed{seed}.tsv"
+    shell:
+        "hardpack verify {input} --out {output} --delta gaps --seed {wildcards.seed} {params.attrs} > {log} 2>&1"
+
+
+rule ellipsoid_verdict_fractions:
+    """Per shape: the fractions of packings jammed and decided at first or second order, backbone
+    Z and rattler fraction (hardpack.jamming.ellipsoid_verdicts)."""
+    input:
+        summary("ellipsoids/verdicts{part}"),
+    output:
+        "results/ellipsoids/verdict_fractions{part}.nc",
+    wildcard_constraints:
+        part="2d|3d|_near_sphere",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("ellipsoid_verdict_fractions"),
+        runtime=job_runtime("ellipsoid_verdict_fractions"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/ellipsoid_verdict_fractions/{part}.log",
+    benchmark:
+        "results/benchmarks/ellipsoid_verdict_fractions/{part}.tsv"
+    script:
+        "../scripts/ellipsoid_verdict_fractions.py"
 
 
 rule fig_ellipsoid_jamming:

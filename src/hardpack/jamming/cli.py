@@ -1,7 +1,8 @@
 """``hardpack verify PACKING.nc --out VERDICT.nc``: jamming verdict of a stored packing.
 
 Ellipse and ellipsoid packings go to :func:`hardpack.jamming.second_order.verify_ellipsoids`
-(first- and second-order tests, contacts within mu - 1 <= delta, default 1e-9). Sphere packings:
+(first- and second-order tests, contacts within mu - 1 <= delta, default 1e-9, or ``--delta gaps``
+from the gap distribution). Sphere packings:
 prints :meth:`JammingResult.summary` and writes :meth:`JammingResult.to_dataset` with
 :func:`hardpack.io.write_dataset` (provenance attributes, atomic write). The generator's
 reduced pressure, when the packing file carries one (attribute ``pressure``,
@@ -28,11 +29,12 @@ def register(subparsers) -> None:
     )
     p.add_argument("packing", help="packing netCDF file (hardpack.io.save_packing)")
     p.add_argument("--out", required=True, help="output netCDF file for the verdict")
-    p.add_argument("--delta", type=float, default=None,
+    p.add_argument("--delta", type=_delta, default=None,
                    help=f"relative gap tolerance of the contact list, 0 < delta < 1 (default "
                         f"{DEFAULT_DELTA:g} for the ideal method, {SEQUENTIAL_DELTA:g} for the "
                         "sequential one, whose contacts for Z and forces stay at "
-                        f"{DEFAULT_DELTA:g})")
+                        f"{DEFAULT_DELTA:g}); ellipses and ellipsoids: 'gaps' reads it off the "
+                        "gap distribution (packings compressed to a high pressure)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random loads (default 0)")
     p.add_argument("--method", choices=METHODS, default="ideal",
                    help="ideal: Algorithm 13 (default); sequential: Algorithm 14")
@@ -49,7 +51,20 @@ def register(subparsers) -> None:
     p.add_argument("--workers", type=int, default=1,
                    help="sequential method: loading sequences run at once, one process each "
                         "(default 1; the result does not depend on it)")
+    p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",
+                   help="extra attribute stored in the verdict (repeatable), e.g. alpha=1.5")
     p.set_defaults(func=cmd_verify)
+
+
+def _key_value(text: str):
+    from hardpack.cli import _key_value as parse
+
+    return parse(text)
+
+
+def _delta(text: str):
+    """--delta: a number, or 'gaps' (ellipsoids)."""
+    return text if text == "gaps" else float(text)
 
 
 def _verify_ellipsoids(packing, args) -> int:
@@ -58,9 +73,10 @@ def _verify_ellipsoids(packing, args) -> int:
     from hardpack.io import write_dataset
     from hardpack.jamming.second_order import verify_ellipsoids
 
-    result = verify_ellipsoids(packing, delta=args.delta)
+    result = verify_ellipsoids(packing, delta=args.delta, seed=args.seed)
     out = result.to_dataset()
     out.attrs["source"] = str(args.packing)
+    out.attrs.update(dict(args.attr or []))
     write_dataset(out, args.out, seed=args.seed)
     print(result.summary())
     print(f"written {args.out}")
@@ -74,6 +90,10 @@ def cmd_verify(args) -> int:
     if ds.attrs.get("shape_kind") == "ellipsoid":
         # verify_ellipsoids checks the overlaps itself (with the Perram-Wertheim function)
         return _verify_ellipsoids(dataset_to_packing(ds, source=str(args.packing), allow_overlap=True), args)
+    if args.delta == "gaps":
+        from hardpack.errors import InvalidInputError
+
+        raise InvalidInputError("--delta gaps is for ellipse and ellipsoid packings; give sphere packings a number")
     packing = dataset_to_packing(ds, source=str(args.packing))
     pressure = next((float(ds.attrs[k]) for k in PRESSURE_ATTRS if k in ds.attrs), None)
     if pressure is not None and not (math.isfinite(pressure) and pressure > 0):
@@ -94,6 +114,7 @@ def cmd_verify(args) -> int:
         print(f"MD contact forces: LP virial / MD collisional pressure = {cmp.pressure_ratio:.4f}, "
               f"rms force difference {cmp.rms_relative:.3g} of the mean ({cmp.n_matched} of "
               f"{cmp.n_lp_contacts} contacts matched)")
+    out.attrs.update(dict(args.attr or []))
     write_dataset(out, args.out, seed=args.seed)
     print(result.summary())
     print(f"written {args.out}")

@@ -21,7 +21,7 @@ from hardpack.io import load_dataset, write_dataset
 from hardpack.io.atomic import write_text
 from hardpack.validation.analytic import hgrid_rows, moment_table_rows
 from hardpack.validation.containers import container_rows
-from hardpack.validation.ellipsoids import crystal_rows, ellipsoid_rows
+from hardpack.validation.ellipsoids import crystal_rows, ellipsoid_jamming_rows, ellipsoid_rows
 from hardpack.validation.freeenergy import bcmd_rows, density_rows, ladder_rows, simplex_rows
 from hardpack.validation.glass import entropy_rows, eos_rows, freezing_rows, smix_rows
 from hardpack.validation.jamming import jamming_rows, strict_ls_rows
@@ -57,6 +57,7 @@ ROW_BUILDERS = {
     "glass_entropy": lambda datasets: [row for ds in datasets for row in entropy_rows(ds)],
     "glass_freezing": lambda datasets: [row for ds in datasets for row in freezing_rows(ds)],
     "ellipsoids": ellipsoid_rows,
+    "ellipsoid_jamming": ellipsoid_jamming_rows,
     "ellipsoid_crystals": crystal_rows,
     "containers": container_rows,
 }
