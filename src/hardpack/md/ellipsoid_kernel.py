@@ -480,7 +480,7 @@ def support_rate_bound(P, i, d):
 
 
 #: length of a pair's trace state (:func:`pair_start`)
-PAIR_STATE = 13
+PAIR_STATE = 14
 
 
 @njit(cache=True)
@@ -529,6 +529,7 @@ def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
     h = FIRST_STEP * amin / speed if speed > 0.0 else np.inf
     st[0], st[1], st[2], st[3], st[4], st[5], st[6] = tin, z0, d0, lam, gap0, sep0, zc
     st[7], st[8], st[9], st[10], st[11], st[12] = touching, spin0, grow_speed, rate_tol, h, MIN_STEP_FRACTION * h
+    st[13] = 0.0
     if speed == 0.0:  # nothing moves: zeta is constant
         return np.inf, False
     if touching:
@@ -550,20 +551,24 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
         return t + tin, 0
     if lower >= min(tout, tmax - t):
         return np.inf, 0
-    return pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st)
+    return pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, np.inf)
 
 
 @njit(cache=True)
-def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
+def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
     """Trace of i and j (shifted) from the state ``st`` of :func:`pair_start` to
-    min(t + tout, tmax): (time, kind) as :func:`predict_pair`."""
+    min(t + tout, tmax): (time, kind) as :func:`predict_pair`, or, after at least one step, a
+    suspension (lower bound on the collision time, 2) as soon as that lower bound (the time
+    reached plus its safe time) is at or after window time ``tyield``; ``st`` then holds the state
+    to continue from."""
     end = min(tout, tmax - t)
     t0, z0, d0, lam, gap0, sep0, zc = st[0], st[1], st[2], st[3], st[4], st[5], st[6]
     touching = st[7] != 0.0
     spin0, grow_speed, rate_tol, h, hmin_step = st[8], st[9], st[10], st[11], st[12]
     if h == np.inf:  # nothing moves
         return np.inf, 0
-    steps = 0
+    steps = int(st[13])
+    steps0 = steps
     while True:
         # the shortest step moves the time by a few ulps: a rest of the interval shorter than
         # that holds no event the time can resolve, and every CHECK advances the time
@@ -576,6 +581,10 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
         safe = _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + t0)
         if t0 + safe >= end:
             return np.inf, 0
+        if steps > steps0 and t + t0 + safe >= tyield:
+            st[0], st[1], st[2], st[3], st[4], st[5], st[6] = t0, z0, d0, lam, gap0, sep0, zc
+            st[7], st[8], st[11], st[13] = 1.0 if touching else 0.0, spin0, h, steps
+            return t + t0 + safe, 2
         h = min(max(h, hfloor), end - t0)
         if safe > h:
             t1 = t0 + safe
@@ -898,13 +907,18 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
             if lower > 0.0:
                 tins[m] = lower
                 done[m] = 3
-    for _ in range(3 * m_n):  # best first: each pair is (screened,) started, then traced
+    while True:  # best first: each pair is (screened,) started, then traced step by step
         q = -1
         tq = np.inf
+        t2 = np.inf  # the second smallest key
         for m in range(m_n):
-            if done[m] != 2 and tins[m] < tq:
-                tq = tins[m]
-                q = m
+            if done[m] != 2:
+                if tins[m] < tq:
+                    t2 = tq
+                    tq = tins[m]
+                    q = m
+                elif tins[m] < t2:
+                    t2 = tins[m]
         if q < 0 or t + tq >= min(best, horizon):
             break
         e = nb[i, q]
@@ -925,8 +939,12 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
                 done[q] = 1 if lower < touts[q] else 2
                 tins[q] = lower
             continue
+        tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q],
+                              t + t2)
+        if kind == 2:  # suspended: its lower bound is now after the second smallest key
+            tins[q] = tc - t
+            continue
         done[q] = 2
-        tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q])
         if tc < best:
             best = tc
             partner = j if kind == 0 else CHECK
