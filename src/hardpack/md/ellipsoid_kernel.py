@@ -360,8 +360,8 @@ def _safe_time(gap, sep_rate, spin, grow_speed, kappa, t):
     between the particles' support planes normal to a fixed unit vector u is a lower bound on the
     distance of the surfaces at all times; it grows at the rate ``sep_rate`` = u . (v_j - v_i) of
     the centres less the rates of the support functions h(u) = sqrt(u^T X^-1 u), each at most
-    c |w x u| (1 + kappa t') for a spin w (``spin`` = c_i |w_i x u| + c_j |w_j x u|, c = min(R,
-    (a_max^2 - a_min^2) / (2 a_min)) at the window start: derived in :func:`support_rate_bound`)
+    c |w x u| (1 + kappa t') for a spin w (``spin`` = c_i |w_i x u| + c_j |w_j x u|,
+    c = a_max - a_min at the window start: derived in :func:`support_rate_bound`)
     plus |kappa| R for the growth (``grow_speed``). The first root of
     gap - (grow_speed + spin (1 + kappa t) - sep_rate) s - spin kappa s^2 / 2 = 0, or inf."""
     if gap <= 0.0:
@@ -460,23 +460,27 @@ def _spin_across(P, i, n, nn):
 
 @njit(cache=True, inline="always")
 def support_rate_bound(P, i, d):
-    """c_i = min(R_i, (a_max^2 - a_min^2) / (2 a_min)) with the window-start semiaxes: |dh/dt| <=
-    c_i |w_i x u| for the support function h(u) = sqrt(u^T X^-1 u) of particle i along a fixed
-    unit vector u while it spins at w_i.
+    """c_i = a_max - a_min with the window-start semiaxes: |dh/dt| <= c_i |w_i x u| for the
+    support function h(u) = sqrt(u^T X^-1 u) of particle i along a fixed unit vector u while it
+    spins at w_i.
 
     Derived here: with M = X^-1, dM/dt = W M - M W, so d(u^T M u)/dt = -2 (w x u) . (M u) and
-    dh/dt = -(w x u) . (M u) / h, the speed along u of the support point M u / h turning about the
-    centre; w x u is normal to u, so |dh/dt| <= |w x u| |M u|_perp / h, where the part of M u
-    normal to u is at most (a_max^2 - a_min^2) / 2 (eigenvalues of M between a_min^2 and
-    a_max^2) and h >= a_min, and also <= |w x u| R (the support point is within R of the
-    centre). A spin about u does not change h(u)."""
-    _, _, cr, cax, _, _, _, _ = columns(d)
+    dh/dt = -(w x u) . (M u) / h, the speed along u of the support point p = M u / h turning about
+    the centre; w x u is normal to u, so |dh/dt| <= |w x u| |p_perp|, p_perp the part of p normal
+    to u. In the body frame (M = diag(a_k^2), weights x_k = u_k^2 summing to 1),
+    |p_perp|^2 = (sum a_k^4 x_k - (sum a_k^2 x_k)^2) / sum a_k^2 x_k, the variance over the mean
+    of a_k^2 under the weights x. For a mean m the variance is at most (a_max^2 - m)(m - a_min^2)
+    (all weight on the extreme semiaxes), and (a_max^2 - m)(m - a_min^2) / m is largest at
+    m = a_max a_min, where it equals (a_max - a_min)^2: so |p_perp| <= a_max - a_min, attained
+    in the plane of the longest and shortest semiaxes (the support function of an ellipse turns
+    fastest there). A spin about u does not change h(u)."""
+    _, _, _, cax, _, _, _, _ = columns(d)
     amin = P[i, cax]
     amax = P[i, cax]
     for k in range(1, d):
         amin = min(amin, P[i, cax + k])
         amax = max(amax, P[i, cax + k])
-    return min(P[i, cr], 0.5 * (amax * amax - amin * amin) / amin)
+    return amax - amin
 
 
 #: length of a pair's trace state (:func:`pair_start`)
