@@ -470,8 +470,11 @@ def test_small_box_compression_keeps_exact_lists_and_never_stalls(semiaxes):
     [1.0, 1.0, 1.0], pytest.param([1.0, 1.9, 1.9], marks=pytest.mark.slow)])
 def test_small_systems_compress_to_jamming(semiaxes):
     """The two starts above jam (Z = 1e6) in bounded time without overlaps: the spheres at a
-    density between the random close packing of spheres and the fcc crystal (40 spheres pack at
-    0.636-0.671 with the sphere engine and this protocol), the spheroids 1.9:1 in the range of
+    density in the range of the sphere engine's jammed packings of 40 spheres with this protocol
+    (60 random starts: 0.6288-0.6715, the amorphous ones 0.636 +- 0.0035; a round-off change of
+    the trajectory moves this start's density within that range, so the lower bound is the
+    lowest of the 60 less three standard deviations) and the fcc crystal, the spheroids 1.9:1 in
+    the range of
     spheroids near that aspect ratio, 0.68-0.71 (Donev 2006, sec. 5.2; 0.70 for 1000 of them,
     Fig. 5.1)."""
     packing = random_ellipsoid_packing(40, semiaxes, 0.2, seed=1)
@@ -480,7 +483,7 @@ def test_small_systems_compress_to_jamming(semiaxes):
     assert res.packing.overlap_report().n_overlapping == 0
     assert res.stats["max_overlap"] <= 1e-12
     if semiaxes[1] == 1.0:
-        assert 0.63 < res.stats["phi"] < np.pi / np.sqrt(18)
+        assert 0.618 < res.stats["phi"] < np.pi / np.sqrt(18)
     else:
         assert 0.68 <= res.stats["phi"] <= 0.71
 

@@ -101,7 +101,7 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
-from hardpack.geometry.contact import _inverse_sym, contact_point, pw_contact_into, pw_rate, shape_inverse_into
+from hardpack.geometry.contact import contact_point, pw_contact_into, pw_rate, shape_inverse_into
 from hardpack.md.kernel import (
     A_KE,
     A_KEINT,
@@ -259,7 +259,7 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     for k in range(d):
         r[k] = xb[k] - xa[k]
     n = ws[5, :d]
-    zeta, lam, _ = pw_contact_into(r, wm[0], wm[1], lam0, n, wm[2], wm[3], ws[6, :d])
+    zeta, lam, _ = pw_contact_into(r, wm[0], wm[1], lam0, n)
     ws[10, 0] += 1.0
     contact_point(xa, wm[0], lam, n, rc)
     rn = 0.0
@@ -399,20 +399,16 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
     for a in range(d):
         for b in range(d):
             y[a, b] = lam * mj[a, b] + (1.0 - lam) * mi[a, b]
-    _inverse_sym(y, wm[2])
     u = ws[5, :d]
+    _adjugate_times(y, r, u)  # along Y^-1 r (det Y > 0)
     uu = 0.0
     for a in range(d):
-        acc = 0.0
-        for b in range(d):
-            acc += wm[2, a, b] * r[b]
-        u[a] = acc
-        uu += acc * acc
-    uu = np.sqrt(uu)
+        uu += u[a] * u[a]
+    uu = 1.0 / np.sqrt(uu)
     ur = 0.0
     sep = 0.0
     for a in range(d):
-        u[a] /= uu
+        u[a] *= uu
         ur += u[a] * r[a]
         sep += u[a] * (P[j, cv + a] - P[i, cv + a])
     width = ur - np.sqrt(_quad(mi, u)) - np.sqrt(_quad(mj, u))
@@ -425,12 +421,30 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
 
 @njit(cache=True, inline="always")
 def _quad(m, x):
-    """x^T m x."""
-    acc = 0.0
-    for a in range(x.shape[0]):
-        for b in range(x.shape[0]):
-            acc += x[a] * m[a, b] * x[b]
-    return acc
+    """x^T m x for a symmetric m (its upper triangle)."""
+    if x.shape[0] == 2:
+        return m[0, 0] * x[0] * x[0] + m[1, 1] * x[1] * x[1] + 2.0 * m[0, 1] * x[0] * x[1]
+    return m[0, 0] * x[0] * x[0] + m[1, 1] * x[1] * x[1] + m[2, 2] * x[2] * x[2] \
+        + 2.0 * (m[0, 1] * x[0] * x[1] + m[0, 2] * x[0] * x[2] + m[1, 2] * x[1] * x[2])
+
+
+@njit(cache=True, inline="always")
+def _adjugate_times(y, r, out):
+    """out = adj(y) r = det(y) y^-1 r for a symmetric 2 x 2 or 3 x 3 y (its upper triangle)."""
+    if r.shape[0] == 2:
+        out[0] = y[1, 1] * r[0] - y[0, 1] * r[1]
+        out[1] = y[0, 0] * r[1] - y[0, 1] * r[0]
+        return
+    y00, y01, y02, y11, y12, y22 = y[0, 0], y[0, 1], y[0, 2], y[1, 1], y[1, 2], y[2, 2]
+    c00 = y11 * y22 - y12 * y12
+    c01 = y12 * y02 - y01 * y22
+    c02 = y01 * y12 - y11 * y02
+    c11 = y00 * y22 - y02 * y02
+    c12 = y02 * y01 - y00 * y12
+    c22 = y00 * y11 - y01 * y01
+    out[0] = c00 * r[0] + c01 * r[1] + c02 * r[2]
+    out[1] = c01 * r[0] + c11 * r[1] + c12 * r[2]
+    out[2] = c02 * r[0] + c12 * r[1] + c22 * r[2]
 
 
 @njit(cache=True, inline="always")
@@ -822,10 +836,11 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     particle index (Algorithm 5 with NNLs). The pairs are searched best first: each has a key, a
     lower bound on its collision time, first the start t_in of its bounding-sphere overlap (or,
     for the pairs whose bounding spheres overlap now, the cheap bound of :func:`_screen_time`),
-    then, once :func:`pair_start` has evaluated zeta at t_in, t_in plus its safe time; the pair
-    of the smallest key is started or, if started, traced (:func:`pair_trace`), until the
-    smallest key is after the earliest event found (``done``: 0 new, 3 screened, 1 started,
-    2 finished; ``pst`` the states of the started pairs)."""
+    then, once :func:`pair_start` has evaluated zeta at that first key, the key plus its safe
+    time, then the lower bound its trace has reached; the pair of the smallest key is started
+    or, if started, traced one stretch (:func:`pair_trace`, suspended once its lower bound passes
+    the second smallest key), until the smallest key is after the earliest event found (``done``:
+    0 new, 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs)."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 2 * d
@@ -931,12 +946,15 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
         for k in range(d):
             sh[k] = imgvec[im, k]
         if done[q] == 0 or done[q] == 3:
-            tstart = 0.0 if done[q] == 3 else tq
-            lower, now = pair_start(P, i, j, sh, t, tstart, kappa, ws, wm, pst[q])
+            # no contact before the key (t_in or the screening bound): the trace starts there
+            if tq >= touts[q]:
+                done[q] = 2
+                continue
+            lower, now = pair_start(P, i, j, sh, t, tq, kappa, ws, wm, pst[q])
             if now:
                 done[q] = 2
-                if t + tstart < best:
-                    best = t + tstart
+                if t + tq < best:
+                    best = t + tq
                     partner = j
             else:
                 lower = max(lower, tq)
