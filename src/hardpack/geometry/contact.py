@@ -79,7 +79,7 @@ def shape_inverse(semiaxes, orientation_row, out):
     shape_inverse_into(semiaxes, orientation_row, out, np.empty((semiaxes.shape[0], semiaxes.shape[0])))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def shape_inverse_into(semiaxes, orientation_row, out, q):
     """:func:`shape_inverse` with a (d, d) scratch array ``q`` for the rotation (no allocation:
     the event-driven MD calls it in its innermost loop)."""
@@ -156,7 +156,7 @@ def _pw_maximise(r_ab, a_inv, b_inv, lam0):
     return zeta, lam, n, iterations
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def pw_contact_into(r_ab, a_inv, b_inv, lam0, n):
     """:func:`pw_contact` without allocation: the normal goes into ``n`` (d,). Returns (zeta, lam,
     number of iterations). The iteration runs on scalars, one routine per dimension
@@ -205,7 +205,7 @@ def _newton_step(lam, lo, hi, last_step, fp, fpp):
     return new, lo, hi, step, False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _pw_newton3(r_ab, a_inv, b_inv, lam, n):
     """The Newton iteration of :func:`pw_contact_into` in 3D on scalars (the upper triangles of
     the symmetric X_A^-1, X_B^-1), from lam in (0, 1)."""
@@ -251,7 +251,7 @@ def _pw_newton3(r_ab, a_inv, b_inv, lam, n):
     return lam * (1.0 - lam) * rn - 1.0, lam, iterations
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _pw_newton2(r_ab, a_inv, b_inv, lam, n):
     """The Newton iteration of :func:`pw_contact_into` in 2D on scalars, from lam in (0, 1)."""
     r0, r1 = r_ab[0], r_ab[1]
@@ -285,7 +285,7 @@ def _pw_newton2(r_ab, a_inv, b_inv, lam, n):
     return lam * (1.0 - lam) * rn - 1.0, lam, iterations
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def contact_point(r_a, a_inv, lam, n, out):
     """Contact point r_C = r_A + (1 - lam) X_A^-1 n (Donev 2006, Eq. 2.13).
 
@@ -340,7 +340,7 @@ def _spin_dot_impl(w, p, c, n):
     return vector
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def pw_rate(lam, n, r_a, r_b, r_c, v_a, v_b, w_a, w_b, g_a, g_b):
     """Time derivative of the Perram-Wertheim potential, 2 lam (1 - lam) n . v_C (Donev 2006, Eq. 2.21).
 

@@ -171,7 +171,7 @@ def ncol(d: int) -> int:
     return columns(d)[7]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def orientation_at(P, i, t, out):
     """Orientation of particle i at window time t (Algorithm 1, module docstring) into ``out``."""
     d = 2 if P.shape[1] == 11 else 3
@@ -221,7 +221,7 @@ def work_arrays(d):
     return np.zeros((11, 4)), np.empty((4, d, d))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pose(P, i, t, kappa, shift, x, xinv, o, ax, q):
     """Centre (plus ``shift``) and inverse shape matrix of particle i at window time t (``q``:
     (d, d) scratch)."""
