@@ -70,9 +70,12 @@ halved to the time resolution to find it). Steps are at least a few ulps of the 
 interval shorter than that holds no event; after MAX_TRACE_STEPS accepted steps the trace stops
 with a CHECK event at the time reached, later than the start: the particle re-predicts from there
 (a "safe time", Algorithm 11 step e). The neighbours are searched best first (:func:`_predict`):
-each has a lower bound on its collision time, t_in, then t_in plus its safe time once zeta at t_in
-is known; the pair with the smallest bound is started or traced until that bound is after the
-earliest event found. The horizon of every trace is also capped by the first contact time of the
+each has a lower bound on its collision time, t_in (or, when the bounding spheres overlap already,
+the safe time of a slab normal to a guessed direction, :func:`_screen_time`), then that bound plus
+the safe time once zeta there is known, then the bound its trace has reached; the pair with the
+smallest bound is started there or traced one stretch, until its bound passes the second smallest
+(so a pair that does not collide is not traced past the earliest collision of the others), and
+the search ends when the smallest bound is after the earliest event found. The horizon of every trace is also capped by the first contact time of the
 inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are apart: the
 particle collides by then at the latest (if no collision is located before it, a CHECK is scheduled
 there). So every event but a collision advances the time; the event loop still stops a window as
