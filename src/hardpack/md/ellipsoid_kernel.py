@@ -75,10 +75,10 @@ the safe time of a slab normal to a guessed direction, :func:`_screen_time`), th
 the safe time once zeta there is known, then the bound its trace has reached; the pair with the
 smallest bound is started there or traced one stretch, until its bound passes the second smallest
 (so a pair that does not collide is not traced past the earliest collision of the others), and
-the search ends when the smallest bound is after the earliest event found. The horizon of every trace is also capped by the first contact time of the
-inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are apart: the
-particle collides by then at the latest (if no collision is located before it, a CHECK is scheduled
-there). So every event but a collision advances the time; the event loop still stops a window as
+the search ends when the smallest bound is after the earliest event found. The horizon of every
+trace is also capped by the first contact time of the inscribed spheres (radius the smallest
+semiaxis) of any pair whose inscribed spheres are apart: the particle collides by then at the latest
+(if no collision is located before it, a CHECK is scheduled there). So every event but a collision advances the time; the event loop still stops a window as
 STALLED (an engine failure the driver reports) after a long run of other events at one time.
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
