@@ -78,8 +78,9 @@ smallest bound is started there or traced one stretch, until its bound passes th
 the search ends when the smallest bound is after the earliest event found. The horizon of every
 trace is also capped by the first contact time of the inscribed spheres (radius the smallest
 semiaxis) of any pair whose inscribed spheres are apart: the particle collides by then at the latest
-(if no collision is located before it, a CHECK is scheduled there). So every event but a collision advances the time; the event loop still stops a window as
-STALLED (an engine failure the driver reports) after a long run of other events at one time.
+(if no collision is located before it, a CHECK is scheduled there). So every event but a collision
+advances the time; the event loop still stops a window as STALLED (an engine failure the driver
+reports) after a long run of other events at one time.
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
 here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
