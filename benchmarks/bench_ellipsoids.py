@@ -4,6 +4,7 @@ test suite.
 
     python benchmarks/bench_ellipsoids.py                 # N = 1e4, 3D and 2D, alpha = 1.5
     python benchmarks/bench_ellipsoids.py --n 2000 --windows 3
+    python benchmarks/bench_ellipsoids.py --alphas 1.1 1.5 2.0 2.5   # rates vs aspect ratio
 
 Each configuration: RSA at phi = 0.2 (hardpack.initial.random_ellipsoid_packing), a fast LS
 compression (Gamma = 0.3) to the target phi, a warm-up window that lets the adaptive neighbour shell
@@ -61,18 +62,22 @@ def run(d: int, n: int, alpha: float, kind: str, windows: int, seed: int = 1) ->
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=10_000)
-    parser.add_argument("--alpha", type=float, default=1.5)
+    parser.add_argument("--alphas", type=float, nargs="+", default=[1.5],
+                        help="aspect ratios (one table row per shape and alpha)")
+    parser.add_argument("--kinds", nargs="+", default=["prolate", "oblate", "ellipse"],
+                        choices=["prolate", "oblate", "ellipse"])
     parser.add_argument("--windows", type=int, default=4)
     args = parser.parse_args()
-    run(2, 64, args.alpha, "prolate", 1)  # compile (or load the numba cache)
-    run(3, 64, args.alpha, "prolate", 1)
+    run(2, 64, 1.5, "prolate", 1)  # compile (or load the numba cache)
+    run(3, 64, 1.5, "prolate", 1)
     print(f"{'d':>2} {'N':>6} {'alpha':>5} {'kind':>8} {'phi':>6} {'Z':>7} {'coll/s wall':>12} "
           f"{'coll/s cpu':>11} {'evals/coll':>10} {'events/coll':>11}")
-    for d, kind in ((3, "prolate"), (3, "oblate"), (2, "ellipse")):
-        r = run(d, args.n, args.alpha, kind, args.windows)
-        print(f"{r['d']:>2} {r['N']:>6} {r['alpha']:>5} {r['kind']:>8} {r['phi']:>6.3f} {r['Z']:>7.3f} "
-              f"{r['rate_wall']:>12.4g} {r['rate_cpu']:>11.4g} {r['evals_per_coll']:>10.1f} "
-              f"{r['events_per_coll']:>11.2f}", flush=True)
+    for kind in args.kinds:
+        for alpha in args.alphas:
+            r = run(2 if kind == "ellipse" else 3, args.n, alpha, kind, args.windows)
+            print(f"{r['d']:>2} {r['N']:>6} {r['alpha']:>5} {r['kind']:>8} {r['phi']:>6.3f} {r['Z']:>7.3f} "
+                  f"{r['rate_wall']:>12.4g} {r['rate_cpu']:>11.4g} {r['evals_per_coll']:>10.1f} "
+                  f"{r['events_per_coll']:>11.2f}", flush=True)
 
 
 if __name__ == "__main__":

@@ -172,6 +172,50 @@ def test_slab_width_is_a_lower_bound_on_the_distance(d, seed):
 
 
 @pytest.mark.parametrize("d", [2, 3])
+def test_support_rate_bound_holds_and_is_tight(d):
+    """The rate of the support function h(u) = sqrt(u^T X^-1 u) along a fixed unit vector u of
+    a spinning ellipsoid is at most (a_max - a_min) |w x u| (:func:`support_rate_bound`): the
+    exact rate -(w x u) . (X^-1 u) / h over random shapes, orientations, spins and directions
+    never exceeds it, and comes within 1 % of it (so a bound 1 % too small fails), and the rate
+    from finite differences of h under free rotation agrees with the exact one."""
+    from hardpack.geometry.contact import shape_inverse
+
+    rng = np.random.default_rng(7)
+    worst = 0.0
+    for _ in range(4000):
+        ax = np.sort(rng.uniform(0.2, 3.0, d))[::-1]
+        if d == 3:
+            q = rng.standard_normal(4)
+            q /= np.linalg.norm(q)
+            w = rng.standard_normal(3)
+        else:
+            q = rng.uniform(0, 2 * np.pi, 1)
+            w = rng.standard_normal(1)
+        u = rng.standard_normal(d)
+        u /= np.linalg.norm(u)
+        P = np.zeros((1, ek.ncol(d)))
+        cv, ct, cr, cax, cor, cw, cii, _ = ek.columns(d)
+        P[0, cr], P[0, cax:cax + d], P[0, cor:cw], P[0, cw:cii] = ax[0], ax, q, w
+        m = np.empty((d, d))
+        shape_inverse(ax, q, m)
+        h = np.sqrt(u @ m @ u)
+        wxu = np.cross(w, u) if d == 3 else w[0] * np.array([-u[1], u[0]])
+        rate = -wxu @ m @ u / h
+        bound = ek.support_rate_bound(P, 0, d) * np.linalg.norm(wxu)
+        assert abs(rate) <= bound * (1 + 1e-12) + 1e-15
+        worst = max(worst, abs(rate) / bound)
+        if _ < 20:  # the exact rate is the derivative of h under free rotation
+            o = np.empty(4)
+            hs = []
+            for dt in (-1e-6, 1e-6):
+                ek.orientation_at(P, 0, dt, o)
+                shape_inverse(ax, o[:4 if d == 3 else 1], m)
+                hs.append(np.sqrt(u @ m @ u))
+            assert (hs[1] - hs[0]) / 2e-6 == pytest.approx(rate, rel=1e-5, abs=1e-8)
+    assert worst > 0.99
+
+
+@pytest.mark.parametrize("d", [2, 3])
 @pytest.mark.parametrize("seed", range(40))
 def test_safe_time_is_a_lower_bound_on_the_contact_time(d, seed):
     """The safe time of a pair (:func:`hardpack.md.ellipsoid_kernel.pair_start`: the slab width
@@ -426,8 +470,11 @@ def test_small_box_compression_keeps_exact_lists_and_never_stalls(semiaxes):
     [1.0, 1.0, 1.0], pytest.param([1.0, 1.9, 1.9], marks=pytest.mark.slow)])
 def test_small_systems_compress_to_jamming(semiaxes):
     """The two starts above jam (Z = 1e6) in bounded time without overlaps: the spheres at a
-    density between the random close packing of spheres and the fcc crystal (40 spheres pack at
-    0.636-0.671 with the sphere engine and this protocol), the spheroids 1.9:1 in the range of
+    density in the range of the sphere engine's jammed packings of 40 spheres with this protocol
+    (60 random starts: 0.6288-0.6715, the amorphous ones 0.636 +- 0.0035; a round-off change of
+    the trajectory moves this start's density within that range, so the lower bound is the
+    lowest of the 60 less three standard deviations) and the fcc crystal, the spheroids 1.9:1 in
+    the range of
     spheroids near that aspect ratio, 0.68-0.71 (Donev 2006, sec. 5.2; 0.70 for 1000 of them,
     Fig. 5.1)."""
     packing = random_ellipsoid_packing(40, semiaxes, 0.2, seed=1)
@@ -436,7 +483,7 @@ def test_small_systems_compress_to_jamming(semiaxes):
     assert res.packing.overlap_report().n_overlapping == 0
     assert res.stats["max_overlap"] <= 1e-12
     if semiaxes[1] == 1.0:
-        assert 0.63 < res.stats["phi"] < np.pi / np.sqrt(18)
+        assert 0.618 < res.stats["phi"] < np.pi / np.sqrt(18)
     else:
         assert 0.68 <= res.stats["phi"] <= 0.71
 

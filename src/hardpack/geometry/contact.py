@@ -79,46 +79,35 @@ def shape_inverse(semiaxes, orientation_row, out):
     shape_inverse_into(semiaxes, orientation_row, out, np.empty((semiaxes.shape[0], semiaxes.shape[0])))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def shape_inverse_into(semiaxes, orientation_row, out, q):
     """:func:`shape_inverse` with a (d, d) scratch array ``q`` for the rotation (no allocation:
     the event-driven MD calls it in its innermost loop)."""
     d = semiaxes.shape[0]
     if d == 2:
         c, s = np.cos(orientation_row[0]), np.sin(orientation_row[0])
-        q[0, 0], q[0, 1], q[1, 0], q[1, 1] = c, s, -s, c
-    else:
-        s, p1, p2, p3 = orientation_row[0], orientation_row[1], orientation_row[2], orientation_row[3]
-        diag = s * s - 0.5
-        # Q = 2 [p p^T - s P + (s^2 - 1/2) I], P the cross-product matrix of p (Donev 2006, Sec. 1.4.3)
-        q[0, 0], q[0, 1], q[0, 2] = 2 * (p1 * p1 + diag), 2 * (p1 * p2 + s * p3), 2 * (p1 * p3 - s * p2)
-        q[1, 0], q[1, 1], q[1, 2] = 2 * (p2 * p1 - s * p3), 2 * (p2 * p2 + diag), 2 * (p2 * p3 + s * p1)
-        q[2, 0], q[2, 1], q[2, 2] = 2 * (p3 * p1 + s * p2), 2 * (p3 * p2 - s * p1), 2 * (p3 * p3 + diag)
-    for i in range(d):
-        for j in range(d):
-            acc = 0.0
-            for k in range(d):
-                acc += q[k, i] * semiaxes[k] * semiaxes[k] * q[k, j]
-            out[i, j] = acc
-
-
-@numba.njit(cache=True)
-def _inverse_sym(y, out):
-    """Inverse of a symmetric positive definite 2 x 2 or 3 x 3 matrix by its adjugate."""
-    if y.shape[0] == 2:
-        det = y[0, 0] * y[1, 1] - y[0, 1] * y[1, 0]
-        out[0, 0], out[1, 1] = y[1, 1] / det, y[0, 0] / det
-        out[0, 1] = out[1, 0] = -y[0, 1] / det
+        a2, b2 = semiaxes[0] * semiaxes[0], semiaxes[1] * semiaxes[1]
+        out[0, 0] = c * c * a2 + s * s * b2
+        out[1, 1] = s * s * a2 + c * c * b2
+        out[0, 1] = out[1, 0] = c * s * (a2 - b2)
         return
-    c00 = y[1, 1] * y[2, 2] - y[1, 2] * y[2, 1]
-    c01 = y[1, 2] * y[2, 0] - y[1, 0] * y[2, 2]
-    c02 = y[1, 0] * y[2, 1] - y[1, 1] * y[2, 0]
-    det = y[0, 0] * c00 + y[0, 1] * c01 + y[0, 2] * c02
-    out[0, 0], out[0, 1], out[0, 2] = c00 / det, c01 / det, c02 / det
-    out[1, 0], out[2, 0] = out[0, 1], out[0, 2]
-    out[1, 1] = (y[0, 0] * y[2, 2] - y[0, 2] * y[2, 0]) / det
-    out[1, 2] = out[2, 1] = (y[0, 2] * y[1, 0] - y[0, 0] * y[1, 2]) / det
-    out[2, 2] = (y[0, 0] * y[1, 1] - y[0, 1] * y[1, 0]) / det
+    s, p1, p2, p3 = orientation_row[0], orientation_row[1], orientation_row[2], orientation_row[3]
+    diag = s * s - 0.5
+    # Q = 2 [p p^T - s P + (s^2 - 1/2) I], P the cross-product matrix of p (Donev 2006, Sec. 1.4.3);
+    # X^-1 = Q^T O^2 Q, (X^-1)_ij = sum_k Q_ki a_k^2 Q_kj
+    q00, q01, q02 = 2 * (p1 * p1 + diag), 2 * (p1 * p2 + s * p3), 2 * (p1 * p3 - s * p2)
+    q10, q11, q12 = 2 * (p2 * p1 - s * p3), 2 * (p2 * p2 + diag), 2 * (p2 * p3 + s * p1)
+    q20, q21, q22 = 2 * (p3 * p1 + s * p2), 2 * (p3 * p2 - s * p1), 2 * (p3 * p3 + diag)
+    a0, a1, a2 = semiaxes[0] * semiaxes[0], semiaxes[1] * semiaxes[1], semiaxes[2] * semiaxes[2]
+    u00, u01, u02 = a0 * q00, a0 * q01, a0 * q02
+    u10, u11, u12 = a1 * q10, a1 * q11, a1 * q12
+    u20, u21, u22 = a2 * q20, a2 * q21, a2 * q22
+    out[0, 0] = q00 * u00 + q10 * u10 + q20 * u20
+    out[1, 1] = q01 * u01 + q11 * u11 + q21 * u21
+    out[2, 2] = q02 * u02 + q12 * u12 + q22 * u22
+    out[0, 1] = out[1, 0] = q00 * u01 + q10 * u11 + q20 * u21
+    out[0, 2] = out[2, 0] = q00 * u02 + q10 * u12 + q20 * u22
+    out[1, 2] = out[2, 1] = q01 * u02 + q11 * u12 + q21 * u22
 
 
 @numba.njit(cache=True)
@@ -163,15 +152,16 @@ def _pw_maximise(r_ab, a_inv, b_inv, lam0):
     """:func:`pw_contact` and the number of Newton/bisection iterations it took."""
     d = r_ab.shape[0]
     n = np.zeros(d)
-    zeta, lam, iterations = pw_contact_into(r_ab, a_inv, b_inv, lam0, n, np.empty((d, d)), np.empty((d, d)),
-                                            np.empty(d))
+    zeta, lam, iterations = pw_contact_into(r_ab, a_inv, b_inv, lam0, n)
     return zeta, lam, n, iterations
 
 
-@numba.njit(cache=True)
-def pw_contact_into(r_ab, a_inv, b_inv, lam0, n, y, y_inv, dn):
-    """:func:`pw_contact` without allocation: the normal goes into ``n`` (d,), ``y``, ``y_inv``
-    (d, d) and ``dn`` (d,) are scratch. Returns (zeta, lam, number of iterations)."""
+@numba.njit(cache=True, inline="always")
+def pw_contact_into(r_ab, a_inv, b_inv, lam0, n):
+    """:func:`pw_contact` without allocation: the normal goes into ``n`` (d,). Returns (zeta, lam,
+    number of iterations). The iteration runs on scalars, one routine per dimension
+    (:func:`_pw_newton2`, :func:`_pw_newton3`; only the upper triangles of the symmetric
+    matrices are read)."""
     d = r_ab.shape[0]
     if not (lam0 >= 0.0 and lam0 <= 1.0):
         raise ValueError("pw_contact: the initial guess lam0 must be in [0, 1]")
@@ -185,60 +175,117 @@ def pw_contact_into(r_ab, a_inv, b_inv, lam0, n, y, y_inv, dn):
             n[i] = 0.0
         return -1.0, lam0, 0
     lam = lam0 if 0.0 < lam0 < 1.0 else 0.5
+    if d == 3:
+        return _pw_newton3(r_ab, a_inv, b_inv, lam, n)
+    return _pw_newton2(r_ab, a_inv, b_inv, lam, n)
+
+
+@numba.njit(cache=True, inline="always")
+def _newton_step(lam, lo, hi, last_step, fp, fpp):
+    """One safeguarded Newton step of :func:`pw_contact_into` on f' (module docstring): returns
+    (new lambda, lo, hi, step, done)."""
+    if fp > 0.0:
+        lo = lam
+    elif fp < 0.0:
+        hi = lam
+    else:
+        return lam, lo, hi, last_step, True
+    tol = 4.0 * _EPS * lam
+    new = lam - fp / fpp if fpp < 0.0 else -1.0
+    step = abs(new - lam)
+    if step <= tol:
+        return lam, lo, hi, last_step, True
+    if lo < new < hi and step >= 0.5 * last_step and last_step <= _NOISE * lam:
+        return lam, lo, hi, last_step, True  # round-off in f' stops Newton: lambda is as exact as f' allows
+    if not (lo < new < hi and step < 0.5 * last_step):
+        if hi - lo <= tol:
+            return lam, lo, hi, last_step, True
+        new = 0.5 * (lo + hi)
+        step = abs(new - lam)
+    return new, lo, hi, step, False
+
+
+@numba.njit(cache=True, inline="always")
+def _pw_newton3(r_ab, a_inv, b_inv, lam, n):
+    """The Newton iteration of :func:`pw_contact_into` in 3D on scalars (the upper triangles of
+    the symmetric X_A^-1, X_B^-1), from lam in (0, 1)."""
+    r0, r1, r2 = r_ab[0], r_ab[1], r_ab[2]
+    a00, a01, a02, a11, a12, a22 = a_inv[0, 0], a_inv[0, 1], a_inv[0, 2], a_inv[1, 1], a_inv[1, 2], a_inv[2, 2]
+    b00, b01, b02, b11, b12, b22 = b_inv[0, 0], b_inv[0, 1], b_inv[0, 2], b_inv[1, 1], b_inv[1, 2], b_inv[2, 2]
+    d00, d01, d02, d11, d12, d22 = b00 - a00, b01 - a01, b02 - a02, b11 - a11, b12 - a12, b22 - a22
     lo, hi = 0.0, 1.0
     last_step = 1.0
     rn = 0.0
+    n0 = n1 = n2 = 0.0
     iterations = 0
     while iterations < MAX_ITERATIONS:
         iterations += 1
-        for i in range(d):
-            for j in range(d):
-                y[i, j] = lam * b_inv[i, j] + (1.0 - lam) * a_inv[i, j]
-        _inverse_sym(y, y_inv)
-        rn = 0.0
-        for i in range(d):
-            acc = 0.0
-            for j in range(d):
-                acc += y_inv[i, j] * r_ab[j]
-            n[i] = acc
-            rn += r_ab[i] * acc
-        ndn = 0.0
-        for i in range(d):
-            acc = 0.0
-            for j in range(d):
-                acc += (b_inv[i, j] - a_inv[i, j]) * n[j]
-            dn[i] = acc
-            ndn += n[i] * acc
-        dn_y_dn = 0.0
-        for i in range(d):
-            for j in range(d):
-                dn_y_dn += dn[i] * y_inv[i, j] * dn[j]
+        # Y = lam B + (1 - lam) A (not A + lam D: that cancels when B << A), inverted by its adjugate
+        mu = 1.0 - lam
+        y00, y01, y02 = lam * b00 + mu * a00, lam * b01 + mu * a01, lam * b02 + mu * a02
+        y11, y12, y22 = lam * b11 + mu * a11, lam * b12 + mu * a12, lam * b22 + mu * a22
+        c00 = y11 * y22 - y12 * y12
+        c01 = y12 * y02 - y01 * y22
+        c02 = y01 * y12 - y11 * y02
+        inv = 1.0 / (y00 * c00 + y01 * c01 + y02 * c02)
+        i00, i01, i02 = c00 * inv, c01 * inv, c02 * inv
+        i11 = (y00 * y22 - y02 * y02) * inv
+        i12 = (y02 * y01 - y00 * y12) * inv
+        i22 = (y00 * y11 - y01 * y01) * inv
+        n0 = i00 * r0 + i01 * r1 + i02 * r2
+        n1 = i01 * r0 + i11 * r1 + i12 * r2
+        n2 = i02 * r0 + i12 * r1 + i22 * r2
+        rn = r0 * n0 + r1 * n1 + r2 * n2
+        e0 = d00 * n0 + d01 * n1 + d02 * n2
+        e1 = d01 * n0 + d11 * n1 + d12 * n2
+        e2 = d02 * n0 + d12 * n1 + d22 * n2
+        ndn = n0 * e0 + n1 * e1 + n2 * e2
+        dyd = e0 * (i00 * e0 + i01 * e1 + i02 * e2) + e1 * (i01 * e0 + i11 * e1 + i12 * e2) \
+            + e2 * (i02 * e0 + i12 * e1 + i22 * e2)
         fp = (1.0 - 2.0 * lam) * rn - lam * (1.0 - lam) * ndn
-        fpp = -2.0 * rn - 2.0 * (1.0 - 2.0 * lam) * ndn + 2.0 * lam * (1.0 - lam) * dn_y_dn
-        if fp > 0.0:
-            lo = lam
-        elif fp < 0.0:
-            hi = lam
-        else:
+        fpp = -2.0 * rn - 2.0 * (1.0 - 2.0 * lam) * ndn + 2.0 * lam * (1.0 - lam) * dyd
+        lam, lo, hi, last_step, done = _newton_step(lam, lo, hi, last_step, fp, fpp)
+        if done:
             break
-        tol = 4.0 * _EPS * lam
-        new = lam - fp / fpp if fpp < 0.0 else -1.0
-        step = abs(new - lam)
-        if step <= tol:
-            break
-        if lo < new < hi and step >= 0.5 * last_step and last_step <= _NOISE * lam:
-            break  # round-off in f' stops Newton from converging further: lambda is as exact as f' allows
-        if not (lo < new < hi and step < 0.5 * last_step):
-            if hi - lo <= tol:
-                break
-            new = 0.5 * (lo + hi)
-            step = abs(new - lam)
-        last_step = step
-        lam = new
+    n[0], n[1], n[2] = n0, n1, n2
     return lam * (1.0 - lam) * rn - 1.0, lam, iterations
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
+def _pw_newton2(r_ab, a_inv, b_inv, lam, n):
+    """The Newton iteration of :func:`pw_contact_into` in 2D on scalars, from lam in (0, 1)."""
+    r0, r1 = r_ab[0], r_ab[1]
+    a00, a01, a11 = a_inv[0, 0], a_inv[0, 1], a_inv[1, 1]
+    b00, b01, b11 = b_inv[0, 0], b_inv[0, 1], b_inv[1, 1]
+    d00, d01, d11 = b00 - a00, b01 - a01, b11 - a11
+    lo, hi = 0.0, 1.0
+    last_step = 1.0
+    rn = 0.0
+    n0 = n1 = 0.0
+    iterations = 0
+    while iterations < MAX_ITERATIONS:
+        iterations += 1
+        mu = 1.0 - lam
+        y00, y01, y11 = lam * b00 + mu * a00, lam * b01 + mu * a01, lam * b11 + mu * a11
+        inv = 1.0 / (y00 * y11 - y01 * y01)
+        i00, i01, i11 = y11 * inv, -y01 * inv, y00 * inv
+        n0 = i00 * r0 + i01 * r1
+        n1 = i01 * r0 + i11 * r1
+        rn = r0 * n0 + r1 * n1
+        e0 = d00 * n0 + d01 * n1
+        e1 = d01 * n0 + d11 * n1
+        ndn = n0 * e0 + n1 * e1
+        dyd = e0 * (i00 * e0 + i01 * e1) + e1 * (i01 * e0 + i11 * e1)
+        fp = (1.0 - 2.0 * lam) * rn - lam * (1.0 - lam) * ndn
+        fpp = -2.0 * rn - 2.0 * (1.0 - 2.0 * lam) * ndn + 2.0 * lam * (1.0 - lam) * dyd
+        lam, lo, hi, last_step, done = _newton_step(lam, lo, hi, last_step, fp, fpp)
+        if done:
+            break
+    n[0], n[1] = n0, n1
+    return lam * (1.0 - lam) * rn - 1.0, lam, iterations
+
+
+@numba.njit(cache=True, inline="always")
 def contact_point(r_a, a_inv, lam, n, out):
     """Contact point r_C = r_A + (1 - lam) X_A^-1 n (Donev 2006, Eq. 2.13).
 
@@ -293,7 +340,7 @@ def _spin_dot_impl(w, p, c, n):
     return vector
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def pw_rate(lam, n, r_a, r_b, r_c, v_a, v_b, w_a, w_b, g_a, g_b):
     """Time derivative of the Perram-Wertheim potential, 2 lam (1 - lam) n . v_C (Donev 2006, Eq. 2.21).
 

@@ -70,13 +70,17 @@ halved to the time resolution to find it). Steps are at least a few ulps of the 
 interval shorter than that holds no event; after MAX_TRACE_STEPS accepted steps the trace stops
 with a CHECK event at the time reached, later than the start: the particle re-predicts from there
 (a "safe time", Algorithm 11 step e). The neighbours are searched best first (:func:`_predict`):
-each has a lower bound on its collision time, t_in, then t_in plus its safe time once zeta at t_in
-is known; the pair with the smallest bound is started or traced until that bound is after the
-earliest event found. The horizon of every trace is also capped by the first contact time of the
-inscribed spheres (radius the smallest semiaxis) of any pair whose inscribed spheres are apart: the
-particle collides by then at the latest (if no collision is located before it, a CHECK is scheduled
-there). So every event but a collision advances the time; the event loop still stops a window as
-STALLED (an engine failure the driver reports) after a long run of other events at one time.
+each has a lower bound on its collision time, t_in (or, when the bounding spheres overlap already,
+the safe time of a slab normal to a guessed direction, :func:`_screen_time`), then that bound plus
+the safe time once zeta there is known, then the bound its trace has reached; the pair with the
+smallest bound is started there or traced one stretch, until its bound passes the second smallest
+(so a pair that does not collide is not traced past the earliest collision of the others), and
+the search ends when the smallest bound is after the earliest event found. The horizon of every
+trace is also capped by the first contact time of the inscribed spheres (radius the smallest
+semiaxis) of any pair whose inscribed spheres are apart: the particle collides by then at the latest
+(if no collision is located before it, a CHECK is scheduled there). So every event but a collision
+advances the time; the event loop still stops a window as STALLED (an engine failure the driver
+reports) after a long run of other events at one time.
 
 **Collision law** (Donev 2006, Algorithm 12, with the signs and the squared lever arms derived
 here; the printed update pushes an approaching pair together, see the sphere kernel): with n the
@@ -101,7 +105,7 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
-from hardpack.geometry.contact import _inverse_sym, contact_point, pw_contact_into, pw_rate, shape_inverse_into
+from hardpack.geometry.contact import contact_point, pw_contact_into, pw_rate, shape_inverse_into
 from hardpack.md.kernel import (
     A_KE,
     A_KEINT,
@@ -171,7 +175,7 @@ def ncol(d: int) -> int:
     return columns(d)[7]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def orientation_at(P, i, t, out):
     """Orientation of particle i at window time t (Algorithm 1, module docstring) into ``out``."""
     d = 2 if P.shape[1] == 11 else 3
@@ -221,7 +225,7 @@ def work_arrays(d):
     return np.zeros((11, 4)), np.empty((4, d, d))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pose(P, i, t, kappa, shift, x, xinv, o, ax, q):
     """Centre (plus ``shift``) and inverse shape matrix of particle i at window time t (``q``:
     (d, d) scratch)."""
@@ -259,7 +263,7 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     for k in range(d):
         r[k] = xb[k] - xa[k]
     n = ws[5, :d]
-    zeta, lam, _ = pw_contact_into(r, wm[0], wm[1], lam0, n, wm[2], wm[3], ws[6, :d])
+    zeta, lam, _ = pw_contact_into(r, wm[0], wm[1], lam0, n)
     ws[10, 0] += 1.0
     contact_point(xa, wm[0], lam, n, rc)
     rn = 0.0
@@ -360,8 +364,8 @@ def _safe_time(gap, sep_rate, spin, grow_speed, kappa, t):
     between the particles' support planes normal to a fixed unit vector u is a lower bound on the
     distance of the surfaces at all times; it grows at the rate ``sep_rate`` = u . (v_j - v_i) of
     the centres less the rates of the support functions h(u) = sqrt(u^T X^-1 u), each at most
-    c |w x u| (1 + kappa t') for a spin w (``spin`` = c_i |w_i x u| + c_j |w_j x u|, c = min(R,
-    (a_max^2 - a_min^2) / (2 a_min)) at the window start: derived in :func:`support_rate_bound`)
+    c |w x u| (1 + kappa t') for a spin w (``spin`` = c_i |w_i x u| + c_j |w_j x u|,
+    c = a_max - a_min at the window start: derived in :func:`support_rate_bound`)
     plus |kappa| R for the growth (``grow_speed``). The first root of
     gap - (grow_speed + spin (1 + kappa t) - sep_rate) s - spin kappa s^2 / 2 = 0, or inf."""
     if gap <= 0.0:
@@ -399,20 +403,16 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
     for a in range(d):
         for b in range(d):
             y[a, b] = lam * mj[a, b] + (1.0 - lam) * mi[a, b]
-    _inverse_sym(y, wm[2])
     u = ws[5, :d]
+    _adjugate_times(y, r, u)  # along Y^-1 r (det Y > 0)
     uu = 0.0
     for a in range(d):
-        acc = 0.0
-        for b in range(d):
-            acc += wm[2, a, b] * r[b]
-        u[a] = acc
-        uu += acc * acc
-    uu = np.sqrt(uu)
+        uu += u[a] * u[a]
+    uu = 1.0 / np.sqrt(uu)
     ur = 0.0
     sep = 0.0
     for a in range(d):
-        u[a] /= uu
+        u[a] *= uu
         ur += u[a] * r[a]
         sep += u[a] * (P[j, cv + a] - P[i, cv + a])
     width = ur - np.sqrt(_quad(mi, u)) - np.sqrt(_quad(mj, u))
@@ -425,12 +425,30 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
 
 @njit(cache=True, inline="always")
 def _quad(m, x):
-    """x^T m x."""
-    acc = 0.0
-    for a in range(x.shape[0]):
-        for b in range(x.shape[0]):
-            acc += x[a] * m[a, b] * x[b]
-    return acc
+    """x^T m x for a symmetric m (its upper triangle)."""
+    if x.shape[0] == 2:
+        return m[0, 0] * x[0] * x[0] + m[1, 1] * x[1] * x[1] + 2.0 * m[0, 1] * x[0] * x[1]
+    return m[0, 0] * x[0] * x[0] + m[1, 1] * x[1] * x[1] + m[2, 2] * x[2] * x[2] \
+        + 2.0 * (m[0, 1] * x[0] * x[1] + m[0, 2] * x[0] * x[2] + m[1, 2] * x[1] * x[2])
+
+
+@njit(cache=True, inline="always")
+def _adjugate_times(y, r, out):
+    """out = adj(y) r = det(y) y^-1 r for a symmetric 2 x 2 or 3 x 3 y (its upper triangle)."""
+    if r.shape[0] == 2:
+        out[0] = y[1, 1] * r[0] - y[0, 1] * r[1]
+        out[1] = y[0, 0] * r[1] - y[0, 1] * r[0]
+        return
+    y00, y01, y02, y11, y12, y22 = y[0, 0], y[0, 1], y[0, 2], y[1, 1], y[1, 2], y[2, 2]
+    c00 = y11 * y22 - y12 * y12
+    c01 = y12 * y02 - y01 * y22
+    c02 = y01 * y12 - y11 * y02
+    c11 = y00 * y22 - y02 * y02
+    c12 = y02 * y01 - y00 * y12
+    c22 = y00 * y11 - y01 * y01
+    out[0] = c00 * r[0] + c01 * r[1] + c02 * r[2]
+    out[1] = c01 * r[0] + c11 * r[1] + c12 * r[2]
+    out[2] = c02 * r[0] + c12 * r[1] + c22 * r[2]
 
 
 @njit(cache=True, inline="always")
@@ -460,27 +478,31 @@ def _spin_across(P, i, n, nn):
 
 @njit(cache=True, inline="always")
 def support_rate_bound(P, i, d):
-    """c_i = min(R_i, (a_max^2 - a_min^2) / (2 a_min)) with the window-start semiaxes: |dh/dt| <=
-    c_i |w_i x u| for the support function h(u) = sqrt(u^T X^-1 u) of particle i along a fixed
-    unit vector u while it spins at w_i.
+    """c_i = a_max - a_min with the window-start semiaxes: |dh/dt| <= c_i |w_i x u| for the
+    support function h(u) = sqrt(u^T X^-1 u) of particle i along a fixed unit vector u while it
+    spins at w_i.
 
     Derived here: with M = X^-1, dM/dt = W M - M W, so d(u^T M u)/dt = -2 (w x u) . (M u) and
-    dh/dt = -(w x u) . (M u) / h, the speed along u of the support point M u / h turning about the
-    centre; w x u is normal to u, so |dh/dt| <= |w x u| |M u|_perp / h, where the part of M u
-    normal to u is at most (a_max^2 - a_min^2) / 2 (eigenvalues of M between a_min^2 and
-    a_max^2) and h >= a_min, and also <= |w x u| R (the support point is within R of the
-    centre). A spin about u does not change h(u)."""
-    _, _, cr, cax, _, _, _, _ = columns(d)
+    dh/dt = -(w x u) . (M u) / h, the speed along u of the support point p = M u / h turning about
+    the centre; w x u is normal to u, so |dh/dt| <= |w x u| |p_perp|, p_perp the part of p normal
+    to u. In the body frame (M = diag(a_k^2), weights x_k = u_k^2 summing to 1),
+    |p_perp|^2 = (sum a_k^4 x_k - (sum a_k^2 x_k)^2) / sum a_k^2 x_k, the variance over the mean
+    of a_k^2 under the weights x. For a mean m the variance is at most (a_max^2 - m)(m - a_min^2)
+    (all weight on the extreme semiaxes), and (a_max^2 - m)(m - a_min^2) / m is largest at
+    m = a_max a_min, where it equals (a_max - a_min)^2: so |p_perp| <= a_max - a_min, attained
+    in the plane of the longest and shortest semiaxes (the support function of an ellipse turns
+    fastest there). A spin about u does not change h(u)."""
+    _, _, _, cax, _, _, _, _ = columns(d)
     amin = P[i, cax]
     amax = P[i, cax]
     for k in range(1, d):
         amin = min(amin, P[i, cax + k])
         amax = max(amax, P[i, cax + k])
-    return min(P[i, cr], 0.5 * (amax * amax - amin * amin) / amin)
+    return amax - amin
 
 
 #: length of a pair's trace state (:func:`pair_start`)
-PAIR_STATE = 13
+PAIR_STATE = 14
 
 
 @njit(cache=True)
@@ -529,6 +551,7 @@ def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
     h = FIRST_STEP * amin / speed if speed > 0.0 else np.inf
     st[0], st[1], st[2], st[3], st[4], st[5], st[6] = tin, z0, d0, lam, gap0, sep0, zc
     st[7], st[8], st[9], st[10], st[11], st[12] = touching, spin0, grow_speed, rate_tol, h, MIN_STEP_FRACTION * h
+    st[13] = 0.0
     if speed == 0.0:  # nothing moves: zeta is constant
         return np.inf, False
     if touching:
@@ -550,20 +573,24 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
         return t + tin, 0
     if lower >= min(tout, tmax - t):
         return np.inf, 0
-    return pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st)
+    return pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, np.inf)
 
 
 @njit(cache=True)
-def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
+def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
     """Trace of i and j (shifted) from the state ``st`` of :func:`pair_start` to
-    min(t + tout, tmax): (time, kind) as :func:`predict_pair`."""
+    min(t + tout, tmax): (time, kind) as :func:`predict_pair`, or, after at least one step, a
+    suspension (lower bound on the collision time, 2) as soon as that lower bound (the time
+    reached plus its safe time) is at or after window time ``tyield``; ``st`` then holds the state
+    to continue from."""
     end = min(tout, tmax - t)
     t0, z0, d0, lam, gap0, sep0, zc = st[0], st[1], st[2], st[3], st[4], st[5], st[6]
     touching = st[7] != 0.0
     spin0, grow_speed, rate_tol, h, hmin_step = st[8], st[9], st[10], st[11], st[12]
     if h == np.inf:  # nothing moves
         return np.inf, 0
-    steps = 0
+    steps = int(st[13])
+    steps0 = steps
     while True:
         # the shortest step moves the time by a few ulps: a rest of the interval shorter than
         # that holds no event the time can resolve, and every CHECK advances the time
@@ -576,6 +603,10 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st):
         safe = _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + t0)
         if t0 + safe >= end:
             return np.inf, 0
+        if steps > steps0 and t + t0 + safe >= tyield:
+            st[0], st[1], st[2], st[3], st[4], st[5], st[6] = t0, z0, d0, lam, gap0, sep0, zc
+            st[7], st[8], st[11], st[13] = 1.0 if touching else 0.0, spin0, h, steps
+            return t + t0 + safe, 2
         h = min(max(h, hfloor), end - t0)
         if safe > h:
             t1 = t0 + safe
@@ -809,10 +840,11 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     particle index (Algorithm 5 with NNLs). The pairs are searched best first: each has a key, a
     lower bound on its collision time, first the start t_in of its bounding-sphere overlap (or,
     for the pairs whose bounding spheres overlap now, the cheap bound of :func:`_screen_time`),
-    then, once :func:`pair_start` has evaluated zeta at t_in, t_in plus its safe time; the pair
-    of the smallest key is started or, if started, traced (:func:`pair_trace`), until the
-    smallest key is after the earliest event found (``done``: 0 new, 3 screened, 1 started,
-    2 finished; ``pst`` the states of the started pairs)."""
+    then, once :func:`pair_start` has evaluated zeta at that first key, the key plus its safe
+    time, then the lower bound its trace has reached; the pair of the smallest key is started
+    or, if started, traced one stretch (:func:`pair_trace`, suspended once its lower bound passes
+    the second smallest key), until the smallest key is after the earliest event found (``done``:
+    0 new, 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs)."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 2 * d
@@ -898,13 +930,18 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
             if lower > 0.0:
                 tins[m] = lower
                 done[m] = 3
-    for _ in range(3 * m_n):  # best first: each pair is (screened,) started, then traced
+    while True:  # best first: each pair is (screened,) started, then traced step by step
         q = -1
         tq = np.inf
+        t2 = np.inf  # the second smallest key
         for m in range(m_n):
-            if done[m] != 2 and tins[m] < tq:
-                tq = tins[m]
-                q = m
+            if done[m] != 2:
+                if tins[m] < tq:
+                    t2 = tq
+                    tq = tins[m]
+                    q = m
+                elif tins[m] < t2:
+                    t2 = tins[m]
         if q < 0 or t + tq >= min(best, horizon):
             break
         e = nb[i, q]
@@ -913,20 +950,27 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
         for k in range(d):
             sh[k] = imgvec[im, k]
         if done[q] == 0 or done[q] == 3:
-            tstart = 0.0 if done[q] == 3 else tq
-            lower, now = pair_start(P, i, j, sh, t, tstart, kappa, ws, wm, pst[q])
+            # no contact before the key (t_in or the screening bound): the trace starts there
+            if tq >= touts[q]:
+                done[q] = 2
+                continue
+            lower, now = pair_start(P, i, j, sh, t, tq, kappa, ws, wm, pst[q])
             if now:
                 done[q] = 2
-                if t + tstart < best:
-                    best = t + tstart
+                if t + tq < best:
+                    best = t + tq
                     partner = j
             else:
                 lower = max(lower, tq)
                 done[q] = 1 if lower < touts[q] else 2
                 tins[q] = lower
             continue
+        tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q],
+                              t + t2)
+        if kind == 2:  # suspended: its lower bound is now after the second smallest key
+            tins[q] = tc - t
+            continue
         done[q] = 2
-        tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q])
         if tc < best:
             best = tc
             partner = j if kind == 0 else CHECK
