@@ -389,6 +389,11 @@ def test_ellipsoid_jamming_rows_judge_the_second_order_claims():
     assert bad["donev-5.6-stress-eigenvalue-gap"].status == FAIL
     small = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts(n=40)])}
     assert {r.status for r in small.values()} == {NA}
+    # a claim about every packing: one packing of six not jammed fails it (a standard error over
+    # the packings, 0.17, would have let 5 of 6 pass)
+    one_off = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts(jammed=(1, 1, 1, 1, 1, 0))])}
+    assert one_off["donev-5.6-ls-ellipsoids-jammed"].status == FAIL
+    assert one_off["donev-5.6-ls-ellipsoids-jammed"].reproduced == pytest.approx(5 / 6)
 
 
 def test_ellipsoid_jamming_rows_without_near_sphere_packings_are_na():
