@@ -92,6 +92,29 @@ def wrap_into_cell(X, H, Hinv):
             X[i, q] -= acc
 
 
+@njit(cache=True, inline="always")
+def _image_box(xi, xj, Hinv, reach, cfac, ds, lo, hi, od):
+    """The lattice images n of j whose centre x_j + H n can lie within ``reach`` of x_i: the box
+    lo <= n <= hi (``ds`` = H^-1 (x_j - x_i), ``cfac`` = the row norms of H^-1, ``od`` set to
+    lo as the first image); returns the number of images in the box (0 when it is empty)."""
+    d = xi.shape[0]
+    for k in range(d):
+        acc = 0.0
+        for q in range(d):
+            acc += Hinv[k, q] * (xj[q] - xi[q])
+        ds[k] = acc
+        c = reach * cfac[k]
+        lo[k] = int(np.ceil(-c - acc))
+        hi[k] = int(np.floor(c - acc))
+    total = 1
+    for k in range(d):
+        if hi[k] < lo[k]:
+            return 0
+        total *= hi[k] - lo[k] + 1
+        od[k] = lo[k]
+    return total
+
+
 @njit(cache=True)
 def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
     """List every bounding sphere j < jstop (j != i) that overlaps i's, in both lists; returns
@@ -110,21 +133,7 @@ def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
         if j == i:
             continue
         reach = ri + bs[j, d]
-        for k in range(d):
-            acc = 0.0
-            for q in range(d):
-                acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
-            ds[k] = acc
-            c = reach * cfac[k]
-            lo[k] = int(np.ceil(-c - acc))
-            hi[k] = int(np.floor(c - acc))
-        total = 1
-        for k in range(d):
-            if hi[k] < lo[k]:
-                total = 0
-                break
-            total *= hi[k] - lo[k] + 1
-            od[k] = lo[k]
+        total = _image_box(bs[i, :d], bs[j, :d], Hinv, reach, cfac, ds, lo, hi, od)
         for _ in range(total):
             code = 0
             d2 = 0.0
@@ -392,21 +401,7 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
     gmin = np.inf
     for i in range(n):
         for j in range(i, n):
-            for k in range(d):
-                acc = 0.0
-                for q in range(d):
-                    acc += Hinv[k, q] * (X[j, q] - X[i, q])
-                ds[k] = acc
-                c = reach * cfac[k]
-                lo[k] = int(np.ceil(-c - acc))
-                hi[k] = int(np.floor(c - acc))
-            total = 1
-            for k in range(d):
-                if hi[k] < lo[k]:
-                    total = 0
-                    break
-                total *= hi[k] - lo[k] + 1
-                od[k] = lo[k]
+            total = _image_box(X[i], X[j], Hinv, reach, cfac, ds, lo, hi, od)
             sigma = self_sigma if i == j else A[i] + A[j]
             for _ in range(total):
                 skip = i == j
