@@ -42,14 +42,18 @@ def _largest(target, cell: dict, keys, n: int, label: str) -> Row:
     return evaluate(target, samples=cell[best], n=n, label=label, detail=_detail(cell, best))
 
 
+def _summaries_3d(summaries):
+    """(summary, smallest N) of the 3D summaries: the ellipse ones have no targets."""
+    for s in summaries:
+        if int(np.asarray(s["d"].values).ravel()[0]) == 3:
+            yield s, int(np.asarray(s["N"].values).min())
+
+
 def ellipsoid_rows(summaries) -> list[Row]:
     """Rows of the 3D ellipsoid summaries (module docstring); ellipse summaries have no targets."""
     targets = load_targets()
     out = []
-    for s in summaries:
-        if int(np.asarray(s["d"].values).ravel()[0]) != 3:
-            continue
-        n = int(np.asarray(s["N"].values).min())
+    for s, n in _summaries_3d(summaries):
         cells = _cells(s)
         phi, z = cells["phi"], cells["z_mean"]
         spheres = [k for k in phi if k[1] == 1.0]
@@ -156,10 +160,7 @@ def ellipsoid_jamming_rows(summaries) -> list[Row]:
     packings; a summary without the packings a row needs leaves it n/a."""
     targets = load_targets()
     out = []
-    for s in summaries:
-        if int(np.asarray(s["d"].values).ravel()[0]) != 3:
-            continue
-        n = int(np.asarray(s["N"].values).min())
+    for s, n in _summaries_3d(summaries):
         alpha = np.asarray(s["alpha"].values, float)
         jammed = np.asarray(s["jammed"].values, float) > 0
         second = np.asarray(s["order_code"].values) == 2
