@@ -66,7 +66,7 @@ from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
 from hardpack.md import deforming_kernel as dk
-from hardpack.md.compress import CompressResult, StopCriteria, _check_final_stage, default_window
+from hardpack.md.compress import CompressResult, StopCriteria, _check_final_stage, _stop_reason, default_window
 from hardpack.md.simulation import OverlapError, maxwell_boltzmann
 
 #: default alpha: relative volume relaxation per window (module docstring, step 2)
@@ -326,17 +326,6 @@ class DeformingSimulation:
             s *= 0.5
         self.H, self.X = H0, X0
         return 0.0, 0.0
-
-
-def _stop_reason(stop: StopCriteria, sim: DeformingSimulation, started: float) -> str | None:
-    rec = sim.records
-    if rec["Z"] and sim.growth_rate > 0 and stop.max_pressure is not None and rec["Z"][-1] >= stop.max_pressure:
-        return "max_pressure"
-    if stop.max_collisions is not None and sim.collisions >= stop.max_collisions:
-        return "max_collisions"
-    if stop.max_wall_time is not None and time.perf_counter() - started >= stop.max_wall_time:
-        return "max_wall_time"
-    return None
 
 
 def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria | None = None,
