@@ -508,3 +508,25 @@ def test_spheres_and_bad_input_are_refused():
         compress_ellipsoids(ell, 0.1, 1, eps_f=0.0)
     with pytest.raises(InvalidInputError, match="seed"):
         compress_ellipsoids(ell, 0.1, -1)
+
+
+def test_a_stalled_window_raises_the_ellipsoid_error_and_restores_the_start(monkeypatch):
+    """The window loop (Engine.run_window) hands a STALLED kernel status to the ellipsoid engine's
+    own error, with the particles back at the window start, never a silent window."""
+    from hardpack.md.ellipsoid_engine import EngineStalledError
+    from hardpack.md.kernel import WindowStatus
+
+    eng = _pair_engine(3, 2)
+    start = eng.P.copy()
+
+    def stalled(kappa, eff_skin, coll_target, cap, rebuild, log):
+        eng.P[:, :3] += 1.0  # the kernel moved the particles before it stalled
+        acc = np.zeros(6)
+        iacc = np.zeros(ek.N_COUNTERS, dtype=np.int64)
+        iacc[ek.I_STALL_PARTICLE], iacc[ek.I_STALL_PARTNER] = 0, 1
+        return WindowStatus.STALLED, acc, iacc
+
+    monkeypatch.setattr(eng, "_run_events", stalled)
+    with pytest.raises(EngineStalledError, match="particle 0 with particle 1"):
+        eng.run_window(0.0, 0.1, 10, np.inf)
+    assert np.array_equal(eng.P, start) and not eng.lists_valid

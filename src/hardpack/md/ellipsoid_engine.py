@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from hardpack.md import ellipsoid_kernel as ek
-from hardpack.md.engine import SKIN_SLACK, Engine, WindowResult, _aligned_rows
+from hardpack.md.engine import Engine, WindowResult, _aligned_rows
 from hardpack.md.kernel import WindowStatus
 
 
@@ -120,62 +120,32 @@ class EllipsoidEngine(Engine):
         return 2.0 * sum(self.energies()) / ((self.d + rotational_dof(self.d)) * self.n)
 
     # ----------------------------------------------------------------- one window
-    def run_window(self, kappa: float, skin: float, coll_target: int, t_cap: float,
-                   rebuild: bool = False, log=None) -> WindowResult:
-        """Run one window from a synchronisation point and synchronise at its end (as
-        :meth:`hardpack.md.engine.Engine.run_window`; ``log`` is not supported). ``checks``
-        (CHECK events) and contact-function evaluations are stored in :attr:`last_checks` and
-        :attr:`last_evaluations`."""
+    # (the window loop is Engine.run_window; ``log``, collision logging for contact forces, is not
+    # implemented for ellipsoids. ``checks`` (CHECK events) and contact-function evaluations of
+    # the last window are stored in :attr:`last_checks` and :attr:`last_evaluations`.)
+    def _run_events(self, kappa, eff_skin, coll_target, cap, rebuild, log):
         if log is not None:
             raise NotImplementedError("collision logging (contact forces) is not implemented for ellipsoids")
-        if not rebuild and self.lists_valid:
-            eff_skin = min(skin, self._room())
-            rebuild = eff_skin < skin / SKIN_SLACK or \
-                self._grid_time(kappa, eff_skin) < 2.0 * self.last_duration
-        else:
-            rebuild = True
-        if rebuild:
-            self._new_bounds(skin)
-        start = self.P.copy()
-        while True:
-            eff_skin = min(skin, self._room())
-            cap = min(t_cap, self._grid_time(kappa, eff_skin))
-            if kappa < 0.0:
-                cap = min(cap, 0.5 / -kappa)
-            self.cnt[:] = 0
-            acc = np.array([0.0, 0.0, 0.0, self.totals()[0], 0.0, 0.0])
-            iacc = np.zeros(ek.N_COUNTERS, dtype=np.int64)
-            status = WindowStatus(ek.run_events(
-                self.P, self.box, kappa, self.eps_f, eff_skin, self.sfac, self.imgvec, self.lvl,
-                self.rcap, self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
-                self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
-                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild))
-            if status in (WindowStatus.OVERFLOW, WindowStatus.CELL_OVERFLOW, WindowStatus.BOUND_TOO_SMALL):
-                self.P[:] = start
-                if status == WindowStatus.OVERFLOW:
-                    self.alloc_lists(2 * self.capacity)
-                elif status == WindowStatus.CELL_OVERFLOW:
-                    self.cell_floor = 2 * self.cell_capacity
-                    self.alloc_cells(self.cell_floor)
-                else:
-                    self._new_bounds(skin)
-                rebuild = True
-                continue
-            if status == WindowStatus.STUCK:
-                raise RuntimeError("no event can ever happen: no particle moves and none grows")
-            if status == WindowStatus.STALLED:
-                t, i, p = float(acc[0]), int(iacc[ek.I_STALL_PARTICLE]), int(iacc[ek.I_STALL_PARTNER])
-                self.P[:] = start
-                self.lists_valid = False
-                what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
-                raise EngineStalledError(
-                    f"the ellipsoid event loop stalled at window time {t!r}: more than "
-                    f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time without a "
-                    f"collision (the last one of "
-                    f"particle {i} with {what}, engine order); the state is back at the window start. "
-                    "This is an engine failure: report it with the start packing, seed and options")
-            break
-        self.lists_valid = True
+        acc = np.array([0.0, 0.0, 0.0, self.totals()[0], 0.0, 0.0])
+        iacc = np.zeros(ek.N_COUNTERS, dtype=np.int64)
+        status = WindowStatus(ek.run_events(
+            self.P, self.box, kappa, self.eps_f, eff_skin, self.sfac, self.imgvec, self.lvl,
+            self.rcap, self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
+            self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
+            self.heap, self.hpos, acc, iacc, coll_target, cap, rebuild))
+        return status, acc, iacc
+
+    def _raise_stalled(self, acc, iacc):
+        t, i, p = float(acc[0]), int(iacc[ek.I_STALL_PARTICLE]), int(iacc[ek.I_STALL_PARTNER])
+        what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
+        raise EngineStalledError(
+            f"the ellipsoid event loop stalled at window time {t!r}: more than "
+            f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time without a "
+            f"collision (the last one of "
+            f"particle {i} with {what}, engine order); the state is back at the window start. "
+            "This is an engine failure: report it with the start packing, seed and options")
+
+    def _window_result(self, acc, iacc, kappa):
         duration = float(acc[0])
         self.last_duration = duration
         ek.synchronise(self.P, duration, kappa)

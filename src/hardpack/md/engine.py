@@ -278,9 +278,10 @@ class Engine:
         decision depends only on the state, so a restarted run repeats it exactly.
         ``log``: optional (pairs (M, 2) int32, values (M, d + 1)) arrays, M >= coll_target, that
         receive the window's collisions (:func:`hardpack.md.kernel.run_events`).
+
+        The event kernel itself is called by :meth:`_run_events` and the result read by
+        :meth:`_window_result`, the two places where the sphere and ellipsoid engines differ.
         """
-        if log is None:
-            log = (self._no_log_pair, self._no_log_val)
         if not rebuild and self.lists_valid:
             eff_skin = min(skin, self._room())
             rebuild = eff_skin < skin / SKIN_SLACK or \
@@ -296,15 +297,7 @@ class Engine:
             if kappa < 0.0:  # end shrinking windows before radii could vanish
                 cap = min(cap, 0.5 / -kappa)
             self.cnt[:] = 0
-            acc = np.zeros(kernel.A_WALL + self.d)
-            acc[kernel.A_KE] = self.kinetic_energy()
-            iacc = np.zeros(kernel.N_COUNTERS, dtype=np.int64)
-            status = WindowStatus(kernel.run_events(
-                self.P, self.dims, self.box, kappa, eff_skin, self.sfac, self.imgvec, self.wmode,
-                self.walled, self.wspec, self.lvl, self.rcap,
-                self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
-                self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
-                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild, *log))
+            status, acc, iacc = self._run_events(kappa, eff_skin, int(coll_target), float(cap), rebuild, log)
             if status in (WindowStatus.OVERFLOW, WindowStatus.CELL_OVERFLOW, WindowStatus.BOUND_TOO_SMALL):
                 self.P[:] = start  # redo the window after a full rebuild
                 if status == WindowStatus.OVERFLOW:
@@ -318,8 +311,35 @@ class Engine:
                 continue
             if status == WindowStatus.STUCK:
                 raise RuntimeError("no event can ever happen: no particle moves and none grows")
+            if status == WindowStatus.STALLED:
+                self.P[:] = start
+                self.lists_valid = False
+                self._raise_stalled(acc, iacc)
             break
         self.lists_valid = True
+        return self._window_result(acc, iacc, kappa)
+
+    def _run_events(self, kappa: float, eff_skin: float, coll_target: int, cap: float, rebuild: bool,
+                    log) -> tuple[WindowStatus, np.ndarray, np.ndarray]:
+        """One call of the event kernel: (status, float accumulators, integer counters)."""
+        if log is None:
+            log = (self._no_log_pair, self._no_log_val)
+        acc = np.zeros(kernel.A_WALL + self.d)
+        acc[kernel.A_KE] = self.kinetic_energy()
+        iacc = np.zeros(kernel.N_COUNTERS, dtype=np.int64)
+        status = WindowStatus(kernel.run_events(
+            self.P, self.dims, self.box, kappa, eff_skin, self.sfac, self.imgvec, self.wmode,
+            self.walled, self.wspec, self.lvl, self.rcap,
+            self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
+            self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
+            self.heap, self.hpos, acc, iacc, coll_target, cap, rebuild, *log))
+        return status, acc, iacc
+
+    def _raise_stalled(self, acc: np.ndarray, iacc: np.ndarray) -> None:
+        raise RuntimeError("the sphere event kernel never reports a stalled window")
+
+    def _window_result(self, acc: np.ndarray, iacc: np.ndarray, kappa: float) -> WindowResult:
+        """Synchronise every particle to the window's end and summarise the window."""
         duration = float(acc[kernel.A_T])
         self.last_duration = duration
         ke_end = kernel.synchronise(self.P, self.dims, duration, kappa)
