@@ -16,6 +16,7 @@ from hardpack.structure.containers import (
     container_summary,
     core_density,
     fit_window_power_law,
+    fixed_wall_layer_density,
     radial_density_profile,
     wall_layer_density,
     window_study,
@@ -223,3 +224,35 @@ def test_figures_are_written(tmp_path):
     save(plot_extrapolation(_summary(bulk=_bulk())), tmp_path / "extrapolation_bulk.pdf")
     save(plot_window_fluctuations(_windows()), tmp_path / "windows.pdf")
     assert all((tmp_path / f).stat().st_size > 1000 for f in ("profile.pdf", "extrapolation.png", "windows.pdf"))
+
+
+def _curved_wall_summary(phi0=0.642, bulk=(0.6412, 0.6428, 0.6416)):
+    """Containers whose wall layer thins with curvature (0.52 - 0.3 a/R, as measured from 0.48 at
+    a/R = 0.13 to 0.51 at 0.05) on top of a line phi0 - 0.4 a/R with a universal wall."""
+    profiles = []
+    sizes = (500, 1000, 2000, 5000)
+    deltas = {n: (0.62 / n) ** (1 / 3) for n in sizes}
+    for n in sizes:
+        d = deltas[n]
+        for seed in (1, 2, 3):
+            profiles.append(_profile(n, seed, d, 0.6, 0.64 if n == max(sizes) else np.nan,
+                                     wall_layer=0.52 - 0.3 * d))
+    ref = wall_layer_density(profiles[-1])  # the shells' layer density (the a / 4 grid cuts the layer edge)
+    for prof in profiles:
+        d = prof.attrs["a_over_R"]
+        prof.attrs["phi"] = phi0 - 0.4 * d - (1 - (1 - d) ** 3) * (ref - wall_layer_density(prof))
+    return container_summary(profiles, bulk=_bulk(bulk))
+
+
+def test_fixing_the_wall_layer_removes_its_curvature_from_the_extrapolation():
+    """The plain Eq. 7.2 line overshoots phi_0 when the first layer thins in small containers; with
+    every layer at the largest container's density the intercept is phi_0 again (exactly here)."""
+    ds = _curved_wall_summary()
+    assert ds.attrs["phi0"] > 0.642 + 0.004  # the bias the plain line takes from the layer's trend
+    assert ds.attrs["phi0_fixed_layer"] == pytest.approx(0.642, abs=1e-12)
+    rows = _rows(ds)
+    assert rows["containers-fixed-wall-layer-vs-periodic"].status == PASS
+    assert rows["donev-7.3-bulk-phi0"].status == FAIL
+    assert _rows(_curved_wall_summary(bulk=(0.6352, 0.6368, 0.6356)))["containers-fixed-wall-layer-vs-periodic"].status == FAIL
+    with pytest.raises(InvalidInputError, match="one length"):
+        fixed_wall_layer_density([0.1, 0.2], [0.6, 0.6], [0.5], [100, 200])

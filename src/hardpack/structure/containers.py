@@ -326,7 +326,9 @@ def container_summary(profiles, fit_min_n: int = 1, bulk=()) -> xr.Dataset:
         (:func:`extrapolate_bulk_density` over every packing with N >= fit_min_n, NaN when fewer
         than 3 such packings or only one a/R), ``n_fit``, ``n_sizes_fit``, ``fit_min_n``,
         ``core_margin``. ``phi_wall_layer`` is the density of the layer within one a of the wall,
-        the part of Eq. 7.1's wall correction that wall curvature changes most. With ``bulk``:
+        the part of Eq. 7.1's wall correction that wall curvature changes most;
+        ``phi0_fixed_layer`` +- ``phi0_fixed_layer_err`` is the same fit after
+        :func:`fixed_wall_layer_density` (every wall layer at the largest container's density). With ``bulk``:
         dimension ``bulk_sample`` (``bulk_seed``, ``phi_bulk``) and attributes ``phi_bulk``, its
         standard error ``phi_bulk_err`` (NaN for one packing), ``n_bulk``, ``bulk_N``.
 
@@ -356,10 +358,13 @@ def container_summary(profiles, fit_min_n: int = 1, bulk=()) -> xr.Dataset:
     n, seed, delta, phi, core = (np.array(c) for c in zip(*rows))
     wall = np.array([layer[(int(a), int(b))] for a, b in zip(n, seed)])
     use = n >= fit_min_n
-    fit = {"phi0": np.nan, "phi0_err": np.nan, "slope": np.nan, "slope_err": np.nan}
+    fit = {"phi0": np.nan, "phi0_err": np.nan, "slope": np.nan, "slope_err": np.nan,
+           "phi0_fixed_layer": np.nan, "phi0_fixed_layer_err": np.nan}
     if use.sum() >= 3 and np.ptp(delta[use]) > 0:
         f = extrapolate_bulk_density(delta[use], phi[use])
-        fit = {"phi0": f.phi0, "phi0_err": f.phi0_err, "slope": f.slope, "slope_err": f.slope_err}
+        fixed = extrapolate_bulk_density(delta[use], fixed_wall_layer_density(delta, phi, wall, n)[use])
+        fit = {"phi0": f.phi0, "phi0_err": f.phi0_err, "slope": f.slope, "slope_err": f.slope_err,
+               "phi0_fixed_layer": fixed.phi0, "phi0_fixed_layer_err": fixed.phi0_err}
     data = {"a_over_R": ("sample", delta), "phi_avg": ("sample", phi), "phi_core": ("sample", core),
             "phi_wall_layer": ("sample", wall)}
     coords = {"N": ("sample", n), "seed": ("sample", seed)}
@@ -497,6 +502,40 @@ def wall_layer_density(profile: xr.Dataset) -> float:
     outer = np.clip(profile["r_outer"].values, radius - a, radius)
     vol = outer**3 - inner**3
     return float(np.sum(profile["phi"].values * vol) / (radius**3 - (radius - a) ** 3))
+
+
+def fixed_wall_layer_density(delta, phi_avg, phi_layer, n) -> np.ndarray:
+    """Average densities with every container's wall layer at the density of the largest
+    container's (mean over its seeds): the test of Eq. 7.1's assumption that the wall
+    correction does not depend on R (Donev 2006, Sec. 7.3.2.1).
+
+    The layer R - a < r <= R holds the fraction 1 - (1 - a/R)^3 of a container's volume, so
+
+        phi_avg' = phi_avg + (1 - (1 - a/R)^3) (phi_layer(N_max) - phi_layer(N)).
+
+    A linear fit of phi_avg' in a/R then extrapolates without the curvature dependence of the
+    first layer (its density rises with R); what Eq. 7.2 leaves in the slope is the wall
+    correction of the largest container.
+
+    Parameters
+    ----------
+    delta, phi_avg, phi_layer : array_like
+        a / R, the average density and the wall-layer density (:func:`wall_layer_density`) of
+        each packing.
+    n : array_like of int
+        Its number of particles; the reference layer is the mean over the largest N.
+
+    Returns
+    -------
+    numpy.ndarray
+        phi_avg' of each packing.
+    """
+    delta, phi_avg, phi_layer, n = (np.asarray(v) for v in (delta, phi_avg, phi_layer, n))
+    if not (delta.shape == phi_avg.shape == phi_layer.shape == n.shape) or delta.ndim != 1:
+        raise InvalidInputError("delta, phi_avg, phi_layer and n must be 1-d arrays of one length, got shapes "
+                                f"{delta.shape}, {phi_avg.shape}, {phi_layer.shape}, {n.shape}")
+    reference = float(np.mean(phi_layer[n == n.max()]))
+    return phi_avg + (1.0 - (1.0 - delta) ** 3) * (reference - phi_layer)
 
 
 def _bulk_density(bulk, data: dict, coords: dict) -> dict:

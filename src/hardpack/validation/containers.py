@@ -43,6 +43,15 @@ def _bulk_rows(targets, summary) -> list[Row]:
                              label=f"periodic, N = {a['bulk_N']}",
                              detail="the containers' compression protocol in a periodic cube; per seed "
                                     + ", ".join(f"{v:.4f}" for v in bulk)))
+        if "phi0_fixed_layer" in a:
+            diff = float(a["phi0_fixed_layer"]) - float(a["phi_bulk"])
+            err = float(np.hypot(a["phi0_fixed_layer_err"], a["phi_bulk_err"]))
+            rows.append(evaluate(targets["containers-fixed-wall-layer-vs-periodic"], diff, err,
+                                 n=int(fitted.max()) if fitted.size else None, sizes=int(a["n_sizes_fit"]),
+                                 seeds=int(a["n_bulk"]), label="Eq. 7.2, wall layer fixed",
+                                 detail=f"intercept {a['phi0_fixed_layer']:.4f} +- {a['phi0_fixed_layer_err']:.4f} "
+                                        f"(plain fit {a['phi0']:.4f}) against periodic "
+                                        f"{a['phi_bulk']:.4f} +- {a['phi_bulk_err']:.4f}"))
     return rows
 
 
