@@ -34,14 +34,24 @@ def rotational_dof(d: int) -> int:
 
 
 class EllipsoidEngine(Engine):
-    """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box."""
+    """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box, or in a spherical
+    container (``boundary``, a :class:`hardpack.geometry.boundaries.SphericalContainer` inside the
+    box, which then only serves the cell grid)."""
 
     def __init__(self, positions, velocities, semiaxes, orientations, angular_velocities, box,
-                 capacity: int = 32, eps_f: float = ek.EPS_F):
+                 capacity: int = 32, eps_f: float = ek.EPS_F, boundary=None):
         n, d = positions.shape
         self.n, self.d = n, d
         self.eps_f = float(eps_f)
         self.box = np.ascontiguousarray(box, dtype=float)
+        kind = "periodic" if boundary is None else boundary.kind
+        if kind not in ("periodic", "spherical_container"):
+            raise ValueError(f"the ellipsoid engine runs periodic cells or spherical containers, not {kind}")
+        self.wmode = ek.PERIODIC_MODE if kind == "periodic" else ek.SPHERE_MODE
+        self.wspec = np.zeros(d + 1)
+        if kind == "spherical_container":
+            self.wspec[:d] = boundary.centre
+            self.wspec[d] = boundary.radius
         cv, ct, cr, cax, cor, cw, cii, width = ek.columns(d)
         self.P = _aligned_rows(n, width)
         self.P[:, :d] = positions
@@ -143,13 +153,15 @@ class EllipsoidEngine(Engine):
             if kappa < 0.0:
                 cap = min(cap, 0.5 / -kappa)
             self.cnt[:] = 0
-            acc = np.array([0.0, 0.0, 0.0, self.totals()[0], 0.0, 0.0])
+            acc = np.zeros(ek.N_ACC)
+            acc[3] = self.totals()[0]
             iacc = np.zeros(ek.N_COUNTERS, dtype=np.int64)
             status = WindowStatus(ek.run_events(
                 self.P, self.box, kappa, self.eps_f, eff_skin, self.sfac, self.imgvec, self.lvl,
                 self.rcap, self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
                 self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
-                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild))
+                self.heap, self.hpos, acc, iacc, int(coll_target), float(cap), rebuild,
+                self.wmode, self.wspec))
             if status in (WindowStatus.OVERFLOW, WindowStatus.CELL_OVERFLOW, WindowStatus.BOUND_TOO_SMALL):
                 self.P[:] = start
                 if status == WindowStatus.OVERFLOW:
@@ -167,7 +179,7 @@ class EllipsoidEngine(Engine):
                 t, i, p = float(acc[0]), int(iacc[ek.I_STALL_PARTICLE]), int(iacc[ek.I_STALL_PARTNER])
                 self.P[:] = start
                 self.lists_valid = False
-                what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
+                what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK", ek.WALL: "the container wall"}.get(p, f"particle {p}")
                 raise EngineStalledError(
                     f"the ellipsoid event loop stalled at window time {t!r}: more than "
                     f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time without a "
@@ -187,6 +199,7 @@ class EllipsoidEngine(Engine):
             ke_end=self.totals()[0], collisions=int(iacc[0]), events=int(iacc[1]),
             stale=int(iacc[2]), exits=int(iacc[3]), grazing=int(iacc[4]),
             max_overlap=float(worst), n_overlapping=int(n_over), mean_neighbours=float(self.nn.mean()),
+            wall_collisions=int(iacc[ek.I_WALL]), wall_momentum=np.array([acc[ek.A_WALL]]),
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:
