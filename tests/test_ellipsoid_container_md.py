@@ -1,0 +1,121 @@
+"""Ellipsoids and ellipses in a hard spherical container: the wall events of the ellipsoid MD
+(:func:`hardpack.md.ellipsoid_kernel.wall_predict`, :func:`~hardpack.md.ellipsoid_kernel.wall_collide`;
+Donev 2006, Ch. 7 and sec. 3.5).
+
+- A single rotating ellipsoid (and ellipse) bouncing ~10^3 times: kinetic energy (translational
+  plus rotational) and the angular momentum about the container centre (the wall force is radial)
+  are conserved to round-off, and the exact gap (:mod:`hardpack.geometry.ellipsoid_container`)
+  never goes below round-off. A wrong torque sign or lever arm breaks the angular momentum.
+- A sphere-shaped ellipsoid reproduces the wall collision times of the sphere kernel
+  (:func:`hardpack.events.roots.container_root`), without and with growth.
+- An ideal gas of small ellipsoids: the wall pressure is N kT / V up to the finite size of the
+  particles (between R/(R - a_min) and R/(R - a_max)) and the statistical error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hardpack.geometry.boundaries import SphericalContainer
+from hardpack.geometry.ellipsoid_container import container_gaps
+from hardpack.geometry.shapes import Ellipsoids
+from hardpack.md.ellipsoid_engine import EllipsoidEngine, moments_of_inertia
+from hardpack.md.engine import Engine
+
+
+def _orient(rng, n, d):
+    if d == 2:
+        return rng.uniform(0, 2 * np.pi, n)
+    q = rng.standard_normal((n, 4))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def _angular_momentum(eng, centre):
+    x = eng.positions - centre
+    v = eng.velocities
+    w = eng.angular_velocities
+    inertia = eng.inertia
+    if eng.d == 2:
+        return float((x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]).sum() + (inertia * w).sum())
+    return np.cross(x, v).sum(axis=0) + (inertia[:, None] * w).sum(axis=0)
+
+
+def _gaps(eng, cont):
+    shape = Ellipsoids(eng.semiaxes.copy(), eng.orientations.copy())
+    return container_gaps(eng.positions, shape, cont.centre, cont.radius)[0]
+
+
+@pytest.mark.parametrize("d", [3, 2])
+def test_a_single_ellipsoid_bounces_conserving_energy_and_angular_momentum(d):
+    rng = np.random.default_rng(4 + d)
+    centre = np.full(d, 5.0)
+    cont = SphericalContainer(tuple(centre), 4.0)
+    axes = np.array([[1.0, 0.6, 0.3][:d]])
+    nw = 3 if d == 3 else 1
+    w = rng.standard_normal((1, nw)) * 3
+    eng = EllipsoidEngine(centre[None] + 0.3, rng.standard_normal((1, d)), axes, _orient(rng, 1, d),
+                          w if d == 3 else w[:, 0], 10 * np.ones(d), boundary=cont)
+    e0 = sum(eng.energies())
+    l0 = _angular_momentum(eng, centre)
+    bounces = 0
+    worst = np.inf
+    for _ in range(40):
+        res = eng.run_window(0.0, 0.5, 25, 1e9)
+        bounces += res.wall_collisions
+        worst = min(worst, _gaps(eng, cont).min())
+    assert bounces == 1000
+    assert sum(eng.energies()) == pytest.approx(e0, rel=1e-10)
+    assert np.allclose(_angular_momentum(eng, centre), l0, rtol=0, atol=1e-9 * (1 + np.abs(l0).max()))
+    assert worst > -1e-12 * cont.radius
+    # the rotation exchanged energy with the translation (the lever arm is not radial)
+    assert eng.energies()[1] != pytest.approx(0.5 * (w**2).sum() * moments_of_inertia(axes)[0], rel=1e-3)
+
+
+@pytest.mark.parametrize("kappa", [0.0, 0.02])
+def test_a_sphere_shaped_ellipsoid_hits_the_wall_when_the_sphere_kernel_says(kappa):
+    rng = np.random.default_rng(9)
+    d = 3
+    centre = np.full(d, 5.0)
+    cont = SphericalContainer(tuple(centre), 4.0)
+    x0 = centre + rng.uniform(-1, 1, d)
+    v0 = rng.standard_normal(d)
+    r = 0.5
+    ell = EllipsoidEngine(x0[None], v0[None], np.full((1, d), r), _orient(rng, 1, d),
+                          rng.standard_normal((1, 3)), 10 * np.ones(d), boundary=cont)
+    sph = Engine(x0[None].copy(), v0[None].copy(), np.array([r]), 10 * np.ones(d), boundary=cont)
+    for _ in range(30):
+        a = ell.run_window(kappa, 0.3, 1, 1e9)
+        b = sph.run_window(kappa, 0.3, 1, 1e9)
+        assert a.wall_collisions == b.wall_collisions == 1
+        assert a.duration == pytest.approx(b.duration, rel=1e-11, abs=1e-13)
+        assert np.allclose(ell.positions, sph.positions, rtol=0, atol=1e-10)
+        assert np.allclose(ell.velocities, sph.velocities, rtol=0, atol=1e-10)
+        assert a.wall_momentum[0] == pytest.approx(b.wall_momentum[0], rel=1e-10)
+
+
+def test_an_ideal_gas_of_small_ellipsoids_presses_the_wall_with_n_kt_over_v():
+    rng = np.random.default_rng(2)
+    d, n = 3, 40
+    centre = np.full(d, 1.0)
+    cont = SphericalContainer(tuple(centre), 1.0)
+    axes = np.tile([0.004, 0.003, 0.002], (n, 1))
+    u = rng.standard_normal((n, d))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    pos = centre + u * 0.95 * rng.uniform(0, 1, (n, 1)) ** (1 / 3)
+    inertia = moments_of_inertia(axes)
+    eng = EllipsoidEngine(pos, rng.standard_normal((n, d)), axes, _orient(rng, n, d),
+                          rng.standard_normal((n, 3)) / np.sqrt(inertia)[:, None], 2 * np.ones(d),
+                          boundary=cont)
+    area = 4 * np.pi * cont.radius**2
+    volume = 4 / 3 * np.pi * cont.radius**3
+    ratios = []
+    for _ in range(40):
+        res = eng.run_window(0.0, 0.05, 50 * n, 1e9)
+        kt = 2 * res.ke_integral / (d * n * res.duration)  # translational kT, time averaged
+        ratios.append(res.wall_momentum[0] / (area * res.duration) * volume / (n * kt))
+    ratios = np.array(ratios)
+    mean, se = ratios.mean(), ratios.std(ddof=1) / np.sqrt(len(ratios))
+    lo, hi = cont.radius / (cont.radius - axes.min()), cont.radius / (cont.radius - axes.max())
+    assert lo - 4 * se <= mean <= hi + 4 * se, (mean, se, lo, hi)
+    assert se < 0.01
