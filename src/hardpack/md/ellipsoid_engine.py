@@ -199,7 +199,8 @@ class EllipsoidEngine(Engine):
             ke_end=self.totals()[0], collisions=int(iacc[0]), events=int(iacc[1]),
             stale=int(iacc[2]), exits=int(iacc[3]), grazing=int(iacc[4]),
             max_overlap=float(worst), n_overlapping=int(n_over), mean_neighbours=float(self.nn.mean()),
-            wall_collisions=int(iacc[ek.I_WALL]), wall_momentum=np.array([acc[ek.A_WALL]]),
+            wall_collisions=int(iacc[ek.I_WALL]),
+            wall_momentum=np.concatenate([[acc[ek.A_WALL]], np.zeros(self.d - 1)]),
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:
