@@ -119,3 +119,79 @@ def test_an_ideal_gas_of_small_ellipsoids_presses_the_wall_with_n_kt_over_v():
     lo, hi = cont.radius / (cont.radius - axes.min()), cont.radius / (cont.radius - axes.max())
     assert lo - 4 * se <= mean <= hi + 4 * se, (mean, se, lo, hi)
     assert se < 0.01
+
+
+# ---------------------------------------------------------------- start, compression, storage, CLI
+def test_container_start_is_seeded_inside_and_refuses_impossible_requests():
+    from hardpack.errors import InvalidInputError
+    from hardpack.initial import random_ellipsoid_packing
+
+    for d, axes in ((3, [1.0, 1.0, 1 / 1.9]), (2, [1.0, 0.5])):
+        p = random_ellipsoid_packing(30, axes, 0.1, 3, boundary="spherical_container")
+        assert p.boundary.kind == "spherical_container" and p.phi == pytest.approx(0.1)
+        assert p.containment_report().n_outside == 0 and p.overlap_report().n_overlapping == 0
+        q = random_ellipsoid_packing(30, axes, 0.1, 3, boundary="spherical_container")
+        assert np.array_equal(p.positions, q.positions)
+        assert np.array_equal(p.shape.orientations, q.shape.orientations)
+    with pytest.raises(InvalidInputError, match="lower phi"):
+        random_ellipsoid_packing(30, [1.0, 1.0, 0.2], 0.3, 3, boundary="spherical_container", max_trials=200)
+    with pytest.raises(InvalidInputError, match="'periodic' or 'spherical_container'"):
+        random_ellipsoid_packing(3, [1.0, 0.5], 0.1, 3, boundary="hard_walls")
+
+
+@pytest.mark.parametrize("d", [3, 2])
+def test_compression_in_a_container_jams_inside_and_round_trips(tmp_path, d):
+    from hardpack.initial import random_ellipsoid_packing
+    from hardpack.io import load_packing
+    from hardpack.md import StopCriteria
+    from hardpack.md.ellipsoid import compress_ellipsoids
+
+    axes = [1.0, 1.0, 1 / 1.9] if d == 3 else [1.0, 0.5]
+    p = random_ellipsoid_packing(30, axes, 0.1, 5, boundary="spherical_container")
+    res = compress_ellipsoids(p, 0.1, 1, stop=StopCriteria(max_pressure=1e6), final_growth_rate=0.01,
+                              switch_pressure=100)
+    final = res.packing
+    assert str(final.boundary) == str(p.boundary)
+    assert res.stats["containment_check"] == "passed" and res.stats["max_wall_overlap"] <= 1e-9
+    assert res.stats["Z"] >= 1e6 and res.stats["phi"] > (0.55 if d == 3 else 0.7)
+    assert np.nanmax(res.timeseries["wall_collisions"].values) > 0
+    # the jammed packing touches the wall: the smallest gap is far below the particle size
+    gap = container_gaps(final.positions, final.shape, final.boundary.centre, final.boundary.radius)[0]
+    assert -1e-9 < gap.min() / final.shape.bounding_radii.max() < 1e-4
+    res.save(tmp_path / "j.nc")
+    back = load_packing(tmp_path / "j.nc")
+    assert np.array_equal(back.positions, final.positions) and str(back.boundary) == str(final.boundary)
+
+
+def test_cli_init_and_compress_ellipsoids_in_a_container(tmp_path):
+    from hardpack.cli import main
+    from hardpack.io import load_packing
+
+    start, out = tmp_path / "s.nc", tmp_path / "j.nc"
+    assert main(["init", "--n", "24", "--d", "3", "--phi", "0.1", "--seed", "2", "--semiaxes", "1", "1",
+                 str(1 / 1.9), "--boundary", "spherical_container", "--out", str(start)]) == 0
+    p = load_packing(start)
+    assert p.shape.kind == "ellipsoid" and p.boundary.kind == "spherical_container"
+    assert main(["compress", "--init", str(start), "--out", str(out), "--growth-rate", "0.1",
+                 "--max-pressure", "1e5", "--seed", "1"]) == 0
+    jammed = load_packing(out)
+    assert str(jammed.boundary) == str(p.boundary) and jammed.containment_report().n_outside == 0
+
+
+def test_a_packing_crossing_the_wall_is_refused_by_the_engine():
+    from hardpack.errors import InvalidInputError
+    from hardpack.geometry.packing import Packing
+    from hardpack.md import StopCriteria
+    from hardpack.md.ellipsoid import compress_ellipsoids
+
+    shape = Ellipsoids([[1.0, 0.5, 0.5]], [[1, 0, 0, 0]])
+    cont = SphericalContainer((5, 5, 5), 3.0)
+    bad = Packing([[7.2, 5, 5]], lattice=10 * np.eye(3), shape=shape, boundary=cont, allow_overlap=True)
+    with pytest.raises(InvalidInputError, match="crosses the container wall"):
+        compress_ellipsoids(bad, 0.1, 1)
+    # one particle (no pairs: the pair virial stays 1, so the run stops at a target phi); it
+    # gets velocities without a mean removed (which would leave it at rest)
+    ok = bad.replace(positions=[[5, 5, 7.4]])  # extent 0.5 along z: inside
+    res = compress_ellipsoids(ok, 0.1, 1, stop=StopCriteria(max_pressure=None, target_phi=0.2))
+    assert res.packing.containment_report().n_outside == 0
+    assert res.stats["phi"] == pytest.approx(0.2) and res.timeseries["wall_collisions"].values.max() > 0

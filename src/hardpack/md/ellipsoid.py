@@ -258,7 +258,11 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
 
     seeds = np.random.SeedSequence(seed).spawn(2)
     inertia = moments_of_inertia(packing.shape.semiaxes)
-    sim = EllipsoidSimulation(packing, maxwell_boltzmann(n, d, seeds[0]),
+    if packing.boundary.kind == "periodic":
+        velocities = maxwell_boltzmann(n, d, seeds[0])
+    else:  # the wall takes momentum: no mean to remove (N may be 1); kT is set below
+        velocities = np.random.default_rng(seeds[0]).standard_normal((n, d))
+    sim = EllipsoidSimulation(packing, velocities,
                               random_angular_velocities(n, d, inertia, seeds[1]), growth_rate,
                               overlap_tol=overlap_tol, eps_f=eps_f)
     sim.engine.rescale_velocities(1.0)

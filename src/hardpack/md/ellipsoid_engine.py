@@ -45,6 +45,10 @@ class EllipsoidEngine(Engine):
         self.eps_f = float(eps_f)
         self.box = np.ascontiguousarray(box, dtype=float)
         kind = "periodic" if boundary is None else boundary.kind
+        if kind == "spherical_container":
+            # the box only serves the cell grid (no images), whose bounding-radius caps are at most
+            # a quarter of its side: widen it so that a particle as large as the container fits
+            self.box = np.maximum(self.box, 8.0 * boundary.radius)
         if kind not in ("periodic", "spherical_container"):
             raise ValueError(f"the ellipsoid engine runs periodic cells or spherical containers, not {kind}")
         self.wmode = ek.PERIODIC_MODE if kind == "periodic" else ek.SPHERE_MODE
