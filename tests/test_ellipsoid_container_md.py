@@ -195,3 +195,56 @@ def test_a_packing_crossing_the_wall_is_refused_by_the_engine():
     res = compress_ellipsoids(ok, 0.1, 1, stop=StopCriteria(max_pressure=None, target_phi=0.2))
     assert res.packing.containment_report().n_outside == 0
     assert res.stats["phi"] == pytest.approx(0.2) and res.timeseries["wall_collisions"].values.max() > 0
+
+
+# ---------------------------------------------------------------- the M&M extrapolation and its row
+def _mm_packing(n, radius, phi_target):
+    """n oblate spheroids 1 : 1.9 : 1.9 in a container of ``radius``; the particle size gives phi."""
+    from hardpack.geometry.packing import Packing
+
+    a = (phi_target * radius**3 / (n * 1.9**2)) ** (1 / 3)
+    rng = np.random.default_rng(n)
+    u = rng.standard_normal((n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    pos = radius + u * (radius - 2 * a) * rng.uniform(0, 1, (n, 1))
+    shape = Ellipsoids(np.tile([a, 1.9 * a, 1.9 * a], (n, 1)), np.tile([1.0, 0, 0, 0], (n, 1)))
+    return Packing(pos, lattice=2 * radius * np.eye(3), shape=shape,
+                   boundary=SphericalContainer((radius,) * 3, radius), allow_overlap=True)
+
+
+def _mm_summary(sizes=(250, 500, 1000, 2000), seeds=(1, 2), phi0=0.700, slope=0.5, fit_min_n=500, noise=3e-4):
+    from hardpack.structure.containers import ellipsoid_container_summary
+
+    rng = np.random.default_rng(1)
+    packings, seed_list = [], []
+    for n in sizes:
+        for s in seeds:
+            # a / R = (phi / N)^(1/3) for a = (O1 O2 O3)^(1/3): solve phi = phi0 - slope a/R by iteration
+            phi = phi0
+            for _ in range(50):
+                phi = phi0 - slope * (phi / n) ** (1 / 3)
+            packings.append(_mm_packing(n, 10.0, phi + noise * rng.standard_normal()))
+            seed_list.append(s)
+    return ellipsoid_container_summary(packings, seed_list, fit_min_n=fit_min_n)
+
+
+def test_mm_extrapolation_recovers_a_known_line():
+    ds = _mm_summary(noise=0.0)
+    a = ds.attrs
+    assert a["phi0"] == pytest.approx(0.700, abs=1e-12) and a["slope"] == pytest.approx(-0.5, abs=1e-10)
+    assert a["n_fit"] == 6 and a["n_sizes_fit"] == 3
+    # a is the geometric mean semiaxis: a/R = (phi / N)^(1/3)
+    assert np.allclose(ds["a_over_R"].values, (ds["phi_avg"].values / ds["N"].values) ** (1 / 3), rtol=1e-12)
+
+
+def test_mm_row_passes_fails_and_is_na_below_its_size():
+    from hardpack.validation.containers import container_rows
+    from hardpack.validation.rows import FAIL, NA, PASS
+
+    def row(ds):
+        return {r.target: r for r in container_rows([ds])}["donev-7.3-mm-phi0"]
+
+    assert row(_mm_summary()).status == PASS
+    assert row(_mm_summary(phi0=0.690, noise=1e-5)).status == FAIL
+    assert row(_mm_summary(sizes=(30, 45, 60), seeds=(1,), fit_min_n=30)).status == NA  # smoke size
+    assert row(_mm_summary(sizes=(1000, 2000), fit_min_n=500)).status == NA  # two sizes
