@@ -55,7 +55,8 @@ def _mm_rows(targets, summary) -> list[Row]:
     a = summary.attrs
     fitted = n[n >= a["fit_min_n"]]
     sizes = ", ".join(map(str, sorted(set(fitted.tolist()))))
-    semiaxes = ":".join(f"{v:g}" for v in np.atleast_1d(a["semiaxes"]))
+    axes = np.atleast_1d(np.asarray(a["semiaxes"], float))
+    semiaxes = ":".join(f"{v:.3g}" for v in axes / axes.min())
     return [evaluate(targets["donev-7.3-mm-phi0"], float(a["phi0"]), float(a["phi0_err"]),
                      n=int(fitted.max()) if fitted.size else 0, sizes=int(a["n_sizes_fit"]),
                      label=f"Eq. 7.2 intercept, semiaxes {semiaxes}",
