@@ -8,7 +8,7 @@
   container, no images across walls, fractional coordinates, tiling); every refused lattice.
 - Ellipsoid overlaps by the Perram-Wertheim contact function on exact cases (parallel ellipsoids,
   spheres as ellipsoids), hard walls by the ellipsoid's extent; a spherical container by the
-  bounding spheres or NotImplementedError (the containment potential is not implemented).
+  exact farthest surface point.
 - The netCDF store: shapes and boundaries round trip bit for bit, files of format 1 (written by
   the code before particle shapes, tests/data) load as spheres in a periodic cell, damaged or
   newer files are refused.
@@ -249,13 +249,17 @@ def test_ellipsoids_between_hard_walls_are_checked_by_their_extent_along_the_wal
         ok.replace(positions=[[reach * (1 - 1e-6), 4.0]])
 
 
-def test_ellipsoids_in_a_spherical_container_are_decided_by_bounding_spheres_or_not_at_all():
+def test_ellipsoids_in_a_spherical_container_are_decided_by_their_farthest_point():
     shape = Ellipsoids([[1.0, 0.5, 0.5], [1.0, 0.5, 0.5]], [[1, 0, 0, 0]] * 2)
     inside = Packing([[4, 4, 4], [4, 4, 6]], lattice=8 * np.eye(3), shape=shape,
                      boundary=SphericalContainer((4, 4, 4), 3.2))
     assert inside.containment_report().n_outside == 0
-    with pytest.raises(NotImplementedError, match=r"containment potential .* \(Donev 2006, Sec. 2\.2\.2\.2\)"):
-        inside.replace(positions=[[4, 4, 4], [4, 4, 6.5]])
+    # the second one's bounding sphere (radius 1) crosses the wall, the ellipsoid (extent 0.5
+    # along z, farthest point at distance 2.7 + 0.5 = 3.2 on the z axis) touches it
+    touching = inside.replace(positions=[[4, 4, 4], [4, 4, 6.7]])
+    assert touching.containment_report().overlap == pytest.approx(0.0, abs=1e-14)
+    with pytest.raises(InvalidInputError, match="particle 1 crosses the container wall by 1.000e-01"):
+        inside.replace(positions=[[4, 4, 4], [4, 4, 6.8]])
 
 
 # ---------------------------------------------------------------- hard walls

@@ -83,13 +83,20 @@ def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed:
 
 
 def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=None,
-                             max_trials: int = 100_000) -> Packing:
+                             max_trials: int = 100_000, boundary: str = "periodic") -> Packing:
     """Seeded RSA packing of ``n`` ellipsoids (or ellipses) with random orientations at volume fraction ``phi``.
 
     The particles are placed largest bounding radius first (a stable sort, so equal particles keep
     their order) at uniformly random positions and orientations by
     :func:`hardpack.geometry.ellipsoid_rsa.ellipsoid_rsa` (Perram-Wertheim overlap test, Donev 2006,
     Sec. 2.2.2), in a periodic box whose size gives ``phi``. The result depends only on the arguments.
+
+    With ``boundary="spherical_container"`` (Donev 2006, Ch. 7) the particles fill a spherical
+    container of volume (particle volume) / phi centred in a cube of side 2 R: a dilute random start
+    whose bounding spheres (radius the largest semiaxis) are placed by sphere RSA inside the
+    container (as :func:`random_packing`), with uniformly random orientations, so that no two
+    particles overlap and every particle is inside; the bounding spheres fill phi times the mean
+    a_max^d / prod a, which must stay below RSA saturation (e.g. phi <= 0.15 for aspect ratio 2).
 
     Parameters
     ----------
@@ -102,14 +109,17 @@ def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=
     seed : int
         Seed of ``numpy.random.default_rng``.
     box_shape : sequence of d floats, optional
-        Relative box lengths (default a cube).
+        Relative box lengths (default a cube; not with a spherical container).
     max_trials : int, default 100000
         Trials per particle before giving up.
+    boundary : {"periodic", "spherical_container"}
+        A periodic cell or a spherical container (above); phi is over the boundary's volume.
 
     Returns
     -------
     Packing
-        Ellipsoids in a periodic orthorhombic cell, checked for overlaps by the packing model.
+        Ellipsoids in a periodic orthorhombic cell or a spherical container, checked for overlaps
+        and containment by the packing model.
 
     Raises
     ------
@@ -136,8 +146,42 @@ def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=
     shape = np.ones(d) if box_shape is None else np.asarray(box_shape, float)
     if shape.shape != (d,) or not (np.isfinite(shape).all() and (shape > 0).all()):
         raise InvalidInputError(f"box_shape must be {d} positive numbers, got {box_shape!r}")
+    if boundary not in ("periodic", "spherical_container"):
+        raise InvalidInputError(f"ellipsoid start packings have boundary 'periodic' or 'spherical_container', "
+                                f"got {boundary!r}")
     axes = axes[np.argsort(-axes.max(axis=1), kind="stable")]
     volume = Ellipsoids(axes, np.zeros(n) if d == 2 else np.tile([1.0, 0, 0, 0], (n, 1))).volumes(d).sum()
+    if boundary == "spherical_container":
+        if box_shape is not None:
+            raise InvalidInputError("a spherical container sits in a cube: leave box_shape unset")
+        return _ellipsoids_in_a_container(axes, volume / phi, phi, np.random.default_rng(seed), max_trials)
     box = shape * (volume / (phi * np.prod(shape))) ** (1.0 / d)
     positions, orientations = ellipsoid_rsa(axes, box, np.random.default_rng(seed), max_trials)
     return Packing(positions, lattice=np.diag(box), shape=Ellipsoids(axes, orientations))
+
+
+def _ellipsoids_in_a_container(axes: np.ndarray, volume: float, phi: float, rng, max_trials: int) -> Packing:
+    """Dilute random start of :func:`random_ellipsoid_packing` in a spherical container of ``volume``:
+    bounding spheres by RSA inside it, random orientations."""
+    from hardpack.geometry.shapes import Ellipsoids
+
+    n, d = axes.shape
+    radius = (volume / unit_ball_volume(d)) ** (1.0 / d)
+    bound = axes.max(axis=1)
+    if radius < bound.max():
+        raise InvalidInputError(f"phi = {phi:g} leaves a container (radius {radius:.4g}) smaller than the "
+                                f"largest particle (largest semiaxis {bound.max():.4g}): lower phi")
+    box = np.full(d, 2.0 * radius)
+    container = SphericalContainer(tuple(box / 2), radius)
+    try:
+        positions = random_sequential_addition(bound, box, rng, max_trials,
+                                               container=(np.asarray(container.centre), radius))
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{exc}. The start places the bounding spheres (phi {phi:g} times "
+                                f"{float(np.mean(bound**d / axes.prod(axis=1))):.3g}): lower phi") from exc
+    if d == 2:
+        orientations = rng.uniform(0.0, 2.0 * np.pi, n)
+    else:
+        orientations = rng.standard_normal((n, 4))
+        orientations /= np.linalg.norm(orientations, axis=1, keepdims=True)
+    return Packing(positions, lattice=np.diag(box), shape=Ellipsoids(axes, orientations), boundary=container)

@@ -188,3 +188,59 @@ rule fig_container_windows:
         "results/benchmarks/fig_container_windows.tsv"
     script:
         "../scripts/plot_containers.py"
+
+
+# M&M-shaped ellipsoids in spherical containers (Donev 2006, Sec. 7.3.2.1 and Fig. 7.6): a dilute
+# random start inside the container, LS compression by the generic compress job, and the Eq. 7.2
+# extrapolation of the average density over (N, seed).
+
+
+rule mm_container_init:
+    """Dilute random start of one container size and seed: bounding spheres by RSA inside the
+    container, random orientations (hardpack init --semiaxes --boundary spherical_container)."""
+    output:
+        "results/mm_containers/{name}/init/seed{seed}.nc",
+    params:
+        n=lambda w: SYSTEMS["mm_containers"][w.name]["N"],
+        phi=lambda w: SYSTEMS["mm_containers"][w.name]["init_phi"],
+        semiaxes=lambda w: " ".join(f"{a:.17g}" for a in SYSTEMS["mm_containers"][w.name]["semiaxes"]),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("mm_container_init"),
+        runtime=job_runtime("mm_container_init"),
+    group:
+        "setup"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/mm_container_init/{name}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/mm_container_init/{name}/seed{seed}.tsv"
+    shell:
+        "hardpack init --n {params.n} --d 3 --phi {params.phi} --semiaxes {params.semiaxes}"
+        " --boundary spherical_container --seed {wildcards.seed} --out {output} > {log} 2>&1"
+
+
+rule mm_container_summary:
+    """The M&M container packings over (N, seed) and the Eq. 7.2 extrapolation of their average
+    density to a/R -> 0 over the sizes N >= fit_min_n."""
+    input:
+        mm_container_files("jammed") if MM_CONTAINERS else [],
+    output:
+        "results/mm_containers/summary.nc",
+    params:
+        fit_min_n=lambda w: MM_CONTAINERS["fit_min_n"],
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("mm_container_summary"),
+        runtime=job_runtime("mm_container_summary"),
+    group:
+        "summaries"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/mm_container_summary.log",
+    benchmark:
+        "results/benchmarks/mm_container_summary.tsv"
+    script:
+        "../scripts/mm_container_summary.py"

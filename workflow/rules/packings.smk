@@ -38,7 +38,8 @@ rule init:
 rule compress:
     """LS compression of one start configuration to the system's reduced pressure: the LS ensembles'
     two-stage protocol (with contact forces), one growth rate of the rate scan, the ellipsoid
-    study's two-stage protocol, spheres in a spherical container, or spheres in a deforming cell."""
+    study's two-stage protocol, spheres or M&M-shaped ellipsoids in a spherical container, or spheres
+    in a deforming cell."""
     input:
         start_packing,
     output:
@@ -48,7 +49,7 @@ rule compress:
         options=lambda w: system(w)["compress"],
         checkpoint=checkpoint_option,
     wildcard_constraints:
-        study="ls|ls_rates|ellipsoids|containers|strict_ls",
+        study="ls|ls_rates|ellipsoids|containers|mm_containers|strict_ls",
     threads: 1
     resources:
         mem_mb=job_mem_mb("compress"),

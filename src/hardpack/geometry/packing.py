@@ -30,9 +30,10 @@ Sec. 2.2.2.1; :mod:`hardpack.geometry.contact`) is below 1 - tol: the relative o
 the sphere's 1 - distance / (r_i + r_j) for equal semiaxes. Candidate pairs are those whose bounding
 spheres overlap (:mod:`hardpack.geometry.ellipsoid_pairs`). An ellipsoid crosses a hard wall when
 its centre is closer to the wall than (1 - tol) times its extent sqrt(e_k^T X^-1 e_k) along the
-wall normal e_k (the distance of the tangent plane, Donev 2006, Sec. 2.2.5.1). Ellipsoids in a
-spherical container are decided by their bounding spheres only; any other case needs the
-containment potential (Donev 2006, Sec. 2.2.2.2) and raises :class:`NotImplementedError`.
+wall normal e_k (the distance of the tangent plane, Donev 2006, Sec. 2.2.5.1). An ellipsoid crosses
+the wall of a spherical container when its farthest surface point from the container centre is
+beyond the wall by more than tol times its largest semiaxis (the exact farthest point of
+:mod:`hardpack.geometry.ellipsoid_container`).
 """
 
 from __future__ import annotations
@@ -54,10 +55,6 @@ from hardpack.geometry.shapes import Ellipsoids, Spheres, as_finite_array
 DEFAULT_OVERLAP_TOL = 1e-9
 MIN_DIM, MAX_DIM = 1, 12
 SHAPES = (Spheres, Ellipsoids)
-PENDING_ELLIPSOID_CONTAINMENT = (
-    "needs the containment potential of an ellipsoid in a sphere (Donev 2006, Sec. 2.2.2.2), which is "
-    "not implemented yet"
-)
 
 
 @dataclass(frozen=True)
@@ -145,9 +142,6 @@ class Packing:
         outside 1..12; the lattice is missing or singular; the boundary is not one of the above or
         does not fit the lattice; overlap_tol is outside [0, 1); or, unless ``allow_overlap``,
         particles overlap or cross the boundary beyond ``overlap_tol``.
-    NotImplementedError
-        Unless ``allow_overlap``, when the bounding spheres of ellipsoids cross a spherical
-        container (the containment potential is not implemented yet).
     """
 
     positions: np.ndarray
@@ -398,9 +392,10 @@ class Packing:
         """Count particles crossing a hard wall or the container by more than ``tol`` of their
         radius (see :mod:`hardpack.geometry.boundaries`); the worst particle is named.
 
-        Ellipsoids: against hard walls, by their extent along each wall normal (module docstring);
-        in a spherical container, a packing whose bounding spheres are inside has none and any
-        other raises NotImplementedError (the containment potential is pending).
+        Ellipsoids: against hard walls, by their extent along each wall normal; in a spherical
+        container, by the exact gap h = R - rho to the farthest surface point
+        (:mod:`hardpack.geometry.ellipsoid_container`), as the relative overlap -h / a_max (the
+        sphere's 1 - (R - |x - c|) / r for equal semiaxes).
         """
         if self.shape.kind == "sphere":
             return self.boundary.containment(self.positions, self.shape.radii, self.lattice, tol)
@@ -410,14 +405,14 @@ class Packing:
             inv = inverse_shapes(self.shape.semiaxes, self.shape.orientations.reshape(self.n_particles, -1))
             extents = np.sqrt(np.einsum("nkk->nk", inv))  # sqrt(e_k^T X^-1 e_k), Donev 2006, Sec. 2.2.5.1
             return self.boundary.containment(self.positions, extents, self.lattice, tol)
-        report = self.boundary.containment(self.positions, self.shape.bounding_radii, self.lattice, 0.0)
-        if report.n_outside:
-            raise NotImplementedError(
-                f"the bounding spheres of {report.n_outside} of the {self.shape.name} cross the boundary "
-                f"(e.g. particle {report.worst} and {report.wall}); deciding whether the particles cross it "
-                f"{PENDING_ELLIPSOID_CONTAINMENT}. Packing(..., allow_overlap=True) skips the check"
-            )
-        return ContainmentReport(0, -1, "every bounding sphere is inside", float("-inf"))
+        if self.boundary.kind == "periodic":
+            return self.boundary.containment(self.positions, self.shape.bounding_radii, self.lattice, tol)
+        from hardpack.geometry.ellipsoid_container import container_gaps
+
+        gap, _ = container_gaps(self.positions, self.shape, self.boundary.centre, self.boundary.radius)
+        overlap = -gap / self.shape.bounding_radii
+        i = int(np.argmax(overlap))
+        return ContainmentReport(int((overlap > tol).sum()), i, "the container wall", float(overlap[i]))
 
     def __repr__(self) -> str:
         if self.shape.kind == "sphere":

@@ -37,21 +37,25 @@ log = logging.getLogger("hardpack.md")
 
 
 def check_ellipsoid_packing(packing: Packing) -> None:
-    """Refuse packings the ellipsoid engine cannot run (other shapes or boundaries, sheared
-    cells, fewer than 2 particles, boxes too small, overlaps)."""
+    """Refuse packings the ellipsoid engine cannot run (other shapes, hard flat walls, sheared
+    cells, fewer than 2 particles in a periodic cell, overlaps, particles outside a container)."""
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
     if packing.shape.kind != "ellipsoid":
         raise InvalidInputError(f"the ellipsoid MD engine runs ellipsoids or ellipses; this packing "
                                 f"holds {packing.shape.name} (use hardpack.md.compress for spheres)")
-    if packing.boundary.kind != "periodic":
-        raise InvalidInputError("the ellipsoid MD engine needs a periodic cell (hard walls and "
-                                "containers are not implemented for it)")
+    if packing.boundary.kind not in ("periodic", "spherical_container"):
+        raise InvalidInputError("the ellipsoid MD engine runs periodic cells and spherical containers "
+                                "(hard flat walls need the ellipsoid-plane potential, not implemented)")
     if not packing.is_orthorhombic:
         raise InvalidInputError("the ellipsoid MD engine supports orthorhombic (diagonal) periodic "
                                 "cells only; this lattice is sheared: pass a diagonal lattice")
-    if packing.n_particles < 2:
-        raise InvalidInputError("MD needs at least 2 particles")
+    if packing.n_particles < (2 if packing.boundary.kind == "periodic" else 1):
+        raise InvalidInputError("MD in a periodic cell needs at least 2 particles")
+    walls = packing.containment_report(DEFAULT_OVERLAP_TOL)
+    if walls.n_outside:
+        raise InvalidInputError(f"the start configuration crosses the container wall ({walls}); "
+                                "hard-particle MD needs every particle inside")
     report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
     if report.n_overlapping:
         raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
@@ -60,7 +64,8 @@ def check_ellipsoid_packing(packing: Packing) -> None:
 
 def random_angular_velocities(n: int, d: int, inertia: np.ndarray, seed) -> np.ndarray:
     """Maxwell-Boltzmann angular velocities at kT = 1 (omega_k ~ N(0, 1/I)), zero total angular
-    momentum not enforced (a periodic box does not conserve it); (n, 3) in 3D, (n,) in 2D."""
+    momentum not enforced (a periodic box does not conserve it, a container exchanges none with the
+    particles but need not start without); (n, 3) in 3D, (n,) in 2D."""
     rng = np.random.default_rng(seed)
     w = rng.standard_normal((n, rotational_dof(d))) / np.sqrt(inertia)[:, None]
     return w[:, 0] if d == 2 else w
@@ -72,10 +77,13 @@ class EllipsoidSimulation(Simulation):
 
     def __init__(self, packing: Packing, velocities: np.ndarray, angular_velocities: np.ndarray,
                  growth_rate: float, overlap_tol: float = DEFAULT_OVERLAP_TOL, eps_f: float = EPS_F):
-        self._setup(packing, growth_rate, overlap_tol)  # periodic (check_ellipsoid_packing)
+        self._setup(packing, growth_rate, overlap_tol)
         shape = packing.shape
-        self.engine = EllipsoidEngine(packing.fractional() * self.box, velocities, shape.semiaxes,
-                                      shape.orientations, angular_velocities, self.box, eps_f=eps_f)
+        container = self.boundary.kind == "spherical_container"
+        positions = packing.positions if container else packing.fractional() * self.box
+        self.engine = EllipsoidEngine(positions, velocities, shape.semiaxes, shape.orientations,
+                                      angular_velocities, self.box, eps_f=eps_f,
+                                      boundary=self.boundary if container else None)
         self.contacts = None
 
     def _inverse(self) -> np.ndarray:
@@ -90,11 +98,28 @@ class EllipsoidSimulation(Simulation):
         inv = self._inverse()
         eng = self.engine
         pos = eng.positions[inv]
-        pos = pos - np.floor(pos / self.box) * self.box
-        pos[pos >= self.box] = 0.0
+        if self.boundary.kind == "periodic":
+            pos = pos - np.floor(pos / self.box) * self.box
+            pos[pos >= self.box] = 0.0
         shape = Ellipsoids(eng.semiaxes[inv].copy(), eng.orientations[inv].copy())
-        return Packing(pos, lattice=self.lattice, species=self.species, shape=shape,
+        return Packing(pos, lattice=self.lattice, species=self.species, shape=shape, boundary=self.boundary,
                        overlap_tol=self.overlap_tol, allow_overlap=True)
+
+    def _check_walls(self, res) -> None:
+        """Raise :class:`OverlapError` when a particle crosses the container wall by more than the
+        tolerance times its largest semiaxis (the exact farthest point,
+        :mod:`hardpack.geometry.ellipsoid_container`)."""
+        from hardpack.geometry.ellipsoid_container import container_gaps
+
+        eng = self.engine
+        shape = Ellipsoids(eng.semiaxes.copy(), eng.orientations.copy())
+        gap, _ = container_gaps(eng.positions, shape, self.boundary.centre, self.boundary.radius)
+        over = -gap / eng.radii
+        i = int(np.argmax(over))
+        if over[i] > self.overlap_tol:
+            raise OverlapError(f"at the end of window {self.windows - 1}: {int((over > self.overlap_tol).sum())} "
+                               f"ellipsoid(s) cross the container wall; worst (engine order) {i} by {over[i]:.3e} "
+                               f"of its largest semiaxis > tolerance {self.overlap_tol:g}")
 
     def angular_velocities(self) -> np.ndarray:
         return self.engine.angular_velocities[self._inverse()].copy()
@@ -171,7 +196,10 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
     Parameters
     ----------
     packing : Packing
-        Periodic, orthorhombic, N >= 2 ellipsoids (3D) or ellipses (2D) without overlaps.
+        Ellipsoids (3D) or ellipses (2D) without overlaps: N >= 2 in a periodic orthorhombic cell, or
+        N >= 1 inside a spherical container (Donev 2006, Ch. 7; the wall events of
+        :mod:`hardpack.md.ellipsoid_kernel`; the window records then hold ``Z_wall``, the pressure
+        on the wall, and ``wall_collisions``).
     growth_rate : float
         Gamma (module docstring), finite.
     seed : int
@@ -230,14 +258,18 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
 
     seeds = np.random.SeedSequence(seed).spawn(2)
     inertia = moments_of_inertia(packing.shape.semiaxes)
-    sim = EllipsoidSimulation(packing, maxwell_boltzmann(n, d, seeds[0]),
+    if packing.boundary.kind == "periodic":
+        velocities = maxwell_boltzmann(n, d, seeds[0])
+    else:  # the wall takes momentum: no mean to remove (N may be 1); kT is set below
+        velocities = np.random.default_rng(seeds[0]).standard_normal((n, d))
+    sim = EllipsoidSimulation(packing, velocities,
                               random_angular_velocities(n, d, inertia, seeds[1]), growth_rate,
                               overlap_tol=overlap_tol, eps_f=eps_f)
     sim.engine.rescale_velocities(1.0)
     fp = _fingerprint(packing, growth_rate=float(growth_rate), seed=int(seed), window=window,
                       overlap_tol=overlap_tol, final_growth_rate=final_growth_rate, eps_f=float(eps_f),
                       switch_pressure=float(switch_pressure) if final_growth_rate else None,
-                      kind="ellipsoid")
+                      kind="ellipsoid", boundary=str(packing.boundary))
     reason = run_windows(sim, stop, stage_window, checkpoint, fp, final_growth_rate=final_growth_rate,
                          switch_pressure=switch_pressure, progress=progress, progress_interval=progress_interval,
                          checkpoint_interval=checkpoint_interval, label="ellipsoids: ")
@@ -246,6 +278,9 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
     report = final.overlap_report(overlap_tol)
     if report.n_overlapping:
         raise OverlapError(f"the final ellipsoid packing has overlaps beyond {overlap_tol:g}: {report}")
+    walls = final.containment_report(overlap_tol)
+    if walls.n_outside:
+        raise OverlapError(f"the final ellipsoid packing crosses the container wall beyond {overlap_tol:g}: {walls}")
     final = final.replace(allow_overlap=False)
     last = {k: (sim.records[k][-1] if sim.records[k] else float("nan")) for k in ("Z", "phi_J_est")}
     stats = {
@@ -261,6 +296,9 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
         "overlap_check": "passed", "mass": 1.0, "kT": 1.0,
         "moment_of_inertia": "spherically symmetric: (2/15)(a^2+b^2+c^2) in 3D, (a^2+b^2)/4 in 2D",
     }
+    if final.boundary.kind == "spherical_container":
+        stats.update({"max_wall_overlap": float(walls.overlap), "containment_check": "passed",
+                      "Z_wall": float(sim.records["Z_wall"][-1]) if sim.records["Z_wall"] else float("nan")})
     if final_growth_rate is not None:
         stats.update({"final_growth_rate": float(final_growth_rate), "switch_pressure": float(switch_pressure)})
     ts_attrs = {k: stats[k] for k in ("growth_rate", "seed", "stop_reason", "final_growth_rate",

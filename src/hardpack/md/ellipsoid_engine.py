@@ -15,6 +15,9 @@ from hardpack.md import ellipsoid_kernel as ek
 from hardpack.md.engine import Engine, WindowResult, _aligned_rows
 from hardpack.md.kernel import WindowStatus
 
+#: in a container the cell grid spans at least this many container radii along each axis
+GRID_BOX_RADII = 8.0
+
 
 class EngineStalledError(RuntimeError):
     """The event loop stopped advancing the time (an engine failure, never valid input's fault)."""
@@ -34,14 +37,28 @@ def rotational_dof(d: int) -> int:
 
 
 class EllipsoidEngine(Engine):
-    """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box."""
+    """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box, or in a spherical
+    container (``boundary``, a :class:`hardpack.geometry.boundaries.SphericalContainer` inside the
+    box, which then only serves the cell grid)."""
 
     def __init__(self, positions, velocities, semiaxes, orientations, angular_velocities, box,
-                 capacity: int = 32, eps_f: float = ek.EPS_F):
+                 capacity: int = 32, eps_f: float = ek.EPS_F, boundary=None):
         n, d = positions.shape
         self.n, self.d = n, d
         self.eps_f = float(eps_f)
         self.box = np.ascontiguousarray(box, dtype=float)
+        kind = "periodic" if boundary is None else boundary.kind
+        if kind == "spherical_container":
+            # the box only serves the cell grid (no images), whose bounding-radius caps are at most
+            # a quarter of its side: widen it so that a particle as large as the container fits
+            self.box = np.maximum(self.box, GRID_BOX_RADII * boundary.radius)
+        if kind not in ("periodic", "spherical_container"):
+            raise ValueError(f"the ellipsoid engine runs periodic cells or spherical containers, not {kind}")
+        self.wmode = ek.PERIODIC_MODE if kind == "periodic" else ek.SPHERE_MODE
+        self.wspec = np.zeros(d + 1)
+        if kind == "spherical_container":
+            self.wspec[:d] = boundary.centre
+            self.wspec[d] = boundary.radius
         cv, ct, cr, cax, cor, cw, cii, width = ek.columns(d)
         self.P = _aligned_rows(n, width)
         self.P[:, :d] = positions
@@ -126,18 +143,20 @@ class EllipsoidEngine(Engine):
     def _run_events(self, kappa, eff_skin, coll_target, cap, rebuild, log):
         if log is not None:
             raise NotImplementedError("collision logging (contact forces) is not implemented for ellipsoids")
-        acc = np.array([0.0, 0.0, 0.0, self.totals()[0], 0.0, 0.0])
+        acc = np.zeros(ek.N_ACC)
+        acc[3] = self.totals()[0]
         iacc = np.zeros(ek.N_COUNTERS, dtype=np.int64)
         status = WindowStatus(ek.run_events(
             self.P, self.box, kappa, self.eps_f, eff_skin, self.sfac, self.imgvec, self.lvl,
             self.rcap, self.ncl, self.coff, self.ccount, self.cid, self.cbs, self.slot_of,
             self.bs, self.nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey,
-            self.heap, self.hpos, acc, iacc, coll_target, cap, rebuild))
+            self.heap, self.hpos, acc, iacc, coll_target, cap, rebuild, self.wmode, self.wspec))
         return status, acc, iacc
 
     def _raise_stalled(self, acc, iacc):
         t, i, p = float(acc[0]), int(iacc[ek.I_STALL_PARTICLE]), int(iacc[ek.I_STALL_PARTNER])
-        what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
+        what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK",
+                ek.WALL: "the container wall"}.get(p, f"particle {p}")
         raise EngineStalledError(
             f"the ellipsoid event loop stalled at window time {t!r}: more than "
             f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time without a "
@@ -157,6 +176,8 @@ class EllipsoidEngine(Engine):
             ke_end=self.totals()[0], collisions=int(iacc[0]), events=int(iacc[1]),
             stale=int(iacc[2]), exits=int(iacc[3]), grazing=int(iacc[4]),
             max_overlap=float(worst), n_overlapping=int(n_over), mean_neighbours=float(self.nn.mean()),
+            wall_collisions=int(iacc[ek.I_WALL]),
+            wall_momentum=np.concatenate([[acc[ek.A_WALL]], np.zeros(self.d - 1)]),
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:

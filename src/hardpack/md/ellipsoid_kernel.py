@@ -106,6 +106,7 @@ from numba import njit
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
 from hardpack.geometry.contact import contact_point, pw_contact_into, pw_rate, shape_inverse_into
+from hardpack.geometry.ellipsoid_container import farthest_point_body
 from hardpack.md.kernel import (
     A_KE,
     A_KEINT,
@@ -123,18 +124,28 @@ from hardpack.md.kernel import (
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted
 CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
+WALL = -4  # event: the particle hits the wall of the spherical container
+
+#: boundary modes of :func:`run_events`, tuples whose LENGTH is a compile-time constant (as in
+#: :mod:`hardpack.md.kernel`): the periodic specialisation has no wall code at all
+PERIODIC_MODE = ()
+SPHERE_MODE = (0, 0)
 
 #: extra counters (after the sphere engine's): CHECK events; the particle and partner of the
 #: last event of a STALLED window
 I_CHECK = 5
 I_STALL_PARTICLE = 6
 I_STALL_PARTNER = 7
-N_COUNTERS = 8
+#: wall collisions (container mode)
+I_WALL = 8
+N_COUNTERS = 9
 #: a window stops as STALLED after this many consecutive events at one time without a collision,
 #: plus 10 per particle
 STALL_EVENTS = 1000
-#: extra accumulator: contact-function evaluations
+#: extra accumulators: contact-function evaluations; the momentum given to the container wall
 A_EVAL = 5
+A_WALL = 6
+N_ACC = 7
 
 #: default tolerance on the Hermite interpolation error of zeta (Donev 2006, sec. 3.5.1: 1e-4..1e-3)
 EPS_F = 1e-4
@@ -684,13 +695,251 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
         else:
             h *= 4.0
 
+# ------------------------------------------------------------------ the container wall
+#: a wall collision time is located when |h - h_c| is below this many ulps of the container radius
+H_TOL_ULPS = 64.0
+
+
+@njit(cache=True, inline="always")
+def _rotation_into(o, q):
+    """Rotation Q (lab to body; :mod:`hardpack.geometry.shapes`) of an orientation row into q."""
+    if q.shape[0] == 2:
+        c, s = np.cos(o[0]), np.sin(o[0])
+        q[0, 0], q[0, 1], q[1, 0], q[1, 1] = c, s, -s, c
+        return
+    s, p1, p2, p3 = o[0], o[1], o[2], o[3]
+    diag = s * s - 0.5
+    q[0, 0], q[0, 1], q[0, 2] = 2 * (p1 * p1 + diag), 2 * (p1 * p2 + s * p3), 2 * (p1 * p3 - s * p2)
+    q[1, 0], q[1, 1], q[1, 2] = 2 * (p2 * p1 - s * p3), 2 * (p2 * p2 + diag), 2 * (p2 * p3 + s * p1)
+    q[2, 0], q[2, 1], q[2, 2] = 2 * (p3 * p1 + s * p2), 2 * (p3 * p2 - s * p1), 2 * (p3 * p3 + diag)
+
+
+@njit(cache=True)
+def wall_arrays(d):
+    """Scratch arrays (ww (8, 4), wq (d, d)) of the wall functions."""
+    return np.zeros((8, 4)), np.empty((d, d))
+
+
+@njit(cache=True)
+def wall_gap(P, i, t, kappa, wspec, ww, wq):
+    """(h, dh/dt) of particle i at window time t: the gap h = R - rho between the container wall
+    (centre wspec[:d], radius wspec[d]) and the particle's farthest surface point
+    (:func:`hardpack.geometry.ellipsoid_container.farthest_point_body`), and its rate by the
+    envelope theorem, dh/dt = -n . (v + w x r_c + g r_c) (n the outward unit normal at the
+    farthest point, r_c that point less the particle centre, g the relative growth rate). On
+    return ww[5, :d] holds r_c, ww[6, :d] n."""
+    d = wq.shape[0]
+    cv, ct, _, cax, _, cw, _, _ = columns(d)
+    dt = t - P[i, ct]
+    grow = 1.0 + kappa * t
+    x, o, a, b, xb, rc, n = ww[0, :d], ww[1], ww[2, :d], ww[3, :d], ww[4, :d], ww[5, :d], ww[6, :d]
+    for k in range(d):
+        x[k] = P[i, k] + P[i, cv + k] * dt - wspec[k]
+        a[k] = P[i, cax + k] * grow
+    orientation_at(P, i, t, o)
+    _rotation_into(o, wq)
+    for k in range(d):
+        acc = 0.0
+        for m in range(d):
+            acc += wq[k, m] * x[m]
+        b[k] = acc
+    rho = np.sqrt(farthest_point_body(b, a, xb))
+    for m in range(d):
+        acc = 0.0
+        for k in range(d):
+            acc += wq[k, m] * xb[k]
+        n[m] = acc / rho
+        rc[m] = acc - x[m]
+    g = kappa / grow
+    rate = 0.0
+    for k in range(d):
+        rate += n[k] * (P[i, cv + k] + g * rc[k])
+    c = ww[7]
+    _cross_n(rc, n, c)  # n . (w x r_c) = w . (r_c x n)
+    nw = 3 if d == 3 else 1
+    for k in range(nw):
+        rate += P[i, cw + k] * c[k]
+    return wspec[d] - rho, -rate
+
+
+@njit(cache=True)
+def _wall_refine(P, i, kappa, wspec, hc, lo, dlo, hi, hhi, dhi, guess, ww, wq):
+    """First crossing of h = hc in [lo, hi] (h(lo) >= hc > h(hi)), safeguarded Newton as
+    :func:`_refine`: (t_c, rate there, hi, h(hi), rate at hi)."""
+    htol = H_TOL_ULPS * EPS * wspec[wspec.shape[0] - 1]
+    tt = guess if lo < guess < hi else 0.5 * (lo + hi)
+    for _ in range(100):
+        z, zd = wall_gap(P, i, tt, kappa, wspec, ww, wq)
+        f = z - hc
+        if f >= 0.0:
+            lo, dlo = tt, zd
+        else:
+            hi, hhi, dhi = tt, z, zd
+        if abs(f) <= htol:
+            return tt, zd, hi, hhi, dhi
+        nt = tt - f / zd if zd != 0.0 else -1.0
+        if f >= 0.0 and abs(nt - tt) <= 4e-16 * abs(tt):
+            break
+        if hi - lo <= 4e-16 * abs(hi) + 1e-300:
+            break
+        if not (lo < nt < hi):
+            nt = 0.5 * (lo + hi)
+        if nt == tt:
+            break
+        tt = nt
+    return lo, dlo, hi, hhi, dhi
+
+
+@njit(cache=True)
+def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
+    """First wall collision of particle i in window time [t, tmax): (time, kind), kind 0 a
+    collision, 1 a CHECK (step cap reached), time inf for none.
+
+    The gap h(t) = R - rho(t) (:func:`wall_gap`) decreases at most at the rate
+    |v| + |kappa| a_max(0) + |w| a_max(t) (the centre, the growth and the spin of the farthest
+    point, at distance <= a_max from the centre), so no contact happens within the safe time of
+    :func:`_safe_time` (Donev 2006, sec. 3.5.1: jump ahead with a bound on the rate). When the safe
+    time is shorter than the trace step, an ordinary step as in :func:`pair_trace`: the cubic
+    Hermite interpolant of h and dh/dt at both ends, checked at the midpoint against the tolerance
+    eps_f times the smallest semiaxis (or a tenth of the interpolant's minimum, far from the wall),
+    halved until it passes; a sample at or below the contact level (0, or h(t) if the particle
+    starts touching: after a wall collision, or a graze) brackets a crossing located by
+    :func:`_wall_refine`. A crossing whose rate is not below -GRAZE_RATE times the particle's
+    speed scale is a graze; the trace goes on from just past it."""
+    d = wq.shape[0]
+    cv, _, cr, cax, _, cw, _, _ = columns(d)
+    if not tmax > t:
+        return np.inf, 0
+    amax0 = P[i, cr]
+    amin0 = P[i, cax]
+    for k in range(1, d):
+        amin0 = min(amin0, P[i, cax + k])
+    vv = 0.0
+    for k in range(d):
+        vv += P[i, cv + k] ** 2
+    w2 = 0.0
+    nw = 3 if d == 3 else 1
+    for k in range(nw):
+        w2 += P[i, cw + k] ** 2
+    spin = np.sqrt(w2) * amax0
+    grow_speed = np.sqrt(vv) + abs(kappa) * amax0
+    speed = grow_speed + spin * (1.0 + kappa * t)
+    if speed == 0.0:
+        return np.inf, 0
+    rate_tol = GRAZE_RATE * speed
+    h0, d0 = wall_gap(P, i, t, kappa, wspec, ww, wq)
+    hc = 0.0
+    touching = False
+    if h0 <= 0.0:
+        if d0 < -rate_tol:
+            return t, 0
+        hc = h0
+        touching = True
+    step = FIRST_STEP * amin0 * (1.0 + kappa * t) / speed
+    hmin_step = MIN_STEP_FRACTION * step
+    tol_abs = eps_f * amin0 * (1.0 + kappa * t)
+    t0 = t
+    steps = 0
+    while True:
+        hfloor = max(hmin_step, 8.0 * EPS * abs(t0))
+        if tmax - t0 <= hfloor:
+            return np.inf, 0
+        if steps >= MAX_TRACE_STEPS:
+            return t0, 1
+        safe = 0.0 if touching else _safe_time(h0 - hc, 0.0, spin, grow_speed, kappa, t0)
+        if t0 + safe >= tmax:
+            return np.inf, 0
+        if safe > step:
+            t1 = t0 + safe
+            h1, d1 = wall_gap(P, i, t1, kappa, wspec, ww, wq)
+            steps += 1
+            if h1 > hc:
+                t0, h0, d0 = t1, h1, d1
+                continue
+            step = safe  # round-off of the bound: an ordinary step over the same interval
+        step = min(max(step, hfloor), tmax - t0)
+        t1 = t0 + step
+        tm = t0 + 0.5 * step
+        h1, d1 = wall_gap(P, i, t1, kappa, wspec, ww, wq)
+        hm, dm = wall_gap(P, i, tm, kappa, wspec, ww, wq)
+        steps += 1
+        if touching and hm <= hc:  # still in contact at the midpoint
+            if dm < -rate_tol:  # approaching: the collision is at the latest here
+                if step <= hfloor:
+                    return tm, 0
+                step *= 0.5
+                continue
+            hc = min(hc, hm)  # touching, not approaching: move on
+            t0, h0, d0 = tm, hm, dm
+            continue
+        if hm <= hc or h1 <= hc:  # a crossing of hc from above
+            if hm <= hc:
+                _, root = _hermite_min(h0 - hc, hm - hc, d0 * 0.5 * step, dm * 0.5 * step)
+                tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, t0, d0, tm, hm, dm,
+                                                     t0 + 0.5 * step * min(root, 1.0), ww, wq)
+            else:
+                _, root = _hermite_min(hm - hc, h1 - hc, dm * 0.5 * step, d1 * 0.5 * step)
+                tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, tm, dm, t1, h1, d1,
+                                                     tm + 0.5 * step * min(root, 1.0), ww, wq)
+            if dc < -rate_tol:
+                return tc, 0
+            touching = True  # a grazing touch: touching from just past it on
+            hc = min(hc, hhi)
+            t0, h0, d0 = thi, hhi, dhi
+            continue
+        err = abs(0.5 * (h0 + h1) + 0.125 * step * (d0 - d1) - hm)
+        hmn, _ = _hermite_min(h0 - hc, h1 - hc, d0 * step, d1 * step)
+        tol = max(tol_abs, RELATIVE_TOL * hmn)
+        if (err <= tol and hmn > 2.0 * err) or step <= hfloor:
+            touching = False
+            t0, h0, d0 = t1, h1, d1
+            if err > 0.0:
+                fac = 0.8 * (max(min(tol, 0.5 * hmn), 0.0) / err) ** 0.25
+                step *= min(max(fac, 0.5), 4.0)
+            else:
+                step *= 4.0
+        else:
+            step *= 0.5
+
+
+@njit(cache=True)
+def wall_collide(P, i, t, kappa, wspec, ww, wq):
+    """Collision of particle i with the container wall at window time t (the particle is first
+    advanced to t): the collision law of :func:`collide` with an infinitely massive wall, at the
+    farthest point r_C with the outward normal n: v_n = n . (v + w x (r_C - x) + g (r_C - x)) > 0
+    for an approaching particle, impulse -J n on the particle with
+    J = 2 v_n / (1/m + |(r_C - x) x n|^2 / I), which reverses v_n: v -= J n,
+    w -= J (r_C - x) x n / I. Returns (J, the momentum given to the wall, >= 0; change of the
+    translational kinetic energy), J = 0 for a skipped (separating) particle."""
+    d = wq.shape[0]
+    cv, _, _, _, _, cw, cii, _ = columns(d)
+    advance(P, i, t, ww[1])
+    _, hd = wall_gap(P, i, t, kappa, wspec, ww, wq)
+    vn = -hd
+    if not vn > 0.0:
+        return 0.0, 0.0
+    rc, n, c = ww[5, :d], ww[6, :d], ww[7]
+    lev = _cross_n(rc, n, c)
+    jimp = 2.0 * vn / (1.0 + lev * P[i, cii])
+    ke0 = 0.0
+    ke1 = 0.0
+    for k in range(d):
+        ke0 += P[i, cv + k] ** 2
+        P[i, cv + k] -= jimp * n[k]
+        ke1 += P[i, cv + k] ** 2
+    nw = 3 if d == 3 else 1
+    for k in range(nw):
+        P[i, cw + k] -= jimp * P[i, cii] * c[k]
+    return jimp, 0.5 * (ke1 - ke0)
+
 
 @njit(cache=True)
 def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of,
-             bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch):
+             bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode):
     """Partial NNL update of particle i at window time t (Donev 2006, Algorithm 10), as in
     :func:`hardpack.md.kernel.run_events` stage (1) with the bounding radius R_i (largest
-    semiaxis) in place of the sphere radius. Returns 0 or a :class:`WindowStatus` to stop with."""
+    semiaxis) in place of the sphere radius; in a container (``wmode``) without periodic images and
+    wraps. Returns 0 or a :class:`WindowStatus` to stop with."""
     d = L.shape[0]
     cbits = 2 * d
     cmask = (1 << cbits) - 1
@@ -711,7 +960,7 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
     stride = 1
     for k in range(d):
         x = P[i, k]
-        if x < 0.0 or x >= L[k]:
+        if len(wmode) == 0 and (x < 0.0 or x >= L[k]):
             x -= L[k] * np.floor(x * invL[k])
             if x >= L[k]:
                 x -= L[k]
@@ -721,6 +970,8 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
         gk = int(x * invL[k] * ncl[h, k])
         if gk >= ncl[h, k]:
             gk = ncl[h, k] - 1
+        if len(wmode) > 0 and gk < 0:
+            gk = 0
         c += gk * stride
         stride *= ncl[h, k]
     a = P[i, cr] * (1.0 + kappa * t)
@@ -792,12 +1043,13 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
                     for k in range(d):
                         dx = cbs[sj, k] - bs[i, k]
                         sh = 1
-                        if dx > 0.5 * L[k]:
-                            dx -= L[k]
-                            sh = 0
-                        elif dx < -0.5 * L[k]:
-                            dx += L[k]
-                            sh = 2
+                        if len(wmode) == 0:  # no images in a container
+                            if dx > 0.5 * L[k]:
+                                dx -= L[k]
+                                sh = 0
+                            elif dx < -0.5 * L[k]:
+                                dx += L[k]
+                                sh = 2
                         code += sh << (2 * k)
                         d2 += dx * dx
                     s = ri + cbs[sj, d]
@@ -835,7 +1087,8 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
 
 
 @njit(cache=True)
-def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm):
+def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm, wmode, wspec,
+             ww, wq):
     """Next event of particle i from window time t: (time, partner), partner EXIT, CHECK or a
     particle index (Algorithm 5 with NNLs). The pairs are searched best first: each has a key, a
     lower bound on its collision time, first the start t_in of its bounding-sphere overlap (or,
@@ -844,7 +1097,9 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     time, then the lower bound its trace has reached; the pair of the smallest key is started
     or, if started, traced one stretch (:func:`pair_trace`, suspended once its lower bound passes
     the second smallest key), until the smallest key is after the earliest event found (``done``:
-    0 new, 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs)."""
+    0 new, 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs). In a
+    container (``wmode``) the wall collision (:func:`wall_predict`) before the exit comes first
+    and bounds the pair search (partner WALL, or CHECK when its trace reached the step cap)."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 2 * d
@@ -864,6 +1119,11 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     best = exit_root(dd, dv, vv, bs[i, d] - ri * grow, ri * kappa)
     partner = EXIT if best < np.inf else NONE
     best += t
+    if len(wmode) > 0:
+        tw, kind = wall_predict(P, i, t, best, kappa, wspec, eps_f, ww, wq)
+        if tw < best:
+            best = tw
+            partner = WALL if kind == 0 else CHECK
     horizon = best  # no collision of i is later than the first contact of inscribed spheres
     amin_i = P[i, cax]
     for k in range(1, d):
@@ -1048,18 +1308,24 @@ def collide(P, i, j, t, L, kappa, ws, wm):
 @njit(cache=True)
 def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
-               coll_target, t_cap, rebuild_lists):
+               coll_target, t_cap, rebuild_lists, wmode=PERIODIC_MODE, wspec=None):
     """One window of ellipsoid MD; arguments, accumulators and return codes as in
     :func:`hardpack.md.kernel.run_events` (no ``dims``: d is the length of ``L``; ``eps_f`` the
     trace tolerance; ``iacc`` has N_COUNTERS entries: after the sphere engine's, I_CHECK counts
     CHECK events and I_STALL_PARTICLE, I_STALL_PARTNER name the last event of a STALLED window (its
     time in acc[A_T]); acc[A_KE]
-    enters the current translational kinetic energy; ``acc`` has a sixth entry, A_EVAL, that
-    receives the number of contact-function evaluations)."""
-    ws, wm = work_arrays(L.shape[0])
+    enters the current translational kinetic energy; ``acc`` has N_ACC entries: A_EVAL receives
+    the number of contact-function evaluations, A_WALL the momentum given to the container wall).
+    ``wmode`` PERIODIC_MODE or SPHERE_MODE (a spherical container of centre wspec[:d] and radius
+    wspec[d] inside the box L, which then has no periodic images: wall collisions, counted in
+    iacc[I_WALL], count towards ``coll_target``); the periodic specialisation has no wall code."""
+    d = L.shape[0]
+    ws, wm = work_arrays(d)
+    ww, wq = wall_arrays(d)
+    spec = np.zeros(d + 1) if wspec is None else wspec
     status = _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                   slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
-                  coll_target, t_cap, rebuild_lists, ws, wm)
+                  coll_target, t_cap, rebuild_lists, ws, wm, wmode, spec, ww, wq)
     acc[A_EVAL] = ws[10, 0]
     return status
 
@@ -1067,11 +1333,12 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
 @njit(cache=True)
 def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
          slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
-         coll_target, t_cap, rebuild_lists, ws, wm):
+         coll_target, t_cap, rebuild_lists, ws, wm, wmode, wspec, ww, wq):
     d = L.shape[0]
     n = P.shape[0]
     cap = nb.shape[1]
     invL = 1.0 / L
+    lbig = 4.0 * L  # in a container: no images (every pair is within the box, |dx| < L)
     oldnb = np.empty(cap, dtype=np.int64)
     clo = np.empty(d, dtype=np.int64)
     cspan = np.empty(d, dtype=np.int64)
@@ -1091,12 +1358,13 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         nn[:] = 0
         for i in range(n):
             status = _rebuild(i, 0.0, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount,
-                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch)
+                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode)
             if status != 0:
                 acc[A_T] = 0.0
                 return status
     for i in range(n):
-        key, partner = _predict(i, 0.0, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm)
+        key, partner = _predict(i, 0.0, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm,
+                                wmode, wspec, ww, wq)
         ep[i] = partner
         if partner >= 0:
             ec[i] = cnt[partner]
@@ -1130,20 +1398,34 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         iacc[I_EVENTS] += 1
         npred = 1
         upd[0] = i
+        wall_hit = False
         if p == EXIT:
             iacc[I_EXIT] += 1
             status = _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount,
-                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch)
+                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode)
             if status != 0:
                 acc[A_T] = t
                 return status
         elif p == CHECK:
             iacc[I_CHECK] += 1
+        elif len(wmode) > 0 and p == WALL:
+            jimp, dke = wall_collide(P, i, t, kappa, wspec, ww, wq)
+            if jimp > 0.0:
+                same = 0
+                wall_hit = True
+                acc[A_WALL] += jimp
+                acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+                acc[A_TKE] = t
+                acc[A_KE] += dke
+                cnt[i] += 1
+                iacc[I_WALL] += 1
+            else:
+                iacc[I_GRAZE] += 1
         elif p < 0 or ec[i] != cnt[p]:
             iacc[I_STALE] += 1
         else:
             j = p
-            jimp, vir, dke = collide(P, i, j, t, L, kappa, ws, wm)
+            jimp, vir, dke = collide(P, i, j, t, L if len(wmode) == 0 else lbig, kappa, ws, wm)
             if jimp > 0.0:
                 same = 0
                 acc[A_VIRIAL] += vir
@@ -1160,12 +1442,17 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         for q in range(npred):
             k = upd[q]
             key, partner = _predict(k, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done,
-                                    pst, ws, wm)
+                                    pst, ws, wm, wmode, wspec, ww, wq)
             ep[k] = partner
             if partner >= 0:
                 ec[k] = cnt[partner]
             hsize = heap_set(hkey, heap, hpos, hsize, k, key)
         if iacc[I_COLL] >= coll_target and npred == 2:
+            acc[A_T] = t
+            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+            acc[A_TKE] = t
+            return WindowStatus.DONE_COLLISIONS
+        if len(wmode) > 0 and wall_hit and iacc[I_COLL] + iacc[I_WALL] >= coll_target:
             acc[A_T] = t
             acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
             acc[A_TKE] = t

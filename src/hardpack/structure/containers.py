@@ -11,6 +11,8 @@
 - :func:`core_density`, :func:`container_summary`: the per-packing numbers of a container study
   (average density, delta = a / R, the density of the core away from the wall) over (N, seed),
   with the Eq. 7.2 extrapolation.
+- :func:`ellipsoid_container_summary`: the same extrapolation for ellipsoids in containers (the
+  M&M-shaped spheroids of Sec. 7.3.2.1), from the packings' average densities.
 - :func:`window_study`, :func:`fit_window_power_law`: sigma_phi against the window diameter 2R/D
   over several periodic packings and the log-log fit of the text, sigma_phi ~ 0.1 (2R/D)^-2.
 
@@ -558,3 +560,66 @@ def _bulk_density(bulk, data: dict, coords: dict) -> dict:
     coords["bulk_seed"] = ("bulk_sample", np.array(seeds))
     err = float(values.std(ddof=1) / np.sqrt(len(values))) if len(values) > 1 else float("nan")
     return {"phi_bulk": float(values.mean()), "phi_bulk_err": err, "n_bulk": len(values), "bulk_N": sizes.pop()}
+
+
+def ellipsoid_container_summary(packings, seeds, fit_min_n: int = 1) -> xr.Dataset:
+    """Jammed ellipsoids in spherical containers over (N, seed) and the Eq. 7.2 bulk extrapolation
+    (Donev 2006, Sec. 7.3.2.1 and Fig. 7.6: M&M-shaped oblate spheroids, phi_0 = 0.700 +- 0.002).
+
+    The average density is the packing's phi (particle volume over the container's), the length
+    unit the geometric mean semiaxis a = (O_1 O_2 O_3)^(1/3) (Donev 2006, Sec. 7.3.1.2: a = D/2 for
+    spheres), averaged over the particles, and the line phi_avg = phi_0 - s a/R is fitted over the
+    packings with N >= fit_min_n (:func:`extrapolate_bulk_density`).
+
+    Parameters
+    ----------
+    packings : sequence of Packing
+        Ellipsoids in spherical containers.
+    seeds : sequence of int
+        The seed of each packing.
+    fit_min_n : int, default 1
+        Smallest N in the fit.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension ``sample`` (coordinates ``N``, ``seed``) with ``a_over_R`` and ``phi_avg``;
+        attributes ``phi0``, ``phi0_err``, ``slope``, ``slope_err`` (NaN with fewer than 3 packings
+        or one a/R in the fit), ``n_fit``, ``n_sizes_fit``, ``fit_min_n``, ``semiaxes`` (of the
+        first particle of the first packing) and ``hardpack_kind`` "ellipsoid_container_summary".
+
+    Raises
+    ------
+    InvalidInputError
+        No packings, a packing that is not ellipsoids in a spherical container, seeds of another
+        length, or a repeated (N, seed).
+    """
+    packings, seeds = list(packings), [int(s) for s in seeds]
+    if not packings or len(packings) != len(seeds):
+        raise InvalidInputError(f"an ellipsoid container summary needs packings and one seed each, got "
+                                f"{len(packings)} packings and {len(seeds)} seeds")
+    rows = []
+    for p, seed in zip(packings, seeds):
+        if p.shape.kind != "ellipsoid" or p.boundary.kind != "spherical_container":
+            raise InvalidInputError(f"expected ellipsoids in a spherical container, got {p!r}")
+        a = float(np.mean(np.prod(p.shape.semiaxes, axis=1) ** (1.0 / p.dim)))
+        rows.append((p.n_particles, seed, a / p.boundary.radius, float(p.phi)))
+    rows.sort()
+    pairs = [r[:2] for r in rows]
+    if len(set(pairs)) != len(pairs):
+        raise InvalidInputError(f"a (N, seed) pair repeats among the packings: {pairs}")
+    n, seed, delta, phi = (np.array(c) for c in zip(*rows))
+    use = n >= fit_min_n
+    fit = {"phi0": np.nan, "phi0_err": np.nan, "slope": np.nan, "slope_err": np.nan}
+    if use.sum() >= 3 and np.ptp(delta[use]) > 0:
+        f = extrapolate_bulk_density(delta[use], phi[use])
+        fit = {"phi0": f.phi0, "phi0_err": f.phi0_err, "slope": f.slope, "slope_err": f.slope_err}
+    return xr.Dataset(
+        {"a_over_R": ("sample", delta), "phi_avg": ("sample", phi)},
+        coords={"N": ("sample", n), "seed": ("sample", seed)},
+        attrs={"hardpack_kind": "ellipsoid_container_summary", **fit, "n_fit": int(use.sum()),
+               "n_sizes_fit": len(set(n[use].tolist())), "fit_min_n": int(fit_min_n),
+               "semiaxes": [float(v) for v in packings[0].shape.semiaxes[0]], "index": '["N", "seed"]',
+               "source": "Donev 2006, Sec. 7.3.2.1, Eq. 7.2 and Fig. 7.6 (linear fit in a/R, a the "
+                         "geometric mean semiaxis)"},
+    )

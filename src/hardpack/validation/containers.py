@@ -8,6 +8,10 @@ Inputs (the pipeline's ``containers`` summaries, told apart by ``hardpack_kind``
   packings of the largest container against "about 0.64" (Fig. 7.5), over seeds; and, with the
   summary's periodic packings of the same protocol, their density against the same 0.642 +- 0.002
   (the bulk value phi_0 that the extrapolation estimates).
+- ``ellipsoid_container_summary``
+  (:func:`hardpack.structure.containers.ellipsoid_container_summary`): the Eq. 7.2 intercept of
+  jammed M&M-shaped oblate spheroids in spherical containers against 0.700 +- 0.002
+  (Sec. 7.3.2.1), judged at the largest N of the fit with its number of sizes.
 - ``window_study`` (:func:`hardpack.structure.containers.window_study`): sigma_phi averaged over
   the packings, fitted by a power law over 2R/D >= fit_min_diameter
   (:func:`~hardpack.structure.containers.fit_window_power_law`): the exponent against -2 and the
@@ -55,6 +59,21 @@ def _bulk_rows(targets, summary) -> list[Row]:
     return rows
 
 
+def _mm_rows(targets, summary) -> list[Row]:
+    n = np.asarray(summary["N"].values)
+    a = summary.attrs
+    fitted = n[n >= a["fit_min_n"]]
+    sizes = ", ".join(map(str, sorted(set(fitted.tolist()))))
+    axes = np.atleast_1d(np.asarray(a["semiaxes"], float))
+    semiaxes = ":".join(f"{v:.3g}" for v in axes / axes.min())
+    return [evaluate(targets["donev-7.3-mm-phi0"], float(a["phi0"]), float(a["phi0_err"]),
+                     n=int(fitted.max()) if fitted.size else 0, sizes=int(a["n_sizes_fit"]),
+                     label=f"Eq. 7.2 intercept, semiaxes {semiaxes}",
+                     detail=f"linear fit over {a['n_fit']} packings, N = {sizes or 'none'}; "
+                            f"slope {a['slope']:.3f} +- {a['slope_err']:.3f}; a/R = "
+                            f"{float(np.min(summary['a_over_R'])):.3f}..{float(np.max(summary['a_over_R'])):.3f}")]
+
+
 def _wall_layer_detail(summary) -> str:
     """Mean density of the layer within one a of the wall, and of the core, per container size
     (Eq. 7.1 takes the wall correction as independent of R and the core as the bulk; a trend of
@@ -91,6 +110,8 @@ def container_rows(datasets) -> list[Row]:
         kind = ds.attrs.get("hardpack_kind")
         if kind == "container_summary":
             out += _bulk_rows(targets, ds)
+        elif kind == "ellipsoid_container_summary":
+            out += _mm_rows(targets, ds)
         elif kind == "window_study":
             out += _window_rows(targets, ds)
     return out

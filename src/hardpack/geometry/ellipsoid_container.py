@@ -1,0 +1,181 @@
+"""An ellipsoid (d = 3) or ellipse (d = 2) inside a spherical container: the farthest point.
+
+Donev 2006 (dissertation, Ch. 7 and Sec. 2.2.2) puts ellipsoids in a spherical container with the
+"ellipsoid inside a larger ellipsoid" potential; here the container is a sphere, and the exact gap
+is a one-dimensional problem (derived here). With the container centre at the origin, the particle
+centre at c and the body-frame semiaxes a_k (rotation Q, lab to body), the body-frame centre is
+b = Q c and a surface point is c + Q^T z with sum_k z_k^2 / a_k^2 = 1. The container of radius R
+holds the particle iff rho = max_z |b + z| <= R, and the gap is h = R - rho.
+
+**Secular equation.** Maximising |b + z|^2 over the ellipsoid z^T A^-1 z <= 1 (A = diag a_k^2) is a
+trust-region problem, for which the Lagrange (S-lemma) dual is exact:
+
+    rho^2 = min_{mu >= a_max^2} phi(mu),  phi(mu) = mu + |b|^2 + sum_k a_k^2 b_k^2 / (mu - a_k^2),
+
+phi is convex with phi'(mu) = 1 - g(mu), g(mu) = sum_k a_k^2 b_k^2 / (mu - a_k^2)^2 (decreasing
+on mu > a_max^2). If g(mu) = 1 has a root mu* > a_max^2 (always, unless b has no component along
+the longest semiaxes), rho^2 = phi(mu*) and the farthest point is z_k = a_k^2 b_k / (mu* - a_k^2),
+x = b + z with x_k = mu* b_k / (mu* - a_k^2). The root is bracketed in
+[max(a_max^2, a_min^2 + s), a_max^2 + s] with s = sqrt(sum_k a_k^2 b_k^2) (bounding the
+denominators by a_min^2 and a_max^2), and found by Newton on 1/sqrt(g) - 1 (exactly linear for a
+sphere) kept inside the bracket by bisection. Otherwise (the "hard case": the centre lies in the
+plane normal to the longest axis, e.g. c at the centre, or a spheroid's centre on the container's
+radius through its equator) mu* = a_max^2: the other components are as above and the longest-axis
+component takes the rest of the constraint, z_max^2 = a_max^2 (1 - sum_{k not max} z_k^2 / a_k^2).
+Every mu >= a_max^2 gives phi(mu) >= rho^2 (weak duality), so round-off in mu* only makes the gap a
+little smaller (safe), and the value is stationary in mu (second-order error).
+
+Exact cases: a sphere of radius r has rho = |c| + r; an ellipsoid centred in the container has
+rho = a_max.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Newton iterations of the secular equation (it converges in a handful)
+MAX_ITER = 100
+
+
+@njit(cache=True)
+def farthest_point_body(b, a, x):
+    """rho^2 = max |b + z|^2 over the body-frame ellipsoid sum z_k^2 / a_k^2 <= 1, and the farthest
+    point x = b + z (body frame, into ``x``) (module docstring). ``b``, ``a``, ``x``: length d."""
+    d = b.shape[0]
+    a2max = 0.0
+    a2min = np.inf
+    for k in range(d):
+        a2 = a[k] * a[k]
+        a2max = max(a2max, a2)
+        a2min = min(a2min, a2)
+    w = 0.0  # sum a_k^2 b_k^2
+    wmax = 0.0  # the part along the longest semiaxes
+    for k in range(d):
+        a2 = a[k] * a[k]
+        t = a2 * b[k] * b[k]
+        w += t
+        if a2 == a2max:
+            wmax += t
+    # hard case: no component along the longest axes and g(a_max^2) <= 1
+    if wmax == 0.0:
+        g = 0.0
+        for k in range(d):
+            a2 = a[k] * a[k]
+            if a2 < a2max:
+                q = a[k] * b[k] / (a2max - a2)
+                g += q * q
+        if g <= 1.0:
+            rest = a2max * (1.0 - g)
+            first = True
+            rho2 = 0.0
+            for k in range(d):
+                a2 = a[k] * a[k]
+                if a2 < a2max:
+                    x[k] = a2max * b[k] / (a2max - a2)
+                elif first:
+                    x[k] = np.sqrt(rest)
+                    first = False
+                else:
+                    x[k] = 0.0
+                rho2 += x[k] * x[k]
+            return rho2
+    # the unknown is u = mu - a_max^2 > 0, so that the denominators mu - a_k^2 = u + (a_max^2 - a_k^2)
+    # carry no cancellation when mu* is close to a_max^2 (a small component along the longest axis)
+    s = np.sqrt(w)
+    lo = max(0.0, a2min + s - a2max)
+    hi = s
+    u = hi
+    tiny = np.finfo(np.float64).eps
+    for _ in range(MAX_ITER):
+        g = 0.0
+        dg = 0.0
+        for k in range(d):
+            a2 = a[k] * a[k]
+            den = u + (a2max - a2)
+            if den <= 0.0:
+                g = np.inf
+                break
+            q = a2 * b[k] * b[k] / (den * den)
+            g += q
+            dg -= 2.0 * q / den
+        if g > 1.0:
+            lo = u
+        elif g < 1.0:
+            hi = u
+        else:
+            break
+        if g < np.inf:  # Newton on F = g^-1/2 - 1, F' = -g^-3/2 dg / 2 > 0
+            f = 1.0 / np.sqrt(g) - 1.0
+            fp = -0.5 * dg / (g * np.sqrt(g))
+            nu = u - f / fp if fp > 0.0 else 0.5 * (lo + hi)
+            if not (lo < nu < hi):
+                nu = 0.5 * (lo + hi)
+        else:
+            nu = 0.5 * (lo + hi)
+        done = abs(nu - u) <= 4.0 * tiny * u or hi - lo <= 4.0 * tiny * hi
+        u = nu
+        if done:
+            break
+    u = max(u, lo)
+    # phi(mu) >= rho^2 for every mu > a_max^2 (weak duality): the safe value
+    mu = u + a2max
+    phi = mu
+    for k in range(d):
+        a2 = a[k] * a[k]
+        den = u + (a2max - a2)
+        bb = b[k] * b[k]
+        phi += bb + (a2 * bb / den if den > 0.0 else 0.0)
+        x[k] = mu * b[k] / den if den > 0.0 else 0.0
+    return phi
+
+
+@njit(cache=True)
+def farthest_points(positions, semiaxes, rotations, centre):
+    """rho (N,) and the farthest surface points (N, d) (lab frame) of N ellipsoids from ``centre``
+    (module docstring); ``rotations`` (N, d, d) lab to body (Q)."""
+    n, d = positions.shape
+    rho = np.empty(n)
+    pts = np.empty((n, d))
+    b = np.empty(d)
+    x = np.empty(d)
+    for i in range(n):
+        for k in range(d):
+            s = 0.0
+            for m in range(d):
+                s += rotations[i, k, m] * (positions[i, m] - centre[m])
+            b[k] = s
+        rho[i] = np.sqrt(farthest_point_body(b, semiaxes[i], x))
+        for m in range(d):
+            s = centre[m]
+            for k in range(d):
+                s += rotations[i, k, m] * x[k]
+            pts[i, m] = s
+    return rho, pts
+
+
+def container_gaps(positions, shape, centre, radius):
+    """Gap h = R - rho of every ellipsoid to the wall of a spherical container (negative when it
+    crosses the wall), and the farthest surface points (lab frame).
+
+    Parameters
+    ----------
+    positions : numpy.ndarray, shape (N, d)
+        Particle centres.
+    shape : hardpack.geometry.shapes.Ellipsoids
+        Semiaxes and orientations.
+    centre : sequence of float, shape (d,)
+        Container centre.
+    radius : float
+        Container radius R.
+
+    Returns
+    -------
+    gap : numpy.ndarray, shape (N,)
+    points : numpy.ndarray, shape (N, d)
+    """
+    rot = np.ascontiguousarray(shape.rotations(), dtype=float)
+    rho, pts = farthest_points(np.ascontiguousarray(positions, dtype=float),
+                               np.ascontiguousarray(shape.semiaxes, dtype=float), rot,
+                               np.asarray(centre, dtype=float))
+    return float(radius) - rho, pts
