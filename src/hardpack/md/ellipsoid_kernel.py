@@ -119,6 +119,7 @@ from hardpack.md.kernel import (
     I_GRAZE,
     I_STALE,
     WindowStatus,
+    update_neighbour_list,
 )
 
 EXIT = -1  # event: the particle leaves its bounding sphere
@@ -935,155 +936,16 @@ def wall_collide(P, i, t, kappa, wspec, ww, wq):
 
 @njit(cache=True)
 def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of,
-             bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode):
-    """Partial NNL update of particle i at window time t (Donev 2006, Algorithm 10), as in
-    :func:`hardpack.md.kernel.run_events` stage (1) with the bounding radius R_i (largest
-    semiaxis) in place of the sphere radius; in a container (``wmode``) without periodic images and
-    wraps. Returns 0 or a :class:`WindowStatus` to stop with."""
-    d = L.shape[0]
-    cbits = 2 * d
-    cmask = (1 << cbits) - 1
-    cback = cmask // 3 * 2
-    cap = nb.shape[1]
-    ccap = cid.shape[0] // ccount.shape[0]
-    nlev = ncl.shape[0]
-    _, _, cr, _, _, _, _, _ = columns(d)
+             bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode, walled):
+    """Partial NNL update of particle i at window time t (Donev 2006, Algorithm 10): advance i to
+    t and :func:`hardpack.md.kernel.update_neighbour_list` with the bounding radius R_i (largest
+    semiaxis) in place of the sphere radius; in a container (``wmode``, ``walled`` all 1) without
+    periodic images and wraps. Returns 0 or a :class:`WindowStatus` to stop with."""
+    _, _, cr, _, _, _, _, _ = columns(L.shape[0])
     advance(P, i, t, scratch)
-    nold = nn[i]
-    for m in range(nold):  # remember the old neighbours, marked with their image code + 1
-        j = nb[i, m] >> cbits
-        oldnb[m] = j
-        mark[j] = (nb[i, m] & cmask) + 1
-    nn[i] = 0
-    h = lvl[i]
-    c = coff[h]
-    stride = 1
-    for k in range(d):
-        x = P[i, k]
-        if len(wmode) == 0 and (x < 0.0 or x >= L[k]):
-            x -= L[k] * np.floor(x * invL[k])
-            if x >= L[k]:
-                x -= L[k]
-            x = max(x, 0.0)
-            P[i, k] = x
-        bs[i, k] = x
-        gk = int(x * invL[k] * ncl[h, k])
-        if gk >= ncl[h, k]:
-            gk = ncl[h, k] - 1
-        if len(wmode) > 0 and gk < 0:
-            gk = 0
-        c += gk * stride
-        stride *= ncl[h, k]
-    a = P[i, cr] * (1.0 + kappa * t)
-    ri = a + skin * sfac[i]
-    if ri > rcap[h]:
-        ri = rcap[h]
-        if a + 0.25 * skin * sfac[i] >= rcap[h]:
-            return WindowStatus.BOUND_TOO_SMALL
-    bs[i, d] = ri
-    slot = slot_of[i]
-    if slot < 0 or slot // ccap != c:
-        if ccount[c] >= ccap:
-            return WindowStatus.CELL_OVERFLOW
-        if slot >= 0:
-            old = slot // ccap
-            last = old * ccap + ccount[old] - 1
-            moved = cid[last]
-            cid[slot] = moved
-            for k in range(d + 1):
-                cbs[slot, k] = cbs[last, k]
-            slot_of[moved] = slot
-            ccount[old] -= 1
-        slot = c * ccap + ccount[c]
-        ccount[c] += 1
-        cid[slot] = i
-        slot_of[i] = slot
-    for k in range(d + 1):
-        cbs[slot, k] = bs[i, k]
-    for lv in range(nlev):
-        beta = ri + rcap[lv]
-        ncells = 1
-        for k in range(d):
-            m = ncl[lv, k]
-            lo = int(np.floor((bs[i, k] - beta) * invL[k] * m))
-            span = int(np.floor((bs[i, k] + beta) * invL[k] * m)) - lo + 1
-            if span >= m:
-                lo = 0
-                span = m
-            clo[k] = lo
-            cspan[k] = span
-            codo[k] = 0
-            ncells *= span
-        for _ in range(ncells):
-            gc = coff[lv]
-            stride = 1
-            gap2 = 0.0
-            for k in range(d):
-                m = ncl[lv, k]
-                u = clo[k] + codo[k]
-                if cspan[k] < m:
-                    w = L[k] / m
-                    gap = max(u * w - bs[i, k], bs[i, k] - (u + 1) * w, 0.0)
-                    gap2 += gap * gap
-                gc += (u % m) * stride
-                stride *= m
-            for k in range(d):
-                codo[k] += 1
-                if codo[k] < cspan[k]:
-                    break
-                codo[k] = 0
-            if gap2 >= beta * beta:
-                continue
-            base = gc * ccap
-            for sj in range(base, base + ccount[gc]):
-                j = cid[sj]
-                if j != i:
-                    code = 0
-                    d2 = 0.0
-                    for k in range(d):
-                        dx = cbs[sj, k] - bs[i, k]
-                        sh = 1
-                        if len(wmode) == 0:  # no images in a container
-                            if dx > 0.5 * L[k]:
-                                dx -= L[k]
-                                sh = 0
-                            elif dx < -0.5 * L[k]:
-                                dx += L[k]
-                                sh = 2
-                        code += sh << (2 * k)
-                        d2 += dx * dx
-                    s = ri + cbs[sj, d]
-                    if d2 < s * s:
-                        if nn[i] >= cap or nn[j] >= cap:
-                            return WindowStatus.OVERFLOW
-                        nb[i, nn[i]] = (j << cbits) | code
-                        nn[i] += 1
-                        back = (i << cbits) | (cback - code)
-                        if mark[j] == 0:
-                            nb[j, nn[j]] = back
-                            nn[j] += 1
-                        else:
-                            # a kept neighbour: j's entry changes with the image, which a wrap
-                            # of i changes, and so can a move of the bounding centres across half
-                            # the box (a small box: L < 2 (R_i + R_j) + the moves of both centres)
-                            changed = mark[j] != code + 1
-                            mark[j] = 0
-                            if changed:
-                                for q2 in range(nn[j]):
-                                    if nb[j, q2] >> cbits == i:
-                                        nb[j, q2] = back
-                                        break
-    for m in range(nold):
-        j = oldnb[m]
-        if mark[j] != 0:
-            mark[j] = 0
-            last = nn[j] - 1
-            for q2 in range(last + 1):
-                if nb[j, q2] >> cbits == i:
-                    nb[j, q2] = nb[j, last]
-                    nn[j] = last
-                    break
-    return 0
+    return update_neighbour_list(i, P[i, cr] * (1.0 + kappa * t), P, L, invL, skin, sfac, lvl, rcap, ncl, coff,
+                                 ccount, cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, wmode,
+                                 walled)
 
 
 @njit(cache=True)
@@ -1343,6 +1205,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
     clo = np.empty(d, dtype=np.int64)
     cspan = np.empty(d, dtype=np.int64)
     codo = np.empty(d, dtype=np.int64)
+    walled = np.ones(d, dtype=np.int8)  # in a container (wmode) no axis has images
     tins = np.empty(cap)
     touts = np.empty(cap)
     pst = np.empty((cap, PAIR_STATE))
@@ -1358,7 +1221,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         nn[:] = 0
         for i in range(n):
             status = _rebuild(i, 0.0, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount,
-                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode)
+                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode, walled)
             if status != 0:
                 acc[A_T] = 0.0
                 return status
@@ -1402,7 +1265,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         if p == EXIT:
             iacc[I_EXIT] += 1
             status = _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount,
-                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode)
+                              cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode, walled)
             if status != 0:
                 acc[A_T] = t
                 return status

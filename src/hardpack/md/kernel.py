@@ -166,6 +166,160 @@ def prefetch_row(typingctx, arr, idx):
     return sig, codegen
 
 
+@njit(cache=True, inline="always")
+def update_neighbour_list(i, a, P, L, invL, skin, sfac, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of,
+                          bs, nb, nn, mark, oldnb, clo, cspan, codo, wmode, walled):
+    """Partial near-neighbour-list update of particle i (Donev 2006, Algorithm 10), shared by the
+    sphere and ellipsoid kernels: wrap i's position into the box (not along walled axes), give it
+    a new bounding sphere of radius a + skin sfac[i] (capped at its level's ``rcap``) in its grid
+    cell, list every overlapping bounding sphere with its periodic image code, and update the
+    lists of the new, kept and former neighbours (module docstring). ``a`` is i's current (bounding)
+    radius; the position columns P[i, :d] must be at the update time. ``wmode`` (compile-time
+    length) and ``walled`` as in :func:`run_events` (a container walls every axis).
+
+    Returns 0, or the :class:`WindowStatus` that ends the window (BOUND_TOO_SMALL,
+    CELL_OVERFLOW, OVERFLOW); the caller records the time.
+    """
+    d = L.shape[0]
+    cbits = 2 * d
+    cmask = (1 << cbits) - 1
+    cback = cmask // 3 * 2  # digit-wise 2 - code: the image code of the reverse pair
+    cap = nb.shape[1]
+    ccap = cid.shape[0] // ccount.shape[0]  # slots per cell
+    nlev = ncl.shape[0]
+    nold = nn[i]
+    for m in range(nold):  # remember the old neighbours, marked with their image code + 1
+        j = nb[i, m] >> cbits
+        oldnb[m] = j
+        mark[j] = (nb[i, m] & cmask) + 1
+    nn[i] = 0
+    h = lvl[i]
+    c = coff[h]
+    stride = 1
+    for k in range(d):  # wrap into the box and find the new cell on i's level
+        x = P[i, k]
+        if (len(wmode) == 0 or walled[k] == 0) and (x < 0.0 or x >= L[k]):
+            x -= L[k] * np.floor(x * invL[k])
+            if x >= L[k]:
+                x -= L[k]
+            x = max(x, 0.0)
+            P[i, k] = x
+        bs[i, k] = x
+        gk = int(x * invL[k] * ncl[h, k])
+        if gk >= ncl[h, k]:
+            gk = ncl[h, k] - 1
+        if len(wmode) > 0 and gk < 0:  # a walled axis: no wrap, a round-off crossing
+            gk = 0
+        c += gk * stride
+        stride *= ncl[h, k]
+    ri = a + skin * sfac[i]
+    if ri > rcap[h]:
+        ri = rcap[h]
+        if a + 0.25 * skin * sfac[i] >= rcap[h]:
+            return WindowStatus.BOUND_TOO_SMALL
+    bs[i, d] = ri
+    slot = slot_of[i]  # move i's bounding sphere into cell c's slots
+    if slot < 0 or slot // ccap != c:
+        if ccount[c] >= ccap:
+            return WindowStatus.CELL_OVERFLOW
+        if slot >= 0:  # leave the old cell: its last entry fills the hole
+            old = slot // ccap
+            last = old * ccap + ccount[old] - 1
+            moved = cid[last]
+            cid[slot] = moved
+            for k in range(d + 1):
+                cbs[slot, k] = cbs[last, k]
+            slot_of[moved] = slot
+            ccount[old] -= 1
+        slot = c * ccap + ccount[c]
+        ccount[c] += 1
+        cid[slot] = i
+        slot_of[i] = slot
+    for k in range(d + 1):
+        cbs[slot, k] = bs[i, k]
+    for lv in range(nlev):  # list every overlapping bounding sphere, level by level
+        beta = ri + rcap[lv]  # reach: R_i + R_j <= beta on level lv
+        ncells = 1
+        for k in range(d):  # the cells within beta of i's centre along each axis
+            m = ncl[lv, k]
+            lo = int(np.floor((bs[i, k] - beta) * invL[k] * m))
+            span = int(np.floor((bs[i, k] + beta) * invL[k] * m)) - lo + 1
+            if span >= m:  # all of them (no distance pruning along this axis)
+                lo = 0
+                span = m
+            clo[k] = lo
+            cspan[k] = span
+            codo[k] = 0
+            ncells *= span
+        for _ in range(ncells):
+            gc = coff[lv]
+            stride = 1
+            gap2 = 0.0  # squared distance from i's centre to the cell
+            for k in range(d):
+                m = ncl[lv, k]
+                u = clo[k] + codo[k]
+                if cspan[k] < m:
+                    w = L[k] / m
+                    gap = max(u * w - bs[i, k], bs[i, k] - (u + 1) * w, 0.0)
+                    gap2 += gap * gap
+                gc += (u % m) * stride
+                stride *= m
+            for k in range(d):  # odometer step
+                codo[k] += 1
+                if codo[k] < cspan[k]:
+                    break
+                codo[k] = 0
+            if gap2 >= beta * beta:  # no sphere of this cell can reach i's
+                continue
+            base = gc * ccap
+            for sj in range(base, base + ccount[gc]):
+                j = cid[sj]
+                if j != i:
+                    code = 0
+                    d2 = 0.0
+                    for k in range(d):
+                        dx = cbs[sj, k] - bs[i, k]
+                        sh = 1
+                        if len(wmode) == 0 or walled[k] == 0:  # no images along walls
+                            if dx > 0.5 * L[k]:
+                                dx -= L[k]
+                                sh = 0
+                            elif dx < -0.5 * L[k]:
+                                dx += L[k]
+                                sh = 2
+                        code += sh << (2 * k)
+                        d2 += dx * dx
+                    s = ri + cbs[sj, d]
+                    if d2 < s * s:
+                        if nn[i] >= cap or nn[j] >= cap:
+                            return WindowStatus.OVERFLOW
+                        nb[i, nn[i]] = (j << cbits) | code
+                        nn[i] += 1
+                        back = (i << cbits) | (cback - code)
+                        if mark[j] == 0:  # new neighbour
+                            nb[j, nn[j]] = back
+                            nn[j] += 1
+                        else:  # still a neighbour: j's entry changes with the image
+                            changed = mark[j] != code + 1
+                            mark[j] = 0
+                            if changed:
+                                for q2 in range(nn[j]):
+                                    if nb[j, q2] >> cbits == i:
+                                        nb[j, q2] = back
+                                        break
+    for m in range(nold):  # drop i from the lists of former neighbours
+        j = oldnb[m]
+        if mark[j] != 0:
+            mark[j] = 0
+            last = nn[j] - 1
+            for q2 in range(last + 1):
+                if nb[j, q2] >> cbits == i:
+                    nb[j, q2] = nb[j, last]
+                    nn[j] = last
+                    break
+    return 0
+
+
 @njit(cache=True)
 def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
@@ -306,16 +460,13 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
     n = P.shape[0]
     cbits = 2 * d  # neighbour entry = j << cbits | image code (module docstring)
     cmask = (1 << cbits) - 1
-    cback = cmask // 3 * 2  # digit-wise 2 - code: the image code of the reverse pair
     cap = nb.shape[1]
-    ccap = cid.shape[0] // ccount.shape[0]  # slots per cell
     invL = 1.0 / L
     xi = np.empty(d)
     vi = np.empty(d)
     rv = np.empty(d)
     upd = np.empty(2, dtype=np.int64)
     oldnb = np.empty(cap, dtype=np.int64)
-    nlev = ncl.shape[0]
     clo = np.empty(d, dtype=np.int64)
     cspan = np.empty(d, dtype=np.int64)
     codo = np.empty(d, dtype=np.int64)
@@ -454,140 +605,12 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
             for k in range(d):
                 P[i, k] += P[i, d + k] * dt
             P[i, 2 * d] = t
-            nold = nn[i]
-            for m in range(nold):  # remember the old neighbours, marked with their image code + 1
-                j = nb[i, m] >> cbits
-                oldnb[m] = j
-                mark[j] = (nb[i, m] & cmask) + 1
-            nn[i] = 0
-            h = lvl[i]
-            c = coff[h]
-            stride = 1
-            for k in range(d):  # wrap into the box and find the new cell on i's level
-                x = P[i, k]
-                if (len(wmode) == 0 or walled[k] == 0) and (x < 0.0 or x >= L[k]):
-                    x -= L[k] * np.floor(x * invL[k])
-                    if x >= L[k]:
-                        x -= L[k]
-                    x = max(x, 0.0)
-                    P[i, k] = x
-                bs[i, k] = x
-                gk = int(x * invL[k] * ncl[h, k])
-                if gk >= ncl[h, k]:
-                    gk = ncl[h, k] - 1
-                if len(wmode) > 0 and gk < 0:  # a walled axis: no wrap, a round-off crossing
-                    gk = 0
-                c += gk * stride
-                stride *= ncl[h, k]
-            a = P[i, 2 * d + 1] * (1.0 + kappa * t)
-            ri = a + skin * sfac[i]
-            if ri > rcap[h]:
-                ri = rcap[h]
-                if a + 0.25 * skin * sfac[i] >= rcap[h]:
-                    acc[A_T] = t
-                    return WindowStatus.BOUND_TOO_SMALL
-            bs[i, d] = ri
-            slot = slot_of[i]  # move i's bounding sphere into cell c's slots
-            if slot < 0 or slot // ccap != c:
-                if ccount[c] >= ccap:
-                    acc[A_T] = t
-                    return WindowStatus.CELL_OVERFLOW
-                if slot >= 0:  # leave the old cell: its last entry fills the hole
-                    old = slot // ccap
-                    last = old * ccap + ccount[old] - 1
-                    moved = cid[last]
-                    cid[slot] = moved
-                    for k in range(d + 1):
-                        cbs[slot, k] = cbs[last, k]
-                    slot_of[moved] = slot
-                    ccount[old] -= 1
-                slot = c * ccap + ccount[c]
-                ccount[c] += 1
-                cid[slot] = i
-                slot_of[i] = slot
-            for k in range(d + 1):
-                cbs[slot, k] = bs[i, k]
-            for lv in range(nlev):  # list every overlapping bounding sphere, level by level
-                beta = ri + rcap[lv]  # reach: R_i + R_j <= beta on level lv
-                ncells = 1
-                for k in range(d):  # the cells within beta of i's centre along each axis
-                    m = ncl[lv, k]
-                    lo = int(np.floor((bs[i, k] - beta) * invL[k] * m))
-                    span = int(np.floor((bs[i, k] + beta) * invL[k] * m)) - lo + 1
-                    if span >= m:  # all of them (no distance pruning along this axis)
-                        lo = 0
-                        span = m
-                    clo[k] = lo
-                    cspan[k] = span
-                    codo[k] = 0
-                    ncells *= span
-                for _ in range(ncells):
-                    gc = coff[lv]
-                    stride = 1
-                    gap2 = 0.0  # squared distance from i's centre to the cell
-                    for k in range(d):
-                        m = ncl[lv, k]
-                        u = clo[k] + codo[k]
-                        if cspan[k] < m:
-                            w = L[k] / m
-                            gap = max(u * w - bs[i, k], bs[i, k] - (u + 1) * w, 0.0)
-                            gap2 += gap * gap
-                        gc += (u % m) * stride
-                        stride *= m
-                    for k in range(d):  # odometer step
-                        codo[k] += 1
-                        if codo[k] < cspan[k]:
-                            break
-                        codo[k] = 0
-                    if gap2 >= beta * beta:  # no sphere of this cell can reach i's
-                        continue
-                    base = gc * ccap
-                    for sj in range(base, base + ccount[gc]):
-                        j = cid[sj]
-                        if j != i:
-                            code = 0
-                            d2 = 0.0
-                            for k in range(d):
-                                dx = cbs[sj, k] - bs[i, k]
-                                sh = 1
-                                if len(wmode) == 0 or walled[k] == 0:  # no images along walls
-                                    if dx > 0.5 * L[k]:
-                                        dx -= L[k]
-                                        sh = 0
-                                    elif dx < -0.5 * L[k]:
-                                        dx += L[k]
-                                        sh = 2
-                                code += sh << (2 * k)
-                                d2 += dx * dx
-                            s = ri + cbs[sj, d]
-                            if d2 < s * s:
-                                if nn[i] >= cap or nn[j] >= cap:
-                                    acc[A_T] = t
-                                    return WindowStatus.OVERFLOW
-                                nb[i, nn[i]] = (j << cbits) | code
-                                nn[i] += 1
-                                back = (i << cbits) | (cback - code)
-                                if mark[j] == 0:  # new neighbour
-                                    nb[j, nn[j]] = back
-                                    nn[j] += 1
-                                else:  # still a neighbour: j's entry changes with the image
-                                    changed = mark[j] != code + 1
-                                    mark[j] = 0
-                                    if changed:
-                                        for q2 in range(nn[j]):
-                                            if nb[j, q2] >> cbits == i:
-                                                nb[j, q2] = back
-                                                break
-            for m in range(nold):  # drop i from the lists of former neighbours
-                j = oldnb[m]
-                if mark[j] != 0:
-                    mark[j] = 0
-                    last = nn[j] - 1
-                    for q2 in range(last + 1):
-                        if nb[j, q2] >> cbits == i:
-                            nb[j, q2] = nb[j, last]
-                            nn[j] = last
-                            break
+            status = update_neighbour_list(i, P[i, 2 * d + 1] * (1.0 + kappa * t), P, L, invL, skin, sfac, lvl,
+                                           rcap, ncl, coff, ccount, cid, cbs, slot_of, bs, nb, nn, mark,
+                                           oldnb, clo, cspan, codo, wmode, walled)
+            if status != 0:
+                acc[A_T] = t
+                return status
 
         for q in range(npred):  # predict (Alg. 5 with NNLs) and update the heap
             i = upd[q]
