@@ -15,7 +15,6 @@ from hardpack.md import ellipsoid_kernel as ek
 from hardpack.md.engine import SKIN_SLACK, Engine, WindowResult, _aligned_rows
 from hardpack.md.kernel import WindowStatus
 
-
 #: in a container the cell grid spans at least this many container radii along each axis
 GRID_BOX_RADII = 8.0
 
@@ -187,7 +186,8 @@ class EllipsoidEngine(Engine):
                 t, i, p = float(acc[0]), int(iacc[ek.I_STALL_PARTICLE]), int(iacc[ek.I_STALL_PARTNER])
                 self.P[:] = start
                 self.lists_valid = False
-                what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK", ek.WALL: "the container wall"}.get(p, f"particle {p}")
+                what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK",
+                    ek.WALL: "the container wall"}.get(p, f"particle {p}")
                 raise EngineStalledError(
                     f"the ellipsoid event loop stalled at window time {t!r}: more than "
                     f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time without a "
