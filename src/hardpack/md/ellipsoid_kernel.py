@@ -699,6 +699,10 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
 # ------------------------------------------------------------------ the container wall
 #: a wall collision time is located when |h - h_c| is below this many ulps of the container radius
 H_TOL_ULPS = 64.0
+#: wall traces accept steps below this fraction of their first step unconditionally (a wall
+#: evaluation is cheap; the pairs' MIN_STEP_FRACTION, 1e-9, is longer than the flight between two
+#: wall contacts of a particle pinned across the container at reduced wall pressures ~1e10)
+WALL_MIN_STEP_FRACTION = 1e-14
 
 
 @njit(cache=True, inline="always")
@@ -837,7 +841,7 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
         hc = h0
         touching = True
     step = FIRST_STEP * amin0 * (1.0 + kappa * t) / speed
-    hmin_step = MIN_STEP_FRACTION * step
+    hmin_step = WALL_MIN_STEP_FRACTION * step
     tol_abs = eps_f * amin0 * (1.0 + kappa * t)
     t0 = t
     steps = 0
