@@ -95,3 +95,61 @@ def test_bad_protocol_input_is_refused():
         microsegregated_packing(labels, 0, compress_rate=-1.0)
     with pytest.raises(InvalidInputError, match="glass_labels"):
         microsegregated_packing(labels.assign_attrs(hardpack_kind="packing"), 0)
+
+
+def _fake_packing(ensemble, R, nu, s_c, phi_j, n=1024):
+    import xarray as xr
+
+    return xr.Dataset(attrs={"ensemble": ensemble, "R": R, "nu": nu, "s_c": s_c, "s_33": s_c, "s_mix": 0.6365,
+                             "phi_J": phi_j, "N": n, "s_c_window": "4x4", "growth_phi_J_est_start": 0.907,
+                             "growth_pressure_error_mean": 0.001})
+
+
+def _fake_summary(n=1024, clustered_gain=0.004, spread=0.001):
+    from hardpack.glass.microsegregated import summary_dataset
+
+    packings = []
+    ensembles = [("random", 0.01, 0.5, 0.63), ("R1_nu0.1", 1, 0.1, 0.60), ("R1_nu0.5", 1, 0.5, 0.55),
+                 ("R3_nu0.3", 3, 0.3, 0.45), ("R5_nu0.1", 5, 0.1, 0.40), ("R5_nu0.5", 5, 0.5, 0.30)]
+    for k, (name, R, nu, s) in enumerate(ensembles):
+        for dphi in (-spread, spread):
+            packings.append(_fake_packing(name, R, nu, s, 0.846 + clustered_gain * k / 5 + dphi, n))
+    return summary_dataset(packings)
+
+
+def test_summary_groups_the_ensembles():
+    ds = _fake_summary()
+    assert list(ds.ensemble.values) == ["R1_nu0.1", "R1_nu0.5", "R3_nu0.3", "R5_nu0.1", "R5_nu0.5", "random"]
+    row = ds.sel(ensemble="R5_nu0.5")
+    assert float(row.phi_J) == pytest.approx(0.850) and int(row.n_packings) == 2
+    assert float(row.phi_J_err) == pytest.approx(0.001)  # sd sqrt(2) * 0.001 / sqrt(2)
+    with pytest.raises(InvalidInputError, match="mixes"):
+        from hardpack.glass.microsegregated import summary_dataset
+
+        summary_dataset([_fake_packing("a", 1, 0.1, 0.5, 0.85), _fake_packing("a", 2, 0.1, 0.5, 0.85)])
+
+
+def test_rows_judge_the_text_claims():
+    from hardpack.validation.glass import microsegregated_rows
+
+    rows = {r.target: r for r in microsegregated_rows(_fake_summary())}
+    assert rows["donev-13.5-phij-random"].status == "pass"
+    assert rows["donev-13.5-phij-est-start"].status == "pass"
+    assert rows["donev-13.5-clustered-denser"].status == "pass"
+    assert rows["donev-13.5-sc-phij-anticorrelated"].status == "pass"
+    # no gain from clustering: both claims fail; a small system: every row n/a
+    flat = {r.target: r for r in microsegregated_rows(_fake_summary(clustered_gain=0.0))}
+    assert flat["donev-13.5-clustered-denser"].status == "fail"
+    assert flat["donev-13.5-sc-phij-anticorrelated"].status == "fail"
+    small = microsegregated_rows(_fake_summary(n=64))
+    assert {r.status for r in small} == {"n/a"}
+    few = microsegregated_rows(_fake_summary().isel(ensemble=[0, 4, 5]))
+    assert [r.status for r in few if r.target == "donev-13.5-sc-phij-anticorrelated"] == ["n/a"]
+
+
+def test_figure_draws(tmp_path):
+    from hardpack.plots.glass import plot_microsegregated
+    from hardpack.plots.style import save
+
+    save(plot_microsegregated(_fake_summary()), tmp_path / "f.png")
+    assert (tmp_path / "f.png").stat().st_size > 0

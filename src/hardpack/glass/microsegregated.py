@@ -138,6 +138,7 @@ def grow_species(packing: Packing, species: int, ratio: float, pressure: float, 
              "growth_wall_time": time.perf_counter() - started, "growth_phi_end": float(final.phi),
              "growth_pressure_error_mean": float(errors.mean()) if errors.size else float("nan"),
              "growth_pressure_error_rms": float(np.sqrt(np.mean(errors ** 2))) if errors.size else float("nan"),
+             "growth_phi_J_est_start": float(records["phi_J_est"][0]) if errors.size else float("nan"),
              "growth_overlap_check": "passed" if report.n_overlapping == 0 else "failed"}
     if report.n_overlapping:
         raise RuntimeError(f"the grown packing overlaps ({report}): an engine failure")
@@ -152,7 +153,8 @@ def grow_species(packing: Packing, species: int, ratio: float, pressure: float, 
     return final, ts, stats
 
 
-def microsegregated_packing(labels: xr.Dataset, realisation: int = 0, *, ratio: float = 1.4, pressure: float = 100.0,
+def microsegregated_packing(labels: xr.Dataset, realisation: int = 0, *, ensemble: str = "", ratio: float = 1.4,
+                            pressure: float = 100.0,
                             growth_rate: float = 1e-5, compress_rate: float = 1e-5, max_pressure: float = 1e12,
                             seed: int = 0, cell_step: float = CELL_STEP, progress=None):
     """Labelled crystal -> B growth at constant pressure -> LS compression to jamming (Donev 2006,
@@ -165,6 +167,9 @@ def microsegregated_packing(labels: xr.Dataset, realisation: int = 0, *, ratio: 
         window entropy at the largest window is s_c.
     realisation : int
         Which label realisation labels the crystal.
+    ensemble : str
+        Name of the label ensemble (stored; the summary groups by it; "random" marks the
+        uncorrelated labels of the MRJ reference).
     ratio, pressure, growth_rate : float
         Target diameter ratio, reduced pressure and dD/dt of the B disks during the growth.
     compress_rate : float
@@ -209,8 +214,62 @@ def microsegregated_packing(labels: xr.Dataset, realisation: int = 0, *, ratio: 
         "s_c": float(s[-1, -1]), "s_c_window": f"{rows}x{cols}",
         "s_33": float(s[2, 2]) if min(rows, cols) >= 3 else float("nan"),
         "s_mix": float(labels.attrs["s_mix"]), "R": float(labels.attrs["R"]), "nu": float(labels.attrs["nu"]),
+        "ensemble": str(ensemble), "N": int(result.packing.n_particles),
         "label_realisation": int(realisation), "label_realisations": int(k),
         "label_seed": int(labels.attrs.get("seed", -1)), "start_phi": float(crystal.phi),
         "compress_rate": float(compress_rate), "max_pressure": float(max_pressure),
     })
     return result, growth_ts
+
+
+def summary_dataset(packings) -> xr.Dataset:
+    """phi_J and s_c of each label ensemble (Donev 2006, Figs. 13.16-13.17) from the jammed packings
+    of :func:`microsegregated_packing`.
+
+    Parameters
+    ----------
+    packings : iterable of xarray.Dataset
+        Packing datasets whose attributes carry ``ensemble``, ``R``, ``nu``, ``phi_J``, ``s_c``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Along ``ensemble`` (sorted by name): ``R``, ``nu``, ``s_c``, ``s_33``, ``s_mix``,
+        ``phi_J`` (mean over the ensemble's packings), ``phi_J_err`` (standard error; NaN for one
+        packing), ``n_packings``, ``phi_J_est_start`` (mean phi~_J at the start of the growth,
+        Fig. 13.14), ``growth_pressure_error`` (mean); attributes ``N``, ``s_c_window``,
+        ``hardpack_kind`` = "microsegregated_summary".
+    """
+    groups: dict[str, list] = {}
+    for ds in packings:
+        if "phi_J" not in ds.attrs or "ensemble" not in ds.attrs:
+            raise InvalidInputError("expected packings of hardpack glass-microsegregated (attributes phi_J, ensemble)")
+        groups.setdefault(str(ds.attrs["ensemble"]), []).append(ds.attrs)
+    if not groups:
+        raise InvalidInputError("no packings to summarise")
+    names = sorted(groups)
+    sizes = {int(a["N"]) for g in groups.values() for a in g}
+    windows = {str(a["s_c_window"]) for g in groups.values() for a in g}
+    if len(sizes) != 1 or len(windows) != 1:
+        raise InvalidInputError(f"the packings mix sizes {sorted(sizes)} or s_c windows {sorted(windows)}")
+
+    def column(key, reduce=np.mean):
+        return np.array([reduce([float(a[key]) for a in groups[name]]) for name in names])
+
+    def stderr(values):
+        return float(np.std(values, ddof=1) / np.sqrt(len(values))) if len(values) > 1 else float("nan")
+
+    for name in names:
+        if len({(float(a["R"]), float(a["nu"]), float(a["s_c"])) for a in groups[name]}) != 1:
+            raise InvalidInputError(f"ensemble {name!r} mixes label parameters or label statistics")
+    dim = ("ensemble",)
+    return xr.Dataset(
+        {"R": (dim, column("R")), "nu": (dim, column("nu")), "s_c": (dim, column("s_c")),
+         "s_33": (dim, column("s_33")), "s_mix": (dim, column("s_mix")),
+         "phi_J": (dim, column("phi_J")), "phi_J_err": (dim, column("phi_J", stderr)),
+         "n_packings": (dim, np.array([len(groups[name]) for name in names])),
+         "phi_J_est_start": (dim, column("growth_phi_J_est_start")),
+         "growth_pressure_error": (dim, column("growth_pressure_error_mean"))},
+        coords={"ensemble": names},
+        attrs={"hardpack_kind": "microsegregated_summary", "N": sizes.pop(), "s_c_window": windows.pop(),
+               "reference": "Donev 2006, sec. 13.5, Figs. 13.16-13.17"})
