@@ -551,10 +551,10 @@ def microseg_packings():
 
 def microseg_minutes(w):
     """Expected minutes of one micro-segregated packing: ~45 / gamma collisions per particle for the
-    growth and ~17 / Gamma for the compression to p = 1e9 (measured at N = 256, gamma = Gamma =
-    1e-3: 4.5e4 and 1.7e4), at ~4e5 collisions per second (deforming-cell kernel, one core)."""
+    growth and ~25 / Gamma for the compression to p = 1e12 (measured at N = 1024, gamma = Gamma =
+    1e-3: 4.5e4 and 2.5e4), at ~4e5 collisions per second (deforming-cell kernel, one core)."""
     n = MICROSEG["shape"][0] * MICROSEG["shape"][1]
-    per_particle = 45.0 / MICROSEG["growth_rate"] + 17.0 / MICROSEG["compress_rate"]
+    per_particle = 45.0 / MICROSEG["growth_rate"] + 25.0 / MICROSEG["compress_rate"]
     return 0.3 + n * per_particle / 4e5 / 60
 
 
