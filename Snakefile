@@ -23,6 +23,7 @@ include: "workflow/rules/ellipsoids.smk"     # hard ellipsoids and ellipses: con
 include: "workflow/rules/containers.smk"    # spheres in spherical containers, window fluctuations (Donev 2006, Sec. 7.3)
 include: "workflow/rules/strict.smk"        # strictly jammed LS packings in a deforming cell (Donev 2006, Sec. 4.7.2.3)
 include: "workflow/rules/glass.smk"         # binary hard-disk glasses: EOS, fits, SOC free energies, s_c
+include: "workflow/rules/microsegregated.smk"  # micro-segregated binary disk packings: phi_J vs s_c (Donev 2006, sec. 13.5)
 include: "workflow/rules/validation.smk"    # validation report and gate
 
 

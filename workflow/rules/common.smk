@@ -45,6 +45,7 @@ RATES = config.get("rates")
 FREEENERGY = config.get("freeenergy")
 POLY = config.get("polydisperse", {})
 GLASS = config.get("glass")
+MICROSEG = config.get("microsegregated")
 ELLIPSOIDS = config.get("ellipsoids")
 ELLIPSOID_CRYSTALS = config.get("ellipsoid_crystals")
 CONTAINERS = config.get("containers")
@@ -107,6 +108,15 @@ def check_config():
         dx = GLASS["composition"]["dx"]
         if not (0 < GLASS["x_large"] - dx and GLASS["x_large"] + dx < 1):
             raise ValueError("config: glass.x_large -+ glass.composition.dx must stay in (0, 1)")
+    if MICROSEG:
+        rows, cols = MICROSEG["shape"]
+        if rows % 2:
+            raise ValueError(f"config: microsegregated.shape rows = {rows} must be even (the triangular crystal)")
+        if MICROSEG["window"][0] > rows or MICROSEG["window"][1] > cols:
+            raise ValueError("config: microsegregated.window must fit microsegregated.shape")
+        if MICROSEG["packings"] > MICROSEG["label_realisations"]:
+            raise ValueError("config: microsegregated.packings must not exceed label_realisations (one "
+                             "packing per label realisation)")
 
 
 def check_ellipsoids():
@@ -535,6 +545,38 @@ def glass_timeseries(system):
     return files
 
 
+# Micro-segregated packings (Donev 2006, sec. 13.5): ensemble name -> Matérn (R, nu). "random" is
+# the uncorrelated labelling (the MRJ reference): R = 0.01 makes the Matérn correlation of
+# neighbouring sites exp(-100) at nu = 1/2, i.e. independent labels.
+MICROSEG_RANDOM = (0.01, 0.5)
+
+
+def _microseg_ensembles():
+    if not MICROSEG:
+        return {}
+    out = {"random": MICROSEG_RANDOM}
+    out.update({f"R{R:g}_nu{nu:g}": (R, nu) for R in MICROSEG["R"] for nu in MICROSEG["nu"]})
+    return out
+
+
+MICROSEG_ENSEMBLES = _microseg_ensembles()
+
+
+def microseg_packings():
+    """Every jammed micro-segregated packing: realisations 0 .. packings - 1 of each ensemble."""
+    return [f"results/microseg/{name}/r{k}.nc" for name in MICROSEG_ENSEMBLES
+            for k in range(MICROSEG["packings"])] if MICROSEG else []
+
+
+def microseg_minutes(w):
+    """Expected minutes of one micro-segregated packing: ~45 / gamma collisions per particle for the
+    growth and ~25 / Gamma for the compression to p = 1e12 (measured at N = 1024, gamma = Gamma =
+    1e-3: 4.5e4 and 2.5e4), at ~4e5 collisions per second (deforming-cell kernel, one core)."""
+    n = MICROSEG["shape"][0] * MICROSEG["shape"][1]
+    per_particle = 45.0 / MICROSEG["growth_rate"] + 25.0 / MICROSEG["compress_rate"]
+    return 0.3 + n * per_particle / 4e5 / 60
+
+
 def glass_bcmd_files(system):
     rate = min(GLASS_SYSTEMS[system]["rates"])
     return [f"results/glass/{system}/bcmd/g{rate:g}/phi{phi:g}/seed{seed}.nc"
@@ -710,6 +752,7 @@ def figures():
     names += ["ellipsoid_snapshot"] if ELLIPSOIDS and "mm" in ELLIPSOIDS else []
     names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
     names += ["glass_eos", "glass_entropy"] if GLASS else []
+    names += ["microsegregated"] if MICROSEG else []
     names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []
     names += ["strict_ls_disks"] if "d2" in SYSTEMS["strict_ls"] else []
     return [f"results/figures/{name}.pdf" for name in names]
@@ -740,6 +783,8 @@ def validation_inputs():
         inputs["glass_eos"] = [summary("glass/binary/eos")]
         inputs["glass_entropy"] = [summary("glass/binary/entropy"), summary("glass/mono/entropy")]
         inputs["glass_freezing"] = [summary("glass/freezing")]
+    if MICROSEG:
+        inputs["glass_microsegregated"] = [summary("microseg/phij_sc")]
     poly = [summary(key) for key in EOS_SUMMARIES]
     if poly:
         inputs["polydisperse"] = poly
@@ -847,6 +892,7 @@ EXPECTED_MINUTES = {
     "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],
                                                          GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
     "glass_bcmd": glass_bcmd_minutes,
+    "microseg_packing": microseg_minutes,
 }
 
 
@@ -875,6 +921,7 @@ PARTICLES = {
                     lambda w: GLASS["N"]),
     **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
     "mm_container_init": lambda w: SYSTEMS["mm_containers"][w.name]["N"],
+    "microseg_packing": lambda w: MICROSEG["shape"][0] * MICROSEG["shape"][1],
 }
 
 

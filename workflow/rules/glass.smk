@@ -3,8 +3,7 @@
 # monodisperse disks at several growth rates in stages through the snapshot densities, the
 # decompression of the triangular crystal, BCMD of the snapshots of the slowest compression in
 # bounding cells, the EOS summaries with the fits of Eqs. 13.3-13.4, s_c - s_mix (Eq. 13.5) and the
-# freezing point (Eq. 13.2). The micro-segregated packings of sec. 13.5 need a constant-pressure,
-# deforming-cell MD that hardpack does not have; they are not part of the study.
+# freezing point (Eq. 13.2). The micro-segregated packings of sec. 13.5 are in microsegregated.smk.
 
 
 

@@ -147,6 +147,46 @@ def cmd_glass_labelled_crystal(args) -> int:
     return 0
 
 
+def cmd_glass_microsegregated(args) -> int:
+    """Micro-segregated packing: B growth at constant pressure, then LS to jamming (Donev 2006, sec. 13.5)."""
+    from hardpack.glass.microsegregated import microsegregated_packing
+    from hardpack.io import load_dataset, write_dataset
+    from hardpack.io.atomic import check_writable
+
+    for path in (args.out, args.growth_timeseries, args.timeseries):
+        if path is not None:
+            check_writable(path)
+    labels = load_dataset(args.labels, kind="glass_labels")
+    result, growth_ts = microsegregated_packing(
+        labels, args.realisation, ensemble=args.ensemble, ratio=args.kappa, pressure=args.pressure,
+        growth_rate=args.growth_rate,
+        compress_rate=args.compress_rate, max_pressure=args.max_pressure, seed=args.seed, cell_step=args.cell_step)
+    config = {k: getattr(args, k) for k in ("labels", "realisation", "ensemble", "kappa", "pressure", "growth_rate",
+                                            "compress_rate", "max_pressure", "cell_step")}
+    result.save(args.out, args.timeseries, config=config)
+    if args.growth_timeseries is not None:
+        write_dataset(growth_ts, args.growth_timeseries, config=config, seed=args.seed)
+    st = result.stats
+    log.info("R = %g, nu = %g: phi_J = %.5f, s_c = %.4f; growth to kappa = %.6g at p = %g: mean pressure error "
+             "%.3g; %d + %d collisions", st["R"], st["nu"], st["phi_J"], st["s_c"], st["growth_ratio"],
+             st["growth_pressure"], st["growth_pressure_error_mean"], st["growth_collisions"], st["collisions"])
+    return 0
+
+
+def cmd_glass_microsegregated_summary(args) -> int:
+    """phi_J and s_c per label ensemble of micro-segregated packings (Donev 2006, Figs. 13.16-13.17)."""
+    from hardpack.glass.microsegregated import summary_dataset
+    from hardpack.io import load_dataset, write_dataset
+
+    ds = summary_dataset([load_dataset(p, kind="packing") for p in args.files])
+    write_dataset(ds, args.out)
+    for name in ds.ensemble.values:
+        row = ds.sel(ensemble=name)
+        log.info("%s: R = %g, nu = %g, s_c = %.4f, phi_J = %.5f +- %.5f (%d packings)", name, float(row.R),
+                 float(row.nu), float(row.s_c), float(row.phi_J), float(row.phi_J_err), int(row.n_packings))
+    return 0
+
+
 def register(subparsers) -> None:
     p = subparsers.add_parser("glass-crystal", help=cmd_glass_crystal.__doc__)
     p.add_argument("--nx", type=int, required=True, help="rectangular 2-disk cells along x")
@@ -208,3 +248,25 @@ def register(subparsers) -> None:
     p.add_argument("--phi", type=float, required=True, help="volume fraction (< pi/sqrt(12))")
     p.add_argument("--out", required=True, help="packing netCDF")
     p.set_defaults(func=cmd_glass_labelled_crystal)
+
+    p = subparsers.add_parser("glass-microsegregated", help=cmd_glass_microsegregated.__doc__)
+    p.add_argument("--labels", required=True, help="glass-labels netCDF (its window entropy is s_c)")
+    p.add_argument("--realisation", type=int, default=0, help="which label realisation (default 0)")
+    p.add_argument("--ensemble", default="", help="name of the label ensemble (\"random\": the MRJ reference)")
+    p.add_argument("--kappa", type=float, default=1.4, help="target diameter ratio (default 1.4)")
+    p.add_argument("--pressure", type=float, default=100.0,
+                   help="reduced pressure pV/(NkT) held during the growth (default 100)")
+    p.add_argument("--growth-rate", type=float, default=1e-5, help="dD/dt of the B disks (default 1e-5)")
+    p.add_argument("--compress-rate", type=float, default=1e-5, help="LS growth rate to jamming (default 1e-5)")
+    p.add_argument("--max-pressure", type=float, default=1e12, help="reduced pressure of jamming (default 1e12)")
+    p.add_argument("--cell-step", type=float, default=0.1, help="alpha of the deforming cell (default 0.1)")
+    p.add_argument("--seed", type=int, required=True, help="seed of the start velocities")
+    p.add_argument("--out", required=True, help="jammed packing netCDF (phi_J, s_c in its attributes)")
+    p.add_argument("--timeseries", help="time series of the compression to jamming")
+    p.add_argument("--growth-timeseries", help="time series of the growth (Fig. 13.14)")
+    p.set_defaults(func=cmd_glass_microsegregated)
+
+    p = subparsers.add_parser("glass-microsegregated-summary", help=cmd_glass_microsegregated_summary.__doc__)
+    p.add_argument("files", nargs="+", help="jammed packings of glass-microsegregated")
+    p.add_argument("--out", required=True, help="summary netCDF")
+    p.set_defaults(func=cmd_glass_microsegregated_summary)

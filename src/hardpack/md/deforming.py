@@ -46,6 +46,12 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
    Donev suggests re-reducing, untested by him, sec. 3.2.4) so that a sheared cell keeps short
    lattice vectors.
 
+Growth is uniform (every radius at the same relative rate, d<D>/dt = Gamma, as in
+:func:`hardpack.md.compress`) or, with a ``growing`` mask, confined to some particles, each at
+dD/dt = Gamma while the others keep their size (Donev 2006, sec. 13.5 grows the large disks of a
+labelled crystal at constant pressure); the pair's summed growth rate enters the contact
+prediction and the collision law (:func:`hardpack.md.deforming_kernel.pair_sigma`).
+
 This is an overdamped, deterministic barostat: it drives the mean stress to P0 I but does not
 sample the isobaric ensemble's volume fluctuations. Tests: an ideal-gas check that the mean
 volume is N kT Z(phi) / P0, crystals keep their cell, and LS packings of small systems pass the
@@ -135,13 +141,38 @@ def _check_packing(packing: Packing) -> None:
 
 class DeformingSimulation:
     """State of one deforming-cell run; :meth:`run_window` advances it by one window and then
-    deforms the cell (module docstring)."""
+    deforms the cell (module docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        Periodic sphere packing without overlaps.
+    velocities : numpy.ndarray, shape (N, d)
+        Start velocities.
+    growth_rate : float
+        Gamma: with ``growing`` None every radius grows at the same relative rate with
+        d<D>/dt = Gamma (LS growth); with a mask only the masked particles grow, each at
+        dD/dt = Gamma, the others keep their size.
+    applied_pressure, cell_step, overlap_tol
+        As in :func:`compress_deforming`.
+    growing : array_like of bool, shape (N,), optional
+        The particles that grow (Donev 2006, sec. 13.5 grows the B disks only); None: all, uniformly.
+    """
 
     def __init__(self, packing: Packing, velocities: np.ndarray, growth_rate: float,
                  applied_pressure: float | None = None, cell_step: float = CELL_STEP,
-                 overlap_tol: float = DEFAULT_OVERLAP_TOL):
+                 overlap_tol: float = DEFAULT_OVERLAP_TOL, growing=None):
         _check_packing(packing)
         check_cell_options(applied_pressure, cell_step)
+        if growing is not None:
+            growing = np.asarray(growing)
+            if growing.dtype != bool or growing.shape != (packing.n_particles,):
+                raise InvalidInputError(f"growing must be a boolean mask of the {packing.n_particles} particles, "
+                                        f"got dtype {growing.dtype} and shape {growing.shape}")
+            if not growing.any():
+                raise InvalidInputError("the growing mask selects no particle; use growing=None for uniform "
+                                        "growth or growth_rate = 0 for none")
+        self.growing = growing
         self.n, self.d = packing.n_particles, packing.dim
         self.H = np.array(packing.lattice, dtype=float)
         self.X = np.array(packing.wrapped().positions, dtype=float)
@@ -198,9 +229,18 @@ class DeformingSimulation:
             self.H = reduced
         dk.wrap_into_cell(self.X, self.H, np.linalg.inv(self.H))
 
-    def run_window(self, coll_target: int) -> dict:
-        """Run one window of about ``coll_target`` collisions in the current cell, measure the
-        stress, rescale velocities (growing runs), deform the cell; returns the window record."""
+    def relative_rates(self) -> np.ndarray:
+        """kappa_i = (da_i/dt) / a_i of the next window (:mod:`hardpack.md.deforming_kernel`): all
+        Gamma / (2 <a>) (uniform growth), or Gamma / (2 a_i) for the growing particles and 0 for
+        the others."""
+        if self.growing is None:
+            return np.full(self.n, self.growth_rate / (2.0 * float(self.A.mean())))
+        return np.where(self.growing, self.growth_rate / (2.0 * self.A), 0.0)
+
+    def run_window(self, coll_target: int, max_time: float = np.inf) -> dict:
+        """Run one window of about ``coll_target`` collisions (and at most ``max_time`` MD time)
+        in the current cell, measure the stress, rescale velocities (growing runs), deform the
+        cell; returns the window record."""
         start = time.perf_counter()
         n, d = self.n, self.d
         self._reduce_cell()
@@ -208,7 +248,7 @@ class DeformingSimulation:
         lmin = shortest_vector(self.H)
         amax = float(self.A.max())
         mean_a = float(self.A.mean())
-        kappa = self.growth_rate / (2.0 * mean_a)
+        kappa = self.relative_rates()
         skin = np.full(n, min(self.shell * mean_a, 0.45 * (lmin - 2.0 * amax)))
         M = dk.image_ranges(self.H, lmin)
         img = dk.image_table(self.H, M)
@@ -219,8 +259,9 @@ class DeformingSimulation:
             budget = BUDGET_SLACK * coll_target
         else:
             t_cap, budget = np.inf, coll_target
-        if kappa < 0.0:
-            t_cap = min(t_cap, 0.5 / -kappa)
+        if kappa.min() < 0.0:
+            t_cap = min(t_cap, 0.5 / -kappa.min())
+        t_cap = min(t_cap, float(max_time))
         saved = (self.X.copy(), self.V.copy())
         while True:
             nb = np.zeros((n, self.capacity), dtype=np.int64)

@@ -115,6 +115,23 @@ def _image_box(xi, xj, Hinv, reach, cfac, ds, lo, hi, od):
     return total
 
 
+@njit(cache=True, inline="always")
+def pair_sigma(ai, aj, ki, kj, t):
+    """Contact distance sigma(t) = a_i(t) + a_j(t) of a pair at window time t and its rate
+    sigma' = A_i kappa_i + A_j kappa_j (radii a(t) = A (1 + kappa t), A at window time 0).
+
+    The rate is the growth part of the approach speed in both the contact prediction (the root of
+    |r + u t| = sigma(t)) and the collision law (the normal relative velocity is reflected in the
+    frame of the growing surfaces), so a pair in which only one particle grows moves apart after a
+    collision at the speed the LS rule gives it, with that one rate (Donev 2006, sec. 13.5 grows one
+    species only). Equal rates use (A_i + A_j)(1 + kappa t) and (A_i + A_j) kappa: the arithmetic of
+    uniform growth, so that path is unchanged bit for bit."""
+    if ki == kj:
+        s = ai + aj
+        return s * (1.0 + ki * t), s * ki
+    return ai * (1.0 + ki * t) + aj * (1.0 + kj * t), ai * ki + aj * kj
+
+
 @njit(cache=True)
 def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
     """List every bounding sphere j < jstop (j != i) that overlaps i's, in both lists; returns
@@ -166,7 +183,8 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
     predict, process events until ``coll_target`` collisions or ``t_cap``.
 
     X, V : (N, d) positions and velocities at the particles' own times T (N,); A : (N,) radii at
-    window time 0, a_i(t) = A_i (1 + kappa t); skin: bounding-sphere skin (N,) (R_i = a_i(t) +
+    window time 0, a_i(t) = A_i (1 + kappa_i t) (``kappa`` (N,): relative growth rates, equal for
+    uniform LS growth, zero for particles that keep their size); skin: bounding-sphere skin (N,) (R_i = a_i(t) +
     skin_i at the list's time); kin, vir : (d, d) accumulators (zeroed here); acc: (0) end time,
     (1) time integral of the kinetic energy; iacc: counters. Returns a status.
     """
@@ -251,7 +269,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 nn[i] = 0
                 for k in range(d):
                     bs[i, k] = X[i, k]
-                bs[i, d] = A[i] * (1.0 + kappa * t) + skin[i]
+                bs[i, d] = A[i] * (1.0 + kappa[i] * t) + skin[i]
                 st = _list_particle(i, n, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin)
                 if st != 0:
                     acc[0] = t
@@ -278,7 +296,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 T[i] = t
                 T[j] = t
                 dist = np.sqrt(dist2)
-                g = (A[i] + A[j]) * kappa
+                _, g = pair_sigma(A[i], A[j], kappa[i], kappa[j], t)
                 vn = 0.0
                 for k in range(d):
                     rv[k] /= dist
@@ -309,9 +327,9 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
         for q in range(npred):
             i = upd[q]
             dt = t - T[i]
-            grow = 1.0 + kappa * t
+            grow = 1.0 + kappa[i] * t
             ai = A[i]
-            adot = ai * kappa
+            adot = ai * kappa[i]
             dd = 0.0
             dv = 0.0
             vv = 0.0
@@ -337,8 +355,8 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                     rr += r * r
                     ru += r * u
                     uu += u * u
-                s = ai + A[j]
-                tc = contact_root(rr, ru, uu, s * grow, s * kappa, best)
+                sig, sdot = pair_sigma(ai, A[j], kappa[i], kappa[j], t)
+                tc = contact_root(rr, ru, uu, sig, sdot, best)
                 if tc < best:
                     best = tc
                     partner = j
@@ -364,15 +382,14 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
 
 @njit(cache=True)
 def synchronise(X, V, T, A, t, kappa):
-    """Advance all particles to window time t, radii to a_i (1 + kappa t), time origin to t."""
+    """Advance all particles to window time t, radii to A_i (1 + kappa_i t), time origin to t."""
     n, d = X.shape
-    grow = 1.0 + kappa * t
     for i in range(n):
         dt = t - T[i]
         for k in range(d):
             X[i, k] += V[i, k] * dt
         T[i] = 0.0
-        A[i] *= grow
+        A[i] *= 1.0 + kappa[i] * t
 
 
 @njit(cache=True)

@@ -55,3 +55,26 @@ def plot_glass_entropy(binary, mono):
     for ax in axes:
         ax.legend()
     return fig
+
+
+def plot_microsegregated(summary):
+    """s_c against phi_J of each label ensemble, with phi_J's standard error, the uncorrelated
+    ("random") labels marked and s_mix dashed (after Donev 2006, Fig. 13.16)."""
+    fig, ax = figure(1, 1, figsize=(4.8, 3.6))
+    names = summary["ensemble"].values
+    random = names == "random"
+    clustered = ~random
+    points = ax.scatter(summary["phi_J"].values[clustered], summary["s_c"].values[clustered],
+                        c=summary["R"].values[clustered], cmap="viridis", s=18, zorder=3, label="Matérn labels")
+    ax.errorbar(summary["phi_J"].values, summary["s_c"].values, xerr=summary["phi_J_err"].values, fmt="none",
+                ecolor="0.6", lw=0.8, zorder=2)
+    if random.any():
+        ax.plot(summary["phi_J"].values[random], summary["s_c"].values[random], "o", mfc="none", mec="k", ms=8,
+                label="uncorrelated labels")
+    ax.axhline(float(summary["s_mix"].values[0]), color="k", ls="--", lw=0.8, label="s_mix")
+    fig.colorbar(points, ax=ax, label="R")
+    ax.set_xlabel("phi_J")
+    ax.set_ylabel(f"s_c (Markov estimate, {summary.attrs['s_c_window']} windows)")
+    ax.set_title(f"micro-segregated packings, N = {summary.attrs['N']}")
+    ax.legend(loc="lower left", fontsize="small")
+    return fig

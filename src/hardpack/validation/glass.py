@@ -5,11 +5,12 @@ glasses."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from hardpack.glass.thermo import mixing_entropy
-from hardpack.validation.rows import Row, evaluate
+from hardpack.validation.rows import NA, Row, evaluate
 from hardpack.validation.targets import load_targets
 
 
@@ -81,3 +82,51 @@ def entropy_rows(ds) -> list[Row]:
               f"{np.round(ds['glass_excess'].values[sel], 4).tolist()}, Delta f_L = "
               f"{np.round(ds['liquid_excess'].values[sel], 4).tolist()}")
     return [evaluate(target, samples=samples, n=n, detail=detail)]
+
+
+def microsegregated_rows(ds) -> list[Row]:
+    """Micro-segregated packings (Donev 2006, sec. 13.5): phi_J of the uncorrelated labels
+    (Fig. 13.13), phi~_J at the start of the growth (Fig. 13.14), the most clustered ensemble
+    denser than the uncorrelated one, and s_c anticorrelated with phi_J over the ensembles
+    (Figs. 13.16-13.17)."""
+    from scipy.stats import spearmanr
+
+    targets = load_targets()
+    n = int(ds.attrs.get("N", 0))
+    names = [str(x) for x in ds["ensemble"].values]
+    packings = int(ds["n_packings"].min())
+    how = (f"N = {n}, {len(names)} label ensembles, >= {packings} packing(s) each, s_c from "
+           f"{ds.attrs.get('s_c_window')} windows")
+    out = []
+    if "random" in names:
+        row = ds.sel(ensemble="random")
+        k = int(row["n_packings"])
+        # the spread over packings: phi_J_err is the standard error of the mean over k packings
+        sd = float(row["phi_J_err"]) * math.sqrt(k)
+        out.append(evaluate(targets["donev-13.5-phij-random"], float(row["phi_J"]), sd * math.sqrt(1 + 1 / k),
+                            n=n, seeds=k, detail=how))
+    else:
+        out.append(evaluate(targets["donev-13.5-phij-random"], n=n, seeds=packings, detail="no uncorrelated labels"))
+    out.append(evaluate(targets["donev-13.5-phij-est-start"], float(ds["phi_J_est_start"].mean()), n=n,
+                        detail=f"{how}; mean over ensembles of the first growth window"))
+    clustered = [x for x in names if x != "random"]
+    if "random" in names and clustered:
+        top = max(clustered, key=lambda x: (float(ds.sel(ensemble=x)["R"]), float(ds.sel(ensemble=x)["nu"])))
+        a, b = ds.sel(ensemble=top), ds.sel(ensemble="random")
+        diff = float(a["phi_J"] - b["phi_J"])
+        err = math.hypot(float(a["phi_J_err"]), float(b["phi_J_err"]))
+        verdict = float(diff > 2 * err) if math.isfinite(err) else math.nan
+        out.append(evaluate(targets["donev-13.5-clustered-denser"], verdict, n=n, seeds=packings,
+                            detail=f"{how}; phi_J({top}) - phi_J(random) = {diff:.5f} +- {err:.5f}"))
+    else:
+        out.append(evaluate(targets["donev-13.5-clustered-denser"], n=n, seeds=packings,
+                            detail="needs the uncorrelated and a clustered ensemble"))
+    if len(names) >= 6:  # below, |rho| <= 1 cannot exceed 2 / sqrt(n - 1)
+        rho = float(spearmanr(ds["s_c"].values, ds["phi_J"].values).statistic)
+        null = 1 / math.sqrt(len(names) - 1)
+        out.append(evaluate(targets["donev-13.5-sc-phij-anticorrelated"], float(rho < -2 * null), n=n, seeds=packings,
+                            detail=f"{how}; Spearman rho = {rho:.3f}, null standard error {null:.3f}"))
+    else:
+        row = evaluate(targets["donev-13.5-sc-phij-anticorrelated"], n=n, seeds=packings)
+        out.append(replace(row, status=NA, detail=f"n/a: needs at least 6 ensembles, has {len(names)}"))
+    return out
