@@ -207,3 +207,15 @@ def test_window_fluctuations_mean_is_phi():
     se = out.sigma_phi.values / np.sqrt(400)
     assert np.all(np.abs(out.phi_mean.values - pk.phi) < 4 * se)
     assert out.sigma_phi.values[1] < out.sigma_phi.values[0]
+
+
+def test_a_single_sphere_in_a_container_compresses_to_a_target_phi():
+    """N = 1 is valid with walls: the start velocity keeps its momentum (removing the mean of one
+    particle left it at rest, with NaN speed after the kT scaling) and LS growth reaches phi."""
+    v = maxwell_boltzmann(1, 3, 5)
+    assert np.all(np.isfinite(v)) and np.einsum("ij,ij->", v, v) == pytest.approx(3.0)
+    pk = Packing(np.array([[3.2, 2.9, 3.1]]), np.array([0.5]), np.eye(3) * 6.0,
+                 boundary=SphericalContainer((3, 3, 3), 3.0))
+    res = compress(pk, 0.05, 1, stop=StopCriteria(target_phi=0.1, max_pressure=None))
+    assert res.packing.phi == pytest.approx(0.1, rel=1e-9)
+    assert res.packing.containment_report().n_outside == 0

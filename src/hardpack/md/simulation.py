@@ -62,13 +62,14 @@ class OverlapError(RuntimeError):
 
 
 def maxwell_boltzmann(n: int, d: int, seed) -> np.ndarray:
-    """Velocities from numpy.random.default_rng(seed): Gaussian, zero total momentum, and scaled so
-    that kT = 2 KE / (d N) = 1 exactly (m = 1).
+    """Velocities from numpy.random.default_rng(seed): Gaussian, zero total momentum (for n >= 2),
+    and scaled so that kT = 2 KE / (d N) = 1 exactly (m = 1).
 
     Parameters
     ----------
     n : int
-        Number of particles (>= 2 for a non-zero velocity after removing the mean).
+        Number of particles, >= 1. One particle keeps its momentum (removing the mean would leave
+        it at rest; only walls can hold a single particle, and they take momentum anyway).
     d : int
         The dimension.
     seed : int, numpy.random.SeedSequence or None
@@ -81,7 +82,8 @@ def maxwell_boltzmann(n: int, d: int, seed) -> np.ndarray:
     """
     rng = np.random.default_rng(seed)
     v = rng.standard_normal((n, d))
-    v -= v.mean(axis=0)
+    if n > 1:
+        v -= v.mean(axis=0)
     v *= np.sqrt(d * n / np.einsum("ij,ij->", v, v))
     return v
 
