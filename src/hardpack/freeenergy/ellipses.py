@@ -1,0 +1,297 @@
+"""Exact free energy of an isostatic (first-order rigid) ellipse packing.
+
+Donev 2006, dissertation secs. 6.2.2, 6.3.4.2 and 6.4.3; Donev, Stillinger & Torquato 2007,
+Sec. 2.2, Sec. 4.4 and Appendix C.
+
+Degrees of freedom. An ellipse has the centroid r and the angle phi (d_f = 3). The rigidity
+matrix gets, per particle and contact, the block [n ; r_C x n] (r_C the contact point relative to
+the centroid; :func:`hardpack.jamming.ellipsoids.rigidity_transpose_full`). A particle can have its
+centroid fixed (its two translation rows removed) and/or its orientation fixed (its rotation row
+removed). Donev 2006, sec. 6.4.3: a frozen particle that only removes the trivial translations has
+its centroid fixed but not its orientation, since the periodic cell fixes the frame's orientation.
+
+Jamming polytope. The packing is shrunk by (1 - delta) about the centroids. Contact c keeps the
+Perram-Wertheim scale factor mu_c (mu = 1 at tangency), which shrinking raises to mu_c / (1 - delta).
+Linearising mu_c(Q) >= 1 with grad mu = grad zeta / (2 mu) = (s_c / 2 mu_c) a_c, a_c the
+unit-normal gap-rate row of A^T and s_c = 2 lam (1 - lam) |n| (:mod:`hardpack.jamming.ellipsoids`),
+gives the polytope
+
+    P = {dQ : -a_c . dQ <= h_c},   h_c = 2 mu_c (mu_c - 1) / s_c,
+
+(for disks h_c is the surface gap). With M = N_f + 1 it is a simplex, whose volume is Eq. 6.5
+(:func:`hardpack.freeenergy.simplex.log_simplex_volume`). In the PW normalisation of Donev 2006,
+sec. 6.2.1 (footnote 2), the rows grad mu all have the right-hand side delta as delta -> 0, so
+P = delta^{N_f} P_x and f_J = ln|P_x| / N_eff (Eq. 6.2).
+
+Bounding cell (Appendix C, Eq. C1). The cell of an ellipse is the ellipse itself scaled by
+mu = 1 + Delta mu about its initial centroid, at its initial orientation. For small Delta mu the
+allowed displacements dq = (dr, dphi) are
+
+    n . (dr + dphi x r_C) <= Delta mu n . r_C   for every boundary point r_C with unit normal n,
+
+a convex body of volume Delta mu^3 b^2 V_alpha (b the minor semiaxis, alpha = a / b), whose log is
+:func:`cell_log_volume` (b = 1): f_c = -3 ln Delta mu - f_c^J with f_c^J = ln V_alpha. We compute
+V_alpha as the volume of the polytope cut by K equally spaced normals (it converges from above as
+K^-2) with a Richardson step; alpha = 2 gives f_c^J = 2.26940, the 2.269 of Donev 2006,
+sec. 6.3.4 (the 2.268 of its sec. 6.3.4.2 / Appendix C is 0.0014 lower). The largest rotation at
+dr = 0 is Delta mu 2 alpha / (alpha^2 - 1) (4/3 for alpha = 2, as printed). Particles with a fixed
+centroid and a free orientation have the 1D cell |dphi| <= Delta mu 2 alpha / (alpha^2 - 1); fixed
+orientation and free centroid, the ellipse scaled by Delta mu (area pi a b Delta mu^2).
+
+Exact Delta f. BCMD runs from large cells to the disjoint-cell point Delta mu_min (no two cells of
+the shrunk packing overlap: 1 + Delta mu_min = min_ij mu_ij of the shrunk packing). Its Delta f is
+
+    Delta f_exact = [ln|P| - sum_i ln|cell_i(Delta mu_min)|] / N_eff,
+
+with N_eff the number of particles whose centroid moves (Donev 2006, Fig. 6.5: "96 free and four
+frozen"). For exact contacts (mu_c = 1) and Delta mu_min = delta this is f_J - f_c^J (Eq. 6.18).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import ConvexHull, HalfspaceIntersection
+
+from hardpack.errors import InvalidInputError
+from hardpack.freeenergy.simplex import jamming_simplex, log_simplex_volume
+from hardpack.geometry.ellipsoid_pairs import potential_pairs
+from hardpack.geometry.packing import Packing
+from hardpack.jamming.ellipsoids import (
+    check_ellipsoid_packing,
+    contacts_of_pairs,
+    ellipsoid_contacts,
+    rigidity_transpose_full,
+)
+
+ROUND_TOL = 1e-9  # |alpha - 1| below this is a disk
+
+
+def max_rotation(alpha: float) -> float:
+    """Largest rotation of an ellipse of aspect ratio ``alpha`` > 1 at fixed centroid in its cell
+    of size Delta mu = 1: min over the boundary of n.r_C / |r_C x n| = 2 alpha / (alpha^2 - 1)
+    (Donev 2006, sec. 6.3.4.2: 4/3 for alpha = 2)."""
+    alpha = float(alpha)
+    if not alpha > 1.0 + ROUND_TOL:
+        raise InvalidInputError(f"a disk (alpha = {alpha}) rotates freely in its cell; alpha must be > 1")
+    return 2.0 * alpha / (alpha * alpha - 1.0)
+
+
+def _polytope_volume(alpha: float, k: int) -> float:
+    """Volume of the cell body of Eq. C1 (Delta mu = 1, semiaxes alpha and 1) cut by k normals."""
+    th = (np.arange(k) + 0.5) * (2.0 * np.pi / k)
+    n = np.stack([np.cos(th), np.sin(th)], axis=1)
+    xinv = np.array([alpha * alpha, 1.0])  # X^-1 of the ellipse with semiaxes (alpha, 1)
+    r = n * xinv / np.sqrt((n * n * xinv).sum(axis=1))[:, None]  # r_C = X^-1 n / sqrt(n X^-1 n)
+    lever = r[:, 0] * n[:, 1] - r[:, 1] * n[:, 0]  # r_C x n
+    halfspaces = np.column_stack([n, lever, -(n * r).sum(axis=1)])
+    hull = ConvexHull(HalfspaceIntersection(halfspaces, np.zeros(3)).intersections)
+    return float(hull.volume)
+
+
+@functools.lru_cache(maxsize=64)
+def cell_log_volume(alpha: float, n_normals: int = 4000) -> float:
+    """f_c^J = ln V_alpha, the log-volume of the displacements (dr, dphi) of an ellipse with
+    semiaxes (alpha, 1) in its cell of size Delta mu = 1 (Eq. C1; module docstring).
+
+    Parameters
+    ----------
+    alpha : float
+        Aspect ratio, > 1.
+    n_normals : int, default 4000
+        K, the boundary normals of the polytope approximation; the result is the Richardson
+        extrapolation 4/3 V(K) - 1/3 V(K/2) (error ~ K^-4; 1e-7 in ln V at K = 4000, alpha = 2).
+
+    Returns
+    -------
+    float
+        ln V_alpha (2.26940 for alpha = 2), so that f_c = -3 ln Delta mu - ln V_alpha.
+    """
+    alpha = float(alpha)
+    if not alpha > 1.0 + ROUND_TOL or not np.isfinite(alpha):
+        raise InvalidInputError(
+            f"alpha = {alpha} must be a finite aspect ratio > 1 (a disk rotates freely: fix its "
+            "orientation)"
+        )
+    if int(n_normals) < 64:
+        raise InvalidInputError(f"n_normals = {n_normals} is too coarse; use >= 64")
+    k = int(n_normals)
+    v = (4.0 * _polytope_volume(alpha, k) - _polytope_volume(alpha, k // 2)) / 3.0
+    return float(np.log(v))
+
+
+def _cell_log_volumes(packing: Packing, free_translation, free_rotation, dmu: float) -> np.ndarray:
+    """ln|cell_i(dmu)| of every particle (0 for a particle with no free degree of freedom)."""
+    ax = np.sort(packing.shape.semiaxes, axis=1)
+    b, a = ax[:, 0], ax[:, 1]
+    out = np.zeros(packing.n_particles)
+    for i in range(packing.n_particles):
+        alpha = a[i] / b[i]
+        if free_translation[i] and free_rotation[i]:
+            out[i] = 2.0 * np.log(b[i]) + cell_log_volume(round(alpha, 12)) + 3.0 * np.log(dmu)
+        elif free_translation[i]:
+            out[i] = np.log(np.pi * a[i] * b[i] * dmu * dmu)
+        elif free_rotation[i]:
+            out[i] = np.log(2.0 * max_rotation(alpha) * dmu)
+    return out
+
+
+@dataclass(frozen=True)
+class EllipseSimplexReference:
+    """Exact jamming-simplex numbers of an ellipse packing shrunk by (1 - delta) (module docstring).
+
+    Attributes
+    ----------
+    n_particles, n_contacts, n_dof : int
+        N, M (contacts touching a free degree of freedom) and N_f.
+    n_eff : int
+        Particles whose centroid moves (the per-particle divisor).
+    isostaticity_gap : int
+        M - (N_f + 1); when != 0 the volumes are NaN.
+    delta_f : float
+        Delta f_exact of the module docstring (what BCMD measures from large cells down to
+        ``dmu_min``).
+    log_volume : float
+        ln|P|, the actual-gap simplex.
+    f_j : float
+        ln|P_x| / n_eff in the PW normalisation (unit right-hand sides).
+    f_j_minus_fcj : float
+        [ln|P_x| - sum_i ln|cell_i(1)|] / n_eff, the delta -> 0 limit of ``delta_f``.
+    min_force : float
+        Smallest contact force of the unit-sum self-stress A f = 0 (unit-normal rows: forces
+        in the physical sense).
+    dmu_min : float
+        Disjoint-cell point of the shrunk packing.
+    max_contact_gap, next_gap : float
+        Largest mu - 1 of a contact and smallest mu - 1 of a non-contact (unshrunk packing).
+    """
+
+    n_particles: int
+    n_contacts: int
+    n_dof: int
+    n_eff: int
+    isostaticity_gap: int
+    delta_f: float
+    log_volume: float
+    f_j: float
+    f_j_minus_fcj: float
+    min_force: float
+    dmu_min: float
+    max_contact_gap: float
+    next_gap: float
+
+
+def _free_masks(n: int, fixed_translation, fixed_rotation) -> tuple[np.ndarray, np.ndarray]:
+    masks = []
+    for name, idx in (("fixed_translation", fixed_translation), ("fixed_rotation", fixed_rotation)):
+        idx = np.unique(np.asarray([] if idx is None else idx, dtype=np.int64).ravel())
+        if idx.size and (idx.min() < 0 or idx.max() >= n):
+            raise InvalidInputError(f"{name} holds particle indices outside 0..{n - 1}: {idx}")
+        free = np.ones(n, dtype=bool)
+        free[idx] = False
+        masks.append(free)
+    return masks[0], masks[1]
+
+
+def _check_round_rotations(packing: Packing, free_rotation: np.ndarray) -> None:
+    ax = packing.shape.semiaxes
+    round_ = ax.max(axis=1) / ax.min(axis=1) < 1.0 + ROUND_TOL
+    if np.any(round_ & free_rotation):
+        bad = np.flatnonzero(round_ & free_rotation)
+        raise InvalidInputError(
+            f"particles {bad[:10].tolist()} are disks: their rotation is not constrained and the "
+            "free volume is unbounded; list them in fixed_rotation"
+        )
+
+
+def ellipse_simplex_reference(
+    packing: Packing,
+    delta: float,
+    contact_tol: float,
+    fixed_translation=(0,),
+    fixed_rotation=(),
+) -> EllipseSimplexReference:
+    """Exact free energy of ``packing`` shrunk by (1 - delta), from its jamming simplex.
+
+    Donev 2006, secs. 6.2.2 and 6.4.3; Donev et al. 2007, Sec. 2.2 and Appendix C (module
+    docstring).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic 2D packing of ellipses (``Ellipsoids``); disks must have their rotation fixed.
+    delta : float
+        Relative shrink of the particles, in (0, 0.01).
+    contact_tol : float
+        Pairs of the unshrunk packing with mu - 1 <= contact_tol are contacts; in (0, delta).
+    fixed_translation : sequence of int, default (0,)
+        Particles whose centroid is frozen (at least one: the trivial translations).
+    fixed_rotation : sequence of int, default ()
+        Particles whose orientation is frozen.
+
+    Returns
+    -------
+    EllipseSimplexReference
+        Counts, the exact Delta f, f_J, f_J - f_c^J, the smallest force and the gaps; NaN values
+        when the packing is not isostatic (M != N_f + 1).
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not periodic 2D ellipses, delta or contact_tol are out of range, no
+        centroid is fixed, a disk's rotation is free, or the simplex is degenerate (a singular
+        augmented matrix or a contact force <= 0).
+    """
+    check_ellipsoid_packing(packing)
+    if packing.dim != 2:
+        raise InvalidInputError("the exact ellipse free energy is implemented in 2D only")
+    delta = float(delta)
+    if not 0.0 < delta < 1e-2:
+        raise InvalidInputError(f"delta = {delta!r} must be in (0, 0.01): the simplex is linear")
+    if not 0.0 < contact_tol < delta:
+        raise InvalidInputError(
+            f"contact_tol = {contact_tol!r} must be in (0, delta = {delta}): contacts must close "
+            "to much less than the shrink gap"
+        )
+    n = packing.n_particles
+    free_t, free_r = _free_masks(n, fixed_translation, fixed_rotation)
+    if free_t.all():
+        raise InvalidInputError("fix at least one centroid (fixed_translation) to remove the trivial translations")
+    _check_round_rotations(packing, free_r)
+    net0 = ellipsoid_contacts(packing, contact_tol)
+    near = potential_pairs(packing, rel_gap=1e-2)
+    others = near.mu - 1.0
+    next_gap = float(np.min(others[others > contact_tol], initial=np.inf))
+    max_contact_gap = float(np.max(net0.gap, initial=-np.inf))
+    shrunk = packing.replace(shape=type(packing.shape)(packing.shape.semiaxes * (1.0 - delta),
+                                                       packing.shape.orientations))
+    net = contacts_of_pairs(shrunk, net0.i, net0.j, net0.shift, positions=net0.positions)
+    dmu_min = float(np.min(potential_pairs(shrunk, rel_gap=2.0 * delta + 2.0 * contact_tol).mu)) - 1.0
+    free_dof = np.stack([free_t, free_t, free_r], axis=1).ravel()
+    at = rigidity_transpose_full(net).tocsc()[:, free_dof].tocsr()
+    touches = np.diff(at.indptr) > 0
+    at = at[touches]
+    n_dof = int(free_dof.sum())
+    m = at.shape[0]
+    n_eff = int(free_t.sum())
+    gap = m - (n_dof + 1)
+    nan = float("nan")
+    if gap != 0:
+        return EllipseSimplexReference(n, m, n_dof, n_eff, gap, nan, nan, nan, nan, nan, dmu_min,
+                                       max_contact_gap, next_gap)
+    mu = np.sqrt(net.zeta + 1.0)[touches]
+    s = net.scale[touches]
+    h = 2.0 * mu * (mu - 1.0) / s
+    log_v = log_simplex_volume(-at, h)
+    grad_mu = at.multiply((s / (2.0 * mu))[:, None]).tocsr()
+    js = jamming_simplex(grad_mu.T, n_eff=n_eff)  # checks M = N_f + 1 and forces > 0
+    forces = jamming_simplex(at.T, n_eff=n_eff).forces  # in the unit-normal rows
+    log_cells = _cell_log_volumes(shrunk, free_t, free_r, dmu_min).sum()
+    log_cells_unit = _cell_log_volumes(packing, free_t, free_r, 1.0).sum()
+    return EllipseSimplexReference(
+        n, m, n_dof, n_eff, 0, (log_v - log_cells) / n_eff, log_v, js.f_j,
+        (js.log_volume - log_cells_unit) / n_eff, float(forces.min()), dmu_min,
+        max_contact_gap, next_gap,
+    )
