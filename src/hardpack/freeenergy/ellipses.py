@@ -49,6 +49,7 @@ frozen"). For exact contacts (mu_c = 1) and Delta mu_min = delta this is f_J - f
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass
 
@@ -163,7 +164,7 @@ class EllipseSimplexReference:
         Smallest contact force of the unit-sum self-stress A f = 0 (unit-normal rows: forces
         in the physical sense).
     dmu_min : float
-        Disjoint-cell point of the shrunk packing.
+        Disjoint-cell point of the linear model (:func:`linear_model`).
     max_contact_gap, next_gap : float
         Largest mu - 1 of a contact and smallest mu - 1 of a non-contact (unshrunk packing).
     """
@@ -204,6 +205,65 @@ def _check_round_rotations(packing: Packing, free_rotation: np.ndarray) -> None:
             f"particles {bad[:10].tolist()} are disks: their rotation is not constrained and the "
             "free volume is unbounded; list them in fixed_rotation"
         )
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """The linearised jamming problem of an ellipse packing shrunk by (1 - delta).
+
+    Attributes
+    ----------
+    shrunk : Packing
+        The packing with every semiaxis times (1 - delta).
+    contacts : EllipsoidContacts
+        Its contacts (pairs with mu - 1 <= contact_tol before shrinking) with the lever arms
+        r_C = (PW contact point - centroid) / mu_c: the boundary point of each ellipse itself with
+        normal +-u, so that the rows [u; r_C x u] are the face normals of the cells (Eq. C1).
+    gaps : numpy.ndarray
+        h_c = 2 mu_c (mu_c - 1) / s_c, the first-order surface gap of each contact.
+    supports : numpy.ndarray
+        u . r_iC - u . r_jC: the cells of size Delta mu reach the plane of contact c at
+        Delta mu = h_c / supports_c.
+    dmu_min : float
+        The disjoint-cell point of the linear model, min_c h_c / supports_c (= the PW
+        min mu_ij - 1 of the shrunk packing to first order in delta).
+    dmu_min_pw : float
+        min_ij mu_ij - 1 over every pair of the shrunk packing (nonlinear check).
+    max_contact_gap, next_gap : float
+        Largest mu - 1 of a contact and smallest mu - 1 of a non-contact (unshrunk packing).
+    """
+
+    shrunk: Packing
+    contacts: object
+    gaps: np.ndarray
+    supports: np.ndarray
+    dmu_min: float
+    dmu_min_pw: float
+    max_contact_gap: float
+    next_gap: float
+
+
+def linear_model(packing: Packing, delta: float, contact_tol: float) -> LinearModel:
+    """Contacts, gaps and the disjoint-cell point of ``packing`` shrunk by (1 - delta)
+    (module docstring); the arguments are those of :func:`ellipse_simplex_reference`."""
+    net0 = ellipsoid_contacts(packing, contact_tol)
+    if np.any(net0.i == net0.j):
+        raise InvalidInputError("an ellipse touches its own periodic image: use a larger cell")
+    near = potential_pairs(packing, rel_gap=1e-2)
+    others = near.mu - 1.0
+    next_gap = float(np.min(others[others > contact_tol], initial=np.inf))
+    max_contact_gap = float(np.max(net0.gap, initial=-np.inf))
+    shrunk = packing.replace(shape=type(packing.shape)(packing.shape.semiaxes * (1.0 - delta),
+                                                       packing.shape.orientations))
+    net = contacts_of_pairs(shrunk, net0.i, net0.j, net0.shift, positions=net0.positions)
+    mu = np.sqrt(net.zeta + 1.0)
+    net = dataclasses.replace(net, lever_i=net.lever_i / mu[:, None], lever_j=net.lever_j / mu[:, None])
+    gaps = 2.0 * mu * (mu - 1.0) / net.scale
+    supports = np.einsum("cd,cd->c", net.normal, net.lever_i - net.lever_j)
+    dmu_min = float(np.min(gaps / supports, initial=np.inf))
+    pw = potential_pairs(shrunk, rel_gap=2.0 * delta + 2.0 * contact_tol)
+    dmu_min_pw = float(np.min(pw.mu, initial=np.inf)) - 1.0
+    return LinearModel(shrunk, net, gaps, supports, dmu_min, dmu_min_pw, max_contact_gap, next_gap)
 
 
 def ellipse_simplex_reference(
@@ -260,15 +320,9 @@ def ellipse_simplex_reference(
     if free_t.all():
         raise InvalidInputError("fix at least one centroid (fixed_translation) to remove the trivial translations")
     _check_round_rotations(packing, free_r)
-    net0 = ellipsoid_contacts(packing, contact_tol)
-    near = potential_pairs(packing, rel_gap=1e-2)
-    others = near.mu - 1.0
-    next_gap = float(np.min(others[others > contact_tol], initial=np.inf))
-    max_contact_gap = float(np.max(net0.gap, initial=-np.inf))
-    shrunk = packing.replace(shape=type(packing.shape)(packing.shape.semiaxes * (1.0 - delta),
-                                                       packing.shape.orientations))
-    net = contacts_of_pairs(shrunk, net0.i, net0.j, net0.shift, positions=net0.positions)
-    dmu_min = float(np.min(potential_pairs(shrunk, rel_gap=2.0 * delta + 2.0 * contact_tol).mu)) - 1.0
+    model = linear_model(packing, delta, contact_tol)
+    shrunk, net = model.shrunk, model.contacts
+    dmu_min = model.dmu_min
     free_dof = np.stack([free_t, free_t, free_r], axis=1).ravel()
     at = rigidity_transpose_full(net).tocsc()[:, free_dof].tocsr()
     touches = np.diff(at.indptr) > 0
@@ -280,10 +334,10 @@ def ellipse_simplex_reference(
     nan = float("nan")
     if gap != 0:
         return EllipseSimplexReference(n, m, n_dof, n_eff, gap, nan, nan, nan, nan, nan, dmu_min,
-                                       max_contact_gap, next_gap)
+                                       model.max_contact_gap, model.next_gap)
     mu = np.sqrt(net.zeta + 1.0)[touches]
     s = net.scale[touches]
-    h = 2.0 * mu * (mu - 1.0) / s
+    h = model.gaps[touches]
     log_v = log_simplex_volume(-at, h)
     grad_mu = at.multiply((s / (2.0 * mu))[:, None]).tocsr()
     js = jamming_simplex(grad_mu.T, n_eff=n_eff)  # checks M = N_f + 1 and forces > 0
@@ -293,5 +347,72 @@ def ellipse_simplex_reference(
     return EllipseSimplexReference(
         n, m, n_dof, n_eff, 0, (log_v - log_cells) / n_eff, log_v, js.f_j,
         (js.log_volume - log_cells_unit) / n_eff, float(forces.min()), dmu_min,
-        max_contact_gap, next_gap,
+        model.max_contact_gap, model.next_gap,
+    )
+
+
+def freeze_to_isostatic(
+    packing: Packing,
+    delta: float,
+    contact_tol: float,
+    seed: int = 0,
+    max_tries: int = 200,
+) -> tuple[np.ndarray, np.ndarray, EllipseSimplexReference]:
+    """Choose frozen centroids that make ``packing`` isostatic with positive forces.
+
+    Donev 2006, sec. 6.4.3: jammed packings of alpha = 2 ellipses grown from a triangular lattice
+    have M < 3N - 1 contacts; freezing the centroids of F particles (orientations stay free)
+    leaves N_f = 3N - 2F, so F = (3N + 1 - M) / 2 matches M = N_f + 1 (four particles for the
+    printed packing). When 3N + 1 - M is odd one orientation is frozen too. Random subsets (in
+    the order of ``seed``) are tried until the augmented matrix is regular with all forces > 0.
+
+    Parameters
+    ----------
+    packing : Packing
+        A jammed periodic packing of ellipses.
+    delta, contact_tol : float
+        As in :func:`ellipse_simplex_reference`.
+    seed : int, default 0
+        Seed of the order of the tried subsets.
+    max_tries : int, default 200
+        Subsets tried before giving up.
+
+    Returns
+    -------
+    fixed_translation, fixed_rotation : numpy.ndarray of int
+        The frozen centroids and orientations.
+    reference : EllipseSimplexReference
+        The exact numbers of that choice.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing has more than 3N contacts (hyperstatic: no freezing helps) or no tried
+        subset gives a regular simplex with positive forces.
+    """
+    net = ellipsoid_contacts(packing, contact_tol)
+    n, m = packing.n_particles, net.n_contacts
+    excess = 3 * n + 1 - m
+    if excess < 2:
+        raise InvalidInputError(
+            f"the packing has M = {m} contacts for N = {n} ellipses: M >= 3N, so freezing "
+            "centroids cannot make it isostatic (it is hyperstatic)"
+        )
+    n_t, n_r = excess // 2, excess % 2
+    rng = np.random.default_rng(seed)
+    last = "no subset tried"
+    for _ in range(int(max_tries)):
+        pick = rng.choice(n, size=n_t + n_r, replace=False)
+        fixed_t, fixed_r = np.sort(pick[:n_t]), np.sort(pick[n_t:])
+        try:
+            ref = ellipse_simplex_reference(packing, delta, contact_tol, fixed_t, fixed_r)
+        except InvalidInputError as exc:
+            last = str(exc)
+            continue
+        if ref.isostaticity_gap == 0:
+            return fixed_t, fixed_r, ref
+        last = f"isostaticity gap {ref.isostaticity_gap}"
+    raise InvalidInputError(
+        f"no choice of {n_t} frozen centroids and {n_r} frozen orientations in {max_tries} tries "
+        f"makes the packing isostatic with positive forces (last: {last})"
     )
