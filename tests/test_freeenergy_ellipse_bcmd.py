@@ -10,7 +10,7 @@ import pytest
 
 from hardpack.errors import InvalidInputError
 from hardpack.freeenergy import _ellipse_kernel as kern
-from hardpack.freeenergy.ellipse_bcmd import ellipse_bcmd
+from hardpack.freeenergy.ellipse_bcmd import disjoint_cells_check, ellipse_bcmd
 from hardpack.freeenergy.isostatic import remove_rattlers
 from hardpack.geometry.neighbours import pairs_within
 from hardpack.geometry.packing import Packing
@@ -20,41 +20,13 @@ sys.path.insert(0, str(Path(__file__).parent))
 from test_freeenergy_isostatic import LATTICE, POSITIONS, RADII  # noqa: E402
 
 
-def _free_ellipses(n, seed):
-    rng = np.random.default_rng(seed)
-    axes = np.column_stack([rng.uniform(1.0, 3.0, n), np.ones(n)])
-    phi0 = rng.uniform(0.0, np.pi, n)
-    cell = np.column_stack([np.cos(phi0), np.sin(phi0), axes[:, 0], axes[:, 1]])
-    im, ii = np.ones(n), 4.0 / (axes**2).sum(axis=1)
-    qd = rng.normal(size=(n, 3)) * np.sqrt(np.column_stack([im, im, ii]))
-    return cell, im, ii, qd
-
-
 def test_disjoint_cells_kinetic_energy_scales_as_the_cell_volume():
-    # n ellipses alone in cells of their own shape (Eq. C1): the cell body scales as Delta mu, so
-    # its volume as Delta mu^3 and (3/2) ln(K/K0) = 3 ln(dmu0/dmu1) for a slow shrink (the
-    # energy of a billiard in a homothetically shrinking domain scales as the inverse square of
-    # its size, ergodic or not)
-    n = 10
-    cell, im, ii, qd = _free_ellipses(n, 1)
-    q, tq = np.zeros((n, 3)), np.zeros(n)
-    none_f, none_i = np.zeros((0, 3)), np.zeros(0, np.int64)
-    start = np.zeros(n + 1, np.int64)
-    counts = np.zeros(2, np.int64)
-
-    def kinetic():
-        return 0.5 * (np.sum(qd[:, :2] ** 2) + np.sum(qd[:, 2] ** 2 / ii))
-
-    dmu0, dmu1, gamma = 1e-2, 1e-3, 3e-4
-    args = (none_i, none_i, none_f, none_f, np.zeros(0), start, none_i)
-    kern.run_segment(q, qd, tq, cell, im, ii, *args, 0.0, 1.0, dmu0, 0.0, 1e-16, counts, 10**8)
-    k0 = kinetic()
-    kern.run_segment(q, qd, tq, cell, im, ii, *args, 1.0, (dmu0 - dmu1) / gamma, dmu0, gamma,
-                     1e-16, counts, 10**8)
-    assert 1.5 * np.log(kinetic() / k0) == pytest.approx(3 * np.log(dmu0 / dmu1), rel=1e-3)
-    # every ellipse is still inside its cell
-    t = float(tq.max())
-    assert max(kern.cell_value(i, t, q, qd, tq, cell, dmu1, 0.0, t) for i in range(n)) <= 0.0
+    # independent ellipses in cells of their own shape (Eq. C1): the cell body scales as
+    # Delta mu, its volume as Delta mu^3, so (3/2) ln(K/K0) = 3 ln(dmu0/dmu1) for a slow shrink
+    # (measured deviations ~1e-5 at gamma = 3e-4)
+    ds = disjoint_cells_check(seeds=(1,), n=10)
+    assert abs(float(ds["rel_dev"][0])) < 1e-3
+    assert int(ds["events"][0]) > 10_000
 
 
 def test_cell_collision_time_is_the_first_root():

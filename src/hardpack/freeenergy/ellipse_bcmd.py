@@ -271,3 +271,49 @@ def ellipse_bcmd(
         },
         attrs=attrs,
     )
+
+
+def disjoint_cells_check(seeds=(1, 2, 3), n: int = 10, dmu0: float = 1e-2, dmu1: float = 1e-3,
+                         gamma: float = 3e-4) -> xr.Dataset:
+    """The disjoint-cell rung of the ladder for ellipses: ``n`` independent ellipses (aspect
+    ratios uniform in [1, 3], random orientations) in cells of their own shape (Eq. C1) shrunk at
+    the constant rate ``gamma`` from ``dmu0`` to ``dmu1``. The cell body scales as Delta mu, so
+    (3/2) ln(K/K0) = 3 ln(dmu0/dmu1) up to the adiabatic error (the energy of a billiard in a
+    homothetically shrinking domain scales as its inverse squared size, ergodic or not).
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``sample``: ``rel_dev`` = (3/2) ln(K/K0) / (3 ln(dmu0/dmu1)) - 1, ``events``,
+        ``seconds``; attributes ``n_particles`` and the parameters.
+    """
+    rel, events, seconds = [], [], []
+    for seed in seeds:
+        clock = time.perf_counter()
+        rng = np.random.default_rng(seed)
+        axes = np.column_stack([rng.uniform(1.0, 3.0, n), np.ones(n)])
+        phi0 = rng.uniform(0.0, np.pi, n)
+        cell = np.column_stack([np.cos(phi0), np.sin(phi0), axes[:, 0], axes[:, 1]])
+        im, ii = np.ones(n), 4.0 / (axes**2).sum(axis=1)
+        qd = rng.normal(size=(n, 3)) * np.sqrt(np.column_stack([im, im, ii]))
+        q, tq = np.zeros((n, 3)), np.zeros(n)
+        none_f, none_i = np.zeros((0, 3)), np.zeros(0, np.int64)
+        args = (none_i, none_i, none_f, none_f, np.zeros(0), np.zeros(n + 1, np.int64), none_i)
+        counts = np.zeros(2, np.int64)
+
+        def kinetic():
+            return 0.5 * (np.sum(qd[:, :2] ** 2) + np.sum(qd[:, 2] ** 2 / ii))
+
+        kern.run_segment(q, qd, tq, cell, im, ii, *args, 0.0, 1.0, dmu0, 0.0, 1e-16, counts, 10**9)
+        k0 = kinetic()
+        kern.run_segment(q, qd, tq, cell, im, ii, *args, 1.0, (dmu0 - dmu1) / gamma, dmu0, gamma,
+                         1e-16, counts, 10**9)
+        rel.append(1.5 * np.log(kinetic() / k0) / (3.0 * np.log(dmu0 / dmu1)) - 1.0)
+        events.append(int(counts.sum()))
+        seconds.append(time.perf_counter() - clock)
+    return xr.Dataset(
+        {"rel_dev": ("sample", np.array(rel)), "events": ("sample", np.array(events)),
+         "seconds": ("sample", np.array(seconds)), "seed": ("sample", np.array(seeds))},
+        attrs={"hardpack_kind": "bcmd_ellipse_ladder", "n_particles": n, "dmu0": dmu0, "dmu1": dmu1,
+               "gamma": gamma},
+    )

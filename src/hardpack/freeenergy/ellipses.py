@@ -356,15 +356,26 @@ def freeze_to_isostatic(
     delta: float,
     contact_tol: float,
     seed: int = 0,
-    max_tries: int = 200,
+    max_tries: int = 400,
+    mode: str = "centroid",
+    n_frozen: int = 4,
 ) -> tuple[np.ndarray, np.ndarray, EllipseSimplexReference]:
-    """Choose frozen centroids that make ``packing`` isostatic with positive forces.
+    """Choose frozen particles that make ``packing`` isostatic with positive forces.
 
     Donev 2006, sec. 6.4.3: jammed packings of alpha = 2 ellipses grown from a triangular lattice
-    have M < 3N - 1 contacts; freezing the centroids of F particles (orientations stay free)
-    leaves N_f = 3N - 2F, so F = (3N + 1 - M) / 2 matches M = N_f + 1 (four particles for the
-    printed packing). When 3N + 1 - M is odd one orientation is frozen too. Random subsets (in
-    the order of ``seed``) are tried until the augmented matrix is regular with all forces > 0.
+    have M < 3N - 1 contacts, and "by freezing 4 of the particles" the numbers of degrees of
+    freedom and contacts were matched (Fig. 6.5: "96 free and four frozen ellipses"). The text
+    does not say whether those four kept their orientation free (as it prescribes for the one
+    particle frozen to remove the translations), so both readings are offered:
+
+    - ``mode="centroid"``: F centroids fixed, orientations free: N_f = 3N - 2F, so
+      F = (3N + 1 - M) / 2 (one orientation is fixed too when 3N + 1 - M is odd);
+    - ``mode="full"``: ``n_frozen`` particles fixed entirely: N_f = 3(N - n_frozen), and the
+      contacts among frozen particles drop out, so the set must hold exactly
+      M - 3(N - n_frozen) - 1 of them.
+
+    Random subsets (in the order of ``seed``) are tried until the augmented matrix is regular with
+    all forces > 0.
 
     Parameters
     ----------
@@ -374,8 +385,12 @@ def freeze_to_isostatic(
         As in :func:`ellipse_simplex_reference`.
     seed : int, default 0
         Seed of the order of the tried subsets.
-    max_tries : int, default 200
+    max_tries : int, default 400
         Subsets tried before giving up.
+    mode : {"centroid", "full"}, default "centroid"
+        What a frozen particle loses (above).
+    n_frozen : int, default 4
+        Particles frozen entirely in ``mode="full"``.
 
     Returns
     -------
@@ -387,23 +402,41 @@ def freeze_to_isostatic(
     Raises
     ------
     InvalidInputError
-        If the packing has more than 3N contacts (hyperstatic: no freezing helps) or no tried
-        subset gives a regular simplex with positive forces.
+        If ``mode`` is unknown, no set of that kind can match the counts, or no tried subset
+        gives a regular simplex with positive forces.
     """
+    if mode not in ("centroid", "full"):
+        raise InvalidInputError(f"mode must be 'centroid' or 'full', got {mode!r}")
     net = ellipsoid_contacts(packing, contact_tol)
     n, m = packing.n_particles, net.n_contacts
-    excess = 3 * n + 1 - m
-    if excess < 2:
-        raise InvalidInputError(
-            f"the packing has M = {m} contacts for N = {n} ellipses: M >= 3N, so freezing "
-            "centroids cannot make it isostatic (it is hyperstatic)"
-        )
-    n_t, n_r = excess // 2, excess % 2
     rng = np.random.default_rng(seed)
+    if mode == "centroid":
+        excess = 3 * n + 1 - m
+        if excess < 2:
+            raise InvalidInputError(
+                f"the packing has M = {m} contacts for N = {n} ellipses: M >= 3N, so freezing "
+                "centroids cannot make it isostatic (it is hyperstatic)"
+            )
+        n_t, n_r = excess // 2, excess % 2
+    else:
+        internal = m - 3 * (n - int(n_frozen)) - 1
+        if not 0 <= internal <= m:
+            raise InvalidInputError(
+                f"M = {m} contacts cannot match N_f + 1 = {3 * (n - int(n_frozen)) + 1} with "
+                f"{n_frozen} fully frozen particles; choose another n_frozen"
+            )
     last = "no subset tried"
     for _ in range(int(max_tries)):
-        pick = rng.choice(n, size=n_t + n_r, replace=False)
-        fixed_t, fixed_r = np.sort(pick[:n_t]), np.sort(pick[n_t:])
+        if mode == "centroid":
+            pick = rng.choice(n, size=n_t + n_r, replace=False)
+            fixed_t, fixed_r = np.sort(pick[:n_t]), np.sort(pick[n_t:])
+        else:
+            fixed_t = np.sort(rng.choice(n, size=int(n_frozen), replace=False))
+            inside = np.isin(net.i, fixed_t) & np.isin(net.j, fixed_t)
+            if int(inside.sum()) != internal:
+                last = f"{int(inside.sum())} contacts among the frozen, {internal} needed"
+                continue
+            fixed_r = fixed_t
         try:
             ref = ellipse_simplex_reference(packing, delta, contact_tol, fixed_t, fixed_r)
         except InvalidInputError as exc:
@@ -413,6 +446,6 @@ def freeze_to_isostatic(
             return fixed_t, fixed_r, ref
         last = f"isostaticity gap {ref.isostaticity_gap}"
     raise InvalidInputError(
-        f"no choice of {n_t} frozen centroids and {n_r} frozen orientations in {max_tries} tries "
-        f"makes the packing isostatic with positive forces (last: {last})"
+        f"no tried set of frozen particles (mode {mode!r}, {max_tries} tries) makes the packing "
+        f"isostatic with positive forces (last: {last})"
     )
