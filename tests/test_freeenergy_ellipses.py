@@ -169,3 +169,38 @@ def test_not_isostatic_gives_nan_and_the_gap():
     ref = ellipse_simplex_reference(packing, 1e-6, 1e-9, fixed_translation=[0, 1, 2, 3, 4],
                                     fixed_rotation=[1, 2, 3, 4])
     assert ref.isostaticity_gap == 2 and np.isnan(ref.delta_f)
+
+
+# Donev 2006, sec. 6.4.3: a triangular lattice of 100 disks (10 x 10 in a rectangular periodic
+# cell, nearest-neighbour distance 1) turned into ellipses with semiaxes (0.49, 0.245), their
+# orientations uniform in +-0.3 rad (seed 2), compressed by ellipse LS MD
+# (compress_ellipsoids(p, 1e-2, 2, StopCriteria(max_pressure=1e8), final_growth_rate=1e-3,
+# switch_pressure=1e3); about 2 min) to phi = 0.8852.
+LATTICE_ELLIPSES = Path(__file__).parent / "data" / "ellipses_a2_lattice_n100_p1e8.nc"
+
+
+@pytest.fixture(scope="module")
+def lattice_ellipses():
+    from hardpack.io import load_packing
+
+    return load_packing(LATTICE_ELLIPSES)
+
+
+def test_alpha_2_lattice_packing_made_isostatic_by_four_frozen_particles(lattice_ellipses):
+    # as printed: 96 free and four frozen ellipses, M = N_f + 1 with positive forces; contacts
+    # closed to << delta, and the exact value of the printed magnitude (3.6693 for Donev's
+    # packing; another packing and frozen set of the same protocol differs at the 1 % level)
+    from hardpack.freeenergy.ellipses import freeze_to_isostatic
+
+    fixed_t, fixed_r, ref = freeze_to_isostatic(lattice_ellipses, 1e-4, 1e-6, seed=0, mode="full")
+    assert len(fixed_t) == 4 and np.array_equal(fixed_t, fixed_r)
+    assert (ref.n_eff, ref.n_dof, ref.n_contacts, ref.isostaticity_gap) == (96, 288, 289, 0)
+    assert ref.min_force > 0 and ref.max_contact_gap < 1e-2 * 1e-4
+    assert abs(ref.f_j_minus_fcj - 3.6693) < 0.1
+    # delta = 1e-4 is the delta -> 0 limit to O(delta) per degree of freedom
+    assert ref.delta_f == pytest.approx(ref.f_j_minus_fcj, abs=3 * 3 * 1e-4)
+    # the other reading: centroids frozen, orientations free (5 centroids + 1 orientation here)
+    fixed_t, fixed_r, ref = freeze_to_isostatic(lattice_ellipses, 1e-4, 1e-6, seed=0)
+    assert ref.isostaticity_gap == 0 and ref.n_dof == 3 * 100 - 2 * len(fixed_t) - len(fixed_r)
+    with pytest.raises(InvalidInputError, match="mode"):
+        freeze_to_isostatic(lattice_ellipses, 1e-4, 1e-6, mode="half")

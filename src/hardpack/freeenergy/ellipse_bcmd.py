@@ -67,6 +67,12 @@ def _vertices(at: np.ndarray, h: np.ndarray) -> np.ndarray:
     return out
 
 
+def _outside_cells(qv: np.ndarray, cell: np.ndarray, dmu: float, movers: np.ndarray) -> bool:
+    """Whether the configuration qv (N, 3) leaves some particle's cell of size dmu."""
+    zeros_qd, tq0 = np.zeros_like(qv), np.zeros(len(qv))
+    return any(kern.cell_value(i, 0.0, qv, zeros_qd, tq0, cell, dmu, 0.0, 0.0) > 0 for i in movers)
+
+
 def ellipse_bcmd(
     packing: Packing,
     *,
@@ -81,6 +87,7 @@ def ellipse_bcmd(
     equilibration: float = 50.0,
     segment_fraction: float = 0.01,
     max_events: int = 10**10,
+    n_inside_samples: int = 2000,
 ) -> xr.Dataset:
     """Linearised BCMD of an isostatic ellipse packing against its exact jamming simplex.
 
@@ -113,6 +120,10 @@ def ellipse_bcmd(
         Relative fall of Delta mu per segment, in (0, 0.5].
     max_events : int
         Bound on the events of one segment.
+    n_inside_samples : int, default 2000
+        Uniform points of the simplex tested against the cells at dmu_max: the fraction inside,
+        ``inside_fraction``, gives ``exact_in_cells`` = exact + ln(fraction) / N_eff, the exact
+        value of what BCMD measures when the initial cells cut the simplex.
 
     Returns
     -------
@@ -120,6 +131,7 @@ def ellipse_bcmd(
         Per-segment ``dmu``, ``time``, ``gamma``, ``ln_k``, ``delta_f``, ``events``; attributes
         ``bcmd`` (Delta f), ``exact`` (the reference's Delta f), ``diff``, ``f_j_minus_fcj``, the
         counts, ``vertices_outside`` (simplex vertices outside the cells at dmu_max),
+        ``inside_fraction`` (+- ``inside_fraction_err``) and ``exact_in_cells``,
         ``next_gap``, event counts and ``seconds``.
 
     Raises
@@ -184,14 +196,16 @@ def ellipse_bcmd(
     verts = _vertices(-rows[:, free_dof], h)
     full = np.zeros((len(verts), 3 * n))
     full[:, free_dof] = verts
-    zeros_qd = np.zeros((n, 3))
-    tq0 = np.zeros(n)
-    vertices_outside = 0
-    for v in full:
-        qv = v.reshape(n, 3)
-        if any(kern.cell_value(i, 0.0, qv, zeros_qd, tq0, cell, dmu_max, 0.0, 0.0) > 0
-               for i in range(n) if free_t[i] or free_r[i]):
-            vertices_outside += 1
+    movers = np.flatnonzero(free_t | free_r)
+    vertices_outside = sum(_outside_cells(v.reshape(n, 3), cell, dmu_max, movers) for v in full)
+    # the fraction of the simplex inside the cells at dmu_max (uniform points of a simplex are
+    # Dirichlet(1, ..., 1) combinations of its vertices)
+    rng_in = np.random.default_rng(12345)
+    weights = rng_in.dirichlet(np.ones(len(full)), size=n_inside_samples)
+    inside = np.array([not _outside_cells((w @ full).reshape(n, 3), cell, dmu_max, movers)
+                       for w in weights])
+    frac = float(inside.mean())
+    frac_err = float(np.sqrt(frac * (1 - frac) / n_inside_samples)) if n_inside_samples else np.nan
 
     rng = np.random.default_rng(seed)
     n_f = int(free_dof.sum())
@@ -256,7 +270,9 @@ def ellipse_bcmd(
         "segment_fraction": segment_fraction, "bcmd": bcmd, "exact": ref.delta_f,
         "diff": bcmd - ref.delta_f, "f_j_minus_fcj": ref.f_j_minus_fcj, "min_force": ref.min_force,
         "next_gap": model.next_gap, "max_contact_gap": model.max_contact_gap,
-        "vertices_outside": vertices_outside, "n_vertices": int(len(verts)),
+        "vertices_outside": int(vertices_outside), "n_vertices": int(len(verts)),
+        "inside_fraction": frac, "inside_fraction_err": frac_err,
+        "exact_in_cells": ref.delta_f + (np.log(frac) / n_eff if frac > 0 else -np.inf),
         "n_pair": int(counts[0]), "n_wall": int(counts[1]), "n_events": int(counts.sum()),
         "length_unit": unit, "seconds": time.perf_counter() - clock,
     }

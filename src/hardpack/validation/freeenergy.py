@@ -171,6 +171,13 @@ def ellipse_rows(ds) -> list[Row]:
         mean, err, seeds, _ = seed_statistics(diff[ran])
         out.append(evaluate(targets["donev-ch6-ellipse-bcmd-vs-exact"], mean, err, n=n, seeds=seeds,
                             detail=f"BCMD - exact = {np.round(diff[ran], 4).tolist()}; {_cost(ds)}"))
+        in_cells = ds["bcmd"].values[ran] - ds["exact_in_cells"].values[ran]
+        mc = ds["inside_fraction_err"].values[ran] / ds["inside_fraction"].values[ran] / ds["n_eff"].values[ran]
+        mean, err, seeds, _ = seed_statistics(in_cells)
+        err = float(np.hypot(0.0 if not np.isfinite(err) else err, np.sqrt(np.mean(mc**2) / mc.size)))
+        out.append(evaluate(targets["bcmd-ellipse-vs-exact-in-cells"], mean, err, n=n, seeds=seeds,
+                            detail=f"BCMD - exact in cells = {np.round(in_cells, 4).tolist()}; simplex "
+                                   f"fraction inside the cells {np.round(ds['inside_fraction'].values[ran], 4).tolist()}"))
     return out
 
 
