@@ -112,8 +112,11 @@ def register(subparsers) -> None:
     p.add_argument("--dmu-max", type=float, default=1.5e-2, help="initial cell size (default 1.5e-2)")
     p.add_argument("--gamma0", type=float, default=1e-3, help="shrink rate at dmu_max (default 1e-3)")
     p.add_argument("--theta", type=float, default=0.5, help="schedule exponent (default 0.5)")
+    p.add_argument("--freeze", choices=("full", "centroid"), default="full",
+                   help="four particles frozen entirely (default; Donev 2006 Fig. 6.5: 96 free and "
+                        "four frozen) or just enough centroids, orientations free")
     p.add_argument("--freeze-seed", type=int, default=0,
-                   help="seed of the order in which frozen-centroid sets are tried (default 0)")
+                   help="seed of the order in which frozen sets are tried (default 0)")
     p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
     p.add_argument("--exact-only", action="store_true", help="the exact simplex only, no BCMD")
     p.set_defaults(func=cmd_bcmd_ellipse)
@@ -148,11 +151,12 @@ def cmd_bcmd_ellipse(args) -> int:
 
     packing = load_packing(args.packing)
     fixed_t, fixed_r, ref = freeze_to_isostatic(packing, args.delta, args.contact_tol,
-                                                seed=args.freeze_seed)
+                                                seed=args.freeze_seed, mode=args.freeze)
     ax = packing.shape.semiaxes
     alphas = np.unique(np.round(ax.max(axis=1) / ax.min(axis=1), 9))
     common = {"source": str(args.packing), "n_fixed_translation": len(fixed_t),
               "n_fixed_rotation": len(fixed_r), "freeze_seed": args.freeze_seed,
+              "freeze": args.freeze,
               "f_c_j": cell_log_volume(float(alphas[0])) if alphas.size == 1 and alphas[0] > 1 else np.nan}
     print(f"N = {ref.n_particles}, M = {ref.n_contacts}, N_f = {ref.n_dof}: {len(fixed_t)} frozen "
           f"centroids {fixed_t.tolist()}, {len(fixed_r)} frozen orientations {fixed_r.tolist()}")
