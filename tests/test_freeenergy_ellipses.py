@@ -171,10 +171,9 @@ def test_not_isostatic_gives_nan_and_the_gap():
     assert ref.isostaticity_gap == 2 and np.isnan(ref.delta_f)
 
 
-# Donev 2006, sec. 6.4.3: a triangular lattice of 100 disks (10 x 10 in a rectangular periodic
-# cell, nearest-neighbour distance 1) turned into ellipses with semiaxes (0.49, 0.245), their
-# orientations uniform in +-0.3 rad (seed 2), compressed by ellipse LS MD
-# (compress_ellipsoids(p, 1e-2, 2, StopCriteria(max_pressure=1e8), final_growth_rate=1e-3,
+# Donev 2006, sec. 6.4.3: lattice_ellipses(seed=2) (a triangular lattice of 100 disks turned into
+# ellipses with semiaxes (0.49, 0.245), orientations uniform in +-0.3 rad), compressed by ellipse
+# LS MD (compress_ellipsoids(p, 1e-2, 2, StopCriteria(max_pressure=1e8), final_growth_rate=1e-3,
 # switch_pressure=1e3); about 2 min) to phi = 0.8852.
 LATTICE_ELLIPSES = Path(__file__).parent / "data" / "ellipses_a2_lattice_n100_p1e8.nc"
 
@@ -204,3 +203,15 @@ def test_alpha_2_lattice_packing_made_isostatic_by_four_frozen_particles(lattice
     assert ref.isostaticity_gap == 0 and ref.n_dof == 3 * 100 - 2 * len(fixed_t) - len(fixed_r)
     with pytest.raises(InvalidInputError, match="mode"):
         freeze_to_isostatic(lattice_ellipses, 1e-4, 1e-6, mode="half")
+
+
+def test_lattice_ellipses_start():
+    from hardpack.freeenergy.ellipses import lattice_ellipses
+
+    p = lattice_ellipses(seed=2)
+    assert p.n_particles == 100 and p.overlap_report(0.0).n_overlapping == 0
+    # 100 ellipses of area pi 0.49 0.245 in a 10 x 5 sqrt(3) cell
+    assert p.phi == pytest.approx(100 * np.pi * 0.49 * 0.245 / (10 * 5 * np.sqrt(3)), rel=1e-12)
+    assert np.all(np.abs(p.shape.orientations) <= 0.3)
+    with pytest.raises(InvalidInputError, match="even"):
+        lattice_ellipses(ny=9)

@@ -449,3 +449,44 @@ def freeze_to_isostatic(
         f"no tried set of frozen particles (mode {mode!r}, {max_tries} tries) makes the packing "
         f"isostatic with positive forces (last: {last})"
     )
+
+
+def lattice_ellipses(nx: int = 10, ny: int = 10, alpha: float = 2.0, spread: float = 0.6,
+                     seed: int = 0) -> Packing:
+    """The start of Donev 2006, sec. 6.4.3: a triangular lattice of nx * ny unit-spaced disks
+    (ny even, in its rectangular periodic cell nx by ny sqrt(3)/2) with each disk replaced by an
+    ellipse of aspect ratio ``alpha`` inscribed in it (semiaxes 0.49 and 0.49 / alpha), its
+    orientation uniform in +-spread/2 about the x axis. Compressing it to jamming
+    (:func:`hardpack.md.ellipsoid.compress_ellipsoids`) gives a partially disordered packing.
+
+    Parameters
+    ----------
+    nx, ny : int, default 10
+        Lattice sites per row and rows (ny even, so the cell is periodic).
+    alpha : float, default 2.0
+        Aspect ratio, >= 1.
+    spread : float, default 0.6
+        Width of the uniform orientation distribution in radians, in [0, pi].
+    seed : int, default 0
+        Seed of the orientations.
+
+    Returns
+    -------
+    Packing
+        The periodic packing of ellipses (no overlaps: each ellipse lies inside its disk).
+    """
+    if int(nx) < 2 or int(ny) < 2 or int(ny) % 2:
+        raise InvalidInputError(f"need nx >= 2 and an even ny >= 2 for a periodic triangular lattice, got {nx}, {ny}")
+    if not (np.isfinite(alpha) and alpha >= 1.0):
+        raise InvalidInputError(f"alpha must be >= 1, got {alpha}")
+    if not 0.0 <= spread <= np.pi:
+        raise InvalidInputError(f"spread must be in [0, pi], got {spread}")
+    from hardpack.geometry.shapes import Ellipsoids
+
+    nx, ny = int(nx), int(ny)
+    row = np.sqrt(3.0) / 2.0
+    pos = np.array([[i + 0.5 * (j % 2), j * row] for j in range(ny) for i in range(nx)]) + 0.25
+    rng = np.random.default_rng(seed)
+    axes = np.tile([0.49, 0.49 / alpha], (nx * ny, 1))
+    angles = rng.uniform(-spread / 2.0, spread / 2.0, nx * ny)
+    return Packing(pos, lattice=np.diag([float(nx), ny * row]), shape=Ellipsoids(axes, angles))
