@@ -114,6 +114,9 @@ def test_ellipse_rows_against_sec_6_4_3():
     # exact-only summaries give the first two rows
     only = ellipse_rows(_ellipse_summary([3.70, 3.72], [np.nan, np.nan], [np.nan, np.nan]))
     assert [r.target for r in only] == ["donev-ch6-ellipse-fcj", "donev-ch6-ellipse-exact"]
+    only = ellipse_rows(_ellipse_summary([3.70, 3.72], [0, 0], [0, 0]).drop_vars(
+        ["bcmd", "exact_in_cells", "inside_fraction", "inside_fraction_err"]))
+    assert [r.target for r in only] == ["donev-ch6-ellipse-fcj", "donev-ch6-ellipse-exact"]
     assert only[1].status == "fail"  # 3.71 +- 0.017 against 3.6693 +- 0.00005
 
 

@@ -113,8 +113,8 @@ def register(subparsers) -> None:
     p.add_argument("--gamma0", type=float, default=1e-3, help="shrink rate at dmu_max (default 1e-3)")
     p.add_argument("--theta", type=float, default=0.5, help="schedule exponent (default 0.5)")
     p.add_argument("--freeze", choices=("full", "centroid"), default="full",
-                   help="four particles frozen entirely (default; Donev 2006 Fig. 6.5: 96 free and "
-                        "four frozen) or just enough centroids, orientations free")
+                   help="the fewest particles frozen entirely (default; Donev 2006 Fig. 6.5: 96 free "
+                        "and four frozen) or just enough centroids, orientations free")
     p.add_argument("--freeze-seed", type=int, default=0,
                    help="seed of the order in which frozen sets are tried (default 0)")
     p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
@@ -122,11 +122,32 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_bcmd_ellipse)
 
     p = subparsers.add_parser(
+        "ellipse-lattice",
+        help="Start of the isostatic ellipse packing: lattice disks turned into ellipses (Donev 2006, sec. 6.4.3).",
+    )
+    p.add_argument("--out", required=True, help="output packing netCDF file")
+    p.add_argument("--alpha", type=float, default=2.0, help="aspect ratio (default 2)")
+    p.add_argument("--spread", type=float, default=0.6,
+                   help="width of the uniform orientation distribution, radians (default 0.6)")
+    p.add_argument("--seed", type=int, default=0, help="orientation seed (default 0)")
+    p.set_defaults(func=cmd_ellipse_lattice)
+
+    p = subparsers.add_parser(
         "bcmd-ellipse-ladder",
         help="Independent ellipses in shrinking cells of their own shape: BCMD against 3 ln(dmu0/dmu1).",
     )
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_bcmd_ellipse_ladder)
+
+
+def cmd_ellipse_lattice(args) -> int:
+    from hardpack.freeenergy.ellipses import lattice_ellipses
+    from hardpack.io import save_packing
+
+    packing = lattice_ellipses(alpha=args.alpha, spread=args.spread, seed=args.seed)
+    save_packing(packing, args.out, seed=args.seed)
+    print(f"{packing.n_particles} ellipses, alpha = {args.alpha}, phi = {packing.phi:.4f}; written {args.out}")
+    return 0
 
 
 def cmd_bcmd_ellipse_ladder(args) -> int:
@@ -167,7 +188,7 @@ def cmd_bcmd_ellipse(args) -> int:
         attrs = {k: v for k, v in dataclasses.asdict(ref).items()}
         attrs.update(common, hardpack_kind="bcmd_ellipse", exact=ref.delta_f, delta=args.delta,
                      contact_tol=args.contact_tol, fixed_translation=fixed_t, fixed_rotation=fixed_r)
-        write_dataset(xr.Dataset(attrs=attrs), args.out)
+        write_dataset(xr.Dataset(attrs=attrs), args.out, seed=args.seed)
         return 0
     ds = ellipse_bcmd(packing, delta=args.delta, contact_tol=args.contact_tol,
                       fixed_translation=fixed_t, fixed_rotation=fixed_r, dmu_max=args.dmu_max,

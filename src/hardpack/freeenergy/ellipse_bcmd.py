@@ -23,6 +23,13 @@ the part of the simplex that the cells at Delta mu_max cut off, reported as
 ``vertices_outside``). Non-contact pairs are ignored, which is valid while Delta mu_max is well
 below their gap (``next_gap``).
 
+The simplex of a disordered packing is very elongated (Donev 2006, sec. 6.4.2: Delta mu_max /
+delta ~ 10^3 for spheres), and BCMD measures ln(|P cap cells(Delta mu_max)| / V_min), not
+ln(|P| / V_min), when the initial cells cut it: ``inside_fraction`` (uniform points of P inside
+the cells at Delta mu_max) gives ``exact_in_cells`` = exact + ln(inside_fraction) / N_eff, the
+exact value of the quantity this run measures, so that the method's own error and the cut are
+told apart.
+
 Lengths are in units of the smallest semiaxis (Donev 2006, sec. 6.2.1), time in units with m = 1
 and kT = 1 at the start, so gamma is the shrink rate of Donev's tables.
 """

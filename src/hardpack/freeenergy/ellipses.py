@@ -351,6 +351,22 @@ def ellipse_simplex_reference(
     )
 
 
+def _frozen_set(ci, cj, n: int, size: int, internal: int, rng) -> np.ndarray:
+    """A random set of ``size`` particles grown along ``internal`` random contacts (a walk on the
+    contact graph), filled up with random particles; the caller checks its contact count."""
+    chosen = [int(rng.integers(n))]
+    for _ in range(min(internal, size - 1)):
+        at = chosen[-1]
+        partners = np.r_[cj[ci == at], ci[cj == at]]
+        partners = partners[~np.isin(partners, chosen)]
+        if partners.size == 0:
+            break
+        chosen.append(int(rng.choice(partners)))
+    rest = np.setdiff1d(np.arange(n), chosen)
+    chosen += rng.choice(rest, size=size - len(chosen), replace=False).tolist()
+    return np.sort(np.array(chosen, dtype=np.int64))
+
+
 def freeze_to_isostatic(
     packing: Packing,
     delta: float,
@@ -358,7 +374,7 @@ def freeze_to_isostatic(
     seed: int = 0,
     max_tries: int = 400,
     mode: str = "centroid",
-    n_frozen: int = 4,
+    n_frozen: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray, EllipseSimplexReference]:
     """Choose frozen particles that make ``packing`` isostatic with positive forces.
 
@@ -374,8 +390,8 @@ def freeze_to_isostatic(
       contacts among frozen particles drop out, so the set must hold exactly
       M - 3(N - n_frozen) - 1 of them.
 
-    Random subsets (in the order of ``seed``) are tried until the augmented matrix is regular with
-    all forces > 0.
+    Random subsets (in the order of ``seed``; in ``"full"`` mode grown along random contacts) are
+    tried until the augmented matrix is regular with all forces > 0.
 
     Parameters
     ----------
@@ -389,8 +405,9 @@ def freeze_to_isostatic(
         Subsets tried before giving up.
     mode : {"centroid", "full"}, default "centroid"
         What a frozen particle loses (above).
-    n_frozen : int, default 4
-        Particles frozen entirely in ``mode="full"``.
+    n_frozen : int, optional
+        Particles frozen entirely in ``mode="full"``; default the fewest that can match,
+        ceil((3N + 1 - M) / 3) (four for Donev's packing and for ours).
 
     Returns
     -------
@@ -419,6 +436,8 @@ def freeze_to_isostatic(
             )
         n_t, n_r = excess // 2, excess % 2
     else:
+        if n_frozen is None:
+            n_frozen = max(1, -(-(3 * n + 1 - m) // 3))
         internal = m - 3 * (n - int(n_frozen)) - 1
         if not 0 <= internal <= m:
             raise InvalidInputError(
@@ -431,7 +450,7 @@ def freeze_to_isostatic(
             pick = rng.choice(n, size=n_t + n_r, replace=False)
             fixed_t, fixed_r = np.sort(pick[:n_t]), np.sort(pick[n_t:])
         else:
-            fixed_t = np.sort(rng.choice(n, size=int(n_frozen), replace=False))
+            fixed_t = _frozen_set(net.i, net.j, n, int(n_frozen), internal, rng)
             inside = np.isin(net.i, fixed_t) & np.isin(net.j, fixed_t)
             if int(inside.sum()) != internal:
                 last = f"{int(inside.sum())} contacts among the frozen, {internal} needed"
