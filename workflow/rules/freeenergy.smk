@@ -184,9 +184,9 @@ rule ellipse_lattice:
     conda:
         "../envs/hardpack.yaml"
     log:
-        "results/logs/bcmd_ellipse/seed{seed}/start.log",
+        "results/logs/ellipse_lattice/seed{seed}.log",
     benchmark:
-        "results/benchmarks/bcmd_ellipse/seed{seed}/start.tsv"
+        "results/benchmarks/ellipse_lattice/seed{seed}.tsv"
     shell:
         "hardpack ellipse-lattice --seed {wildcards.seed} --out {output} > {log} 2>&1"
 
@@ -207,9 +207,9 @@ rule ellipse_lattice_jam:
     conda:
         "../envs/hardpack.yaml"
     log:
-        "results/logs/bcmd_ellipse/seed{seed}/jammed.log",
+        "results/logs/ellipse_lattice_jam/seed{seed}.log",
     benchmark:
-        "results/benchmarks/bcmd_ellipse/seed{seed}/jammed.tsv"
+        "results/benchmarks/ellipse_lattice_jam/seed{seed}.tsv"
     shell:
         "hardpack compress --init {input} --out {output} --growth-rate 1e-2 --final-growth-rate 1e-3"
         " --switch-pressure 1e3 --max-pressure {params.e[max_pressure]} --seed {wildcards.seed}"
@@ -233,9 +233,9 @@ rule bcmd_ellipse:
     conda:
         "../envs/hardpack.yaml"
     log:
-        "results/logs/bcmd_ellipse/seed{seed}/bcmd.log",
+        "results/logs/bcmd_ellipse/seed{seed}.log",
     benchmark:
-        "results/benchmarks/bcmd_ellipse/seed{seed}/bcmd.tsv"
+        "results/benchmarks/bcmd_ellipse/seed{seed}.tsv"
     shell:
         "hardpack bcmd-ellipse {input} --out {output} --delta {params.e[delta]}"
         " --dmu-max {params.e[dmu_max]} --gamma0 {params.e[gamma0]} --theta {params.e[theta]}"
