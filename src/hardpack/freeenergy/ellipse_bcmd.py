@@ -95,6 +95,7 @@ def ellipse_bcmd(
     segment_fraction: float = 0.01,
     max_events: int = 10**10,
     n_inside_samples: int = 2000,
+    refresh: bool = False,
 ) -> xr.Dataset:
     """Linearised BCMD of an isostatic ellipse packing against its exact jamming simplex.
 
@@ -127,6 +128,12 @@ def ellipse_bcmd(
         Relative fall of Delta mu per segment, in (0, 0.5].
     max_events : int
         Bound on the events of one segment.
+    refresh : bool, default False
+        Re-draw the velocity directions at fixed kinetic energy at every segment boundary and 50
+        times during the equilibration. This leaves the microcanonical ensemble and K unchanged
+        (so the estimator too) and forces mixing, which the linearised dynamics may lack: flat
+        contact planes make a polyhedral billiard (Donev 2006, sec. 6.3.3: ergodicity is
+        plausible only with semi-dispersing walls). Off by default (plain MD, as published).
     n_inside_samples : int, default 2000
         Uniform points of the simplex tested against the cells at dmu_max: the fraction inside,
         ``inside_fraction``, gives ``exact_in_cells`` = exact + ln(fraction) / N_eff, the exact
@@ -240,10 +247,19 @@ def ellipse_bcmd(
         if ev >= max_events:
             raise RuntimeError(f"a segment at dmu = {dmu:.4g} exceeded max_events = {max_events}")
 
+    def redraw():
+        k = kinetic()
+        qd[:] = rng.normal(size=(n, 3)) * np.sqrt(mass_inv)
+        qd[:] *= np.sqrt(k / kinetic())
+
     t_eq = equilibration * dmu_max * float(a_scaled.mean())
     if t_eq > 0:
-        segment(dmu_max, 0.0, t_eq)
-        t += t_eq
+        chunks = 50 if refresh else 1
+        for _ in range(chunks):
+            segment(dmu_max, 0.0, t_eq / chunks)
+            t += t_eq / chunks
+            if refresh:
+                redraw()
     k0 = kinetic()
     rows_out = []
     dmu = dmu_max
@@ -254,6 +270,8 @@ def ellipse_bcmd(
         ev0 = int(counts.sum())
         segment(dmu, gamma, dt)
         t += dt
+        if refresh:
+            redraw()
         rows_out.append((dmu_next, t, gamma, np.log(kinetic() / k0), int(counts.sum()) - ev0))
         dmu = dmu_next
     worst_cell = max(kern.cell_value(i, t, q, qd, tq, cell, dmu_min, 0.0, t)
@@ -274,7 +292,7 @@ def ellipse_bcmd(
         "fixed_rotation": np.asarray(np.flatnonzero(~free_r), np.int64),
         "dmu_max": dmu_max, "dmu_min": dmu_min, "dmu_min_pw": model.dmu_min_pw,
         "gamma0": gamma0, "theta": theta, "seed": int(seed), "equilibration": equilibration,
-        "segment_fraction": segment_fraction, "bcmd": bcmd, "exact": ref.delta_f,
+        "segment_fraction": segment_fraction, "refresh": int(refresh), "bcmd": bcmd, "exact": ref.delta_f,
         "diff": bcmd - ref.delta_f, "f_j_minus_fcj": ref.f_j_minus_fcj, "min_force": ref.min_force,
         "next_gap": model.next_gap, "max_contact_gap": model.max_contact_gap,
         "vertices_outside": int(vertices_outside), "n_vertices": int(len(verts)),
