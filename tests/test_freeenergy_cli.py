@@ -87,3 +87,26 @@ def test_bcmd_ladder_cli(tmp_path):
     checked = ds.sel(check=[c for c in ds.check.values if c != "bcmd-simplex-formula"])
     assert np.all(np.abs(checked["value"]) <= 2 * checked["error"])
     assert float(ds["value"].sel(check="bcmd-simplex-formula")) < 1e-9
+
+
+def test_bcmd_ellipse_cli_exact_only(tmp_path, capsys):
+    # the alpha = 2 lattice packing of test_freeenergy_ellipses: four particles frozen entirely,
+    # 96 free (Donev 2006, Fig. 6.5), exact simplex only
+    from pathlib import Path
+
+    src = Path(__file__).parent / "data" / "ellipses_a2_lattice_n100_p1e8.nc"
+    out = tmp_path / "ell.nc"
+    args = parse(["bcmd-ellipse", str(src), "--out", str(out), "--exact-only"])
+    assert args.func(args) == 0
+    ds = load_dataset(out)
+    assert ds.attrs["n_eff"] == 96 and ds.attrs["isostaticity_gap"] == 0
+    assert ds.attrs["freeze"] == "full" and ds.attrs["n_fixed_translation"] == 4
+    assert ds.attrs["f_c_j"] == pytest.approx(2.2694, abs=1e-4)
+    assert "exact: f_J - f_c^J" in capsys.readouterr().out
+
+
+def test_bcmd_ellipse_ladder_cli(tmp_path):
+    out = tmp_path / "ladder.nc"
+    args = parse(["bcmd-ellipse-ladder", "--out", str(out)])
+    assert args.func(args) == 0
+    assert np.all(np.abs(load_dataset(out)["rel_dev"].values) < 1e-3)

@@ -460,6 +460,11 @@ def bcmd_files(condition):
     return [f"results/bcmd_fcc/reps{dens['reps']}/eos/phi{phi}.nc" for phi in dens["phi"]]
 
 
+def ellipse_bcmd_files():
+    """One isostatic alpha = 2 ellipse packing per seed (Donev 2006, sec. 6.4.3)."""
+    return [f"results/bcmd_ellipse/seed{seed}/bcmd.nc" for seed in FREEENERGY["ellipse"]["seeds"]]
+
+
 def simplex_files(ensemble):
     return [f"results/bcmd_simplex/{ensemble}/{frozen}/seed{seed}.nc"
             for seed in FREEENERGY["simplex"]["seeds"] for frozen in ("particle", "cm")]
@@ -680,6 +685,11 @@ def _combined_summaries():
             simplex_files(ensemble), ["seed", "frozen"],
             ["exact", "bcmd", "rel_diff", "isostatic", "isostaticity_gap", "n_backbone", "dim", "n_events",
              "seconds_bcmd", "next_gap"])
+        if FREEENERGY.get("ellipse"):
+            table["bcmd_ellipse/ellipse"] = _combined(
+                ellipse_bcmd_files(), ["seed"],
+                ["f_j_minus_fcj", "exact", "bcmd", "exact_in_cells", "inside_fraction", "inside_fraction_err",
+                 "n_eff", "n_particles", "n_fixed_translation", "n_events", "seconds", "next_gap"])
     for dim in (2, 3):
         files = ellipsoid_files(dim, "contacts")
         if files:
@@ -779,6 +789,9 @@ def validation_inputs():
         inputs["bcmd_density"] = [summary("bcmd_fcc/density"), summary("bcmd_fcc/eos")]
         inputs["bcmd_simplex"] = [summary(f"bcmd_simplex/{FREEENERGY['simplex']['ensemble']}/simplex")]
         inputs["bcmd_ladder"] = ["results/bcmd_ladder/ladder.nc"]
+        if FREEENERGY.get("ellipse"):
+            inputs["bcmd_ellipse"] = [summary("bcmd_ellipse/ellipse")]
+            inputs["bcmd_ellipse_ladder"] = ["results/bcmd_ellipse/ladder.nc"]
     if GLASS:
         inputs["glass_eos"] = [summary("glass/binary/eos")]
         inputs["glass_entropy"] = [summary("glass/binary/entropy"), summary("glass/mono/entropy")]
@@ -887,6 +900,9 @@ EXPECTED_MINUTES = {
     "bcmd_fcc": lambda w: 0.3 + 4 * int(w.reps) ** 3 / 500,
     "fcc_eos": lambda w: 0.3 + FREEENERGY["density"]["eos_collisions"] / 6e7,
     "bcmd_simplex": lambda w: 0.3 + 3.0 * SYSTEMS["ls"][w.ensemble]["N"] / 1000,
+    # 100 ellipses: LS to Z = 1e8 ~2 min; BCMD at gamma0 = 1e-3 ~7 min (2.2e7 events)
+    "ellipse_lattice_jam": lambda w: 3.0,
+    "bcmd_ellipse": lambda w: 0.5 if FREEENERGY["ellipse"].get("exact_only") else 0.5 + 7.0 * 1e-3 / FREEENERGY["ellipse"]["gamma0"],
     "poly_fluid": lambda w: 0.3 + 3 * len(POLY_FLUID["phi"]) * (POLY_FLUID["collisions"] + 50 * POLY_FLUID["N"]) / 6e6,
     "glass_compress": glass_stage_minutes,
     "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],

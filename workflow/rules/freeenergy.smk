@@ -168,3 +168,95 @@ rule fig_bcmd_density:
         "results/benchmarks/fig_bcmd_density.tsv"
     script:
         "../scripts/plot_bcmd_density.py"
+
+
+rule ellipse_lattice:
+    """Start of the isostatic ellipse packing (Donev 2006, sec. 6.4.3): a triangular lattice of 100
+    disks turned into alpha = 2 ellipses, orientations uniform in +-0.3 rad."""
+    output:
+        "results/bcmd_ellipse/seed{seed}/start.nc",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("ellipse_lattice"),
+        runtime=job_runtime("ellipse_lattice"),
+    group:
+        "setup"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/ellipse_lattice/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/ellipse_lattice/seed{seed}.tsv"
+    shell:
+        "hardpack ellipse-lattice --seed {wildcards.seed} --out {output} > {log} 2>&1"
+
+
+rule ellipse_lattice_jam:
+    """The lattice ellipses compressed to jamming by ellipse LS MD (two-stage protocol)."""
+    input:
+        "results/bcmd_ellipse/seed{seed}/start.nc",
+    output:
+        "results/bcmd_ellipse/seed{seed}/jammed.nc",
+    params:
+        e=FREEENERGY.get("ellipse") if FREEENERGY else None,
+        checkpoint=checkpoint_beside,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("ellipse_lattice_jam"),
+        runtime=job_runtime("ellipse_lattice_jam"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/ellipse_lattice_jam/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/ellipse_lattice_jam/seed{seed}.tsv"
+    shell:
+        "hardpack compress --init {input} --out {output} --growth-rate 1e-2 --final-growth-rate 1e-3"
+        " --switch-pressure 1e3 --max-pressure {params.e[max_pressure]} --seed {wildcards.seed}"
+        " --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
+rule bcmd_ellipse:
+    """The jammed lattice ellipses made isostatic by frozen particles: exact simplex and linearised
+    BCMD at the published parameters (Donev 2006, sec. 6.4.3)."""
+    input:
+        "results/bcmd_ellipse/seed{seed}/jammed.nc",
+    output:
+        "results/bcmd_ellipse/seed{seed}/bcmd.nc",
+    params:
+        e=FREEENERGY.get("ellipse") if FREEENERGY else None,
+        exact_only=lambda w: "--exact-only" if FREEENERGY["ellipse"].get("exact_only") else "",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("bcmd_ellipse"),
+        runtime=job_runtime("bcmd_ellipse"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/bcmd_ellipse/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/bcmd_ellipse/seed{seed}.tsv"
+    shell:
+        "hardpack bcmd-ellipse {input} --out {output} --delta {params.e[delta]}"
+        " --dmu-max {params.e[dmu_max]} --gamma0 {params.e[gamma0]} --theta {params.e[theta]}"
+        " --freeze-seed {wildcards.seed} --seed {wildcards.seed} {params.exact_only} > {log} 2>&1"
+
+
+rule bcmd_ellipse_ladder:
+    """Independent ellipses in shrinking cells of their own shape (the disjoint-cell rung)."""
+    output:
+        "results/bcmd_ellipse/ladder.nc",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("bcmd_ellipse_ladder"),
+        runtime=job_runtime("bcmd_ellipse_ladder"),
+    group:
+        "setup"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/bcmd_ellipse_ladder.log",
+    benchmark:
+        "results/benchmarks/bcmd_ellipse_ladder.tsv"
+    shell:
+        "hardpack bcmd-ellipse-ladder --out {output} > {log} 2>&1"

@@ -1,7 +1,9 @@
 """``hardpack bcmd PACKING.nc --out RESULT.nc``: BCMD free energy of a stored packing;
 ``hardpack bcmd-simplex PACKING.nc --jamming VERDICT.nc --out RESULT.nc``: BCMD of its rattler-free
 backbone against the exact jamming simplex (:mod:`hardpack.freeenergy.isostatic`);
-``hardpack bcmd-ladder --out CHECKS.nc``: the cheap checks of :mod:`hardpack.freeenergy.ladder`.
+``hardpack bcmd-ladder --out CHECKS.nc``: the cheap checks of :mod:`hardpack.freeenergy.ladder`;
+``hardpack bcmd-ellipse PACKING.nc --out RESULT.nc``: a jammed ellipse packing made isostatic by
+frozen centroids, its exact simplex and linearised BCMD (:mod:`hardpack.freeenergy.ellipse_bcmd`).
 
 The cells are centred on the stored positions. ``--phi`` rescales all radii to that volume
 fraction (e.g. a lattice at phi = 0.545); ``--delta`` shrinks them by (1 - delta) (a jammed
@@ -97,6 +99,107 @@ def register(subparsers) -> None:
     )
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_bcmd_ladder)
+
+    p = subparsers.add_parser(
+        "bcmd-ellipse",
+        help="Exact simplex and BCMD free energy of a jammed ellipse packing (Donev ch. 6, sec. 6.4.3).",
+    )
+    p.add_argument("packing", help="jammed 2D ellipse packing netCDF file")
+    p.add_argument("--out", required=True, help="output netCDF file")
+    p.add_argument("--delta", type=float, default=1e-4, help="shrink factor 1 - delta (default 1e-4)")
+    p.add_argument("--contact-tol", type=float, default=1e-6,
+                   help="contacts: Perram-Wertheim mu - 1 <= this (default 1e-6)")
+    p.add_argument("--dmu-max", type=float, default=1.5e-2, help="initial cell size (default 1.5e-2)")
+    p.add_argument("--gamma0", type=float, default=1e-3, help="shrink rate at dmu_max (default 1e-3)")
+    p.add_argument("--theta", type=float, default=0.5, help="schedule exponent (default 0.5)")
+    p.add_argument("--freeze", choices=("full", "centroid"), default="full",
+                   help="the fewest particles frozen entirely (default; Donev 2006 Fig. 6.5: 96 free "
+                        "and four frozen) or just enough centroids, orientations free")
+    p.add_argument("--freeze-seed", type=int, default=0,
+                   help="seed of the order in which frozen sets are tried (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
+    p.add_argument("--exact-only", action="store_true", help="the exact simplex only, no BCMD")
+    p.set_defaults(func=cmd_bcmd_ellipse)
+
+    p = subparsers.add_parser(
+        "ellipse-lattice",
+        help="Start of the isostatic ellipse packing: lattice disks turned into ellipses (Donev 2006, sec. 6.4.3).",
+    )
+    p.add_argument("--out", required=True, help="output packing netCDF file")
+    p.add_argument("--alpha", type=float, default=2.0, help="aspect ratio (default 2)")
+    p.add_argument("--spread", type=float, default=0.6,
+                   help="width of the uniform orientation distribution, radians (default 0.6)")
+    p.add_argument("--seed", type=int, default=0, help="orientation seed (default 0)")
+    p.set_defaults(func=cmd_ellipse_lattice)
+
+    p = subparsers.add_parser(
+        "bcmd-ellipse-ladder",
+        help="Independent ellipses in shrinking cells of their own shape: BCMD against 3 ln(dmu0/dmu1).",
+    )
+    p.add_argument("--out", required=True, help="output netCDF file")
+    p.set_defaults(func=cmd_bcmd_ellipse_ladder)
+
+
+def cmd_ellipse_lattice(args) -> int:
+    from hardpack.freeenergy.ellipses import lattice_ellipses
+    from hardpack.io import save_packing
+
+    packing = lattice_ellipses(alpha=args.alpha, spread=args.spread, seed=args.seed)
+    save_packing(packing, args.out, seed=args.seed)
+    print(f"{packing.n_particles} ellipses, alpha = {args.alpha}, phi = {packing.phi:.4f}; written {args.out}")
+    return 0
+
+
+def cmd_bcmd_ellipse_ladder(args) -> int:
+    from hardpack.freeenergy.ellipse_bcmd import disjoint_cells_check
+    from hardpack.io import write_dataset
+
+    ds = disjoint_cells_check()
+    write_dataset(ds, args.out)
+    print(f"relative deviations {ds['rel_dev'].values.tolist()}, {float(ds['seconds'].sum()):.1f} s")
+    return 0
+
+
+def cmd_bcmd_ellipse(args) -> int:
+    import dataclasses
+
+    import numpy as np
+    import xarray as xr
+
+    from hardpack.freeenergy.ellipse_bcmd import ellipse_bcmd
+    from hardpack.freeenergy.ellipses import cell_log_volume, freeze_to_isostatic
+    from hardpack.io import load_packing, write_dataset
+
+    packing = load_packing(args.packing)
+    fixed_t, fixed_r, ref = freeze_to_isostatic(packing, args.delta, args.contact_tol,
+                                                seed=args.freeze_seed, mode=args.freeze)
+    ax = packing.shape.semiaxes
+    alphas = np.unique(np.round(ax.max(axis=1) / ax.min(axis=1), 9))
+    common = {"source": str(args.packing), "n_fixed_translation": len(fixed_t),
+              "n_fixed_rotation": len(fixed_r), "freeze_seed": args.freeze_seed,
+              "freeze": args.freeze,
+              "f_c_j": cell_log_volume(float(alphas[0])) if alphas.size == 1 and alphas[0] > 1 else np.nan}
+    print(f"N = {ref.n_particles}, M = {ref.n_contacts}, N_f = {ref.n_dof}: {len(fixed_t)} frozen "
+          f"centroids {fixed_t.tolist()}, {len(fixed_r)} frozen orientations {fixed_r.tolist()}")
+    print(f"exact: f_J - f_c^J = {ref.f_j_minus_fcj:.5f} (delta -> 0), Delta f = {ref.delta_f:.5f} at "
+          f"delta = {args.delta:g} (dmu_min = {ref.dmu_min:.6g}); smallest force {ref.min_force:.3g}, "
+          f"next gap {ref.next_gap:.3g}")
+    if args.exact_only:
+        attrs = {k: v for k, v in dataclasses.asdict(ref).items()}
+        attrs.update(common, hardpack_kind="bcmd_ellipse", exact=ref.delta_f, delta=args.delta,
+                     contact_tol=args.contact_tol, fixed_translation=fixed_t, fixed_rotation=fixed_r)
+        write_dataset(xr.Dataset(attrs=attrs), args.out, seed=args.seed)
+        return 0
+    ds = ellipse_bcmd(packing, delta=args.delta, contact_tol=args.contact_tol,
+                      fixed_translation=fixed_t, fixed_rotation=fixed_r, dmu_max=args.dmu_max,
+                      gamma0=args.gamma0, theta=args.theta, seed=args.seed)
+    ds.attrs.update(common)
+    write_dataset(ds, args.out, seed=args.seed)
+    a = ds.attrs
+    print(f"BCMD {a['bcmd']:.5f} against exact {a['exact']:.5f} (difference {a['diff']:+.5f}); "
+          f"{a['n_events']} events, {a['seconds']:.1f} s; {a['vertices_outside']} of "
+          f"{a['n_vertices']} simplex vertices outside the cells at dmu_max")
+    return 0
 
 
 def cmd_bcmd_ladder(args) -> int:

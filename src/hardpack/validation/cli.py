@@ -22,7 +22,14 @@ from hardpack.io.atomic import write_text
 from hardpack.validation.analytic import hgrid_rows, moment_table_rows
 from hardpack.validation.containers import container_rows
 from hardpack.validation.ellipsoids import crystal_rows, ellipsoid_jamming_rows, ellipsoid_rows
-from hardpack.validation.freeenergy import bcmd_rows, density_rows, ladder_rows, simplex_rows
+from hardpack.validation.freeenergy import (
+    bcmd_rows,
+    density_rows,
+    ellipse_ladder_rows,
+    ellipse_rows,
+    ladder_rows,
+    simplex_rows,
+)
 from hardpack.validation.glass import entropy_rows, eos_rows, freezing_rows, microsegregated_rows, smix_rows
 from hardpack.validation.jamming import jamming_rows, strict_ls_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
@@ -52,6 +59,8 @@ ROW_BUILDERS = {
     "bcmd_density": lambda datasets: density_rows(**{ds.attrs["state"]: ds for ds in datasets}),
     "bcmd_simplex": lambda datasets: [row for ds in datasets for row in simplex_rows(ds)],
     "bcmd_ladder": lambda datasets: [row for ds in datasets for row in ladder_rows(ds)],
+    "bcmd_ellipse": lambda datasets: [row for ds in datasets for row in ellipse_rows(ds)],
+    "bcmd_ellipse_ladder": lambda datasets: [row for ds in datasets for row in ellipse_ladder_rows(ds)],
     "polydisperse": polydisperse_rows,
     "glass_eos": lambda datasets: [row for ds in datasets for row in eos_rows(ds)],
     "glass_entropy": lambda datasets: [row for ds in datasets for row in entropy_rows(ds)],

@@ -147,3 +147,48 @@ def ladder_rows(ds) -> list[Row]:
         out.append(evaluate(targets[str(check)], float(r["value"]), float(r["error"]),
                             seeds=int(r["n_samples"]), detail=f"cost {float(r['seconds']):.2g} s"))
     return out
+
+
+def ellipse_rows(ds) -> list[Row]:
+    """Isostatic alpha = 2 ellipse packings (Donev 2006, sec. 6.4.3): the cell constant f_c^J, the
+    exact f_J - f_c^J against the published packing's, and BCMD - exact, from a summary of
+    ``hardpack bcmd-ellipse`` runs (variables over ``sample``: ``f_j_minus_fcj``, ``bcmd``,
+    ``exact``, ``n_particles``, ``n_fixed_translation``; ``bcmd`` NaN for exact-only runs)."""
+    from hardpack.freeenergy.ellipses import cell_log_volume
+
+    targets = load_targets()
+    n = int(np.max(ds["n_particles"].values))
+    fixed = np.asarray(ds["n_fixed_translation"].values).astype(int).tolist()
+    out = [evaluate(targets["donev-ch6-ellipse-fcj"], cell_log_volume(2.0),
+                    detail="cell body of Eq. C1 cut by 4000 normals, Richardson step")]
+    exact = ds["f_j_minus_fcj"].values
+    out.append(evaluate(targets["donev-ch6-ellipse-exact"], samples=exact, n=n,
+                        detail=f"{exact.size} packing(s), f_J - f_c^J = {np.round(exact, 4).tolist()}, "
+                               f"frozen centroids {fixed}"))
+    if "bcmd" not in ds:  # exact-only runs
+        return out
+    diff = ds["bcmd"].values - ds["exact"].values
+    ran = np.isfinite(diff)
+    if ran.any():
+        mean, err, seeds, _ = seed_statistics(diff[ran])
+        out.append(evaluate(targets["donev-ch6-ellipse-bcmd-vs-exact"], mean, err, n=n, seeds=seeds,
+                            detail=f"BCMD - exact = {np.round(diff[ran], 4).tolist()}; {_cost(ds)}"))
+        in_cells = ds["bcmd"].values[ran] - ds["exact_in_cells"].values[ran]
+        mc = ds["inside_fraction_err"].values[ran] / ds["inside_fraction"].values[ran] / ds["n_eff"].values[ran]
+        mean, err, seeds, _ = seed_statistics(in_cells)
+        err = float(np.hypot(0.0 if not np.isfinite(err) else err, np.sqrt(np.mean(mc**2) / mc.size)))
+        inside = np.round(ds["inside_fraction"].values[ran], 4).tolist()
+        out.append(evaluate(targets["bcmd-ellipse-vs-exact-in-cells"], mean, err, n=n, seeds=seeds,
+                            detail=f"BCMD - exact in cells = {np.round(in_cells, 4).tolist()}; simplex "
+                                   f"fraction inside the cells {inside}"))
+    return out
+
+
+def ellipse_ladder_rows(ds) -> list[Row]:
+    """Independent ellipses in shrinking cells (:func:`hardpack.freeenergy.ellipse_bcmd.disjoint_cells_check`):
+    the relative deviation of (3/2) ln(K/K0) from 3 ln(dmu_0/dmu_1) over seeds."""
+    rel = ds["rel_dev"].values
+    mean, err, seeds, _ = seed_statistics(rel)
+    cost = float(ds["seconds"].sum())
+    return [evaluate(load_targets()["bcmd-ellipse-disjoint-cells"], mean, err, seeds=seeds,
+                     detail=f"{int(ds.attrs['n_particles'])} ellipses per run; cost {cost:.2g} s")]
