@@ -43,6 +43,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.freeenergy import _ellipse_kernel as kern
+from hardpack.freeenergy.bcmd import _check
 from hardpack.freeenergy.ellipses import (
     _check_round_rotations,
     _free_masks,
@@ -51,17 +52,6 @@ from hardpack.freeenergy.ellipses import (
 )
 from hardpack.geometry.packing import Packing
 from hardpack.jamming.ellipsoids import check_ellipsoid_packing
-
-
-def _check(name, value, lo=0.0, hi=np.inf, lo_open=True):
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"{name} must be a number, got {value!r}") from None
-    ok = np.isfinite(x) and (x > lo if lo_open else x >= lo) and x <= hi
-    if not ok:
-        raise InvalidInputError(f"{name} = {value!r} is out of range ({'(' if lo_open else '['}{lo}, {hi}])")
-    return x
 
 
 def _vertices(at: np.ndarray, h: np.ndarray) -> np.ndarray:

@@ -57,6 +57,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 
 from hardpack.errors import InvalidInputError
+from hardpack.freeenergy.isostatic import check_shrink_gap
 from hardpack.freeenergy.simplex import jamming_simplex, log_simplex_volume
 from hardpack.geometry.ellipsoid_pairs import potential_pairs
 from hardpack.geometry.packing import Packing
@@ -307,14 +308,7 @@ def ellipse_simplex_reference(
     check_ellipsoid_packing(packing)
     if packing.dim != 2:
         raise InvalidInputError("the exact ellipse free energy is implemented in 2D only")
-    delta = float(delta)
-    if not 0.0 < delta < 1e-2:
-        raise InvalidInputError(f"delta = {delta!r} must be in (0, 0.01): the simplex is linear")
-    if not 0.0 < contact_tol < delta:
-        raise InvalidInputError(
-            f"contact_tol = {contact_tol!r} must be in (0, delta = {delta}): contacts must close "
-            "to much less than the shrink gap"
-        )
+    delta = check_shrink_gap(delta, contact_tol)
     n = packing.n_particles
     free_t, free_r = _free_masks(n, fixed_translation, fixed_rotation)
     if free_t.all():

@@ -90,6 +90,20 @@ class SimplexReference:
     next_gap: float
 
 
+def check_shrink_gap(delta, contact_tol) -> float:
+    """The relative shrink gap delta as a float, refused outside (0, 0.01) (the jamming simplex is
+    linear only there), and the contact tolerance, refused outside (0, delta)."""
+    delta = float(delta)
+    if not 0.0 < delta < 1e-2:
+        raise InvalidInputError(f"delta = {delta!r} must be in (0, 0.01): the simplex is linear")
+    if not 0.0 < contact_tol < delta:
+        raise InvalidInputError(
+            f"contact_tol = {contact_tol!r} must be in (0, delta = {delta}): contacts must close "
+            "to much less than the shrink gap"
+        )
+    return delta
+
+
 def simplex_reference(backbone: Packing, delta: float, contact_tol: float) -> SimplexReference:
     """Exact reference for BCMD on ``backbone`` shrunk by (1 - delta) (module docstring).
 
@@ -121,14 +135,7 @@ def simplex_reference(backbone: Packing, delta: float, contact_tol: float) -> Si
         :func:`jamming_simplex` and :func:`log_simplex_volume`).
     """
     backbone.require_periodic_spheres("the exact simplex free energy")
-    delta = float(delta)
-    if not 0.0 < delta < 1e-2:
-        raise InvalidInputError(f"delta = {delta!r} must be in (0, 0.01): the simplex is linear")
-    if not 0.0 < contact_tol < delta:
-        raise InvalidInputError(
-            f"contact_tol = {contact_tol!r} must be in (0, delta = {delta}): contacts must close "
-            "to much less than the shrink gap"
-        )
+    delta = check_shrink_gap(delta, contact_tol)
     net = contact_network(backbone, contact_tol)
     near = pairs_within(backbone, rel_gap=1e-3)
     next_gap = float(np.min(near.gap[near.gap > contact_tol], initial=np.inf))
