@@ -250,6 +250,26 @@ def test_mm_row_passes_fails_and_is_na_below_its_size():
     assert row(_mm_summary(sizes=(1000, 2000), fit_min_n=500)).status == NA  # two sizes
 
 
+def test_the_shape_name_picks_the_ellipsoid_row():
+    """The summary's shape_name chooses the published bulk density: the same data pass as M&Ms
+    (0.700) and fail as ollipsoids (0.741); a shape without a published value has no row."""
+    from hardpack.validation.containers import container_rows
+    from hardpack.validation.rows import FAIL, PASS
+
+    ds = _mm_summary()
+    ds.attrs["shape_name"] = "ollipsoid"
+    rows = {r.target: r for r in container_rows([ds])}
+    assert list(rows) == ["donev-7.3-ollipsoid-phi0"] and rows["donev-7.3-ollipsoid-phi0"].status == FAIL
+    assert container_rows([_mm_summary(phi0=0.741)]) and \
+        {r.status for r in container_rows([_summary_named(_mm_summary(phi0=0.741), "ollipsoid")])} == {PASS}
+    assert container_rows([_summary_named(_mm_summary(), "prolate")]) == []
+
+
+def _summary_named(ds, name):
+    ds.attrs["shape_name"] = name
+    return ds
+
+
 def test_a_particle_pinned_across_the_container_stays_inside_to_round_off():
     """A prolate spheroid grown until its long axis nearly spans the container (phi -> 1/4) bounces
     between two wall contacts ~1e-10 apart in time: the wall pressure grows past 1e13 while the gap

@@ -49,7 +49,7 @@ MICROSEG = config.get("microsegregated")
 ELLIPSOIDS = config.get("ellipsoids")
 ELLIPSOID_CRYSTALS = config.get("ellipsoid_crystals")
 CONTAINERS = config.get("containers")
-MM_CONTAINERS = config.get("mm_containers")
+ELLIPSOID_CONTAINERS = config.get("ellipsoid_containers")
 STRICT_LS = config.get("strict_ls")
 VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
@@ -233,7 +233,7 @@ def _systems():
             dilute=f"--fraction {SLP_DILUTED['fraction']} --rounds {SLP_DILUTED['rounds']}")
     systems["ellipsoids"] = _ellipsoid_systems()
     systems["containers"] = _container_systems()
-    systems["mm_containers"] = _mm_container_systems()
+    systems["ellipsoid_containers"] = _ellipsoid_container_systems()
     systems["strict_ls"] = _strict_ls_systems()
     return systems
 
@@ -268,21 +268,25 @@ def _container_systems():
     return systems
 
 
-def _mm_container_systems():
-    """M&M-shaped ellipsoids grown to jamming in spherical containers, one system n{N} per container
-    size (Donev 2006, Sec. 7.3.2.1): a dilute start inside the container, the two-stage protocol."""
-    if not MM_CONTAINERS:
+def _ellipsoid_container_systems():
+    """Ellipsoids grown to jamming in spherical containers, one system {shape}_n{N} per shape and
+    container size (Donev 2006, Sec. 7.3.2.1): a dilute start inside the container, the two-stage
+    protocol."""
+    if not ELLIPSOID_CONTAINERS:
         return {}
-    c = MM_CONTAINERS
+    c = ELLIPSOID_CONTAINERS
     compress = (f"--growth-rate {c['growth_rate']} --final-growth-rate {c['final_growth_rate']}"
                 f" --switch-pressure {c['switch_pressure']} --max-pressure {c['max_pressure']}")
-    return {f"n{n}": _system(n, 3, c["seeds"], c["init_phi"], attrs={}, compress=compress,
-                             semiaxes=list(c["semiaxes"]), boundary="spherical_container") for n in c["N"]}
+    return {f"{shape}_n{n}": _system(n, 3, c["seeds"], c["init_phi"], attrs={"shape_name": shape},
+                                     compress=compress, semiaxes=list(axes), boundary="spherical_container")
+            for shape, axes in c["shapes"].items() for n in c["N"]}
 
 
-def mm_container_files(step):
-    """Per-seed files of every M&M container size (results/mm_containers/n{N}/{step}/seed{seed}.nc)."""
-    return [path for name in SYSTEMS["mm_containers"] for path in seed_files("mm_containers", name, step)]
+def ellipsoid_container_files(shape, step):
+    """Per-seed files of every container size of one shape
+    (results/ellipsoid_containers/{shape}_n{N}/{step}/seed{seed}.nc)."""
+    return [path for name, s in SYSTEMS["ellipsoid_containers"].items() if s["attrs"]["shape_name"] == shape
+            for path in seed_files("ellipsoid_containers", name, step)]
 
 
 def container_files(step):
@@ -809,8 +813,9 @@ def validation_inputs():
         inputs["ellipsoid_crystals"] = ["results/ellipsoid_crystals/laminate_family.nc"]
     if CONTAINERS:
         inputs["containers"] = ["results/containers/profile_summary.nc", "results/containers/windows_summary.nc"]
-    if MM_CONTAINERS:
-        inputs.setdefault("containers", []).append("results/mm_containers/summary.nc")
+    if ELLIPSOID_CONTAINERS:
+        inputs.setdefault("containers", []).extend(
+            f"results/ellipsoid_containers/{shape}/summary.nc" for shape in ELLIPSOID_CONTAINERS["shapes"])
     if STRICT_LS:
         inputs["strict_ls"] = [summary(f"strict_ls/{name}/verdict") for name in SYSTEMS["strict_ls"]]
     return inputs
@@ -936,7 +941,7 @@ PARTICLES = {
     **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd"),
                     lambda w: GLASS["N"]),
     **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
-    "mm_container_init": lambda w: SYSTEMS["mm_containers"][w.name]["N"],
+    "ellipsoid_container_init": lambda w: SYSTEMS["ellipsoid_containers"][w.name]["N"],
     "microseg_packing": lambda w: MICROSEG["shape"][0] * MICROSEG["shape"][1],
 }
 

@@ -190,57 +190,60 @@ rule fig_container_windows:
         "../scripts/plot_containers.py"
 
 
-# M&M-shaped ellipsoids in spherical containers (Donev 2006, Sec. 7.3.2.1 and Fig. 7.6): a dilute
-# random start inside the container, LS compression by the generic compress job, and the Eq. 7.2
-# extrapolation of the average density over (N, seed).
+# Ellipsoids in spherical containers (Donev 2006, Sec. 7.3.2.1 and Fig. 7.6), one ensemble per shape
+# (M&M spheroids, ollipsoids): a dilute random start inside the container, LS compression by the
+# generic compress job, and the Eq. 7.2 extrapolation of the average density over (N, seed).
 
 
-rule mm_container_init:
-    """Dilute random start of one container size and seed: bounding spheres by RSA inside the
-    container, random orientations (hardpack init --semiaxes --boundary spherical_container)."""
+rule ellipsoid_container_init:
+    """Dilute random start of one shape, container size and seed: bounding spheres by RSA inside
+    the container, random orientations (hardpack init --semiaxes --boundary spherical_container)."""
     output:
-        "results/mm_containers/{name}/init/seed{seed}.nc",
+        "results/ellipsoid_containers/{name}/init/seed{seed}.nc",
     params:
-        n=lambda w: SYSTEMS["mm_containers"][w.name]["N"],
-        phi=lambda w: SYSTEMS["mm_containers"][w.name]["init_phi"],
-        semiaxes=lambda w: " ".join(f"{a:.17g}" for a in SYSTEMS["mm_containers"][w.name]["semiaxes"]),
+        n=lambda w: SYSTEMS["ellipsoid_containers"][w.name]["N"],
+        phi=lambda w: SYSTEMS["ellipsoid_containers"][w.name]["init_phi"],
+        semiaxes=lambda w: " ".join(f"{a:.17g}" for a in SYSTEMS["ellipsoid_containers"][w.name]["semiaxes"]),
     threads: 1
     resources:
-        mem_mb=job_mem_mb("mm_container_init"),
-        runtime=job_runtime("mm_container_init"),
+        mem_mb=job_mem_mb("ellipsoid_container_init"),
+        runtime=job_runtime("ellipsoid_container_init"),
     group:
         "setup"
     conda:
         "../envs/hardpack.yaml"
     log:
-        "results/logs/mm_container_init/{name}/seed{seed}.log",
+        "results/logs/ellipsoid_container_init/{name}/seed{seed}.log",
     benchmark:
-        "results/benchmarks/mm_container_init/{name}/seed{seed}.tsv"
+        "results/benchmarks/ellipsoid_container_init/{name}/seed{seed}.tsv"
     shell:
         "hardpack init --n {params.n} --d 3 --phi {params.phi} --semiaxes {params.semiaxes}"
         " --boundary spherical_container --seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
-rule mm_container_summary:
-    """The M&M container packings over (N, seed) and the Eq. 7.2 extrapolation of their average
-    density to a/R -> 0 over the sizes N >= fit_min_n."""
+rule ellipsoid_container_summary:
+    """The container packings of one shape over (N, seed) and the Eq. 7.2 extrapolation of their
+    average density to a/R -> 0 over the sizes N >= fit_min_n."""
     input:
-        mm_container_files("jammed") if MM_CONTAINERS else [],
+        lambda w: ellipsoid_container_files(w.shape, "jammed"),
     output:
-        "results/mm_containers/summary.nc",
+        "results/ellipsoid_containers/{shape}/summary.nc",
     params:
-        fit_min_n=lambda w: MM_CONTAINERS["fit_min_n"],
+        fit_min_n=lambda w: ELLIPSOID_CONTAINERS["fit_min_n"],
+        shape_name=lambda w: w.shape,
+    wildcard_constraints:
+        shape="[a-z][a-z0-9]*",
     threads: 1
     resources:
-        mem_mb=job_mem_mb("mm_container_summary"),
-        runtime=job_runtime("mm_container_summary"),
+        mem_mb=job_mem_mb("ellipsoid_container_summary"),
+        runtime=job_runtime("ellipsoid_container_summary"),
     group:
         "summaries"
     conda:
         "../envs/hardpack.yaml"
     log:
-        "results/logs/mm_container_summary.log",
+        "results/logs/ellipsoid_container_summary/{shape}.log",
     benchmark:
-        "results/benchmarks/mm_container_summary.tsv"
+        "results/benchmarks/ellipsoid_container_summary/{shape}.tsv"
     script:
-        "../scripts/mm_container_summary.py"
+        "../scripts/ellipsoid_container_summary.py"

@@ -49,7 +49,7 @@ rule compress:
         options=lambda w: system(w)["compress"],
         checkpoint=checkpoint_option,
     wildcard_constraints:
-        study="ls|ls_rates|ellipsoids|containers|mm_containers|strict_ls",
+        study="ls|ls_rates|ellipsoids|containers|ellipsoid_containers|strict_ls",
     threads: 1
     resources:
         mem_mb=job_mem_mb("compress"),

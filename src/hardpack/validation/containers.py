@@ -10,8 +10,10 @@ Inputs (the pipeline's ``containers`` summaries, told apart by ``hardpack_kind``
   (the bulk value phi_0 that the extrapolation estimates).
 - ``ellipsoid_container_summary``
   (:func:`hardpack.structure.containers.ellipsoid_container_summary`): the Eq. 7.2 intercept of
-  jammed M&M-shaped oblate spheroids in spherical containers against 0.700 +- 0.002
-  (Sec. 7.3.2.1), judged at the largest N of the fit with its number of sizes.
+  jammed ellipsoids in spherical containers, by the summary's ``shape_name``: M&M-shaped oblate
+  spheroids (``mm``) against 0.700 +- 0.002 and ollipsoids (``ollipsoid``) against
+  0.741 +- 0.002 (Sec. 7.3.2.1), judged at the largest N of the fit with its number of sizes;
+  other shapes have no row.
 - ``window_study`` (:func:`hardpack.structure.containers.window_study`): sigma_phi averaged over
   the packings, fitted by a power law over 2R/D >= fit_min_diameter
   (:func:`~hardpack.structure.containers.fit_window_power_law`): the exponent against -2 and the
@@ -59,14 +61,21 @@ def _bulk_rows(targets, summary) -> list[Row]:
     return rows
 
 
-def _mm_rows(targets, summary) -> list[Row]:
+#: the Eq. 7.2 row of each named ellipsoid shape (``shape_name`` of the summary)
+ELLIPSOID_CONTAINER_TARGETS = {"mm": "donev-7.3-mm-phi0", "ollipsoid": "donev-7.3-ollipsoid-phi0"}
+
+
+def _ellipsoid_rows(targets, summary) -> list[Row]:
+    name = summary.attrs.get("shape_name", "mm")
+    if name not in ELLIPSOID_CONTAINER_TARGETS:
+        return []  # a shape without a published bulk density
     n = np.asarray(summary["N"].values)
     a = summary.attrs
     fitted = n[n >= a["fit_min_n"]]
     sizes = ", ".join(map(str, sorted(set(fitted.tolist()))))
     axes = np.atleast_1d(np.asarray(a["semiaxes"], float))
     semiaxes = ":".join(f"{v:.3g}" for v in axes / axes.min())
-    return [evaluate(targets["donev-7.3-mm-phi0"], float(a["phi0"]), float(a["phi0_err"]),
+    return [evaluate(targets[ELLIPSOID_CONTAINER_TARGETS[name]], float(a["phi0"]), float(a["phi0_err"]),
                      n=int(fitted.max()) if fitted.size else 0, sizes=int(a["n_sizes_fit"]),
                      label=f"Eq. 7.2 intercept, semiaxes {semiaxes}",
                      detail=f"linear fit over {a['n_fit']} packings, N = {sizes or 'none'}; "
@@ -111,7 +120,7 @@ def container_rows(datasets) -> list[Row]:
         if kind == "container_summary":
             out += _bulk_rows(targets, ds)
         elif kind == "ellipsoid_container_summary":
-            out += _mm_rows(targets, ds)
+            out += _ellipsoid_rows(targets, ds)
         elif kind == "window_study":
             out += _window_rows(targets, ds)
     return out
