@@ -21,6 +21,7 @@ from hardpack.geometry.lattices import lattice_packing
 from hardpack.geometry.packing import Packing
 from hardpack.io import load_dataset, save_packing
 from hardpack.jamming import cli, contact_network, highs, lp, sequential, verify, workingset
+from hardpack.jamming.highs import recording_fallbacks
 
 
 def _shrunk(p: Packing, s: float) -> Packing:
@@ -113,14 +114,28 @@ def test_trace_within_the_lp_accuracy_is_made_exact(trace_excess):
     assert mot.solver == "working-set" and np.trace(mot.strain) <= 0.0
 
 
-def test_trace_beyond_the_lp_accuracy_is_refused(trace_excess):
+@pytest.fixture
+def every_trace_too_large(monkeypatch):
+    """A negative accuracy: every strict solution, HiGHS's included, breaks Tr eps <= 0 by more."""
+    monkeypatch.setattr(lp, "TRACE_TOLERANCE", -1.0)
+
+
+def test_a_working_set_trace_beyond_the_lp_accuracy_is_solved_again_by_highs(trace_excess):
+    """The working set's round-off (1e-9 of the box in a rotated HCP cell) is not the LP's answer:
+    HiGHS solves that LP again, Tr eps <= 0 holds, and the fallback is counted."""
     trace_excess[0] = 1e-6 * 0.05
-    with pytest.raises(lp.VolumeIncrease, match="Tr eps = .* volume constraint"):
+    with recording_fallbacks() as counts:
+        mot = _strict_motion()
+    assert mot.solver == "highs" and np.trace(mot.strain) <= lp.TRACE_TOLERANCE * 0.05
+    assert counts["lp_volume_to_highs"] == 1
+
+
+def test_a_highs_trace_beyond_the_lp_accuracy_is_refused(every_trace_too_large):
+    with pytest.raises(lp.VolumeIncrease, match="highs solution .*Tr eps = .* volume constraint"):
         _strict_motion()
 
 
-def test_trace_beyond_the_lp_accuracy_leaves_the_strict_test_undetermined(trace_excess):
-    trace_excess[0] = 1e-6
+def test_trace_beyond_the_lp_accuracy_leaves_the_strict_test_undetermined(every_trace_too_large):
     p = _shrunk(lattice_packing("triangular", (2, 2)), 1e-4)
     r = verify(p, delta=0.2, method="sequential", seed=2, threshold=1e-2, contact_delta=1e-3)
     assert r.collective and r.strict is None

@@ -35,6 +35,9 @@ FALLBACKS = {
                              "exact to 1e-7 only",
     "lp_working_set_to_highs": "LPs that the sparse-LU working set gave up and HiGHS solved (the "
                                "same optimum to the solver tolerances; slower)",
+    "lp_volume_to_highs": "strict LPs whose working-set solution broke Tr eps <= 0 beyond the LP "
+                          "accuracy and HiGHS solved again (with a strain description far from "
+                          "the axes the working set's round-off can reach 1e-9 of the box)",
     "uniform_forces_lp_failed": "backbones whose most-uniform-force LP failed: the forces are those "
                                 "of the jamming-gap LP, not the most uniform ones",
 }

@@ -159,15 +159,20 @@ def solve_motion(
     solver = "working-set" if sol is not None else "highs"
     if working_set and sol is None:
         note_fallback("lp_working_set_to_highs")
+    eps = None
     if sol is not None:
         x, f, objective, warm = sol.x, sol.forces, sol.objective, WarmStart.of(sol, keys)
-    else:
+        if strict and np.trace(strain_tensor(x[n_pos:], d)) > TRACE_TOLERANCE * box:
+            note_fallback("lp_volume_to_highs")  # the working set's accuracy, not the LP's answer
+            sol, solver = None, "highs"
+    if sol is None:
         x, f, objective, basis = _highs_motion(g, h, c, upper)
         warm = WarmStart.from_columns(basis, np.zeros(0, dtype=np.int64), keys, nvar)
     disp = np.zeros(n * d)
     disp[dof_moving] = x[:n_pos]
     disp = disp.reshape(n, d)
-    eps = _volume_checked(strain_tensor(x[n_pos:], d), box, solver) if strict else None
+    if strict:
+        eps = _volume_checked(strain_tensor(x[n_pos:], d), box, solver)
     forces = np.zeros(net.n_contacts)
     forces[use] = f[: int(use.sum())]
     return Motion(disp, eps, forces, objective, time.perf_counter() - t0, warm, solver)
