@@ -222,6 +222,15 @@ def test_figures_are_written(tmp_path):
     save(plot_radial_profile(profiles), tmp_path / "profile.pdf")
     save(plot_extrapolation(_summary()), tmp_path / "extrapolation.pdf", tmp_path / "extrapolation.png")
     save(plot_extrapolation(_summary(bulk=_bulk())), tmp_path / "extrapolation_bulk.pdf")
+    mm = _summary(phi0=0.700, slope=-0.4)
+    mm.attrs["shape_name"] = "mm"
+    odd = _summary(phi0=0.690)
+    odd.attrs["shape_name"] = "prolate"  # a shape without a published value: no star
+    fig = plot_extrapolation(_summary(bulk=_bulk()), [mm, odd])
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any("M&M fit" in t for t in labels) and any("0.700" in t for t in labels)
+    assert any("prolate packings" in t for t in labels)
+    save(fig, tmp_path / "extrapolation_ellipsoids.pdf")
     save(plot_window_fluctuations(_windows()), tmp_path / "windows.pdf")
     assert all((tmp_path / f).stat().st_size > 1000 for f in ("profile.pdf", "extrapolation.png", "windows.pdf"))
 

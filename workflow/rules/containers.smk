@@ -141,9 +141,12 @@ rule fig_container_profile:
 
 
 rule fig_container_extrapolation:
-    """phi_avg vs a/R with the linear fit and its intercept (after Donev 2006, Fig. 7.6)."""
+    """phi_avg vs a/R with the linear fit and its intercept (after Donev 2006, Fig. 7.6), spheres
+    and every ellipsoid shape of the config."""
     input:
         "results/containers/profile_summary.nc",
+        lambda w: [f"results/ellipsoid_containers/{shape}/summary.nc"
+                   for shape in (ELLIPSOID_CONTAINERS or {}).get("shapes", {})],
     output:
         pdf="results/figures/container_extrapolation.pdf",
         png=report("results/figures/container_extrapolation.png", caption="../report/containers.rst", category="7 containers"),

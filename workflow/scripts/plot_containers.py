@@ -12,7 +12,7 @@ datasets = [load_dataset(path) for path in snakemake.input]
 if kind == "profile":
     fig = plot_radial_profile(datasets)
 elif kind == "extrapolation":
-    fig = plot_extrapolation(datasets[0])
+    fig = plot_extrapolation(datasets[0], datasets[1:])  # spheres, then the ellipsoid shapes
 else:
     fig = plot_window_fluctuations(datasets[0])
 save(fig, snakemake.output.pdf, snakemake.output.png)

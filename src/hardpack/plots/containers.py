@@ -13,6 +13,8 @@ from hardpack.validation.rows import seed_statistics
 
 #: Donev 2006, Sec. 7.3.2.1: the extrapolated bulk density of jammed spheres, 0.642 +- 0.002
 DONEV_PHI0 = (0.642, 0.002)
+#: Donev 2006, Sec. 7.3.2.1: simulated bulk densities of the named ellipsoid shapes
+DONEV_ELLIPSOID_PHI0 = {"mm": ("M&M", 0.700, 0.002), "ollipsoid": ("ollipsoid", 0.741, 0.002)}
 #: Donev 2006, Fig. 7.5: the core density far from the wall, about 0.64
 DONEV_CORE = 0.64
 
@@ -48,26 +50,31 @@ def plot_radial_profile(profiles):
     return fig
 
 
-def plot_extrapolation(summary):
+def plot_extrapolation(summary, ellipsoids=()):
     """The average density phi_avg against delta = a/R of every packing, the mean per N, and the
     linear fit of Eq. 7.2 extended to delta = 0 with its intercept phi_0 +- s.e., beside Donev's
     0.642 +- 0.002 (Donev 2006, Sec. 7.3.2.1, Fig. 7.6) and, when the summary has them, the mean
-    density of periodic packings made with the same protocol (dashed, band: s.e.).
+    density of periodic packings made with the same protocol (dashed, band: s.e.); the same for
+    each ellipsoid shape, beside Donev's value for the M&M and ollipsoid shapes.
 
     Parameters
     ----------
     summary : xarray.Dataset
         :func:`hardpack.structure.containers.container_summary` output.
+    ellipsoids : sequence of xarray.Dataset, optional
+        :func:`hardpack.structure.containers.ellipsoid_container_summary` outputs (attribute
+        ``shape_name``).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure(figsize=(5.0, 3.4))
+    ellipsoids = list(ellipsoids)
+    fig, ax = figure(figsize=(7.6, 3.6) if ellipsoids else (5.0, 3.4))
     n = np.asarray(summary["N"].values)
     delta = np.asarray(summary["a_over_R"].values, float)
     phi = np.asarray(summary["phi_avg"].values, float)
-    ax.plot(delta, phi, "o", ms=3, mfc="none", color="C0", label="packings")
+    ax.plot(delta, phi, "o", ms=3, mfc="none", color="C0", label="sphere packings")
     for size in np.unique(n):
         mean, sem, _, _ = seed_statistics(phi[n == size])
         ax.errorbar(delta[n == size].mean(), mean, 0 if not np.isfinite(sem) else sem, fmt="s", ms=4, color="C0")
@@ -75,7 +82,7 @@ def plot_extrapolation(summary):
     if np.isfinite(phi0):
         grid = np.linspace(0, delta.max() * 1.05, 50)
         ax.plot(grid, phi0 + slope * grid, "-", color="C1",
-                label=rf"fit (N $\geq$ {summary.attrs['fit_min_n']}): $\phi_0$ = {phi0:.4f} $\pm$ {err:.4f}")
+                label=rf"sphere fit (N $\geq$ {summary.attrs['fit_min_n']}): $\phi_0$ = {phi0:.4f} $\pm$ {err:.4f}")
         ax.errorbar([0], [phi0], [err], fmt="o", color="C1", capsize=3)
     if "phi_bulk" in summary.attrs:
         bulk, bulk_err = summary.attrs["phi_bulk"], summary.attrs["phi_bulk_err"]
@@ -86,11 +93,33 @@ def plot_extrapolation(summary):
             ax.axhspan(bulk - bulk_err, bulk + bulk_err, color="C2", alpha=0.15, lw=0)
     ax.errorbar([0], [DONEV_PHI0[0]], [DONEV_PHI0[1]], fmt="*", ms=8, color="k", capsize=3,
                 label=r"Donev 2006: $\phi_0$ = 0.642 $\pm$ 0.002")
+    for k, ell in enumerate(ellipsoids):
+        _ellipsoid_extrapolation(ax, ell, f"C{k + 3}")
     ax.set_xlim(left=-0.005)
     ax.set_xlabel(r"$\delta = a/R$")
     ax.set_ylabel(r"$\phi_{avg}$")
-    ax.legend(fontsize=7)
+    if ellipsoids:  # beside the axes: the shapes' points span the plot
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0)
+    else:
+        ax.legend(fontsize=7)
     return fig
+
+
+def _ellipsoid_extrapolation(ax, summary, color):
+    """One ellipsoid shape's packings, its Eq. 7.2 line and intercept, and Donev's value."""
+    name = summary.attrs.get("shape_name", "ellipsoids")
+    label, published, published_err = DONEV_ELLIPSOID_PHI0.get(name, (name, np.nan, np.nan))
+    delta = np.asarray(summary["a_over_R"].values, float)
+    ax.plot(delta, np.asarray(summary["phi_avg"].values, float), "^", ms=3, mfc="none", color=color,
+            label=f"{label} packings")
+    phi0, err, slope = (summary.attrs[k] for k in ("phi0", "phi0_err", "slope"))
+    if np.isfinite(phi0):
+        grid = np.linspace(0, delta.max() * 1.05, 50)
+        ax.plot(grid, phi0 + slope * grid, "-", color=color, lw=1,
+                label=rf"{label} fit: $\phi_0$ = {phi0:.4f} $\pm$ {err:.4f}")
+    if np.isfinite(published):
+        ax.errorbar([0], [published], [published_err], fmt="*", ms=8, color=color, mec="k", capsize=3,
+                    label=rf"Donev 2006, {label}: {published:.3f} $\pm$ {published_err:.3f}")
 
 
 def plot_window_fluctuations(windows):
