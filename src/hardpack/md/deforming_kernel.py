@@ -80,16 +80,23 @@ def wrap_into_cell(X, H, Hinv):
     n, d = X.shape
     s = np.empty(d)
     for i in range(n):
-        for k in range(d):
-            acc = 0.0
-            for q in range(d):
-                acc += Hinv[k, q] * X[i, q]
-            s[k] = np.floor(acc)
+        _wrap_one(X, i, H, Hinv, s)
+
+
+@njit(cache=True, inline="always")
+def _wrap_one(X, i, H, Hinv, s):
+    """Move position i into the cell by whole lattice vectors (``s``: scratch of length d)."""
+    d = X.shape[1]
+    for k in range(d):
+        acc = 0.0
         for q in range(d):
-            acc = 0.0
-            for k in range(d):
-                acc += H[q, k] * s[k]
-            X[i, q] -= acc
+            acc += Hinv[k, q] * X[i, q]
+        s[k] = np.floor(acc)
+    for q in range(d):
+        acc = 0.0
+        for k in range(d):
+            acc += H[q, k] * s[k]
+        X[i, q] -= acc
 
 
 @njit(cache=True, inline="always")
@@ -202,6 +209,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
     tv[:] = 0.0
     rv = np.empty(d)
     xi = np.empty(d)
+    wrap = np.empty(d)  # scratch of _wrap_one
     upd = np.empty(2, dtype=np.int64)
     for i in range(n):  # complete rebuild at t = 0 (positions wrapped by the caller)
         for k in range(d):
@@ -241,17 +249,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 for k in range(d):
                     X[i, k] += V[i, k] * dt
                 T[i] = t
-                s_acc = np.empty(d)  # wrap i into the cell
-                for k in range(d):
-                    a2 = 0.0
-                    for q in range(d):
-                        a2 += Hinv[k, q] * X[i, q]
-                    s_acc[k] = np.floor(a2)
-                for q in range(d):
-                    a2 = 0.0
-                    for k in range(d):
-                        a2 += H[q, k] * s_acc[k]
-                    X[i, q] -= a2
+                _wrap_one(X, i, H, Hinv, wrap)  # wrap i into the cell
                 for e in range(nn[i]):  # drop i from its old neighbours' lists (each list once)
                     j = nb[i, e] // m
                     if mark[j]:
