@@ -31,7 +31,7 @@ from hardpack.io import checkpoint as ckpt
 from hardpack.md.compress import StopCriteria, _check_final_stage, default_window, run_windows, timeseries_dataset
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, rotational_dof
 from hardpack.md.ellipsoid_kernel import EPS_F
-from hardpack.md.simulation import OverlapError, Simulation, maxwell_boltzmann
+from hardpack.md.simulation import OverlapError, Simulation, check_start_configuration, maxwell_boltzmann
 
 log = logging.getLogger("hardpack.md")
 
@@ -50,16 +50,7 @@ def check_ellipsoid_packing(packing: Packing) -> None:
     if not packing.is_orthorhombic:
         raise InvalidInputError("the ellipsoid MD engine supports orthorhombic (diagonal) periodic "
                                 "cells only; this lattice is sheared: pass a diagonal lattice")
-    if packing.n_particles < (2 if packing.boundary.kind == "periodic" else 1):
-        raise InvalidInputError("MD in a periodic cell needs at least 2 particles")
-    walls = packing.containment_report(DEFAULT_OVERLAP_TOL)
-    if walls.n_outside:
-        raise InvalidInputError(f"the start configuration crosses the container wall ({walls}); "
-                                "hard-particle MD needs every particle inside")
-    report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
-    if report.n_overlapping:
-        raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
-                                "hard-particle MD needs a non-overlapping start")
+    check_start_configuration(packing)
 
 
 def random_angular_velocities(n: int, d: int, inertia: np.ndarray, seed) -> np.ndarray:

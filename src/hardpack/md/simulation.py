@@ -101,18 +101,23 @@ def check_packing(packing: Packing) -> None:
             "the MD engine supports orthorhombic (diagonal) cells only; this lattice is "
             "sheared. Deforming/sheared cells are not implemented yet: pass a diagonal lattice"
         )
+    check_start_configuration(packing)
+
+
+def check_start_configuration(packing: Packing) -> None:
+    """The start checks every MD engine shares: at least 2 particles in a periodic cell (1 is
+    enough with walls), every particle inside its walls, no overlaps."""
     if packing.n_particles < (2 if packing.boundary.kind == "periodic" else 1):
         raise InvalidInputError("MD in a periodic cell needs at least 2 particles")
     walls = packing.containment_report(DEFAULT_OVERLAP_TOL)
     if walls.n_outside:
-        raise InvalidInputError(f"the start configuration crosses the boundary ({walls}); hard-sphere "
-                                "MD needs every particle inside its walls")
+        where = "the container wall" if packing.boundary.kind == "spherical_container" else "the boundary"
+        raise InvalidInputError(f"the start configuration crosses {where} ({walls}); hard-particle MD "
+                                "needs every particle inside its walls")
     report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
     if report.n_overlapping:
-        raise InvalidInputError(
-            f"the start configuration has overlapping particles ({report}); hard-sphere MD needs a "
-            "non-overlapping start"
-        )
+        raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
+                                "hard-particle MD needs a non-overlapping start")
 
 
 class Simulation:
