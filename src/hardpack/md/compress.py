@@ -261,10 +261,23 @@ def timeseries_dataset(sim: Simulation, attrs: dict) -> xr.Dataset:
     return ds
 
 
+def stop_pressure(records: dict) -> float:
+    """The reduced pressure that ends a compression at ``max_pressure``: the collision-virial Z of
+    the last window, or, in a window without pair collisions (Z = 1 exactly: a particle alone in
+    a container, or particles held apart only by hard walls), the pressure on the walls Z_wall,
+    which diverges when such a packing jams."""
+    z = records["Z"][-1]
+    if z == 1.0 and records.get("Z_wall"):
+        z_wall = records["Z_wall"][-1]
+        if math.isfinite(z_wall):
+            return z_wall
+    return z
+
+
 def _stop_reason(stop: StopCriteria, sim: Simulation, started: float) -> str | None:
     rec = sim.records
     if rec["Z"]:
-        if sim.growth_rate > 0 and stop.max_pressure is not None and rec["Z"][-1] >= stop.max_pressure:
+        if sim.growth_rate > 0 and stop.max_pressure is not None and stop_pressure(rec) >= stop.max_pressure:
             return "max_pressure"
         phi = rec["phi"][-1]
         if stop.target_phi is not None:
@@ -324,6 +337,11 @@ def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     n, d = packing.n_particles, packing.dim
     walls = packing.boundary.wall_contacts(packing.positions, packing.radii, packing.lattice, gap)
     on_wall = np.bincount(walls.particle, minlength=n)
+    if packing.boundary.kind == "spherical_container":
+        # a sphere within the gap of the wall on its FAR side too (R + |x - c| <= a (1 + gap))
+        # touches it all round: it cannot move in any direction, as with d + 1 contacts
+        far = packing.boundary.radius + np.linalg.norm(packing.positions - np.array(packing.boundary.centre), axis=1)
+        on_wall[far <= packing.radii * (1.0 + gap)] = d + 1
     alive = np.ones(n, dtype=bool)
     while True:
         keep = alive[i] & alive[j]
@@ -591,6 +609,8 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
         "overlap_check": "passed" if report.n_overlapping == 0 else "failed",
         "mass": 1.0, "kT": 1.0,
     }
+    if sim.boundary.kind != "periodic":
+        stats["Z_wall"] = float(sim.records["Z_wall"][-1]) if sim.records["Z_wall"] else float("nan")
     if final_growth_rate is not None:
         stats.update({
             "final_growth_rate": float(final_growth_rate), "switch_pressure": float(switch_pressure),

@@ -55,6 +55,7 @@ class EllipsoidEngine(Engine):
         if kind not in ("periodic", "spherical_container"):
             raise ValueError(f"the ellipsoid engine runs periodic cells or spherical containers, not {kind}")
         self.wmode = ek.PERIODIC_MODE if kind == "periodic" else ek.SPHERE_MODE
+        self.walled = np.full(d, 0 if kind == "periodic" else 1, dtype=np.int8)  # a container walls every axis
         self.wspec = np.zeros(d + 1)
         if kind == "spherical_container":
             self.wspec[:d] = boundary.centre

@@ -226,18 +226,21 @@ class Engine:
         max_h(a + skin s) GRID_HEADROOM (head room for growth) and has cells of width >= 2 rcap_h
         (at most MAX_CELLS_PER_PARTICLE per particle of the level), so a particle's own level is
         searched in 3^d cells and the other levels in the cells within R_i + rcap_l.
-        rcap <= L_min / 4 keeps every pair to one periodic image (L > 2 (R_i + R_j)); a box too
-        small for even a thin skin is refused."""
+        rcap <= L_min / 4, L_min the shortest PERIODIC box side, keeps every pair to one periodic
+        image (L > 2 (R_i + R_j)); a periodic box too small for even a thin skin is refused. Axes
+        with walls have no images and set no cap (in a spherical container or a closed box a
+        particle may grow to fill the container)."""
         a = self.radii
         amax = float(a.max())
-        lmin = float(self.box.min())
+        periodic = self.box[self.walled == 0]
+        lmin = float(periodic.min()) if periodic.size else np.inf
         self.sfac = self.skin_factors()
         bound = a + skin * self.sfac
         if min(float(bound.max()) * GRID_HEADROOM, 0.25 * lmin) < amax * (1.0 + MIN_SHELL):
             raise InvalidInputError(
                 f"the periodic box is too small for these particles: the largest diameter "
-                f"{2 * amax:.4g} must stay below half the shortest box side {lmin:.4g} (so that a "
-                "pair touches through one periodic image only); use more particles or a larger box"
+                f"{2 * amax:.4g} must stay below half the shortest periodic box side {lmin:.4g} (so "
+                "that a pair touches through one periodic image only); use more particles or a larger box"
             )
         levels = geometric_levels(bound, float(np.prod(self.box)), self.d, LEVEL_RATIO)
         lvl = levels.level
