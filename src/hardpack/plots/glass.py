@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib import rc_context
 
@@ -95,7 +97,8 @@ def plot_microsegregated(summary):
         x = np.linspace(lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo), 100)
         ax.plot(x, fit(x), "r-", lw=1.0, label=_fit_label(fit))
     else:
-        ax.plot([], [], " ", label=str(summary.attrs.get("sc_fit_status", "no fit in the summary")))
+        status = str(summary.attrs.get("sc_fit_status", "no fit in the summary"))
+        ax.plot([], [], " ", label=textwrap.fill(status, 60))
     with rc_context(RC):
         fig.colorbar(points, ax=ax, label=r"$R$ (Matérn correlation length)")
         ax.set_xlabel(r"$\phi_J$")
