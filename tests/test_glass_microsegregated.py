@@ -153,3 +153,133 @@ def test_figure_draws(tmp_path):
 
     save(plot_microsegregated(_fake_summary()), tmp_path / "f.png")
     assert (tmp_path / "f.png").stat().st_size > 0
+
+
+# --- Figs. 13.16-13.17: the exponential fit of s_c(phi_J) and the (R, nu) maps -----------------
+
+def _exponential(phi, s_ref=0.6, decay=150.0, phi_ref=0.846):
+    return s_ref * np.exp(-decay * (np.asarray(phi) - phi_ref))
+
+
+def test_exponential_fit_is_exact_on_exact_data_at_any_reference_density():
+    from hardpack.glass.microsegregated import fit_sc_exponential
+
+    phi = np.linspace(0.846, 0.862, 7)
+    fit = fit_sc_exponential(phi, _exponential(phi))
+    assert fit.s_ref == pytest.approx(0.6, rel=1e-9) and fit.decay == pytest.approx(150.0, rel=1e-9)
+    assert fit.s_ref_err < 1e-9 and fit.decay_err < 1e-6 and fit.n_points == 7
+    np.testing.assert_allclose(fit(phi), _exponential(phi), rtol=1e-9)
+    # quoting s_ref at another density moves s_ref along the curve and leaves the decay
+    moved = fit_sc_exponential(phi, _exponential(phi), phi_ref=0.85)
+    assert moved.s_ref == pytest.approx(_exponential(0.85), rel=1e-9) and moved.decay == pytest.approx(150.0)
+
+
+def test_exponential_fit_recovers_known_parameters_with_calibrated_errors():
+    """Noisy synthetic data (n = 10, sd 0.01 in s_c): over 400 replicates the estimates centre on
+    the true (s_ref, decay) and the reported standard errors match the replicates' scatter."""
+    from hardpack.glass.microsegregated import fit_sc_exponential
+
+    rng = np.random.default_rng(11)
+    phi = np.linspace(0.846, 0.862, 10)
+    fits = [fit_sc_exponential(phi, _exponential(phi) + rng.normal(0.0, 0.01, phi.size)) for _ in range(400)]
+    for name, true in (("s_ref", 0.6), ("decay", 150.0)):
+        values = np.array([getattr(f, name) for f in fits])
+        errors = np.array([getattr(f, name + "_err") for f in fits])
+        sd = values.std(ddof=1)
+        assert abs(values.mean() - true) < 3 * sd / np.sqrt(values.size), name
+        assert errors.mean() / sd == pytest.approx(1.0, abs=0.15), name  # scatter of sd: 3.5 %
+        inside = np.mean(np.abs(values - true) < 2 * errors)
+        assert 0.85 < inside < 0.98, name  # Student t with 8 dof: 0.92
+
+
+@pytest.mark.parametrize("phi, s, match", [
+    ([0.85, 0.86], [0.5, 0.4], "at least 3 points"),
+    ([0.85, np.nan, 0.87], [0.5, 0.4, 0.3], "finite"),
+    ([0.85, 0.86, 0.87], [0.5, np.inf, 0.3], "finite"),
+    ([0.85, 0.86, 0.87], [0.5, 0.4], "one value per ensemble"),
+    ([0.85, 0.86, 0.87], [0.5, 0.0, 0.3], "positive"),
+    ([0.85, 0.85, 0.85], [0.5, 0.4, 0.3], "undetermined"),
+])
+def test_exponential_fit_refuses_bad_input(phi, s, match):
+    from hardpack.glass.microsegregated import fit_sc_exponential
+
+    with pytest.raises(InvalidInputError, match=match):
+        fit_sc_exponential(phi, s)
+
+
+def test_summary_carries_the_fit_or_says_why_not(tmp_path):
+    from hardpack.glass.microsegregated import ExponentialFit, fit_sc_exponential, summary_dataset
+    from hardpack.io import load_dataset, write_dataset
+
+    ds = _fake_summary()
+    assert ds.attrs["sc_fit_status"] == "fitted" and ds.attrs["sc_fit_points"] == 6
+    direct = fit_sc_exponential(ds["phi_J"].values, ds["s_c"].values)
+    write_dataset(ds, tmp_path / "s.nc", seed=1)
+    assert ExponentialFit.from_attrs(load_dataset(tmp_path / "s.nc").attrs) == direct
+    two = summary_dataset([_fake_packing("random", 0.01, 0.5, 0.63, 0.846), _fake_packing("R1", 1, 0.1, 0.6, 0.847)])
+    assert two.attrs["sc_fit_status"].startswith("not fitted") and "at least 3 points" in two.attrs["sc_fit_status"]
+    assert np.isnan(two.attrs["sc_fit_s_ref"]) and ExponentialFit.from_attrs(two.attrs) is None
+
+
+def test_grid_maps_put_each_ensemble_in_its_cell_and_leave_missing_cells_missing():
+    from hardpack.glass.microsegregated import grid_maps
+
+    ds = _fake_summary()  # R1_nu0.1, R1_nu0.5, R3_nu0.3, R5_nu0.1, R5_nu0.5 and random
+    maps = grid_maps(ds, [5, 3, 1], [0.1, 0.3, 0.5])
+    assert maps["R"].values.tolist() == [5, 3, 1] and maps["nu"].values.tolist() == [0.1, 0.3, 0.5]
+    cell = maps.sel(R=3, nu=0.3)
+    assert str(cell["ensemble"].values) == "R3_nu0.3"
+    assert float(cell["phi_J"]) == float(ds.sel(ensemble="R3_nu0.3")["phi_J"])
+    assert float(cell["s_c"]) == float(ds.sel(ensemble="R3_nu0.3")["s_c"])
+    missing = maps.sel(R=1, nu=0.3)
+    assert np.isnan(float(missing["phi_J"])) and np.isnan(float(missing["s_c"])) and int(missing["n_packings"]) == 0
+    assert maps.attrs["missing_cells"] == 4 and maps.attrs["off_grid"] == "random"
+    assert int(np.isfinite(maps["phi_J"].values).sum()) == 5
+
+
+@pytest.mark.parametrize("r_values, nu_values, match", [
+    ([], [0.1], "non-empty"), ([1, np.nan], [0.1], "finite"), ([1, 1], [0.1], "repeat"),
+])
+def test_grid_maps_refuse_a_bad_grid(r_values, nu_values, match):
+    from hardpack.glass.microsegregated import grid_maps
+
+    with pytest.raises(InvalidInputError, match=match):
+        grid_maps(_fake_summary(), r_values, nu_values)
+
+
+def test_grid_maps_refuse_two_ensembles_in_one_cell_and_other_datasets():
+    from hardpack.glass.microsegregated import grid_maps, summary_dataset
+
+    twins = summary_dataset([_fake_packing(name, 1, 0.1, 0.5, 0.85) for name in ("a", "b", "c")])
+    with pytest.raises(InvalidInputError, match="same"):
+        grid_maps(twins, [1], [0.1])
+    with pytest.raises(InvalidInputError, match="microsegregated_summary"):
+        grid_maps(_fake_summary().assign_attrs(hardpack_kind="packing"), [1], [0.1])
+
+
+def test_figures_show_the_fit_and_the_missing_cells(tmp_path):
+    from hardpack.glass.microsegregated import grid_maps, summary_dataset
+    from hardpack.plots.glass import plot_microsegregated, plot_microsegregated_maps
+    from hardpack.plots.style import save
+
+    fig = plot_microsegregated(_fake_summary())
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any("fit" in t and r"s_{\rm ref}" in t for t in labels), labels
+    save(fig, tmp_path / "fit.png")
+    two = summary_dataset([_fake_packing("random", 0.01, 0.5, 0.63, 0.846), _fake_packing("R1", 1, 0.1, 0.6, 0.847)])
+    fig = plot_microsegregated(two)
+    assert any("not fitted" in t.get_text() for t in fig.legends[0].get_texts())
+    save(fig, tmp_path / "nofit.png")
+
+    fig = plot_microsegregated_maps(grid_maps(_fake_summary(), [1, 3, 5], [0.1, 0.3, 0.5]))
+    panels = [ax for ax in fig.axes if ax.get_xlabel().startswith(r"$\nu$")]
+    assert len(panels) == 2
+    for ax in panels:
+        mesh = ax.collections[0].get_array()
+        assert int(np.ma.count_masked(mesh)) == 4  # missing, not drawn as a value
+        assert [t.get_text() for t in ax.texts].count("missing") == 4
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["0.1", "0.3", "0.5"]
+    colourbar_labels = {ax.get_ylabel() for ax in fig.axes if ax not in panels}
+    assert any(r"\phi_J" in s for s in colourbar_labels) and any("s_c" in s for s in colourbar_labels)
+    save(fig, tmp_path / "maps.png")
+    assert all((tmp_path / f).stat().st_size > 0 for f in ("fit.png", "nofit.png", "maps.png"))

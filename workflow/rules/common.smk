@@ -766,7 +766,7 @@ def figures():
     names += ["ellipsoid_snapshot"] if ELLIPSOIDS and "mm" in ELLIPSOIDS else []
     names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
     names += ["glass_eos", "glass_entropy"] if GLASS else []
-    names += ["microsegregated"] if MICROSEG else []
+    names += ["microsegregated", "microsegregated_maps"] if MICROSEG else []
     names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []
     names += ["strict_ls_disks"] if "d2" in SYSTEMS["strict_ls"] else []
     return [f"results/figures/{name}.pdf" for name in names]

@@ -5,7 +5,9 @@
 #   results/microseg/labels/{ensemble}.nc            labels and window entropies (s_c)
 #   results/microseg/{ensemble}/r{realisation}.nc     jammed packing (phi_J, s_c in its attributes)
 #   results/microseg/{ensemble}/growth_r{realisation}.nc   the growth at constant pressure (Fig. 13.14)
-#   results/microseg/phij_sc_summary.nc               phi_J and s_c per ensemble
+#   results/microseg/phij_sc_summary.nc               phi_J and s_c per ensemble, the exponential fit s_c(phi_J)
+#   results/figures/microsegregated.pdf               s_c vs phi_J with the fit (Fig. 13.16)
+#   results/figures/microsegregated_maps.pdf          phi_J(R, nu) and s_c(R, nu) on the config's grid (Fig. 13.17)
 
 
 rule microseg_labels:
@@ -98,7 +100,7 @@ rule microseg_summary:
 
 
 rule fig_microsegregated:
-    """s_c vs phi_J of the micro-segregated packings (after Donev 2006, Fig. 13.16)."""
+    """s_c vs phi_J of the micro-segregated packings with the exponential fit (after Donev 2006, Fig. 13.16)."""
     input:
         summary("microseg/phij_sc"),
     output:
@@ -119,3 +121,30 @@ rule fig_microsegregated:
         "results/benchmarks/fig_microsegregated.tsv"
     script:
         "../scripts/plot_microsegregated.py"
+
+
+rule fig_microsegregated_maps:
+    """phi_J(R, nu) and s_c(R, nu) over the config's grid of Matérn parameters (after Donev 2006, Fig. 13.17)."""
+    input:
+        summary("microseg/phij_sc"),
+    output:
+        pdf="results/figures/microsegregated_maps.pdf",
+        png=report("results/figures/microsegregated_maps.png", caption="../report/microsegregated_maps.rst",
+                   category="5 glasses"),
+    params:
+        R=MICROSEG["R"] if MICROSEG else None,
+        nu=MICROSEG["nu"] if MICROSEG else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_microsegregated_maps"),
+        runtime=job_runtime("fig_microsegregated_maps"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_microsegregated_maps.log",
+    benchmark:
+        "results/benchmarks/fig_microsegregated_maps.tsv"
+    script:
+        "../scripts/plot_microsegregated_maps.py"

@@ -23,12 +23,17 @@ Choices made here (the text does not fix them):
   (:func:`hardpack.md.deforming.compress_deforming`, uniform growth, shape relaxed at fixed
   volume) to a reduced pressure ``max_pressure``; phi_J is the final volume fraction and
   ``phi_J_est`` = phi / (1 - d / p) of its last window.
+
+Figures 13.16 and 13.17 of the text are built from :func:`summary_dataset`: the exponential fit of
+s_c against phi_J (:func:`fit_sc_exponential`, whose parameters the text does not print) and the
+maps of s_c and phi_J over the (R, nu) grid (:func:`grid_maps`).
 """
 
 from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
@@ -40,6 +45,9 @@ from hardpack.md.deforming import CELL_STEP, DeformingSimulation, compress_defor
 from hardpack.md.simulation import maxwell_boltzmann
 
 PHI_MAX = math.pi / math.sqrt(12.0)
+#: phi_J of the uncorrelated labels, the MRJ state of the binary disks (Donev 2006, Fig. 13.13);
+#: the reference density of the exponential fit of s_c(phi_J)
+PHI_MRJ = 0.846
 #: relative shortfall of the size ratio at which the growth counts as finished (round-off of the
 #: kernel's A (1 + kappa t))
 RATIO_TOL = 1e-12
@@ -240,7 +248,10 @@ def summary_dataset(packings) -> xr.Dataset:
         ``phi_J`` (mean over the ensemble's packings), ``phi_J_err`` (standard error; NaN for one
         packing), ``n_packings``, ``phi_J_est_start`` (mean phi~_J at the start of the growth,
         Fig. 13.14), ``growth_pressure_error`` (mean); attributes ``N``, ``s_c_window``,
-        ``hardpack_kind`` = "microsegregated_summary".
+        ``hardpack_kind`` = "microsegregated_summary" and the exponential fit of s_c against
+        phi_J over all the ensembles (:func:`fit_sc_exponential`; ``sc_fit_*`` of
+        :meth:`ExponentialFit.to_attrs`), whose ``sc_fit_status`` is "fitted" or says why there
+        is no fit (its values are then NaN).
     """
     groups: dict[str, list] = {}
     for ds in packings:
@@ -265,7 +276,7 @@ def summary_dataset(packings) -> xr.Dataset:
         if len({(float(a["R"]), float(a["nu"]), float(a["s_c"])) for a in groups[name]}) != 1:
             raise InvalidInputError(f"ensemble {name!r} mixes label parameters or label statistics")
     dim = ("ensemble",)
-    return xr.Dataset(
+    ds = xr.Dataset(
         {"R": (dim, column("R")), "nu": (dim, column("nu")), "s_c": (dim, column("s_c")),
          "s_33": (dim, column("s_33")), "s_mix": (dim, column("s_mix")),
          "phi_J": (dim, column("phi_J")), "phi_J_err": (dim, column("phi_J", stderr)),
@@ -275,3 +286,185 @@ def summary_dataset(packings) -> xr.Dataset:
         coords={"ensemble": names},
         attrs={"hardpack_kind": "microsegregated_summary", "N": sizes.pop(), "s_c_window": windows.pop(),
                "reference": "Donev 2006, sec. 13.5, Figs. 13.16-13.17"})
+    ds.attrs.update(_fit_attrs(ds["phi_J"].values, ds["s_c"].values))
+    return ds
+
+
+def _fit_attrs(phi_j, s_c) -> dict:
+    try:
+        fit = fit_sc_exponential(phi_j, s_c)
+    except InvalidInputError as exc:
+        nan = float("nan")
+        empty = ExponentialFit(nan, nan, nan, nan, nan, PHI_MRJ, len(phi_j), nan)
+        return {**empty.to_attrs(), "sc_fit_status": f"not fitted: {exc}"}
+    return {**fit.to_attrs(), "sc_fit_status": "fitted"}
+
+
+@dataclass(frozen=True)
+class ExponentialFit:
+    """s_c(phi_J) = s_ref exp[-decay (phi_J - phi_ref)] fitted by :func:`fit_sc_exponential`, with
+    the standard errors and the correlation of the two fitted parameters (phi_ref is fixed)."""
+
+    s_ref: float
+    s_ref_err: float
+    decay: float
+    decay_err: float
+    correlation: float
+    phi_ref: float
+    n_points: int
+    rms_residual: float
+
+    FORM = "s_c = s_ref exp[-decay (phi_J - phi_ref)]"
+
+    def __call__(self, phi_j):
+        return self.s_ref * np.exp(-self.decay * (np.asarray(phi_j, float) - self.phi_ref))
+
+    def to_attrs(self, prefix: str = "sc_fit_") -> dict:
+        """The fit as netCDF attributes (floats and the form), keys prefixed."""
+        values = {"form": self.FORM, "phi_ref": self.phi_ref, "s_ref": self.s_ref, "s_ref_err": self.s_ref_err,
+                  "decay": self.decay, "decay_err": self.decay_err, "correlation": self.correlation,
+                  "points": self.n_points, "rms_residual": self.rms_residual}
+        return {prefix + k: v for k, v in values.items()}
+
+    @classmethod
+    def from_attrs(cls, attrs, prefix: str = "sc_fit_"):
+        """The fit stored by :meth:`to_attrs`, or None when the attributes hold no fitted values."""
+        keys = ("s_ref", "s_ref_err", "decay", "decay_err", "correlation", "phi_ref", "points", "rms_residual")
+        if any(prefix + k not in attrs for k in keys) or not math.isfinite(float(attrs[prefix + "s_ref"])):
+            return None
+        values = {k: float(attrs[prefix + k]) for k in keys}
+        values["n_points"] = int(values.pop("points"))
+        return cls(**values)
+
+
+def fit_sc_exponential(phi_j, s_c, phi_ref: float = PHI_MRJ) -> ExponentialFit:
+    """Exponential fit of the configurational entropy against the jamming density (Donev 2006,
+    sec. 13.5, Fig. 13.16, whose fit parameters are not printed).
+
+    The model is s_c(phi_J) = s_ref exp[-decay (phi_J - phi_ref)]: s_ref is s_c at the fixed
+    density phi_ref (default the MRJ density 0.846 of Fig. 13.13, so s_ref compares with s_mix)
+    and decay = -d ln s_c / d phi_J. It is fitted by unweighted nonlinear least squares in s_c,
+    started from the straight-line fit of ln s_c. The standard errors are those of the
+    linearised least squares with the variance estimated from the residuals (RSS / (n - 2)): the
+    scatter about the curve, whatever its source (phi_J of a few packings per ensemble, the
+    sampling of s_c, a curve that is not exponential), sets them.
+
+    Parameters
+    ----------
+    phi_j : array_like
+        Jamming densities, one per label ensemble; finite, not all equal.
+    s_c : array_like
+        Configurational entropies per site of the same ensembles; finite and positive.
+    phi_ref : float
+        The density at which ``s_ref`` is quoted (finite).
+
+    Returns
+    -------
+    ExponentialFit
+        s_ref and decay with standard errors and their correlation, the number of points and the
+        rms residual in s_c.
+
+    Raises
+    ------
+    InvalidInputError
+        Fewer than 3 points (two parameters leave no residual to estimate their errors),
+        arrays of different lengths, non-finite or non-positive s_c, non-finite phi_J or all
+        phi_J equal.
+    """
+    from scipy.optimize import curve_fit
+
+    x = np.asarray(phi_j, dtype=float).ravel()
+    y = np.asarray(s_c, dtype=float).ravel()
+    if x.size != y.size:
+        raise InvalidInputError(f"phi_J and s_c must have one value per ensemble each, got {x.size} and {y.size}")
+    if x.size < 3:
+        raise InvalidInputError(f"the exponential fit has two parameters and needs at least 3 points for their "
+                                f"standard errors, got {x.size}; run more label ensembles (R, nu)")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y)) and math.isfinite(phi_ref)):
+        raise InvalidInputError(f"phi_J, s_c and phi_ref must be finite, got phi_J = {x.tolist()}, "
+                                f"s_c = {y.tolist()}, phi_ref = {phi_ref!r}")
+    if not np.all(y > 0):
+        raise InvalidInputError(f"s_c must be positive (an entropy per site of labels with both species), "
+                                f"got {y.tolist()}")
+    dx = x - phi_ref
+    if np.ptp(dx) == 0:
+        raise InvalidInputError(f"all phi_J equal {x[0]!r}: the decay of s_c with phi_J is undetermined")
+    slope, intercept = np.polyfit(dx, np.log(y), 1)
+
+    def model(u, s_ref, decay):
+        return s_ref * np.exp(-decay * u)
+
+    params, cov = curve_fit(model, dx, y, p0=(math.exp(intercept), -slope))
+    residual = y - model(dx, *params)
+    err = np.sqrt(np.diag(cov))
+    corr = float(cov[0, 1] / (err[0] * err[1])) if np.all(err > 0) else float("nan")
+    return ExponentialFit(s_ref=float(params[0]), s_ref_err=float(err[0]), decay=float(params[1]),
+                          decay_err=float(err[1]), correlation=corr, phi_ref=float(phi_ref), n_points=int(x.size),
+                          rms_residual=float(np.sqrt(np.mean(residual ** 2))))
+
+
+def _grid_values(name: str, values) -> np.ndarray:
+    v = np.asarray(values, dtype=float).ravel()
+    if v.size == 0 or not np.all(np.isfinite(v)):
+        raise InvalidInputError(f"the grid's {name} values must be a non-empty list of finite numbers, got {values!r}")
+    if np.unique(v).size != v.size:
+        raise InvalidInputError(f"the grid's {name} values must not repeat, got {v.tolist()}")
+    return v
+
+
+def grid_maps(summary: xr.Dataset, r_values, nu_values) -> xr.Dataset:
+    """s_c(R, nu) and phi_J(R, nu) of the label ensembles on a grid of Matérn parameters (Donev
+    2006, Fig. 13.17).
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        A ``microsegregated_summary`` dataset (:func:`summary_dataset`).
+    r_values, nu_values : sequence of float
+        The grid's correlation lengths R and smoothness parameters nu, in the order to show them
+        (the config's lists); finite, no repeats.
+
+    Returns
+    -------
+    xarray.Dataset
+        Along ``R`` and ``nu`` (the given values): ``s_c``, ``phi_J`` (mean over the packings),
+        ``phi_J_err``, ``n_packings`` and ``ensemble``. A cell without an ensemble is missing:
+        NaN values, 0 packings, ensemble "". Attributes: ``N``, ``s_c_window`` and
+        ``reference`` of the summary, ``hardpack_kind`` = "microsegregated_maps",
+        ``missing_cells`` and ``off_grid`` (the ensembles off the grid, e.g. "random", comma
+        separated).
+
+    Raises
+    ------
+    InvalidInputError
+        Not a summary, a bad grid, or two ensembles with the same (R, nu).
+    """
+    if summary.attrs.get("hardpack_kind") != "microsegregated_summary":
+        raise InvalidInputError("expected a microsegregated_summary dataset (hardpack glass-microsegregated-summary)")
+    r_grid, nu_grid = _grid_values("R", r_values), _grid_values("nu", nu_values)
+    shape = (r_grid.size, nu_grid.size)
+    columns = {"s_c": np.full(shape, np.nan), "phi_J": np.full(shape, np.nan), "phi_J_err": np.full(shape, np.nan)}
+    n_packings = np.zeros(shape, dtype=int)
+    ensemble = np.full(shape, "", dtype=object)
+    off_grid = []
+    for k, name in enumerate(summary["ensemble"].values):
+        rows = np.flatnonzero(np.isclose(r_grid, float(summary["R"].values[k]), rtol=1e-9, atol=0.0))
+        cols = np.flatnonzero(np.isclose(nu_grid, float(summary["nu"].values[k]), rtol=1e-9, atol=0.0))
+        if rows.size == 0 or cols.size == 0:
+            off_grid.append(str(name))
+            continue
+        i, j = rows[0], cols[0]
+        if ensemble[i, j]:
+            raise InvalidInputError(f"ensembles {ensemble[i, j]!r} and {str(name)!r} have the same "
+                                    f"(R, nu) = ({r_grid[i]:g}, {nu_grid[j]:g})")
+        ensemble[i, j] = str(name)
+        n_packings[i, j] = int(summary["n_packings"].values[k])
+        for key, grid in columns.items():
+            grid[i, j] = float(summary[key].values[k])
+    dims = ("R", "nu")
+    data = {key: (dims, grid) for key, grid in columns.items()}
+    data.update(n_packings=(dims, n_packings), ensemble=(dims, ensemble.astype(str)))
+    attrs = {key: summary.attrs[key] for key in ("N", "s_c_window", "reference")}
+    attrs.update(hardpack_kind="microsegregated_maps", missing_cells=int((n_packings == 0).sum()),
+                 off_grid=",".join(off_grid))
+    return xr.Dataset(data, coords={"R": r_grid, "nu": nu_grid}, attrs=attrs)

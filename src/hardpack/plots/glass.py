@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
+from matplotlib import rc_context
 
 from hardpack.glass import fits
-from hardpack.plots.style import figure
+from hardpack.plots.style import RC, figure
 
 
 def plot_glass_eos(binary, mono):
@@ -57,24 +60,92 @@ def plot_glass_entropy(binary, mono):
     return fig
 
 
+def _value_error(value: float, error: float) -> str:
+    """value +- error in mathtext, the error to two significant digits and the value to its decimals."""
+    if not (np.isfinite(error) and error > 0):
+        return rf"{value:.4g} \pm {error:g}"
+    decimals = max(0, 1 - int(np.floor(np.log10(error))))
+    return rf"{value:.{decimals}f} \pm {error:.{decimals}f}"
+
+
+def _fit_label(fit) -> str:
+    return (rf"fit $s_c = s_{{\rm ref}}\,e^{{-b(\phi_J - {fit.phi_ref:g})}}$ ({fit.n_points} ensembles):" "\n"
+            rf"$s_{{\rm ref}} = {_value_error(fit.s_ref, fit.s_ref_err)}$, "
+            rf"$b = {_value_error(fit.decay, fit.decay_err)}$")
+
+
 def plot_microsegregated(summary):
     """s_c against phi_J of each label ensemble, with phi_J's standard error, the uncorrelated
-    ("random") labels marked and s_mix dashed (after Donev 2006, Fig. 13.16)."""
-    fig, ax = figure(1, 1, figsize=(4.8, 3.6))
+    ("random") labels marked, s_mix dashed and the exponential fit of the summary with its
+    parameters and standard errors in the legend (after Donev 2006, Fig. 13.16)."""
+    from hardpack.glass.microsegregated import ExponentialFit
+
+    fig, ax = figure(1, 1, figsize=(5.2, 4.6), layout="constrained")
     names = summary["ensemble"].values
+    phi_j, s_c = summary["phi_J"].values, summary["s_c"].values
     random = names == "random"
     clustered = ~random
-    points = ax.scatter(summary["phi_J"].values[clustered], summary["s_c"].values[clustered],
-                        c=summary["R"].values[clustered], cmap="viridis", s=18, zorder=3, label="Matérn labels")
-    ax.errorbar(summary["phi_J"].values, summary["s_c"].values, xerr=summary["phi_J_err"].values, fmt="none",
-                ecolor="0.6", lw=0.8, zorder=2)
+    points = ax.scatter(phi_j[clustered], s_c[clustered], c=summary["R"].values[clustered], cmap="viridis", s=18,
+                        zorder=3, label="Matérn labels")
+    ax.errorbar(phi_j, s_c, xerr=summary["phi_J_err"].values, fmt="none", ecolor="0.6", lw=0.8, zorder=2)
     if random.any():
-        ax.plot(summary["phi_J"].values[random], summary["s_c"].values[random], "o", mfc="none", mec="k", ms=8,
-                label="uncorrelated labels")
-    ax.axhline(float(summary["s_mix"].values[0]), color="k", ls="--", lw=0.8, label="s_mix")
-    fig.colorbar(points, ax=ax, label="R")
-    ax.set_xlabel("phi_J")
-    ax.set_ylabel(f"s_c (Markov estimate, {summary.attrs['s_c_window']} windows)")
-    ax.set_title(f"micro-segregated packings, N = {summary.attrs['N']}")
-    ax.legend(loc="lower left", fontsize="small")
+        ax.plot(phi_j[random], s_c[random], "o", mfc="none", mec="k", ms=8, label="uncorrelated labels")
+    ax.axhline(float(summary["s_mix"].values[0]), color="k", ls="--", lw=0.8, label=r"$s_{\rm mix}$")
+    fit = ExponentialFit.from_attrs(summary.attrs)
+    if fit is not None:
+        lo, hi = float(np.min(phi_j)), float(np.max(phi_j))
+        x = np.linspace(lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo), 100)
+        ax.plot(x, fit(x), "r-", lw=1.0, label=_fit_label(fit))
+    else:
+        status = str(summary.attrs.get("sc_fit_status", "no fit in the summary"))
+        ax.plot([], [], " ", label=textwrap.fill(status, 60))
+    with rc_context(RC):
+        fig.colorbar(points, ax=ax, label=r"$R$ (Matérn correlation length)")
+        ax.set_xlabel(r"$\phi_J$")
+        ax.set_ylabel(rf"$s_c$ (Markov estimate, {summary.attrs['s_c_window']} windows)")
+        ax.set_title(f"micro-segregated packings, N = {summary.attrs['N']}")
+        fig.legend(loc="outside lower center", ncols=2)
+    return fig
+
+
+def _map_panel(fig, ax, maps, key, label, fmt):
+    import matplotlib
+    import matplotlib.colors as mcolors
+    from matplotlib.patches import Rectangle
+
+    values = np.ma.masked_invalid(maps[key].values)
+    n_r, n_nu = values.shape
+    cmap = matplotlib.colormaps["viridis"].with_extremes(bad="none")
+    present = values.compressed()
+    norm = mcolors.Normalize(*(present.min(), present.max()) if present.size else (0.0, 1.0))
+    mesh = ax.pcolormesh(np.arange(n_nu + 1) - 0.5, np.arange(n_r + 1) - 0.5, values, cmap=cmap, norm=norm)
+    for i in range(n_r):
+        for j in range(n_nu):
+            if values.mask[i, j]:
+                ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="///", edgecolor="0.6", lw=0))
+                ax.text(j, i, "missing", ha="center", va="center", fontsize=7, color="0.3")
+            else:
+                shade = cmap(norm(values[i, j]))
+                dark = 0.299 * shade[0] + 0.587 * shade[1] + 0.114 * shade[2] < 0.5
+                ax.text(j, i, fmt.format(values[i, j]), ha="center", va="center", fontsize=7,
+                        color="w" if dark else "k")
+    ax.set_xticks(range(n_nu), [f"{v:g}" for v in maps["nu"].values])
+    ax.set_yticks(range(n_r), [f"{v:g}" for v in maps["R"].values])
+    ax.set_xlabel(r"$\nu$ (Matérn smoothness)")
+    ax.set_ylabel(r"$R$ (Matérn correlation length)")
+    ax.grid(False)
+    if present.size:
+        fig.colorbar(mesh, ax=ax, label=label)
+
+
+def plot_microsegregated_maps(maps):
+    """Colour maps of phi_J(R, nu) (left) and s_c(R, nu) (right) over the grid of Matérn
+    parameters, the values written in the cells and cells without an ensemble hatched as missing
+    (after Donev 2006, Fig. 13.17: nu on the x axis, R on the y axis)."""
+    fig, axes = figure(1, 2, figsize=(9.5, 3.8), layout="constrained")
+    with rc_context(RC):
+        _map_panel(fig, axes[0], maps, "phi_J", r"$\phi_J$ (mean over packings)", "{:.4f}")
+        _map_panel(fig, axes[1], maps, "s_c", rf"$s_c$ (Markov estimate, {maps.attrs['s_c_window']} windows)",
+                   "{:.3f}")
+        fig.suptitle(f"micro-segregated packings, N = {maps.attrs['N']}")
     return fig
