@@ -108,10 +108,7 @@ from hardpack.events.roots import contact_root, exit_root
 from hardpack.geometry.contact import contact_point, pw_contact_into, pw_rate, shape_inverse_into
 from hardpack.geometry.ellipsoid_container import farthest_point_body
 from hardpack.md.kernel import (
-    A_KE,
-    A_KEINT,
     A_T,
-    A_TKE,
     A_VIRIAL,
     I_COLL,
     I_EVENTS,
@@ -119,6 +116,9 @@ from hardpack.md.kernel import (
     I_GRAZE,
     I_STALE,
     WindowStatus,
+    end_window,
+    kinetic_step,
+    prefetch_row,
     update_neighbour_list,
 )
 
@@ -1203,6 +1203,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
     d = L.shape[0]
     n = P.shape[0]
     cap = nb.shape[1]
+    cbits = 2 * d
     invL = 1.0 / L
     lbig = 4.0 * L  # in a container: no images (every pair is within the box, |dx| < L)
     oldnb = np.empty(cap, dtype=np.int64)
@@ -1243,9 +1244,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         i = heap[0]
         t = hkey[0]
         if t > t_cap:
-            acc[A_T] = t_cap
-            acc[A_KEINT] += acc[A_KE] * (t_cap - acc[A_TKE])
-            acc[A_TKE] = t_cap
+            end_window(acc, t_cap)
             return WindowStatus.DONE_TIME
         if t == np.inf:
             return WindowStatus.STUCK
@@ -1281,9 +1280,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
                 same = 0
                 wall_hit = True
                 acc[A_WALL] += jimp
-                acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-                acc[A_TKE] = t
-                acc[A_KE] += dke
+                kinetic_step(acc, t, dke)
                 cnt[i] += 1
                 iacc[I_WALL] += 1
             else:
@@ -1296,9 +1293,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             if jimp > 0.0:
                 same = 0
                 acc[A_VIRIAL] += vir
-                acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-                acc[A_TKE] = t
-                acc[A_KE] += dke
+                kinetic_step(acc, t, dke)
                 cnt[i] += 1
                 cnt[j] += 1
                 iacc[I_COLL] += 1
@@ -1314,15 +1309,22 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             if partner >= 0:
                 ec[k] = cnt[partner]
             hsize = heap_set(hkey, heap, hpos, hsize, k, key)
+        if hsize > 1:
+            # look ahead (as the sphere kernel): start loading the rows the next event needs, its
+            # particle's and its partner's neighbours
+            q = heap[0]
+            prefetch_row(bs, q)
+            for m in range(nn[q]):
+                prefetch_row(P, nb[q, m] >> cbits)
+            p = ep[q]
+            if p >= 0:
+                prefetch_row(P, p)
+                prefetch_row(nb, p)
         if iacc[I_COLL] >= coll_target and npred == 2:
-            acc[A_T] = t
-            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-            acc[A_TKE] = t
+            end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS
         if len(wmode) > 0 and wall_hit and iacc[I_COLL] + iacc[I_WALL] >= coll_target:
-            acc[A_T] = t
-            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-            acc[A_TKE] = t
+            end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS
 
 

@@ -113,6 +113,23 @@ I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE, I_WALL = 0, 1, 2, 3, 4, 5
 N_COUNTERS = 6
 
 
+@njit(cache=True, inline="always")
+def kinetic_step(acc, t, dke):
+    """Integrate the kinetic energy, constant since acc[A_TKE], up to window time t into
+    acc[A_KEINT], then change it by ``dke`` (a collision's or reflection's energy change)."""
+    acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
+    acc[A_TKE] = t
+    acc[A_KE] += dke
+
+
+@njit(cache=True, inline="always")
+def end_window(acc, t):
+    """Close the window's accumulators at window time t (its end time, the kinetic integral)."""
+    acc[A_T] = t
+    kinetic_step(acc, t, 0.0)
+
+
+
 # --------------------------------------------------------------------------------- prefetch
 def _prefetch_intrinsic() -> str | None:
     """Name of LLVM's prefetch intrinsic as this llvmlite spells pointers, or None.
@@ -498,9 +515,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
             i = heap[0]
             t = hkey[0]
             if t > t_cap:
-                acc[A_T] = t_cap
-                acc[A_KEINT] += acc[A_KE] * (t_cap - acc[A_TKE])
-                acc[A_TKE] = t_cap
+                end_window(acc, t_cap)
                 return WindowStatus.DONE_TIME
             if t == np.inf:
                 return WindowStatus.STUCK
@@ -540,9 +555,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
                     for k in range(d):
                         P[i, d + k] -= 2.0 * w * rv[k]
                     acc[A_WALL + kw] += 2.0 * w
-                    acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-                    acc[A_TKE] = t
-                    acc[A_KE] += 2.0 * w * adot
+                    kinetic_step(acc, t, 2.0 * w * adot)
                     cnt[i] += 1
                     iacc[I_WALL] += 1
                     wall_hit = True
@@ -588,9 +601,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
                         for k in range(d):
                             log_val[c, k] = -vn * rv[k]
                         log_val[c, d] = -vn * dist
-                    acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-                    acc[A_TKE] = t
-                    acc[A_KE] -= vn * g
+                    kinetic_step(acc, t, -(vn * g))
                     cnt[i] += 1
                     cnt[j] += 1
                     iacc[I_COLL] += 1
@@ -709,14 +720,10 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
                 for m in range(nn[p]):
                     prefetch_row(P, nb[p, m] >> cbits)
         if iacc[I_COLL] >= coll_target and npred == 2:
-            acc[A_T] = t
-            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-            acc[A_TKE] = t
+            end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS
         if len(wmode) > 0 and wall_hit and iacc[I_COLL] + iacc[I_WALL] >= coll_target:
-            acc[A_T] = t
-            acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
-            acc[A_TKE] = t
+            end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS
 
 
