@@ -47,7 +47,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from hardpack.errors import InvalidInputError
-from hardpack.geometry.contact import contact_point, pw_contact, shape_inverse
+from hardpack.geometry.contact import contact_point, inverse_shapes, pw_contact
 from hardpack.geometry.neighbours.pairs import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
 
@@ -146,15 +146,6 @@ class EllipsoidContacts:
 
 
 @numba.njit(cache=True)
-def _shape_inverses(semiaxes, orientations):
-    n, d = semiaxes.shape
-    out = np.empty((n, d, d))
-    for p in range(n):
-        shape_inverse(semiaxes[p], orientations[p], out[p])
-    return out
-
-
-@numba.njit(cache=True)
 def _pair_contacts(positions, shape_inv, bounding, ii, jj, sep):
     m, d = sep.shape
     zeta = np.empty(m)
@@ -212,7 +203,7 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     shape = packing.shape
     semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
     orient = np.ascontiguousarray(np.asarray(shape.orientations, dtype=float).reshape(packing.n_particles, -1))
-    inv = _shape_inverses(semiaxes, orient)
+    inv = inverse_shapes(semiaxes, orient)
     pairs = pairs_within(packing, rel_gap=delta)
     x = np.ascontiguousarray(wrapped_positions(packing))
     ii, jj = pairs.i.astype(np.int64), pairs.j.astype(np.int64)
@@ -253,7 +244,7 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> Ellipsoi
     n = packing.n_particles
     semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
     orient = np.ascontiguousarray(np.asarray(shape.orientations, dtype=float).reshape(n, -1))
-    inv = _shape_inverses(semiaxes, orient)
+    inv = inverse_shapes(semiaxes, orient)
     x = np.ascontiguousarray(packing.positions if positions is None else positions, dtype=float)
     ii, jj = np.asarray(i, np.int64), np.asarray(j, np.int64)
     shift = np.asarray(shift, np.int64).reshape(len(ii), packing.dim)
