@@ -50,6 +50,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.contact import contact_point, inverse_shapes, pw_contact
 from hardpack.geometry.neighbours.pairs import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
+from hardpack.jamming.contacts import ContactArrays
 
 __all__ = [
     "EllipsoidContacts",
@@ -81,7 +82,7 @@ def generators(d: int) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class EllipsoidContacts:
+class EllipsoidContacts(ContactArrays):
     """Contacts (i, j, image shift) of an ellipsoid packing; arrays have length M (module docstring).
 
     ``normal`` is the unit normal u from i to j; ``lever_i``/``lever_j`` are r_C - x_i and
@@ -108,18 +109,6 @@ class EllipsoidContacts:
     delta: float
 
     @property
-    def n_contacts(self) -> int:
-        return len(self.i)
-
-    @property
-    def n_particles(self) -> int:
-        return self.positions.shape[0]
-
-    @property
-    def dim(self) -> int:
-        return self.positions.shape[1]
-
-    @property
     def gap(self) -> np.ndarray:
         """mu - 1, the relative scale gap of every contact (negative for overlaps)."""
         return np.sqrt(np.maximum(self.zeta + 1.0, 0.0)) - 1.0
@@ -131,12 +120,6 @@ class EllipsoidContacts:
         kw = {k: getattr(self, k)[mask] for k in per}
         return EllipsoidContacts(**kw, positions=self.positions, lattice=self.lattice,
                                  shape_inv=self.shape_inv, semiaxes=self.semiaxes, delta=self.delta)
-
-    def among(self, active: np.ndarray | None) -> np.ndarray:
-        """Boolean mask of the contacts whose both ends are ``active`` (all if None)."""
-        if active is None:
-            return np.ones(self.n_contacts, dtype=bool)
-        return active[self.i] & active[self.j]
 
     def counts(self, active: np.ndarray | None = None) -> np.ndarray:
         """Contacts per particle among ``active`` (a self-image contact counts twice)."""
