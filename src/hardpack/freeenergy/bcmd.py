@@ -138,6 +138,17 @@ def _check(name, value, lo=0.0, hi=np.inf, lo_open=True):
     return x
 
 
+def _check_schedule(dmu_max, gamma0, theta, equilibration, segment_fraction) -> tuple[float, ...]:
+    """The shrink schedule's parameters (:func:`shrink_schedule`) and the equilibration time as
+    floats, refused when out of range."""
+    dmu_max = _check("dmu_max", dmu_max)
+    gamma0 = _check("gamma0", gamma0)
+    theta = _check("theta", theta, lo=0.0, lo_open=False)
+    equilibration = _check("equilibration", equilibration, lo=0.0, lo_open=False)
+    segment_fraction = _check("segment_fraction", segment_fraction, hi=0.5)
+    return dmu_max, gamma0, theta, equilibration, segment_fraction
+
+
 def shrink_schedule(dmu_max: float, dmu_min: float, gamma0: float, theta: float, segment_fraction: float):
     """The segments of the BCMD shrink schedule (module docstring): the cell size falls from
     ``dmu_max`` to ``dmu_min`` by the factor 1 - ``segment_fraction`` a segment (the last one
@@ -252,11 +263,8 @@ def run_bcmd(
         raise InvalidInputError(
             "BCMD needs at least 2 particles (one is frozen or the CM is fixed)"
         )
-    dmu_max = _check("dmu_max", dmu_max)
-    gamma0 = _check("gamma0", gamma0)
-    theta = _check("theta", theta, lo=0.0, lo_open=False)
-    equilibration = _check("equilibration", equilibration, lo=0.0, lo_open=False)
-    segment_fraction = _check("segment_fraction", segment_fraction, hi=0.5)
+    dmu_max, gamma0, theta, equilibration, segment_fraction = _check_schedule(
+        dmu_max, gamma0, theta, equilibration, segment_fraction)
     if reset_ratio is not None:
         reset_ratio = _check("reset_ratio", reset_ratio, lo=1.0)
     nb = cell_neighbours(packing, dmu_max)

@@ -43,7 +43,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.freeenergy import _ellipse_kernel as kern
-from hardpack.freeenergy.bcmd import _check, shrink_schedule
+from hardpack.freeenergy.bcmd import _check, _check_schedule, shrink_schedule
 from hardpack.freeenergy.ellipses import (
     _check_round_rotations,
     _free_masks,
@@ -149,11 +149,8 @@ def ellipse_bcmd(
     clock = time.perf_counter()
     check_ellipsoid_packing(packing)
     delta = _check("delta", delta, hi=1e-2)
-    dmu_max = _check("dmu_max", dmu_max)
-    gamma0 = _check("gamma0", gamma0)
-    theta = _check("theta", theta, lo=0.0, lo_open=False)
-    equilibration = _check("equilibration", equilibration, lo=0.0, lo_open=False)
-    segment_fraction = _check("segment_fraction", segment_fraction, hi=0.5)
+    dmu_max, gamma0, theta, equilibration, segment_fraction = _check_schedule(
+        dmu_max, gamma0, theta, equilibration, segment_fraction)
     n = packing.n_particles
     free_t, free_r = _free_masks(n, fixed_translation, fixed_rotation)
     _check_round_rotations(packing, free_r)
