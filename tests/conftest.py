@@ -4,6 +4,8 @@
   sequential addition (seed 2), saved as a packing netCDF (attribute ``seed = 2``): the start of
   the command-line and MD-limit tests.
 - ``workflow_rules``: {rule name: its text} of every rule in ``workflow/rules/*.smk``.
+- ``ideal_gas``: a factory ``ideal_gas(n, d, length, radii=0.01, seed=0)`` of n uniform random
+  points (overlapping spheres of radii ``radii``) in a periodic cube of side ``length``.
 - ``jammed_disks``: the 64-disk bidisperse packing jammed to exact contacts, read from
   ``tests/data`` (how it was made: ``test_jamming_support.make_jammed_disks``).
 """
@@ -13,9 +15,11 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from hardpack.distributions import monodisperse
+from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
 from hardpack.io import save_packing
 
@@ -25,6 +29,16 @@ def rsa_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("rsa") / "init.nc"
     save_packing(random_packing(100, 3, monodisperse(0.5), 0.3, seed=2), path, attrs={"seed": 2})
     return path
+
+
+@pytest.fixture(scope="session")
+def ideal_gas():
+    def make(n, d, length, radii=0.01, seed=0):
+        rng = np.random.default_rng(seed)
+        radii = np.broadcast_to(np.asarray(radii, float), (n,))
+        return Packing(rng.random((n, d)) * length, radii, np.eye(d) * length, allow_overlap=True)
+
+    return make
 
 
 @pytest.fixture(scope="session")

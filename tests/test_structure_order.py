@@ -8,7 +8,6 @@ import pytest
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.lattices import lattice_packing
-from hardpack.geometry.packing import Packing
 from hardpack.structure.order import (
     crystallinity,
     order_map,
@@ -16,12 +15,6 @@ from hardpack.structure.order import (
     steinhardt,
     translational_order,
 )
-
-
-def ideal_gas(n, d, length, radius=0.01, seed=0):
-    rng = np.random.default_rng(seed)
-    return Packing(rng.random((n, d)) * length, np.full(n, radius), np.eye(d) * length,
-                   allow_overlap=True)
 
 
 @pytest.mark.parametrize("name, reps, q6", [
@@ -37,10 +30,10 @@ def test_steinhardt_q6_of_crystals(name, reps, q6):
         assert abs(float(ds.Q6) - math.sqrt(2) / 4) < 1e-12
 
 
-def test_q6_of_isotropic_bonds_is_small():
+def test_q6_of_isotropic_bonds_is_small(ideal_gas):
     """Random bond directions: <Y_6m> over B bonds has |.|^2 ~ 1/(4 pi B) per m, so
     Q6 ~ sqrt(13 / (13 B)) = 1/sqrt(B)."""
-    p = ideal_gas(3000, 3, 12.0, radius=0.5)
+    p = ideal_gas(3000, 3, 12.0, radii=0.5)
     ds = steinhardt(p, neighbours=1.6)
     bonds = int(ds.n_bonds.sum())
     assert float(ds.Q6) < 3 / math.sqrt(bonds)
@@ -58,7 +51,7 @@ def test_translational_order_is_one_for_the_reference_crystal(name, reps):
     assert abs(translational_order(lattice_packing(name, reps)) - 1) < 1e-12
 
 
-def test_translational_order_of_ideal_gas_vanishes_within_counting_noise():
+def test_translational_order_of_ideal_gas_vanishes_within_counting_noise(ideal_gas):
     """Numerator = sum_i (n_i - n_i^ideal) with n_i = 2 c_i / N and c ~ Poisson pair counts:
     sd = sqrt(2 sum n_i^ideal / N); the FCC denominator is known, so T < 5 sd / denominator."""
     n, length = 4000, 15.0
@@ -80,7 +73,7 @@ def test_translational_order_refuses_overlapping_shells():
         translational_order(lattice_packing("fcc", 2), width=0.3)
 
 
-def test_crystallinity_crystal_versus_gas():
+def test_crystallinity_crystal_versus_gas(ideal_gas):
     """Ogarko's criterion with regular-triangulation neighbours: a slightly perturbed FCC
     (octahedra split arbitrarily, 14 neighbours on average) is fully solid-like; the ideal
     gas (random q6 vectors) has essentially no solid-like particle."""
@@ -93,7 +86,7 @@ def test_crystallinity_crystal_versus_gas():
     assert float(gas.crystallinity) < 0.01
 
 
-def test_order_map_pairs_phi_with_t():
+def test_order_map_pairs_phi_with_t(ideal_gas):
     fcc = lattice_packing("fcc", 3)
     gas = ideal_gas(2000, 3, 12.0)
     ds = order_map([fcc, gas])

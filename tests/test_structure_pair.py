@@ -24,12 +24,6 @@ from hardpack.structure.pair import (
 )
 
 
-def ideal_gas(n, d, length, radii=0.01, seed=0):
-    rng = np.random.default_rng(seed)
-    radii = np.broadcast_to(np.asarray(radii, float), (n,))
-    return Packing(rng.random((n, d)) * length, radii, np.eye(d) * length, allow_overlap=True)
-
-
 def chi2_ok(counts, expected):
     sel = expected > 20
     b = int(sel.sum())
@@ -38,7 +32,7 @@ def chi2_ok(counts, expected):
 
 
 @pytest.mark.parametrize("d, n, length", [(2, 3000, 30.0), (3, 3000, 10.0), (4, 2000, 5.0)])
-def test_ideal_gas_g2_is_one_within_counting_noise(d, n, length):
+def test_ideal_gas_g2_is_one_within_counting_noise(d, n, length, ideal_gas):
     ds = pair_correlation(ideal_gas(n, d, length), r_max=0.45 * length, dr=0.02 * length)
     ok, ratio = chi2_ok(ds.pair_count.values, ds.ideal_count.values)
     assert ok, f"chi2/dof = {ratio:.3f} for g2 of the ideal gas in d = {d}"
@@ -46,7 +40,7 @@ def test_ideal_gas_g2_is_one_within_counting_noise(d, n, length):
     assert abs(total / ds.ideal_count.values.sum() - 1) < 5 / math.sqrt(total)
 
 
-def test_ideal_gas_scaled_g2_polydisperse_is_one():
+def test_ideal_gas_scaled_g2_polydisperse_is_one(ideal_gas):
     """g2 in x = r / (r_i + r_j): ideal count uses sum_{i<j} (r_i + r_j)^d (exact binomial sum)."""
     rng = np.random.default_rng(3)
     radii = rng.uniform(0.05, 0.4, 3000)

@@ -24,13 +24,7 @@ from hardpack.structure.sk import (
 )
 
 
-def ideal_gas(n, d, length, seed=0):
-    rng = np.random.default_rng(seed)
-    return Packing(rng.random((n, d)) * length, np.full(n, 0.01), np.eye(d) * length,
-                   allow_overlap=True)
-
-
-def test_ideal_gas_structure_factor_is_one_and_exponential():
+def test_ideal_gas_structure_factor_is_one_and_exponential(ideal_gas):
     _, _, s = structure_factor_vectors(ideal_gas(3000, 3, 12.0), 12.0)
     m = s.size
     assert m > 5000
@@ -40,7 +34,7 @@ def test_ideal_gas_structure_factor_is_one_and_exponential():
     assert abs(frac - math.exp(-3)) < 5 * math.sqrt(math.exp(-3) * (1 - math.exp(-3)) / m)
 
 
-def test_ideal_gas_shell_means_scatter_as_counting_noise():
+def test_ideal_gas_shell_means_scatter_as_counting_noise(ideal_gas):
     sk = structure_factor(ideal_gas(2000, 3, 10.0, seed=1), 15.0)
     z = (sk.S.values - 1) * np.sqrt(sk.n_vectors.values)
     assert abs(np.mean(z**2) - 1) < 5 * math.sqrt(2 / len(z))
@@ -94,7 +88,7 @@ def test_wavevectors_refuse_bad_k_max():
             wavevectors(np.eye(3), bad)
 
 
-def test_s0_extrapolation_recovers_known_line_and_ideal_gas():
+def test_s0_extrapolation_recovers_known_line_and_ideal_gas(ideal_gas):
     k = np.linspace(0.2, 2.0, 12)
     exact = xr.Dataset(dict(S=("k", 0.01 + 0.05 * k), n_vectors=("k", np.full(12, 30))),
                        coords=dict(k=k))
@@ -111,7 +105,7 @@ def test_s0_extrapolation_recovers_known_line_and_ideal_gas():
         extrapolate_s0(sk, 3.0, "cubic")
 
 
-def test_number_variance_ideal_gas_is_binomial():
+def test_number_variance_ideal_gas_is_binomial(ideal_gas):
     """Averaged over configurations the window count of the ideal gas is binomial,
     sigma^2 = N p (1 - p). One configuration's variance also fluctuates (through S(k) at
     k < ~pi/R), so the error bar is the spread over 8 independent configurations."""

@@ -40,6 +40,14 @@ def _key_value(text: str):
         return key, value
 
 
+def add_checkpoint_options(p: argparse.ArgumentParser, checkpoint_help: str) -> None:
+    """Add ``--checkpoint`` (described by ``checkpoint_help``) and ``--checkpoint-interval`` to a
+    subcommand's parser."""
+    p.add_argument("--checkpoint", help=checkpoint_help)
+    p.add_argument("--checkpoint-interval", type=float, default=300.0,
+                   help="seconds between checkpoints (default 300)")
+
+
 def cmd_init(args) -> int:
     """Random sequential addition start configuration, written as a packing netCDF."""
     from hardpack.distributions import from_spec

@@ -138,6 +138,47 @@ def _check(name, value, lo=0.0, hi=np.inf, lo_open=True):
     return x
 
 
+def _check_schedule(dmu_max, gamma0, theta, equilibration, segment_fraction) -> tuple[float, ...]:
+    """The shrink schedule's parameters (:func:`shrink_schedule`) and the equilibration time as
+    floats, refused when out of range."""
+    dmu_max = _check("dmu_max", dmu_max)
+    gamma0 = _check("gamma0", gamma0)
+    theta = _check("theta", theta, lo=0.0, lo_open=False)
+    equilibration = _check("equilibration", equilibration, lo=0.0, lo_open=False)
+    segment_fraction = _check("segment_fraction", segment_fraction, hi=0.5)
+    return dmu_max, gamma0, theta, equilibration, segment_fraction
+
+
+def shrink_schedule(dmu_max: float, dmu_min: float, gamma0: float, theta: float, segment_fraction: float):
+    """The segments of the BCMD shrink schedule (module docstring): the cell size falls from
+    ``dmu_max`` to ``dmu_min`` by the factor 1 - ``segment_fraction`` a segment (the last one
+    ends at ``dmu_min``) at the rate gamma = gamma0 (dmu / dmu_max)^theta of its start.
+
+    Parameters
+    ----------
+    dmu_max, dmu_min : float
+        First and last cell size Delta mu.
+    gamma0 : float
+        Shrink rate at ``dmu_max``.
+    theta : float
+        Schedule exponent.
+    segment_fraction : float
+        Relative shrink of one segment, in (0, 1).
+
+    Yields
+    ------
+    dmu, dmu_next, gamma, dt : float
+        Cell size at the start and end of the segment, its rate and its duration
+        (dmu - dmu_next) / gamma.
+    """
+    dmu = dmu_max
+    while dmu > dmu_min * (1 + 1e-12):
+        gamma = gamma0 * (dmu / dmu_max) ** theta
+        dmu_next = max(dmu * (1.0 - segment_fraction), dmu_min)
+        yield dmu, dmu_next, gamma, (dmu - dmu_next) / gamma
+        dmu = dmu_next
+
+
 def run_bcmd(
     packing: Packing,
     *,
@@ -222,11 +263,8 @@ def run_bcmd(
         raise InvalidInputError(
             "BCMD needs at least 2 particles (one is frozen or the CM is fixed)"
         )
-    dmu_max = _check("dmu_max", dmu_max)
-    gamma0 = _check("gamma0", gamma0)
-    theta = _check("theta", theta, lo=0.0, lo_open=False)
-    equilibration = _check("equilibration", equilibration, lo=0.0, lo_open=False)
-    segment_fraction = _check("segment_fraction", segment_fraction, hi=0.5)
+    dmu_max, gamma0, theta, equilibration, segment_fraction = _check_schedule(
+        dmu_max, gamma0, theta, equilibration, segment_fraction)
     if reset_ratio is not None:
         reset_ratio = _check("reset_ratio", reset_ratio, lo=1.0)
     nb = cell_neighbours(packing, dmu_max)
@@ -298,11 +336,7 @@ def run_bcmd(
     ln_k = 0.0  # chained ln(K/K0)
     n_redraws = 0
     rows = []
-    dmu = dmu_max
-    while dmu > dmu_min * (1 + 1e-12):
-        gamma = gamma0 * (dmu / dmu_max) ** theta
-        dmu_next = max(dmu * (1.0 - segment_fraction), dmu_min)
-        dt = (dmu - dmu_next) / gamma
+    for dmu, dmu_next, gamma, dt in shrink_schedule(dmu_max, dmu_min, gamma0, theta, segment_fraction):
         facc[:] = 0.0
         ev_before = iacc[kern.C_EVENTS]
         k_start = kinetic(v)
@@ -340,7 +374,6 @@ def run_bcmd(
                 iacc[kern.C_EVENTS] - ev_before,
             )
         )
-        dmu = dmu_next
     min_gap = _min_gap(nb, dr)
     if min_gap < -1e-9:
         raise RuntimeError(

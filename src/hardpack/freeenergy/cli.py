@@ -44,25 +44,13 @@ def register(subparsers) -> None:
         default=None,
         help="final cell size (default: the disjoint-cell point)",
     )
-    p.add_argument(
-        "--gamma0",
-        type=float,
-        default=1e-3,
-        help="shrink rate at dmu_max (default 1e-3)",
-    )
-    p.add_argument(
-        "--theta",
-        type=float,
-        default=1.0,
-        help="schedule exponent: gamma = gamma0 (dmu/dmu_max)^theta (default 1)",
-    )
+    _add_schedule_and_seed(p, gamma0=1e-3, theta=1.0)
     p.add_argument(
         "--frozen",
         choices=FROZEN_MODES,
         default="particle",
         help="freeze particle 0 (default) or measure K in the CM frame",
     )
-    p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
     p.add_argument(
         "--reset-ratio",
         type=float,
@@ -86,11 +74,9 @@ def register(subparsers) -> None:
                    help="relative contact gap (default: the verdict's delta, capped at delta/10)")
     p.add_argument("--dmu-max-ratio", type=float, default=100.0,
                    help="initial cell size in units of the disjoint-cell point (default 100)")
-    p.add_argument("--gamma0", type=float, default=0.01, help="shrink rate at dmu_max")
-    p.add_argument("--theta", type=float, default=1.0, help="schedule exponent")
+    _add_schedule_and_seed(p, gamma0=0.01, theta=1.0)
     p.add_argument("--frozen", choices=FROZEN_MODES, default="particle",
                    help="freeze particle 0 (default) or measure K in the CM frame")
-    p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
     p.set_defaults(func=cmd_bcmd_simplex)
 
     p = subparsers.add_parser(
@@ -110,14 +96,12 @@ def register(subparsers) -> None:
     p.add_argument("--contact-tol", type=float, default=1e-6,
                    help="contacts: Perram-Wertheim mu - 1 <= this (default 1e-6)")
     p.add_argument("--dmu-max", type=float, default=1.5e-2, help="initial cell size (default 1.5e-2)")
-    p.add_argument("--gamma0", type=float, default=1e-3, help="shrink rate at dmu_max (default 1e-3)")
-    p.add_argument("--theta", type=float, default=0.5, help="schedule exponent (default 0.5)")
+    _add_schedule_and_seed(p, gamma0=1e-3, theta=0.5)
     p.add_argument("--freeze", choices=("full", "centroid"), default="full",
                    help="the fewest particles frozen entirely (default; Donev 2006 Fig. 6.5: 96 free "
                         "and four frozen) or just enough centroids, orientations free")
     p.add_argument("--freeze-seed", type=int, default=0,
                    help="seed of the order in which frozen sets are tried (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
     p.add_argument("--exact-only", action="store_true", help="the exact simplex only, no BCMD")
     p.set_defaults(func=cmd_bcmd_ellipse)
 
@@ -138,6 +122,15 @@ def register(subparsers) -> None:
     )
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_bcmd_ellipse_ladder)
+
+
+def _add_schedule_and_seed(p, *, gamma0: float, theta: float) -> None:
+    """The options of a BCMD run's shrink schedule (:func:`hardpack.freeenergy.bcmd.shrink_schedule`)
+    and its velocity seed, with the command's defaults."""
+    p.add_argument("--gamma0", type=float, default=gamma0, help=f"shrink rate at dmu_max (default {gamma0:g})")
+    p.add_argument("--theta", type=float, default=theta,
+                   help=f"schedule exponent: gamma = gamma0 (dmu/dmu_max)^theta (default {theta:g})")
+    p.add_argument("--seed", type=int, default=0, help="velocity seed (default 0)")
 
 
 def cmd_ellipse_lattice(args) -> int:

@@ -43,7 +43,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.freeenergy import _ellipse_kernel as kern
-from hardpack.freeenergy.bcmd import _check
+from hardpack.freeenergy.bcmd import _check, _check_schedule, shrink_schedule
 from hardpack.freeenergy.ellipses import (
     _check_round_rotations,
     _free_masks,
@@ -149,11 +149,8 @@ def ellipse_bcmd(
     clock = time.perf_counter()
     check_ellipsoid_packing(packing)
     delta = _check("delta", delta, hi=1e-2)
-    dmu_max = _check("dmu_max", dmu_max)
-    gamma0 = _check("gamma0", gamma0)
-    theta = _check("theta", theta, lo=0.0, lo_open=False)
-    equilibration = _check("equilibration", equilibration, lo=0.0, lo_open=False)
-    segment_fraction = _check("segment_fraction", segment_fraction, hi=0.5)
+    dmu_max, gamma0, theta, equilibration, segment_fraction = _check_schedule(
+        dmu_max, gamma0, theta, equilibration, segment_fraction)
     n = packing.n_particles
     free_t, free_r = _free_masks(n, fixed_translation, fixed_rotation)
     _check_round_rotations(packing, free_r)
@@ -252,18 +249,13 @@ def ellipse_bcmd(
                 redraw()
     k0 = kinetic()
     rows_out = []
-    dmu = dmu_max
-    while dmu > dmu_min * (1 + 1e-12):
-        gamma = gamma0 * (dmu / dmu_max) ** theta
-        dmu_next = max(dmu * (1.0 - segment_fraction), dmu_min)
-        dt = (dmu - dmu_next) / gamma
+    for dmu, dmu_next, gamma, dt in shrink_schedule(dmu_max, dmu_min, gamma0, theta, segment_fraction):
         ev0 = int(counts.sum())
         segment(dmu, gamma, dt)
         t += dt
         if refresh:
             redraw()
         rows_out.append((dmu_next, t, gamma, np.log(kinetic() / k0), int(counts.sum()) - ev0))
-        dmu = dmu_next
     worst_cell = max(kern.cell_value(i, t, q, qd, tq, cell, dmu_min, 0.0, t)
                      for i in range(n) if free_t[i] or free_r[i])
     gaps_end = h + np.einsum("ck,ck->c", ai, q[ci]) + np.einsum("ck,ck->c", aj, q[cj])

@@ -72,6 +72,18 @@ def _check_shape(shape) -> tuple[int, int]:
     return shape
 
 
+def _check_window_fits(n: int, m: int, rows: int, cols: int) -> tuple[int, int]:
+    """Refuse an n x m window that is empty, larger than the rows x cols lattice or too large to code."""
+    if n < 1 or m < 1:
+        raise InvalidInputError(f"window sizes must be >= 1, got {n} x {m}")
+    if n > rows or m > cols:
+        raise InvalidInputError(f"a {n} x {m} window does not fit the {rows} x {cols} lattice; use a larger "
+                                "lattice or a smaller window")
+    if n * m > MAX_WINDOW_SITES:
+        raise InvalidInputError(f"windows of more than {MAX_WINDOW_SITES} sites are not supported, got {n} x {m}")
+    return n, m
+
+
 def matern(r, R: float, nu: float) -> np.ndarray:
     """Matérn correlation C(r) = 2^(1 - nu) / Gamma(nu) (r / R)^nu K_nu(r / R), C(0) = 1
     (module docstring for the parametrisation).
@@ -300,15 +312,7 @@ def window_codes(labels, n: int, m: int) -> np.ndarray:
         int64 codes, shape (realisations, rows, columns): one per window corner.
     """
     arr = _as_labels(labels)
-    n, m = int(n), int(m)
-    rows, cols = arr.shape[-2:]
-    if n < 1 or m < 1:
-        raise InvalidInputError(f"window sizes must be >= 1, got {n} x {m}")
-    if n > rows or m > cols:
-        raise InvalidInputError(f"a {n} x {m} window does not fit the {rows} x {cols} lattice; use a larger "
-                                "lattice or a smaller window")
-    if n * m > MAX_WINDOW_SITES:
-        raise InvalidInputError(f"windows of more than {MAX_WINDOW_SITES} sites are not supported, got {n} x {m}")
+    n, m = _check_window_fits(int(n), int(m), *arr.shape[-2:])
     codes = np.zeros_like(arr)
     for i in range(n):
         for j in range(m):
@@ -422,14 +426,7 @@ def check_window(shape, window) -> tuple[int, int]:
     """
     rows, cols = _check_shape(shape)
     n, m = (int(w) for w in window)
-    if n < 1 or m < 1:
-        raise InvalidInputError(f"window sizes must be >= 1, got {n} x {m}")
-    if n > rows or m > cols:
-        raise InvalidInputError(f"a {n} x {m} window does not fit the {rows} x {cols} lattice; use a larger "
-                                "lattice or a smaller window")
-    if n * m > MAX_WINDOW_SITES:
-        raise InvalidInputError(f"windows of more than {MAX_WINDOW_SITES} sites are not supported, got {n} x {m}")
-    return n, m
+    return _check_window_fits(n, m, rows, cols)
 
 
 def label_study(shape, R: float, nu: float, fraction_a: float, seed: int, count: int = 1,

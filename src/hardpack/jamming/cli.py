@@ -67,15 +67,10 @@ def _delta(text: str):
     return text if text == "gaps" else float(text)
 
 
-def _verify_ellipsoids(packing, args) -> int:
-    """Ellipses and ellipsoids: the first- and second-order tests of
-    :func:`hardpack.jamming.second_order.verify_ellipsoids` (the sphere options do not apply)."""
+def _write_verdict(result, out, args) -> int:
+    """Write the verdict dataset ``out`` with the --attr attributes and print its summary."""
     from hardpack.io import write_dataset
-    from hardpack.jamming.second_order import verify_ellipsoids
 
-    result = verify_ellipsoids(packing, delta=args.delta, seed=args.seed)
-    out = result.to_dataset()
-    out.attrs["source"] = str(args.packing)
     out.attrs.update(dict(args.attr or []))
     write_dataset(out, args.out, seed=args.seed)
     print(result.summary())
@@ -83,8 +78,19 @@ def _verify_ellipsoids(packing, args) -> int:
     return 0
 
 
+def _verify_ellipsoids(packing, args) -> int:
+    """Ellipses and ellipsoids: the first- and second-order tests of
+    :func:`hardpack.jamming.second_order.verify_ellipsoids` (the sphere options do not apply)."""
+    from hardpack.jamming.second_order import verify_ellipsoids
+
+    result = verify_ellipsoids(packing, delta=args.delta, seed=args.seed)
+    out = result.to_dataset()
+    out.attrs["source"] = str(args.packing)
+    return _write_verdict(result, out, args)
+
+
 def cmd_verify(args) -> int:
-    from hardpack.io import dataset_to_packing, load_dataset, write_dataset
+    from hardpack.io import dataset_to_packing, load_dataset
 
     ds = load_dataset(args.packing, kind="packing")
     if ds.attrs.get("shape_kind") == "ellipsoid":
@@ -114,8 +120,4 @@ def cmd_verify(args) -> int:
         print(f"MD contact forces: LP virial / MD collisional pressure = {cmp.pressure_ratio:.4f}, "
               f"rms force difference {cmp.rms_relative:.3g} of the mean ({cmp.n_matched} of "
               f"{cmp.n_lp_contacts} contacts matched)")
-    out.attrs.update(dict(args.attr or []))
-    write_dataset(out, args.out, seed=args.seed)
-    print(result.summary())
-    print(f"written {args.out}")
-    return 0
+    return _write_verdict(result, out, args)

@@ -57,8 +57,31 @@ def check_delta(delta) -> float:
     return value
 
 
+class ContactArrays:
+    """What the contact networks of spheres and of ellipsoids share: contacts (``i``, ``j``) of the
+    particles at ``positions`` (N, d)."""
+
+    @property
+    def n_contacts(self) -> int:
+        return len(self.i)
+
+    @property
+    def n_particles(self) -> int:
+        return self.positions.shape[0]
+
+    @property
+    def dim(self) -> int:
+        return self.positions.shape[1]
+
+    def among(self, active: np.ndarray | None) -> np.ndarray:
+        """Boolean mask of contacts whose both ends are ``active`` (all if None)."""
+        if active is None:
+            return np.ones(self.n_contacts, dtype=bool)
+        return active[self.i] & active[self.j]
+
+
 @dataclass(frozen=True)
-class ContactNetwork:
+class ContactNetwork(ContactArrays):
     """Contacts (i, j, image shift n) of a packing; arrays have length M.
 
     ``positions`` are the wrapped centres used to define ``separation``; ``lattice`` has the
@@ -110,18 +133,6 @@ class ContactNetwork:
         return int(self.periodic.sum())
 
     @property
-    def n_contacts(self) -> int:
-        return len(self.i)
-
-    @property
-    def n_particles(self) -> int:
-        return self.positions.shape[0]
-
-    @property
-    def dim(self) -> int:
-        return self.positions.shape[1]
-
-    @property
     def normal(self) -> np.ndarray:
         """Unit vectors u_ij from i towards (the image of) j."""
         return self.separation / self.distance[:, None]
@@ -155,12 +166,6 @@ class ContactNetwork:
             positions=self.positions, lattice=self.lattice, delta=self.delta, wall=self.wall[mask],
             periodic=self.periodic, centre=self.centre,
         )
-
-    def among(self, active: np.ndarray | None) -> np.ndarray:
-        """Boolean mask of contacts whose both ends are ``active`` (all if None)."""
-        if active is None:
-            return np.ones(self.n_contacts, dtype=bool)
-        return active[self.i] & active[self.j]
 
 
 def contact_network(packing: Packing, delta: float) -> ContactNetwork:

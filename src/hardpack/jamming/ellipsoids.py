@@ -47,9 +47,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from hardpack.errors import InvalidInputError
-from hardpack.geometry.contact import contact_point, pw_contact, shape_inverse
+from hardpack.geometry.contact import contact_point, inverse_shapes, pw_contact
 from hardpack.geometry.neighbours.pairs import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
+from hardpack.jamming.contacts import ContactArrays
 
 __all__ = [
     "EllipsoidContacts",
@@ -81,7 +82,7 @@ def generators(d: int) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class EllipsoidContacts:
+class EllipsoidContacts(ContactArrays):
     """Contacts (i, j, image shift) of an ellipsoid packing; arrays have length M (module docstring).
 
     ``normal`` is the unit normal u from i to j; ``lever_i``/``lever_j`` are r_C - x_i and
@@ -108,18 +109,6 @@ class EllipsoidContacts:
     delta: float
 
     @property
-    def n_contacts(self) -> int:
-        return len(self.i)
-
-    @property
-    def n_particles(self) -> int:
-        return self.positions.shape[0]
-
-    @property
-    def dim(self) -> int:
-        return self.positions.shape[1]
-
-    @property
     def gap(self) -> np.ndarray:
         """mu - 1, the relative scale gap of every contact (negative for overlaps)."""
         return np.sqrt(np.maximum(self.zeta + 1.0, 0.0)) - 1.0
@@ -132,26 +121,11 @@ class EllipsoidContacts:
         return EllipsoidContacts(**kw, positions=self.positions, lattice=self.lattice,
                                  shape_inv=self.shape_inv, semiaxes=self.semiaxes, delta=self.delta)
 
-    def among(self, active: np.ndarray | None) -> np.ndarray:
-        """Boolean mask of the contacts whose both ends are ``active`` (all if None)."""
-        if active is None:
-            return np.ones(self.n_contacts, dtype=bool)
-        return active[self.i] & active[self.j]
-
     def counts(self, active: np.ndarray | None = None) -> np.ndarray:
         """Contacts per particle among ``active`` (a self-image contact counts twice)."""
         keep = self.among(active)
         n = self.n_particles
         return np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep], minlength=n)
-
-
-@numba.njit(cache=True)
-def _shape_inverses(semiaxes, orientations):
-    n, d = semiaxes.shape
-    out = np.empty((n, d, d))
-    for p in range(n):
-        shape_inverse(semiaxes[p], orientations[p], out[p])
-    return out
 
 
 @numba.njit(cache=True)
@@ -212,7 +186,7 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     shape = packing.shape
     semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
     orient = np.ascontiguousarray(np.asarray(shape.orientations, dtype=float).reshape(packing.n_particles, -1))
-    inv = _shape_inverses(semiaxes, orient)
+    inv = inverse_shapes(semiaxes, orient)
     pairs = pairs_within(packing, rel_gap=delta)
     x = np.ascontiguousarray(wrapped_positions(packing))
     ii, jj = pairs.i.astype(np.int64), pairs.j.astype(np.int64)
@@ -253,7 +227,7 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> Ellipsoi
     n = packing.n_particles
     semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
     orient = np.ascontiguousarray(np.asarray(shape.orientations, dtype=float).reshape(n, -1))
-    inv = _shape_inverses(semiaxes, orient)
+    inv = inverse_shapes(semiaxes, orient)
     x = np.ascontiguousarray(packing.positions if positions is None else positions, dtype=float)
     ii, jj = np.asarray(i, np.int64), np.asarray(j, np.int64)
     shift = np.asarray(shift, np.int64).reshape(len(ii), packing.dim)

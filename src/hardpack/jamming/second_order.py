@@ -284,9 +284,17 @@ def first_order_lp(at: sp.spmatrix, trivial: np.ndarray, rng: np.random.Generato
 def _first_order(at: sp.spmatrix, stress_tol: float) -> tuple[float, np.ndarray, str | None]:
     """Self-stress step (2. of the module docstring): (eps*, F, reason if not strict)."""
     eps, forces = self_stress_lp(at.T)
+    return _self_stress_outcome(eps, forces, stress_tol, "; LP 5.9 optimum")
+
+
+def _self_stress_outcome(eps: float, forces: np.ndarray, stress_tol: float,
+                         why_none: str) -> tuple[float, np.ndarray, str | None]:
+    """(eps*, F, reason if not strict) of the self-stress step from the LP 5.9 optimum ``eps`` and its
+    forces: no self-stress below -stress_tol (``why_none`` says why, before the optimum's value),
+    a non-strict one within +-stress_tol (negative forces clipped), a strict one above."""
     if eps < -stress_tol:
-        return eps, np.zeros(at.shape[0]), (
-            "no self-stress (force and torque balance with F >= 0 fails; LP 5.9 optimum "
+        return eps, np.zeros(forces.size), (
+            f"no self-stress (force and torque balance with F >= 0 fails{why_none} "
             f"{eps:.3g}): a strict first-order flex exists")
     if eps <= stress_tol:
         return eps, np.clip(forces, 0.0, None), (
@@ -344,15 +352,7 @@ def _unique_stress(stress: np.ndarray, stress_tol: float) -> tuple[float, np.nda
     total = stress.sum()
     forces = stress * (m / total) if total != 0 else stress
     eps = float(forces.min()) if total != 0 else float("-inf")
-    if eps < -stress_tol:
-        return eps, np.zeros(m), (
-            "no self-stress (force and torque balance with F >= 0 fails: the unique self-stress has "
-            f"mixed signs, LP 5.9 optimum {eps:.3g}): a strict first-order flex exists")
-    if eps <= stress_tol:
-        return eps, np.clip(forces, 0.0, None), (
-            "a self-stress exists but none is strict (LP 5.9 optimum 0): some contact carries no "
-            "force, the first-order test is inconclusive (Donev 2006, Sec. 5.5.3)")
-    return eps, forces, None
+    return _self_stress_outcome(eps, forces, stress_tol, ": the unique self-stress has mixed signs, LP 5.9 optimum")
 
 
 def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, rank_tol: float = 1e-9,

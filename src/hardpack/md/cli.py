@@ -123,6 +123,8 @@ def cmd_eos(args) -> int:
 
 
 def register(subparsers) -> None:
+    from hardpack.cli import add_checkpoint_options
+
     p = subparsers.add_parser("compress", help=cmd_compress.__doc__)
     p.add_argument("--init", required=True, help="start packing (netCDF), e.g. from 'hardpack init'")
     p.add_argument("--out", required=True, help="final packing (netCDF)")
@@ -135,10 +137,8 @@ def register(subparsers) -> None:
     p.add_argument("--target-phi", type=float, help="stop exactly at this volume fraction")
     p.add_argument("--max-collisions", type=int, help="stop after this many collisions")
     p.add_argument("--max-wall-time", type=float, help="stop after this many seconds")
-    p.add_argument("--checkpoint", help="checkpoint file: written at sync points every --checkpoint-interval "
-                   "seconds and on Ctrl-C or SIGTERM, resumed if present, removed once --out is written")
-    p.add_argument("--checkpoint-interval", type=float, default=300.0,
-                   help="seconds between checkpoints (default 300)")
+    add_checkpoint_options(p, "checkpoint file: written at sync points every --checkpoint-interval seconds and "
+                           "on Ctrl-C or SIGTERM, resumed if present, removed once --out is written")
     p.add_argument("--window", type=float,
                    help="collisions per particle between velocity rescalings (default: from Gamma)")
     p.add_argument("--final-growth-rate", type=float,
@@ -174,11 +174,9 @@ def register(subparsers) -> None:
     p.add_argument("--seed", type=int, required=True, help="seed of the initial velocities")
     p.add_argument("--collisions", type=int, required=True, help="collisions to average over")
     p.add_argument("--blocks", type=int, default=20, help="number of blocks for the error bar")
-    p.add_argument("--checkpoint", help="checkpoint file (and CHECKPOINT.prep for the compression to "
-                   "--phi): written every --checkpoint-interval seconds and on Ctrl-C or SIGTERM, "
-                   "resumed if present, removed once --out is written")
-    p.add_argument("--checkpoint-interval", type=float, default=300.0,
-                   help="seconds between checkpoints (default 300)")
+    add_checkpoint_options(p, "checkpoint file (and CHECKPOINT.prep for the compression to --phi): written every "
+                           "--checkpoint-interval seconds and on Ctrl-C or SIGTERM, resumed if present, removed "
+                           "once --out is written")
     p.set_defaults(func=cmd_eos)
 
 

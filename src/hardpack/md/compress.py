@@ -310,6 +310,24 @@ def _check_final_stage(growth_rate: float, final_growth_rate, switch_pressure, s
         )
 
 
+def _check_run_options(packing: Packing, growth_rate, seed, stop: StopCriteria | None, final_growth_rate,
+                       switch_pressure, window) -> StopCriteria:
+    """Refuse invalid options of a compression run (sphere or ellipsoid engine): the growth rate,
+    the seed, the stop criteria (the default ones for None, returned), the two-stage parameters and
+    the window."""
+    if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(growth_rate):
+        raise InvalidInputError(f"growth_rate must be a finite number, got {growth_rate!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    stop = StopCriteria() if stop is None else stop
+    stop.check(float(growth_rate), packing.phi)
+    _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)
+    if window is not None and not (math.isfinite(window) and window > 0):
+        raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
+    return stop
+
+
 def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     """Share of the particle volume in the packing's d + 1 contact backbone.
 
@@ -553,16 +571,7 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
         On SIGINT or SIGTERM, after the checkpoint is written.
     """
     check_packing(packing)
-    if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
-            or not math.isfinite(growth_rate):
-        raise InvalidInputError(f"growth_rate must be a finite number, got {growth_rate!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
-    stop = StopCriteria() if stop is None else stop
-    stop.check(float(growth_rate), packing.phi)
-    _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)
-    if window is not None and not (math.isfinite(window) and window > 0):
-        raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
+    stop = _check_run_options(packing, growth_rate, seed, stop, final_growth_rate, switch_pressure, window)
     if contact_forces and packing.boundary.kind != "periodic":
         raise InvalidInputError("MD contact forces log pair collisions only; with hard walls the wall "
                                 "forces would be missing: compute forces from the packing "

@@ -28,7 +28,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.shapes import Ellipsoids
 from hardpack.io import checkpoint as ckpt
-from hardpack.md.compress import StopCriteria, _check_final_stage, default_window, run_windows, timeseries_dataset
+from hardpack.md.compress import StopCriteria, _check_run_options, default_window, run_windows, timeseries_dataset
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, rotational_dof
 from hardpack.md.ellipsoid_kernel import EPS_F
 from hardpack.md.simulation import OverlapError, Simulation, check_start_configuration, maxwell_boltzmann
@@ -228,18 +228,9 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
         Overlap beyond ``overlap_tol`` at a synchronisation point or at the end.
     """
     check_ellipsoid_packing(packing)
-    if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
-            or not math.isfinite(growth_rate):
-        raise InvalidInputError(f"growth_rate must be a finite number, got {growth_rate!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
     if not (math.isfinite(eps_f) and 0 < eps_f < 1):
         raise InvalidInputError(f"eps_f must be in (0, 1), got {eps_f!r}")
-    stop = StopCriteria() if stop is None else stop
-    stop.check(float(growth_rate), packing.phi)
-    _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)
-    if window is not None and not (math.isfinite(window) and window > 0):
-        raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
+    stop = _check_run_options(packing, growth_rate, seed, stop, final_growth_rate, switch_pressure, window)
     n, d = packing.n_particles, packing.dim
 
     def stage_window(rate: float) -> float:

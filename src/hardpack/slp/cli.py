@@ -98,6 +98,8 @@ def cmd_slp_dilute(args) -> int:
 
 def _slp_options(p) -> None:
     """The SLP settings and checkpoint options shared by ``slp`` and ``slp-dilute``."""
+    from hardpack.cli import add_checkpoint_options
+
     p.add_argument("--alpha", type=float, default=1.5,
                    help="influence-sphere radius gamma / D_mn (1.5: MRJ-like; 3.5: densest)")
     p.add_argument("--strain-bound", type=float, default=0.1, help="|eps_aa| bound (compression)")
@@ -111,11 +113,8 @@ def _slp_options(p) -> None:
     p.add_argument("--tol", type=float, default=1e-10,
                    help="stop when the predicted density gain is below this (paper: 1e-8; see hardpack.slp.driver)")
     p.add_argument("--max-steps", type=int, default=2000, help="maximum number of LPs (per SLP run)")
-    p.add_argument("--checkpoint", help="checkpoint file: written every --checkpoint-interval seconds "
-                   "(slp-dilute: also after every round), resumed if present (same start and options), "
-                   "removed at the end")
-    p.add_argument("--checkpoint-interval", type=float, default=300.0,
-                   help="seconds between checkpoints (default 300)")
+    add_checkpoint_options(p, "checkpoint file: written every --checkpoint-interval seconds (slp-dilute: also "
+                           "after every round), resumed if present (same start and options), removed at the end")
     p.add_argument("--attr", action="append", type=lambda t: tuple(t.split("=", 1)), metavar="KEY=VALUE")
 
 
