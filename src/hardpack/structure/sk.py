@@ -136,8 +136,8 @@ def wavevectors(lattice, k_max: float, max_vectors: int = 5 * 10**7):
         If k_max is not a positive finite number or needs more than max_vectors wavevectors.
     """
     recip, heads, t_lo, t_hi = _heads(lattice, k_max, max_vectors)
-    n, k, _ = _expand(recip, heads, t_lo, t_hi, k_max)
-    return n, k
+    n, k, inside = _expand(recip, heads, t_lo, t_hi, k_max)
+    return n[inside], k[inside]
 
 
 @numba.njit(cache=True, parallel=True)
