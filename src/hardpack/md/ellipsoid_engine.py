@@ -74,21 +74,7 @@ class EllipsoidEngine(Engine):
         from hardpack.md.engine import image_vectors
 
         self.imgvec = image_vectors(self.box)
-        self.cnt = np.zeros(n, dtype=np.int32)
-        self.ep = np.zeros(n, dtype=np.int32)
-        self.ec = np.zeros(n, dtype=np.int32)
-        self.hkey = np.zeros(n)
-        self.heap = np.zeros(n, dtype=np.int32)
-        self.hpos = np.zeros(n, dtype=np.int32)
-        self.bs = np.zeros((n, d + 1))
-        self.nn = np.zeros(n, dtype=np.int32)
-        self.mark = np.zeros(n, dtype=np.int8)
-        self.slot_of = np.zeros(n, dtype=np.int32)
-        self.cell_capacity = 0
-        self.cell_floor = 1
-        self.lists_valid = False
-        self.last_duration = 0.0
-        self.alloc_lists(capacity)
+        self.init_event_state(capacity)
 
     # ----------------------------------------------------------------- views of the state
     @property

@@ -129,6 +129,15 @@ class Engine:
         self.dims = tuple(range(d))  # its length is a compile-time constant in the kernels
         self.imgvec = image_vectors(self.box)
         self.wmode, self.walled, self.wspec = wall_arrays(boundary, d)
+        self._no_log_pair = np.zeros((0, 2), dtype=np.int32)
+        self._no_log_val = np.zeros((0, d + 1))
+        self.init_event_state(capacity)
+
+    def init_event_state(self, capacity: int) -> None:
+        """Arrays of the event loop (collision counters, predicted partners, heap, bounding
+        spheres, neighbour lists of ``capacity`` entries, grid slots), shared by the sphere and
+        ellipsoid engines; the lists and grid are built at the first window."""
+        n, d = self.n, self.d
         self.cnt = np.zeros(n, dtype=np.int32)  # 32-bit integers: less memory traffic
         self.ep = np.zeros(n, dtype=np.int32)
         self.ec = np.zeros(n, dtype=np.int32)
@@ -142,8 +151,6 @@ class Engine:
         self.cell_capacity = 0
         #: smallest cell capacity of any grid (doubled after a full cell; part of the run state)
         self.cell_floor = 1
-        self._no_log_pair = np.zeros((0, 2), dtype=np.int32)
-        self._no_log_val = np.zeros((0, d + 1))
         self.lists_valid = False  # neighbour lists, bounding spheres and grid match P
         self.last_duration = 0.0
         self.alloc_lists(capacity)
