@@ -255,3 +255,47 @@ def test_refuses_what_is_not_ellipsoids_in_a_container(jammed_spheres):
     for bad in (0, 2.5, float("nan"), float("inf"), -3):
         with pytest.raises(InvalidInputError, match="n_shells"):
             ellipsoid_radial_density_profile(p, bad)
+
+
+# ----------------------------------------------------------------------------- summary and figure
+def _profiled(n, seed, margin=1.0):
+    p = random_ellipsoid_packing(n, OLLIPSOID, 0.1, seed, boundary="spherical_container")
+    prof = ellipsoid_radial_density_profile(p, 60)
+    prof.attrs.update(N=n, seed=seed, phi_core=core_density(p, margin), core_margin=margin, shape_name="ollipsoid",
+                      phi=p.phi, a_over_R=prof.attrs["a"] / p.boundary.radius)
+    return p, prof
+
+
+def test_ellipsoid_summary_keeps_each_packings_core_and_wall_layer():
+    from hardpack.structure.containers import ellipsoid_container_summary, wall_layer_density
+
+    made = [_profiled(n, s) for n, s in ((30, 2), (20, 1), (30, 1))]
+    packings, profiles = [m[0] for m in made], [m[1] for m in made]
+    ds = ellipsoid_container_summary(packings, [2, 1, 1], profiles=profiles)
+    assert ds["N"].values.tolist() == [20, 30, 30] and ds["seed"].values.tolist() == [1, 1, 2]
+    assert ds["phi_core"].values.tolist() == [profiles[k].attrs["phi_core"] for k in (1, 2, 0)]
+    assert ds["phi_wall_layer"].values[0] == wall_layer_density(profiles[1])
+    assert ds.attrs["core_margin"] == 1.0
+    assert "phi_core" not in ellipsoid_container_summary(packings, [2, 1, 1])
+    with pytest.raises(InvalidInputError, match="packings' order"):
+        ellipsoid_container_summary(packings, [2, 1, 1], profiles=profiles[::-1])
+    with pytest.raises(InvalidInputError, match="one radial profile per packing"):
+        ellipsoid_container_summary(packings, [2, 1, 1], profiles=profiles[:2])
+    profiles[0].attrs.pop("phi_core")
+    with pytest.raises(InvalidInputError, match="phi_core"):
+        ellipsoid_container_summary(packings, [2, 1, 1], profiles=profiles)
+
+
+def test_ellipsoid_profile_figure_has_a_panel_per_shape(tmp_path):
+    from hardpack.plots.containers import plot_ellipsoid_radial_profiles
+    from hardpack.plots.style import save
+
+    _, olli = _profiled(30, 1)
+    _, mm = _profiled(30, 2)
+    mm.attrs["shape_name"] = "mm"
+    fig = plot_ellipsoid_radial_profiles([mm, olli])
+    assert [ax.get_title() for ax in fig.axes] == ["M&M", "ollipsoid"]
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any("0.700" in t for t in labels) and any("core average" in t for t in labels)
+    save(fig, tmp_path / "profile.pdf", tmp_path / "profile.png")
+    assert (tmp_path / "profile.png").stat().st_size > 1000
