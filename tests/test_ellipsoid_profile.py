@@ -287,7 +287,7 @@ def test_ellipsoid_summary_keeps_each_packings_core_and_wall_layer():
 
 
 def test_ellipsoid_profile_figure_has_a_panel_per_shape(tmp_path):
-    from hardpack.plots.containers import plot_ellipsoid_radial_profiles
+    from hardpack.plots.containers import plot_ellipsoid_radial_profiles, plot_radial_profile
     from hardpack.plots.style import save
 
     _, olli = _profiled(30, 1)
@@ -299,3 +299,6 @@ def test_ellipsoid_profile_figure_has_a_panel_per_shape(tmp_path):
     assert any("0.700" in t for t in labels) and any("core average" in t for t in labels)
     save(fig, tmp_path / "profile.pdf", tmp_path / "profile.png")
     assert (tmp_path / "profile.png").stat().st_size > 1000
+    # the sphere figure reads the same variables
+    save(plot_radial_profile([mm, olli]), tmp_path / "as_spheres.png")
+    assert (tmp_path / "as_spheres.png").stat().st_size > 1000
