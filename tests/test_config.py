@@ -48,6 +48,8 @@ def test_shipped_configs_are_valid(name):
         (lambda c: c["containers"].update(radius=3), "containers: Additional properties.*'radius'"),
         (lambda c: c["containers"].update(N=[100]), r"containers.N: \[100\] should be non-empty|too short"),
         (lambda c: c["containers"].pop("core_margin"), "containers: 'core_margin' is a required property"),
+        (lambda c: c["ellipsoid_containers"].pop("shell_width"),
+         "ellipsoid_containers: 'shell_width' is a required property"),
         (lambda c: c["containers"]["windows"].update(n_windows=1), "containers.windows.n_windows: 1 is less than"),
     ],
 )
@@ -72,6 +74,11 @@ def test_snakemake_dry_run_lists_the_dag(configfile):
     for rule, count in (("container_init", packings + bulk), ("container_profile", packings), ("container_summary", 1),
                         ("container_windows", 1), ("fig_container_profile", 1), ("fig_container_extrapolation", 1),
                         ("fig_container_windows", 1)):
+        assert re.search(rf"^{rule} +{count}$", out.stdout, re.M), rule
+    ell = load(configfile.split("/")[1])["ellipsoid_containers"]
+    shapes = len(ell["shapes"])
+    for rule, count in (("ellipsoid_container_profile", shapes * len(ell["N"]) * len(ell["seeds"])),
+                        ("ellipsoid_container_summary", shapes), ("fig_ellipsoid_container_profile", 1)):
         assert re.search(rf"^{rule} +{count}$", out.stdout, re.M), rule
 
 
@@ -136,6 +143,7 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
     (lambda c: c["freeenergy"]["simplex"].update(seeds=[1, 7]), r"freeenergy.simplex.seeds \[7\] are not seeds"),
     (lambda c: c["containers"]["windows"].update(ensemble="binary2d"), "must be a monodisperse 3D ensemble"),
     (lambda c: c["containers"].update(core_margin=6), "core_margin = 6 a leaves no core"),
+    (lambda c: c["ellipsoid_containers"].update(core_margin=4), "ellipsoid_containers.core_margin = 4 a leaves no core"),
     (lambda c: c["containers"].update(fit_min_n=200), "fewer than 2 container sizes"),
     (lambda c: c["containers"]["windows"].update(fit_min_diameter=0.1), "fit_min_diameter must be >= min_diameter"),
 ])

@@ -133,7 +133,8 @@ def check_ellipsoids():
 
 
 def check_containers():
-    """The window study reads a 3D LS ensemble; the largest container has a core; the fit has points."""
+    """The window study reads a 3D LS ensemble; the largest container (of spheres and of
+    ellipsoids) has a core; the fit has points."""
     if not CONTAINERS:
         return
     windows = CONTAINERS["windows"]
@@ -150,6 +151,10 @@ def check_containers():
                          "the Eq. 7.2 fit")
     if not windows["fit_min_diameter"] >= windows["min_diameter"]:
         raise ValueError("config: containers.windows.fit_min_diameter must be >= min_diameter")
+    ell = ELLIPSOID_CONTAINERS
+    if ell and not ell["core_margin"] < max(ell["N"]) ** (1 / 3):
+        raise ValueError(f"config: ellipsoid_containers.core_margin = {ell['core_margin']} a leaves no core in the "
+                         f"largest container (N = {max(ell['N'])}, R > N^(1/3) a): lower it")
 
 
 check_config()
@@ -768,6 +773,7 @@ def figures():
     names += ["glass_eos", "glass_entropy"] if GLASS else []
     names += ["microsegregated", "microsegregated_maps"] if MICROSEG else []
     names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []
+    names += ["ellipsoid_container_profile"] if ELLIPSOID_CONTAINERS else []
     names += ["strict_ls_disks"] if "d2" in SYSTEMS["strict_ls"] else []
     return [f"results/figures/{name}.pdf" for name in names]
 
@@ -941,7 +947,8 @@ PARTICLES = {
     **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd"),
                     lambda w: GLASS["N"]),
     **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
-    "ellipsoid_container_init": lambda w: SYSTEMS["ellipsoid_containers"][w.name]["N"],
+    **dict.fromkeys(("ellipsoid_container_init", "ellipsoid_container_profile"),
+                    lambda w: SYSTEMS["ellipsoid_containers"][w.name]["N"]),
     "microseg_packing": lambda w: MICROSEG["shape"][0] * MICROSEG["shape"][1],
 }
 

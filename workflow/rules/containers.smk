@@ -195,7 +195,9 @@ rule fig_container_windows:
 
 # Ellipsoids in spherical containers (Donev 2006, Sec. 7.3.2.1 and Fig. 7.6), one ensemble per shape
 # (M&M spheroids, ollipsoids): a dilute random start inside the container, LS compression by the
-# generic compress job, and the Eq. 7.2 extrapolation of the average density over (N, seed).
+# generic compress job, the radial density profile and core density of each packing (the
+# tangent-plane approximation of Sec. 7.3.1.2), the Eq. 7.2 extrapolation of the average density
+# over (N, seed), and the profiles of the largest containers after Fig. 7.5.
 
 
 rule ellipsoid_container_init:
@@ -224,11 +226,39 @@ rule ellipsoid_container_init:
         " --boundary spherical_container --seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
-rule ellipsoid_container_summary:
-    """The container packings of one shape over (N, seed) and the Eq. 7.2 extrapolation of their
-    average density to a/R -> 0 over the sizes N >= fit_min_n."""
+rule ellipsoid_container_profile:
+    """phi(r) in shells of shell_width a (tangent-plane approximation), the average density, a/R
+    and the core density (r <= R - core_margin a) of one jammed ellipsoid packing in a container."""
     input:
-        lambda w: ellipsoid_container_files(w.shape, "jammed"),
+        "results/ellipsoid_containers/{name}/jammed/seed{seed}.nc",
+    output:
+        "results/ellipsoid_containers/{name}/profile/seed{seed}.nc",
+    params:
+        shell_width=lambda w: ELLIPSOID_CONTAINERS["shell_width"],
+        core_margin=lambda w: ELLIPSOID_CONTAINERS["core_margin"],
+        shape_name=lambda w: SYSTEMS["ellipsoid_containers"][w.name]["attrs"]["shape_name"],
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("ellipsoid_container_profile"),
+        runtime=job_runtime("ellipsoid_container_profile"),
+    group:
+        "analyses"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/ellipsoid_container_profile/{name}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/ellipsoid_container_profile/{name}/seed{seed}.tsv"
+    script:
+        "../scripts/container_profile.py"
+
+
+rule ellipsoid_container_summary:
+    """The container packings of one shape over (N, seed), their core densities, and the Eq. 7.2
+    extrapolation of their average density to a/R -> 0 over the sizes N >= fit_min_n."""
+    input:
+        packings=lambda w: ellipsoid_container_files(w.shape, "jammed"),
+        profiles=lambda w: ellipsoid_container_files(w.shape, "profile"),
     output:
         "results/ellipsoid_containers/{shape}/summary.nc",
     params:
@@ -250,3 +280,33 @@ rule ellipsoid_container_summary:
         "results/benchmarks/ellipsoid_container_summary/{shape}.tsv"
     script:
         "../scripts/ellipsoid_container_summary.py"
+
+
+rule fig_ellipsoid_container_profile:
+    """phi(r) near the wall of the largest containers of every ellipsoid shape, with each packing's
+    core density and core average and Donev's bulk density of the shape (after Donev 2006,
+    Fig. 7.5 and Sec. 7.3.2.1)."""
+    input:
+        lambda w: [path for shape in ELLIPSOID_CONTAINERS["shapes"]
+                   for path in seed_files("ellipsoid_containers", f"{shape}_n{max(ELLIPSOID_CONTAINERS['N'])}",
+                                          "profile")],
+    output:
+        pdf="results/figures/ellipsoid_container_profile.pdf",
+        png=report("results/figures/ellipsoid_container_profile.png", caption="../report/containers.rst",
+                   category="7 containers"),
+    params:
+        kind="ellipsoid_profile",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_ellipsoid_container_profile"),
+        runtime=job_runtime("fig_ellipsoid_container_profile"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_ellipsoid_container_profile.log",
+    benchmark:
+        "results/benchmarks/fig_ellipsoid_container_profile.tsv"
+    script:
+        "../scripts/plot_containers.py"

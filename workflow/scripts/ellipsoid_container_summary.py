@@ -1,6 +1,7 @@
-"""Snakemake script: the container packings of one ellipsoid shape over (N, seed) and their Eq. 7.2
-bulk extrapolation (hardpack.structure.containers.ellipsoid_container_summary), with the shape's
-name from the config (``shape_name``, which the validation rows read)."""
+"""Snakemake script: the container packings of one ellipsoid shape over (N, seed), their core
+densities (from their radial profiles, in the same order) and their Eq. 7.2 bulk extrapolation
+(hardpack.structure.containers.ellipsoid_container_summary), with the shape's name from the
+config (``shape_name``, which the validation rows read)."""
 
 import logging
 
@@ -8,10 +9,11 @@ from hardpack.io import load_dataset, load_packing, write_dataset
 from hardpack.structure.containers import ellipsoid_container_summary
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
-paths = list(snakemake.input)
+paths = list(snakemake.input.packings)
 attrs = [load_dataset(p).attrs for p in paths]
 ds = ellipsoid_container_summary([load_packing(p) for p in paths], [int(a["seed"]) for a in attrs],
-                                 fit_min_n=snakemake.params.fit_min_n)
+                                 fit_min_n=snakemake.params.fit_min_n,
+                                 profiles=[load_dataset(p) for p in snakemake.input.profiles])
 ds.attrs["shape_name"] = snakemake.params.shape_name  # the validation row's key (config shapes)
 write_dataset(ds, snakemake.output[0])
 logging.info("%s: %d packings; phi_0 = %.4f +- %.4f over %d packings of %d sizes", snakemake.output[0],

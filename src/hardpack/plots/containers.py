@@ -1,7 +1,7 @@
-"""Figures of the finite-container study of spheres (Donev 2006, Sec. 7.3): the radial density
-profile near the wall (after Fig. 7.5), the average density against a/R with the Eq. 7.2 linear
-extrapolation (after Fig. 7.6) and the window fluctuations sigma_phi(2R/D) of periodic packings
-(after Fig. 7.3)."""
+"""Figures of the finite-container study of spheres and ellipsoids (Donev 2006, Sec. 7.3): the
+radial density profile near the wall (after Fig. 7.5; ellipsoids one panel per shape), the average
+density against a/R with the Eq. 7.2 linear extrapolation (after Fig. 7.6) and the window
+fluctuations sigma_phi(2R/D) of periodic packings (after Fig. 7.3)."""
 
 from __future__ import annotations
 
@@ -35,19 +35,63 @@ def plot_radial_profile(profiles):
     matplotlib.figure.Figure
     """
     fig, ax = figure(figsize=(6.0, 3.2))
+    _draw_profiles(ax, profiles)
+    ax.axhline(DONEV_CORE, color="k", ls="--", lw=1, label=r"Donev 2006: $\phi_0 \approx 0.64$")
+    ax.legend(fontsize=7, loc="lower right")
+    return fig
+
+
+def plot_ellipsoid_radial_profiles(profiles):
+    """phi(r) of ellipsoids in spherical containers against the distance from the wall (R - r) / a,
+    one panel per shape (after Donev 2006, Fig. 7.5): each packing's profile (tangent-plane
+    approximation, Sec. 7.3.1.2), its core density (dotted) and core average phi_avg(r) =
+    3 int_0^r x^2 phi dx / r^3 (thin dashed, Sec. 7.3.2.3), Donev's bulk density of the shape
+    (Sec. 7.3.2.1: 0.700 for the M&M and 0.741 for the ollipsoid shape, dashed), and, shaded, the
+    centre r < 2a where the tangent plane is a poor stand-in for the ball.
+
+    Parameters
+    ----------
+    profiles : sequence of xarray.Dataset
+        Radial profiles (:func:`hardpack.structure.containers.ellipsoid_radial_density_profile`)
+        with the attributes ``shape_name``, ``N``, ``seed``, ``a``, ``radius``, ``phi_core`` and
+        ``core_margin``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    shapes = list(dict.fromkeys(p.attrs["shape_name"] for p in profiles))
+    fig, axes = figure(ncols=max(len(shapes), 1), figsize=(4.2 * max(len(shapes), 1), 3.2), sharey=True)
+    axes = np.atleast_1d(axes)
+    for ax, name in zip(axes, shapes):
+        group = [p for p in profiles if p.attrs["shape_name"] == name]
+        _draw_profiles(ax, group, core_average=True)
+        label, published, _ = DONEV_ELLIPSOID_PHI0.get(name, (name, np.nan, np.nan))
+        if np.isfinite(published):
+            ax.axhline(published, color="k", ls="--", lw=1, label=rf"Donev 2006: $\phi_0$ = {published:.3f}")
+        centre = max(p.attrs["radius"] / p.attrs["a"] for p in group)
+        ax.axvspan(centre - 2, centre, color="0.85", lw=0, label="r < 2a (tangent plane poor)")
+        ax.set_title(label, fontsize=9)
+        ax.legend(fontsize=6, loc="lower right")
+    return fig
+
+
+def _draw_profiles(ax, profiles, core_average=False):
+    """Each profile against (R - r) / a with its core density (dotted) and, optionally, its core
+    average (thin dashed); the core margin (grey line); axes labels and limits."""
     for k, p in enumerate(profiles):
         a, radius = p.attrs["a"], p.attrs["radius"]
-        ax.plot((radius - p["r"].values) / a, p["phi"].values, lw=0.8, color=f"C{k}",
-                label=f"N = {p.attrs['N']}, seed {p.attrs['seed']}")
+        x = (radius - p["r"].values) / a
+        ax.plot(x, p["phi"].values, lw=0.8, color=f"C{k}", label=f"N = {p.attrs['N']}, seed {p.attrs['seed']}")
         ax.axhline(p.attrs["phi_core"], color=f"C{k}", ls=":", lw=0.8)
-    ax.axhline(DONEV_CORE, color="k", ls="--", lw=1, label=r"Donev 2006: $\phi_0 \approx 0.64$")
+        if core_average:
+            ax.plot((radius - p["r_outer"].values) / a, p["phi_core_average"].values, color=f"C{k}", ls="--",
+                    lw=0.6, label=r"core average $\phi_{avg}(r)$" if k == 0 else None)
     margin = profiles[0].attrs["core_margin"] if profiles else 0
     ax.axvline(margin, color="0.5", lw=0.6)
     ax.set_xlabel(r"distance from the wall $(R - r)/a$")
     ax.set_ylabel(r"$\phi(r)$")
     ax.set_ylim(0, 1)
-    ax.legend(fontsize=7, loc="lower right")
-    return fig
 
 
 def plot_extrapolation(summary, ellipsoids=()):

@@ -12,6 +12,7 @@ from hardpack.structure.channels import (
 )
 from hardpack.structure.containers import (
     ball_intersection_volume,
+    ellipsoid_radial_density_profile,
     extrapolate_bulk_density,
     radial_density_profile,
     window_fluctuations,
@@ -47,7 +48,8 @@ from hardpack.structure.tessellation import (
 )
 
 __all__ = [
-    "ball_intersection_volume", "extrapolate_bulk_density", "radial_density_profile",
+    "ball_intersection_volume", "ellipsoid_radial_density_profile", "extrapolate_bulk_density",
+    "radial_density_profile",
     "window_fluctuations",
     "NeighbourList",
     "PowerLawFit",
