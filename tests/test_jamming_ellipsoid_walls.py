@@ -40,6 +40,7 @@ from hardpack.jamming.result import Verdict
 from hardpack.jamming.second_order import verify_ellipsoids
 
 DISKS_IN_CONTAINER = Path(__file__).parent / "data" / "disks_container_n12.nc"
+SPHERES_IN_CONTAINER = Path(__file__).parent / "data" / "spheres_container_n10.nc"
 
 
 def as_ellipses(p: Packing) -> Packing:
@@ -93,6 +94,35 @@ def test_disks_as_ellipses_in_a_container_match_the_sphere_verifier():
     assert ds.attrs["n_wall_contacts"] == 9 and ds.attrs["wall_force"] == pytest.approx(res.wall_force)
     assert int((ds["contact_wall"].values == 0).sum()) == 9
     assert "spherical container" in ds.attrs["boundary"]
+
+
+def test_spheres_as_ellipsoids_in_a_container_match_the_sphere_verifier():
+    """10 spheres compressed in a spherical container (``hardpack compress``, reduced pressure
+    1e12): collectively jammed, M_b = 29 with 10 wall contacts, N_f = 3 N - 3 = 27 (the three
+    rotations about the centre are trivial), two self-stresses. As ellipsoids with three equal
+    semiaxes (no rotation dof): jammed at first order with the same counts; the sphere verifier's
+    forces are a self-stress of the ellipsoid rigidity matrix (force balance of every particle,
+    walls included), and on this packing both LPs pick the same self-stress (measured: the same
+    total wall reaction)."""
+    spheres_packing = load_packing(SPHERES_IN_CONTAINER)
+    spheres = verify(spheres_packing, tests=("local", "collective"))
+    n = spheres_packing.n_particles
+    as_ellipsoids = Packing(spheres_packing.positions, lattice=spheres_packing.lattice, allow_overlap=True,
+                            boundary=spheres_packing.boundary,
+                            shape=Ellipsoids(np.repeat(spheres_packing.radii[:, None], 3, 1), np.tile([1.0, 0, 0, 0], (n, 1))))
+    res = verify_ellipsoids(as_ellipsoids)
+    c = res.collective
+    assert spheres.collective and res.verdict == Verdict.JAMMED and res.order == "first"
+    assert c.n_constraints == spheres.statics.n_contacts == 29 and c.n_dof == spheres.statics.n_dof_collective == 27
+    assert c.n_stresses == 2 and c.n_floppy == 0
+    assert res.n_backbone_wall_contacts == spheres.statics.n_wall_contacts == 10
+    net, sn = res.network, spheres.network
+    index = {(int(i), int(j) if w < 0 else -1): k for k, (i, j, w) in enumerate(zip(net.i, net.j, net.wall))}
+    f = np.zeros(net.n_contacts)
+    for i, j, w, v in zip(sn.i, sn.j, sn.wall, spheres.forces.forces):
+        f[index[(int(i), int(j) if w < 0 else -1)]] = v
+    assert np.abs(rigidity_transpose_full(net).T @ f).max() < 1e-12 * f.max()
+    assert res.wall_force == pytest.approx(spheres.statics.wall_force, rel=1e-9)
 
 
 def test_the_disks_are_jammed_only_because_of_the_container():
@@ -308,6 +338,20 @@ def test_local_farthest_points_of_an_ellipse_by_brute_force():
         np.testing.assert_allclose(np.sort(np.linalg.norm(pts[:count], axis=1)), peaks, atol=1e-8)
         twos += count == 2
     assert twos > 10
+
+
+def test_cli_verify_stores_the_wall_contacts_of_an_ellipse_packing(tmp_path):
+    """``hardpack verify`` of the centred ellipse (a = 2, b = 1) in its container writes the wall
+    contacts and reactions (F = 1 on both tips) into the result dataset."""
+    from hardpack.cli import main
+    from hardpack.io import load_dataset, save_packing
+
+    save_packing(centred([2.0, 1.0], 0.3), tmp_path / "ellipse.nc")
+    assert main(["verify", str(tmp_path / "ellipse.nc"), "--out", str(tmp_path / "v.nc")]) == 0
+    ds = load_dataset(tmp_path / "v.nc")
+    assert ds.attrs["jammed"] == 1 and ds.attrs["order"] == "second"
+    assert ds.attrs["n_wall_contacts"] == 2 and ds.attrs["wall_force"] == pytest.approx(2.0)
+    np.testing.assert_allclose(ds["force"].values[ds["contact_wall"].values == 0], 1.0, rtol=1e-12)
 
 
 # ------------------------------------------------------------------------------------ input
