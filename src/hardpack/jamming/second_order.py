@@ -884,12 +884,14 @@ def _global_near_stress(net, at_full, t_full, owner, frozen):
 def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
                       method: str = "auto", local: bool = True, rank_tol: float = 1e-9,
                       stress_tol: float = 1e-9, eig_tol: float = 1e-9, seed: int = 0) -> EllipsoidJammingResult:
-    """Jamming test of a periodic packing of ellipses or ellipsoids (module docstring).
+    """Jamming test of a packing of ellipses or ellipsoids, periodic or in a spherical container
+    (module docstring; wall contacts: :mod:`hardpack.jamming.ellipsoids`).
 
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell (the contacts must be exact to ``delta``).
+        Ellipses or ellipsoids in a periodic cell or a spherical container (the contacts must be
+        exact to ``delta``; a wall contact's gap counts relative to the particle's a_max).
     delta : float or "gaps", optional
         Contact tolerance mu - 1 (default DEFAULT_DELTA, 1e-9), or "gaps": read off the gap
         distribution (:func:`contact_delta_from_gaps`; packings from a compression to high
@@ -912,8 +914,10 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     Raises
     ------
     InvalidInputError
-        For a packing that is not a periodic ellipsoid packing, overlaps (mu - 1 below
-        -packing.overlap_tol, by the Perram-Wertheim function), a bad ``delta``, ``frozen`` of
+        For a packing that is not an ellipsoid packing in a periodic cell or a spherical container,
+        a particle touching the container along a continuum, overlaps (pairs: mu - 1 below
+        -packing.overlap_tol, by the Perram-Wertheim function; the wall: h / a_max below it), a
+        bad ``delta``, ``frozen`` of
         the wrong shape, an unknown ``method`` or non-positive tolerances.
     """
     check_ellipsoid_packing(packing)
