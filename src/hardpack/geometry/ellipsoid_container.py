@@ -179,3 +179,122 @@ def container_gaps(positions, shape, centre, radius):
                                np.ascontiguousarray(shape.semiaxes, dtype=float), rot,
                                np.asarray(centre, dtype=float))
     return float(radius) - rho, pts
+
+
+#: local maxima per particle returned by :func:`local_farthest_body` (at most two exist)
+MAX_LOCAL = 2
+
+
+@njit(cache=True)
+def _secular(u, a, b, kd, a2d):
+    """g at mu = a_d^2 - u (module docstring), with the longest-axis denominator written as -u."""
+    g = 0.0
+    for k in range(a.shape[0]):
+        a2 = a[k] * a[k]
+        den = -u if k == kd else (a2d - a2) - u
+        g += a2 * b[k] * b[k] / (den * den)
+    return g
+
+
+@njit(cache=True)
+def local_farthest_body(b, a, points):
+    """Every strict local maximum of |b + z| over the body-frame ellipsoid surface
+    sum z_k^2 / a_k^2 = 1: their number (0, 1 or 2; -1 when the maximum is attained on a
+    continuum), the points x = b + z in ``points`` (MAX_LOCAL, d) (body frame, relative to the
+    container centre).
+
+    Derivation (the notation of the module docstring). Every stationary point of |b + z|^2 on the
+    surface is x_k = mu b_k / (mu - a_k^2) with g(mu) = 1 (or a "hard case" point at mu = a_k^2).
+    The Hessian of the Lagrangian on the tangent plane is diag(1 - mu / a_k^2); with
+    D = diag(1 - mu / a_k^2) and normal m_k = b_k / (mu - a_k^2) it is negative definite on m^perp
+    iff D < 0 (mu > a_max^2: the global maximum) or D has one positive entry and
+    m^T D^-1 m = g'(mu) / 2 > 0 (Haynsworth inertia of the bordered matrix). So besides the global
+    maximum there is at most one more, in mu in (a_2nd^2, a_max^2) (a_2nd the second longest
+    semiaxis; none when it equals a_max), at the larger root of g = 1 there, where g' > 0. g is
+    convex on that interval: its minimiser is found by bisection on g', and the root, at
+    u = a_max^2 - mu in [sqrt(w_d), u_min] (w_d = a_max^2 b_d^2: g >= w_d / u^2), by geometric
+    bisection in u, so that the longest-axis component -mu b_d / u keeps its relative precision.
+    In the hard case (b_d = 0) the global maximum is the pair x_d = +-sqrt(rest): both returned
+    (one when rest = 0). An ellipse or ellipsoid whose longest semiaxes are equal (a disk, a sphere,
+    an oblate spheroid) and whose centre has no component along them has a circle or sphere of
+    farthest points: -1.
+
+    Exact case: a prolate spheroid centred in the container has the two tips x = +-a_max e_d.
+    """
+    d = b.shape[0]
+    kd = 0
+    for k in range(d):
+        if a[k] > a[kd]:
+            kd = k
+    a2d = a[kd] * a[kd]
+    a2s = 0.0
+    n_long = 0
+    for k in range(d):
+        a2 = a[k] * a[k]
+        if a2 == a2d:
+            n_long += 1
+        elif a2 > a2s:
+            a2s = a2
+    x = np.empty(d)
+    farthest_point_body(b, a, x)
+    wd = 0.0
+    for k in range(d):
+        if a[k] * a[k] == a2d:
+            wd += a2d * b[k] * b[k]
+    hard = wd == 0.0
+    if hard:
+        g = 0.0
+        for k in range(d):
+            a2 = a[k] * a[k]
+            if a2 < a2d:
+                q = a[k] * b[k] / (a2d - a2)
+                g += q * q
+        hard = g <= 1.0
+    for k in range(d):
+        points[0, k] = x[k]
+    if hard:
+        if n_long > 1:
+            return -1
+        if x[kd] == 0.0:
+            return 1
+        for k in range(d):
+            points[1, k] = x[k]
+        points[1, kd] = -x[kd]
+        return 2
+    if n_long > 1 or d < 2:
+        return 1
+    # second local maximum: u = a_d^2 - mu in (0, a_d^2 - a_2nd^2)
+    width = a2d - a2s
+    lo, hi = 0.0, width
+    for _ in range(200):  # minimiser of the convex g: g'(u) changes sign from - to +
+        mid = 0.5 * (lo + hi)
+        dg = 0.0  # d g / d u
+        for k in range(d):
+            a2 = a[k] * a[k]
+            den = -mid if k == kd else (a2d - a2) - mid
+            dg += 2.0 * a2 * b[k] * b[k] / (den * den * den)
+        if dg < 0.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-15 * width:
+            break
+    umin = 0.5 * (lo + hi)
+    if _secular(umin, a, b, kd, a2d) >= 1.0:
+        return 1
+    lo, hi = min(np.sqrt(wd), umin), umin  # g(lo) >= 1 > g(hi): g decreases on (0, umin)
+    for _ in range(400):
+        mid = np.sqrt(lo * hi) if lo > 0.0 else 0.5 * hi
+        if _secular(mid, a, b, kd, a2d) >= 1.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 2.0 * np.finfo(np.float64).eps * hi:
+            break
+    u = hi
+    mu = a2d - u
+    for k in range(d):
+        a2 = a[k] * a[k]
+        den = -u if k == kd else mu - a2
+        points[1, k] = mu * b[k] / den
+    return 2

@@ -27,6 +27,19 @@ contact c in A^T is the gap rate
 is the sphere code's row (:mod:`hardpack.jamming.rigidity`) plus rotational entries that vanish,
 since the lever arms are parallel to u.
 
+Container walls (Donev 2006, Sec. 4.4.3 for spheres: a contact with a fixed point of the wall;
+ellipsoids in a spherical container as in Ch. 7). With the container centre c and radius R, the
+gap of particle i is h = R - rho, rho the distance from c of its farthest surface point p
+(:mod:`hardpack.geometry.ellipsoid_container`, exact). Every strict local maximum of the
+distance with h <= delta a_max is a wall contact (at most two per particle: the global one and,
+for an elongated particle lying like a chord, its other tip; both tips when the centre is on
+the container's plane through the particle's short axes), stored with ``wall`` = 0 (-1 for a
+pair), j = i, unit normal n = (p - c) / rho (the radial direction, which is the surface normal
+at a farthest point), lever arm r_iC = p - x_i, ``scale`` 1 and ``zeta`` chosen so that ``gap``
+is h / a_max. By the envelope theorem (the point on the body is stationary),
+grad_r h = -n and grad_omega h = -r_iC x n: the pair row with the wall as a fixed particle j,
+u . (-v_i - w_i x r_iC). The Hessian of h is :func:`wall_gap_hessian`.
+
 Stress matrix (Sec. 5.5.2.1, Eq. 5.16). For a self-stress F (A F = 0, F >= 0, in the units of the
 rows above) the stress matrix is the force-weighted sum of the contacts' Hessians of zeta,
 sum_c (F_c / s_c) Hess zeta_c. With the sign convention of Donev (zeta >= 0 for disjoint
@@ -35,7 +48,10 @@ Qdot^T (sum_c F_c / s_c Hess zeta_c) Qdot < 0. We store the negative, the *stiff
 K = -sum_c (F_c / s_c) Hess zeta_c, which is positive on blocked modes. The factor 1 / s_c converts
 zeta to the gap: both vanish on the same set, zeta = gap * s + O(gap^2), so on a floppy mode
 (grad gap . Qdot = 0) Qdot^T Hess zeta Qdot = s Qdot^T Hess gap Qdot; the terms that depend on the
-parametrisation of the rotations (Qddot) drop out because A F = 0 (Eq. 5.15).
+parametrisation of the rotations (Qddot) drop out because A F = 0 (Eq. 5.15). A wall contact
+enters with its gap h itself (s = 1): K gets -F_c Hess h_c in the block of its particle, in the
+same parametrisation of the rotations (x -> x + v, orientation R(omega) = exp(W) times the
+current one) as the pair Hessians.
 """
 
 from __future__ import annotations
@@ -48,6 +64,7 @@ import scipy.sparse as sp
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.contact import contact_point, inverse_shapes, pw_contact
+from hardpack.geometry.ellipsoid_container import local_farthest_body
 from hardpack.geometry.neighbours.pairs import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
 from hardpack.jamming.contacts import ContactArrays
@@ -61,6 +78,8 @@ __all__ = [
     "stiffness_matrix_full",
     "contact_hessians",
     "zeta_hessian",
+    "wall_gap_hessian",
+    "container_contacts",
     "generators",
 ]
 
@@ -88,7 +107,9 @@ class EllipsoidContacts(ContactArrays):
     ``normal`` is the unit normal u from i to j; ``lever_i``/``lever_j`` are r_C - x_i and
     r_C - (x_j + L n); ``scale`` is s = 2 lam (1 - lam) |n|, the factor between grad zeta and the
     gap rows; ``zeta`` and ``lam`` come from the Perram-Wertheim function. ``shape_inv`` holds every
-    particle's X^-1 (N, d, d).
+    particle's X^-1 (N, d, d). ``wall`` is -1 for a pair and 0 for a contact with the container
+    wall (module docstring: j = i, lam NaN, scale 1, lever_j 0, separation p - c); ``centre`` and
+    ``radius`` describe the container (None in a periodic cell).
     """
 
     i: np.ndarray
@@ -107,6 +128,22 @@ class EllipsoidContacts(ContactArrays):
     shape_inv: np.ndarray
     semiaxes: np.ndarray
     delta: float
+    wall: np.ndarray | None = None
+    centre: np.ndarray | None = None
+    radius: float | None = None
+
+    def __post_init__(self):
+        if self.wall is None:
+            object.__setattr__(self, "wall", np.full(len(self.i), -1, dtype=np.int64))
+
+    @property
+    def is_wall(self) -> np.ndarray:
+        """(M,) True for the contacts with the container wall."""
+        return self.wall >= 0
+
+    @property
+    def n_wall_contacts(self) -> int:
+        return int(np.count_nonzero(self.wall >= 0))
 
     @property
     def gap(self) -> np.ndarray:
@@ -116,16 +153,18 @@ class EllipsoidContacts(ContactArrays):
     def subset(self, mask) -> EllipsoidContacts:
         """The network of the contacts in ``mask`` (boolean (M,) or indices)."""
         per = ("i", "j", "shift", "separation", "zeta", "lam", "normal", "raw_normal", "lever_i",
-               "lever_j", "scale")
+               "lever_j", "scale", "wall")
         kw = {k: getattr(self, k)[mask] for k in per}
         return EllipsoidContacts(**kw, positions=self.positions, lattice=self.lattice,
-                                 shape_inv=self.shape_inv, semiaxes=self.semiaxes, delta=self.delta)
+                                 shape_inv=self.shape_inv, semiaxes=self.semiaxes, delta=self.delta,
+                                 centre=self.centre, radius=self.radius)
 
     def counts(self, active: np.ndarray | None = None) -> np.ndarray:
-        """Contacts per particle among ``active`` (a self-image contact counts twice)."""
+        """Contacts per particle among ``active`` (a self-image contact counts twice, a wall contact
+        once)."""
         keep = self.among(active)
         n = self.n_particles
-        return np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep], minlength=n)
+        return np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep & (self.wall < 0)], minlength=n)
 
 
 @numba.njit(cache=True)
@@ -158,10 +197,13 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids (``hardpack.geometry.shapes.Ellipsoids``) in a periodic cell.
+        Ellipses or ellipsoids (``hardpack.geometry.shapes.Ellipsoids``) in a periodic cell or a
+        spherical container.
     delta : float
         Relative contact tolerance, 0 < delta < 1: pairs with mu - 1 <= delta are contacts (mu the
-        common factor by which both particles must be scaled to be tangent).
+        common factor by which both particles must be scaled to be tangent); in a container, the
+        local farthest points with gap h <= delta a_max are wall contacts (module docstring),
+        after the pairs.
 
     Returns
     -------
@@ -171,7 +213,9 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     Raises
     ------
     InvalidInputError
-        If ``packing`` is not a periodic packing of ellipsoids, or delta is not in (0, 1).
+        If ``packing`` is not a periodic or container packing of ellipsoids, delta is not in
+        (0, 1), or a particle within delta of the container touches it along a continuum (a
+        disk, sphere or oblate spheroid centred so that its longest semiaxes lie on the wall).
     """
     check_ellipsoid_packing(packing)
     try:
@@ -196,12 +240,109 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     ii, jj, sep, zeta, lam, raw, point = (a[keep] for a in (ii, jj, sep, zeta, lam, raw, point))
     norm = np.linalg.norm(raw, axis=1)
     u = raw / norm[:, None]
-    return EllipsoidContacts(
+    net = EllipsoidContacts(
         i=ii, j=jj, shift=pairs.shift[keep].astype(np.int64), separation=sep, zeta=zeta, lam=lam,
         normal=u, raw_normal=raw, lever_i=point - x[ii], lever_j=point - (x[ii] + sep),
         scale=2.0 * lam * (1.0 - lam) * norm, positions=x, lattice=np.array(packing.lattice, float),
         shape_inv=inv, semiaxes=semiaxes, delta=delta,
     )
+    if packing.boundary.kind == "spherical_container":
+        net = _with_container(net, shape.rotations(), packing.boundary)
+    return net
+
+
+def container_contacts(positions, semiaxes, rotations, centre, radius, delta):
+    """Wall contacts of ellipsoids in a spherical container (module docstring).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (N, d)
+    semiaxes : ndarray, shape (N, d)
+    rotations : ndarray, shape (N, d, d)
+        Lab to body (``Ellipsoids.rotations``).
+    centre : ndarray, shape (d,)
+    radius : float
+    delta : float
+        Local farthest points with gap h = R - rho <= delta a_max are contacts.
+
+    Returns
+    -------
+    particle : ndarray of int, shape (M,)
+    point : ndarray, shape (M, d)
+        The local farthest surface points (lab frame).
+    gap : ndarray, shape (M,)
+        h = R - rho.
+    continuum : ndarray of bool, shape (N,)
+        Particles within delta of the wall whose farthest points form a continuum.
+    """
+    return _container_contacts(np.ascontiguousarray(positions, dtype=float),
+                               np.ascontiguousarray(semiaxes, dtype=float),
+                               np.ascontiguousarray(rotations, dtype=float),
+                               np.asarray(centre, dtype=float), float(radius), float(delta))
+
+
+@numba.njit(cache=True)
+def _container_contacts(positions, semiaxes, rotations, centre, radius, delta):
+    n, d = positions.shape
+    part = np.empty(2 * n, np.int64)
+    pts = np.empty((2 * n, d))
+    gap = np.empty(2 * n)
+    continuum = np.zeros(n, np.bool_)
+    b = np.empty(d)
+    loc = np.empty((2, d))
+    m = 0
+    for i in range(n):
+        amax = semiaxes[i].max()
+        for k in range(d):
+            s = 0.0
+            for q in range(d):
+                s += rotations[i, k, q] * (positions[i, q] - centre[q])
+            b[k] = s
+        count = local_farthest_body(b, semiaxes[i], loc)
+        if count < 0:
+            continuum[i] = radius - np.sqrt((loc[0] * loc[0]).sum()) <= delta * amax
+            continue
+        for c in range(count):
+            h = radius - np.sqrt((loc[c] * loc[c]).sum())
+            if h <= delta * amax:
+                part[m] = i
+                gap[m] = h
+                for q in range(d):
+                    s = centre[q]
+                    for k in range(d):
+                        s += rotations[i, k, q] * loc[c, k]
+                    pts[m, q] = s
+                m += 1
+    return part[:m], pts[:m], gap[:m], continuum
+
+
+def _with_container(net: EllipsoidContacts, rotations, boundary) -> EllipsoidContacts:
+    """``net`` with the wall contacts of the container appended (module docstring)."""
+    x, d = net.positions, net.dim
+    centre = np.asarray(boundary.centre, dtype=float)
+    part, point, h, continuum = container_contacts(x, net.semiaxes, rotations, centre, boundary.radius, net.delta)
+    if continuum.any():
+        bad = np.flatnonzero(continuum)
+        raise InvalidInputError(
+            f"particles {bad.tolist()} touch the container wall (within delta = {net.delta:g}) along a "
+            "circle or sphere of farthest points (equal longest semiaxes, centred on the container's "
+            "plane through them): the jamming tests need isolated contact points; move or shrink them")
+    rel = point - centre
+    u = rel / np.linalg.norm(rel, axis=1)[:, None]
+    amax = net.semiaxes[part].max(axis=1)
+    m = len(part)
+    wall = EllipsoidContacts(
+        i=part, j=part, shift=np.zeros((m, d), np.int64), separation=rel,
+        zeta=(1.0 + h / amax) ** 2 - 1.0, lam=np.full(m, np.nan), normal=u, raw_normal=u.copy(),
+        lever_i=point - x[part], lever_j=np.zeros((m, d)), scale=np.ones(m), positions=x,
+        lattice=net.lattice, shape_inv=net.shape_inv, semiaxes=net.semiaxes, delta=net.delta,
+        wall=np.zeros(m, np.int64))
+    per = ("i", "j", "shift", "separation", "zeta", "lam", "normal", "raw_normal", "lever_i",
+           "lever_j", "scale", "wall")
+    kw = {k: np.concatenate([getattr(net, k), getattr(wall, k)]) for k in per}
+    return EllipsoidContacts(**kw, positions=x, lattice=net.lattice, shape_inv=net.shape_inv,
+                             semiaxes=net.semiaxes, delta=net.delta, centre=centre,
+                             radius=float(boundary.radius))
 
 
 def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> EllipsoidContacts:
@@ -244,7 +385,7 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> Ellipsoi
 
 
 def check_ellipsoid_packing(packing) -> None:
-    """Refuse anything but a periodic packing of ellipses or ellipsoids."""
+    """Refuse anything but a packing of ellipses or ellipsoids, periodic or in a spherical container."""
     if not isinstance(packing, Packing):
         raise InvalidInputError(
             f"expected a hardpack Packing, got {type(packing).__name__}; build one with "
@@ -255,22 +396,23 @@ def check_ellipsoid_packing(packing) -> None:
             f"this test is for ellipses and ellipsoids, the packing holds {packing.shape.name}; "
             "use hardpack.jamming.verify for spheres"
         )
-    if not np.all(packing.boundary.periodic_axes(packing.dim)):
+    if packing.boundary.kind not in ("periodic", "spherical_container"):
         raise InvalidInputError(
-            "the ellipsoid jamming tests need a periodic cell (fixed walls are not implemented); "
-            "model fixed obstacles as frozen particles (argument `frozen`)"
+            "the ellipsoid jamming tests need a periodic cell or a spherical container (flat hard "
+            "walls are not implemented); model fixed obstacles as frozen particles (argument `frozen`)"
         )
 
 
 def rigidity_transpose_full(net: EllipsoidContacts) -> sp.csr_matrix:
-    """A^T (M, N d_f): row c is the gap rate of contact c (module docstring), all particle dof."""
+    """A^T (M, N d_f): row c is the gap rate of contact c (module docstring), all particle dof; a
+    wall contact has its particle's block only."""
     m, d, n = net.n_contacts, net.dim, net.n_particles
     f = dof_per_particle(d)
     u = net.normal
     ti, tj = _cross(net.lever_i, u), _cross(net.lever_j, u)
-    ti, tj = ti.reshape(m, -1), tj.reshape(m, -1)
+    ti, tj = ti.reshape(m, f - d), tj.reshape(m, f - d)
     block_i = np.concatenate([-u, -ti], axis=1)
-    block_j = np.concatenate([u, tj], axis=1)
+    block_j = np.concatenate([u, tj], axis=1) * (net.wall < 0)[:, None]  # the wall is fixed
     dofs = np.arange(f)
     rows = np.repeat(np.arange(m), 2 * f)
     cols = np.concatenate([net.i[:, None] * f + dofs, net.j[:, None] * f + dofs], axis=1).ravel()
@@ -398,8 +540,116 @@ def zeta_hessian(r_ab, a_inv, b_inv, lam) -> np.ndarray:
 
 def contact_hessians(net: EllipsoidContacts) -> np.ndarray:
     """Hess zeta of every contact, (M, 2 d_f, 2 d_f) in the order (r_i, omega_i, r_j, omega_j)
-    (:func:`zeta_hessian`)."""
-    return _hessians(net.separation, net.shape_inv, net.i, net.j, net.lam, generators(net.dim))
+    (:func:`zeta_hessian`); for a wall contact the Hessian of its gap h (:func:`wall_gap_hessian`)
+    in the (r_i, omega_i) block and zeros elsewhere."""
+    gens = generators(net.dim)
+    pair = np.flatnonzero(net.wall < 0)
+    if pair.size == net.n_contacts:
+        return _hessians(net.separation, net.shape_inv, net.i, net.j, net.lam, gens)
+    f = dof_per_particle(net.dim)
+    out = np.zeros((net.n_contacts, 2 * f, 2 * f))
+    out[pair] = _hessians(net.separation[pair], net.shape_inv, net.i[pair], net.j[pair], net.lam[pair], gens)
+    wall = np.flatnonzero(net.wall >= 0)
+    p = net.i[wall]
+    out[wall, :f, :f] = _wall_hessians(np.ascontiguousarray(net.positions[p] - net.centre),
+                                       np.ascontiguousarray(net.lever_i[wall]), net.shape_inv[p], gens)
+    return out
+
+
+@numba.njit(cache=True)
+def _wall_hessian_one(rel, y, x_inv, gens):
+    """Hessian of h = R - rho; see :func:`wall_gap_hessian`."""
+    d = rel.shape[0]
+    k = gens.shape[0]
+    f = d + k
+    shape = np.linalg.inv(x_inv)
+    p = rel + y
+    rho = np.sqrt(p @ p)
+    xy = shape @ y
+    mu = np.sqrt((p @ p) / (xy @ xy))
+    ey = np.empty((k, d))
+    for a in range(k):
+        ey[a] = gens[a] @ y
+    lqq = np.zeros((f, f))
+    lqy = np.zeros((f, d))
+    for s in range(d):
+        lqq[s, s] = 2.0
+        lqy[s, s] = 2.0
+    for a in range(k):
+        er = gens[a] @ rel
+        for s in range(d):
+            lqq[s, d + a] = lqq[d + a, s] = 2.0 * ey[a, s]
+            lqy[d + a, s] = -2.0 * er[s]
+        for b in range(k):
+            sym = gens[a] @ gens[b] + gens[b] @ gens[a]
+            lqq[d + a, d + b] = 2.0 * (ey[a] @ ey[b]) + p @ (sym @ y)
+    kkt = np.zeros((d + 1, d + 1))
+    rhs = np.zeros((d + 1, f))
+    for s in range(d):
+        for t in range(d):
+            kkt[s, t] = -2.0 * mu * shape[s, t]
+        kkt[s, s] += 2.0
+        kkt[s, d] = kkt[d, s] = -2.0 * xy[s]
+        for q in range(f):
+            rhs[s, q] = -lqy[q, s]
+    sol = np.linalg.solve(kkt, rhs)
+    hv = lqq + lqy @ np.ascontiguousarray(sol[:d])
+    grad = np.empty(f)
+    for s in range(d):
+        grad[s] = p[s] / rho
+    for a in range(k):
+        grad[d + a] = (p @ ey[a]) / rho
+    out = np.empty((f, f))
+    for s in range(f):
+        for t in range(f):
+            out[s, t] = -(0.5 * (hv[s, t] + hv[t, s]) - 2.0 * grad[s] * grad[t]) / (2.0 * rho)
+    return out
+
+
+@numba.njit(cache=True)
+def _wall_hessians(rel, lever, shape_inv, gens):
+    m, d = rel.shape
+    f = d + gens.shape[0]
+    out = np.empty((m, f, f))
+    for c in range(m):
+        out[c] = _wall_hessian_one(rel[c], lever[c], shape_inv[c], gens)
+    return out
+
+
+def wall_gap_hessian(rel, lever, x_inv) -> np.ndarray:
+    """Hessian of the wall gap h = R - rho of a particle in a spherical container with respect to
+    (r, omega) (translation, then rotation as in :func:`zeta_hessian`), at a strict local farthest
+    point p (derived here).
+
+    With rel = x - c, the lever y = p - x in the lab frame, X the shape matrix (X^-1 = ``x_inv``)
+    and R(omega) = exp(W), the point is x + R(omega) y' with y' on the current body surface
+    y'^T X y' = 1, so rho^2 = V(q) = max_y' F(q, y'), F = |rel + R(omega) y'|^2. With the
+    Lagrangian L = F - mu (y'^T X y' - 1) (stationary: p - c = mu X y, mu > 0), the value
+    function has Hess V = L_qq + L_qy y_q, where (y_q, mu_q) solve the KKT system
+    [[L_yy, -c_y], [-c_y^T, 0]] [y_q; mu_q] = [-L_yq; 0], c_y = 2 X y (the constraint does not
+    depend on q). At omega = 0: L_yy = 2 I - 2 mu X, L_rr = 2 I, L_ry = 2 I,
+    L_{r omega_a} = 2 E_a y, L_{omega_a omega_b} = 2 (E_a y).(E_b y) + (p - c).(E_a E_b + E_b E_a) y
+    (R = I + W + W^2 / 2), L_{omega_a y} = -2 E_a rel (grad_y of 2 (rel + y)^T E_a y, E_a^T = -E_a).
+    Then Hess rho = (Hess V - 2 grad rho grad rho^T) / (2 rho) with grad rho = (n, y x n) and
+    Hess h = -Hess rho. At a strict local maximum L_yy is negative definite on the tangent plane,
+    so the KKT matrix is regular; unlike the secular form of
+    :mod:`hardpack.geometry.ellipsoid_container` this holds in the hard case too (a tip).
+
+    Parameters
+    ----------
+    rel : ndarray, shape (d,)
+        Particle centre minus container centre.
+    lever : ndarray, shape (d,)
+        The local farthest point minus the particle centre.
+    x_inv : ndarray, shape (d, d)
+        X^-1 of the particle.
+
+    Returns
+    -------
+    ndarray, shape (d_f, d_f)
+    """
+    rel = np.asarray(rel, float)
+    return _wall_hessian_one(rel, np.asarray(lever, float), np.asarray(x_inv, float), generators(rel.shape[0]))
 
 
 def stiffness_matrix_full(net: EllipsoidContacts, forces: np.ndarray,

@@ -16,7 +16,11 @@ Degrees of freedom. The columns are the particles' translations and rotations, r
   symmetry axis (Donev 2006, Sec. 5.6 penalises the same spin with k u u^T instead). The dof per
   particle are then 3 (ellipses), 2 (disks), 6 (general ellipsoids), 5 (spheroids), 3 (spheres);
 - global translations: with no frozen particle in a periodic cell the d uniform translations of
-  the backbone are trivial floppy modes; they are projected out of the floppy space.
+  the backbone are trivial floppy modes; they are projected out of the floppy space. In a
+  spherical container (wall contacts: :mod:`hardpack.jamming.ellipsoids`) the trivial motions
+  are instead the d(d-1)/2 rigid rotations of the backbone about the container's centre (each
+  particle's centre moves by omega x (x_i - c) and the particle turns by omega), which keep every
+  pair and wall gap; the walls stay fixed, so no translation is trivial.
 
 Procedure (Donev 2006, Sec. 5.5.3, on the rattler-free backbone; dense linear algebra). A
 first-order flex is Qdot != 0 (nontrivial) with A^T Qdot >= 0; first-order rigid = none exists,
@@ -99,6 +103,7 @@ from hardpack.jamming.ellipsoids import (
     contact_hessians,
     dof_per_particle,
     ellipsoid_contacts,
+    generators,
     rigidity_transpose_full,
     stiffness_matrix_full,
 )
@@ -193,6 +198,30 @@ def trivial_translations(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.nd
         full[np.flatnonzero(moving) * f + k, k] = 1.0
     red = t.T @ full
     return red / np.linalg.norm(red, axis=0)
+
+
+def trivial_motions(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray) -> np.ndarray:
+    """Orthonormal trivial motions of the ``moving`` particles in reduced dof (module docstring):
+    the uniform translations in a periodic cell, the rigid rotations about the centre in a
+    container (those that vanish in the reduced dof, e.g. spins of spheres at the centre, are
+    dropped: (n_red, t) with t <= d(d-1)/2)."""
+    if net.centre is None:
+        return trivial_translations(t, net, moving)
+    d, n = net.dim, net.n_particles
+    f = dof_per_particle(d)
+    gens = generators(d)
+    idx = np.flatnonzero(moving)
+    full = np.zeros((n * f, gens.shape[0]))
+    rel = net.positions[idx] - net.centre
+    for a in range(gens.shape[0]):
+        full[(idx[:, None] * f + np.arange(d)).ravel(), a] = (rel @ gens[a].T).ravel()
+        full[idx * f + d + a, a] = 1.0
+    red = t.T @ full
+    if red.size == 0:
+        return np.zeros((red.shape[0], 0))
+    u, s, _ = np.linalg.svd(red, full_matrices=False)
+    keep = s > 1e-12 * max(s.max(initial=0.0), 1e-300)
+    return u[:, keep]
 
 
 # ------------------------------------------------------------------------------------- decisions
@@ -712,6 +741,23 @@ class EllipsoidJammingResult:
         return float(used.counts()[self.backbone].sum() / nb)
 
     @property
+    def contact_forces(self) -> np.ndarray:
+        """(M,) the self-stress on every contact of ``network`` (zero on the unused ones)."""
+        forces = np.zeros(self.network.n_contacts)
+        forces[self.contacts_used] = self.collective.forces
+        return forces
+
+    @property
+    def n_backbone_wall_contacts(self) -> int:
+        """Wall contacts of the backbone (among the M_b)."""
+        return int((self.contacts_used & self.network.is_wall).sum())
+
+    @property
+    def wall_force(self) -> float:
+        """Sum of the wall reactions (the self-stress has mean 1 over the backbone contacts)."""
+        return float(self.contact_forces[self.network.is_wall].sum())
+
+    @property
     def isostaticity_gap(self) -> int:
         """M_b - N_f: constraints minus nontrivial dof of the backbone (0 or 1: isostatic,
         Donev 2006, Sec. 5.4.1; negative: hypostatic)."""
@@ -729,6 +775,9 @@ class EllipsoidJammingResult:
              f"modes {c.n_floppy}, lambda_min(K_V) = {c.lambda_min:.4g}; first-order LP found a flex: "
              f"{'-' if c.lp_flex is None else 'yes' if c.lp_flex else 'no'}"),
         ]
+        if self.network.n_wall_contacts:
+            lines.append(f"container: {self.network.n_wall_contacts} wall contacts, {self.n_backbone_wall_contacts} "
+                         f"of them in the backbone, total reaction {self.wall_force:.4g} (forces of mean 1)")
         if c.approx_stress is not None:
             lines.append(f"near self-stress (smallest singular vector of A, Donev 2006 Sec. 5.6): |A f| / "
                          f"(|A| |f|) = {c.stress_residual:.3g}")
@@ -739,10 +788,13 @@ class EllipsoidJammingResult:
 
     def to_dataset(self) -> xr.Dataset:
         """Per-particle and per-contact arrays and scalar attributes (verdict codes of
-        :class:`Verdict`: 1 jammed, 0 not jammed, -1 not run, -2 undetermined)."""
+        :class:`Verdict`: 1 jammed, 0 not jammed, -1 not run, -2 undetermined). Wall contacts
+        (container) have ``contact_wall`` 0 (-1 for a pair), j = i, ``contact_gap`` h / a_max and
+        their ``force`` is the wall's reaction; attributes ``n_wall_contacts``,
+        ``n_backbone_wall_contacts``, ``wall_force`` (sum of the reactions) and ``boundary``, as
+        for spheres (:meth:`hardpack.jamming.result.JammingResult.to_dataset`)."""
         net, c = self.network, self.collective
-        forces = np.zeros(net.n_contacts)
-        forces[self.contacts_used] = c.forces
+        forces = self.contact_forces
         data = {
             "contact_i": (("contact",), net.i),
             "contact_j": (("contact",), net.j),
@@ -750,6 +802,7 @@ class EllipsoidJammingResult:
             "contact_gap": (("contact",), net.gap),
             "contact_normal": (("contact", "dim"), net.normal),
             "contact_used": (("contact",), self.contacts_used.astype(np.int8)),
+            "contact_wall": (("contact",), net.wall),
             "force": (("contact",), forces),
             "frozen": (("particle",), self.frozen.astype(np.int8)),
             "rattler": (("particle",), self.rattler.astype(np.int8)),
@@ -771,6 +824,8 @@ class EllipsoidJammingResult:
             stress_gap=c.stress_gap,
             order_code=ORDER_CODES[self.order], rattler_fraction=float(self.rattler.sum() / max(net.n_particles, 1)),
             hypostatic=int(self.isostaticity_gap < 0), jammed=int(self.verdict == Verdict.JAMMED),
+            n_wall_contacts=net.n_wall_contacts, n_backbone_wall_contacts=self.n_backbone_wall_contacts,
+            wall_force=self.wall_force,
             **{k: v for k, v in self.params.items() if v is not None},
             **{f"fallback_{k}": int(v) for k, v in self.fallbacks.items()},
             **{f"seconds_{k}": v for k, v in self.seconds.items()},
@@ -829,12 +884,14 @@ def _global_near_stress(net, at_full, t_full, owner, frozen):
 def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
                       method: str = "auto", local: bool = True, rank_tol: float = 1e-9,
                       stress_tol: float = 1e-9, eig_tol: float = 1e-9, seed: int = 0) -> EllipsoidJammingResult:
-    """Jamming test of a periodic packing of ellipses or ellipsoids (module docstring).
+    """Jamming test of a packing of ellipses or ellipsoids, periodic or in a spherical container
+    (module docstring; wall contacts: :mod:`hardpack.jamming.ellipsoids`).
 
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell (the contacts must be exact to ``delta``).
+        Ellipses or ellipsoids in a periodic cell or a spherical container (the contacts must be
+        exact to ``delta``; a wall contact's gap counts relative to the particle's a_max).
     delta : float or "gaps", optional
         Contact tolerance mu - 1 (default DEFAULT_DELTA, 1e-9), or "gaps": read off the gap
         distribution (:func:`contact_delta_from_gaps`; packings from a compression to high
@@ -857,8 +914,10 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     Raises
     ------
     InvalidInputError
-        For a packing that is not a periodic ellipsoid packing, overlaps (mu - 1 below
-        -packing.overlap_tol, by the Perram-Wertheim function), a bad ``delta``, ``frozen`` of
+        For a packing that is not an ellipsoid packing in a periodic cell or a spherical container,
+        a particle touching the container along a continuum, overlaps (pairs: mu - 1 below
+        -packing.overlap_tol, by the Perram-Wertheim function; the wall: h / a_max below it), a
+        bad ``delta``, ``frozen`` of
         the wrong shape, an unknown ``method`` or non-positive tolerances.
     """
     check_ellipsoid_packing(packing)
@@ -890,10 +949,12 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     overlap = net.gap < -packing.overlap_tol
     if overlap.any():
         worst = int(np.argmin(net.gap))
+        what = (f"particle {net.i[worst]} and the container wall, h / a_max" if net.wall[worst] >= 0
+                else f"particles {net.i[worst]} and {net.j[worst]}, mu - 1")
         raise InvalidInputError(
-            f"{int(overlap.sum())} pairs overlap beyond the tolerance {packing.overlap_tol:g} (mu - 1 "
-            f"down to {net.gap[worst]:.3g}, particles {net.i[worst]} and {net.j[worst]}); jamming "
-            "tests need a packing of hard particles: finish or repair it first")
+            f"{int(overlap.sum())} contacts overlap beyond the tolerance {packing.overlap_tol:g} (worst: "
+            f"{what} = {net.gap[worst]:.3g}); jamming tests need a packing of hard particles: finish or "
+            "repair it first")
     at_full = rigidity_transpose_full(net)
     hess = contact_hessians(net)
     t_full, dof = dof_basis(net, ~frozen)
@@ -934,7 +995,7 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
         used = present[net.i] & present[net.j] & (active[net.i] | active[net.j])
         contacts = np.flatnonzero(used)
         at, stiff, stiff_sparse, quad, tm = _submatrices(net, at_full, hess, t_full, owner, contacts, active)
-        trivial = (trivial_translations(tm, net, active) if not frozen.any() and active.any()
+        trivial = (trivial_motions(tm, net, active) if not frozen.any() and active.any()
                    else np.zeros((at.shape[1], 0)))
         dense = method == "dense" or (method == "auto" and at.shape[1] <= DENSE_LIMIT)
         if not active.any():
@@ -960,7 +1021,8 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
                       f"compress to a higher pressure (the test alone said: {dec.verdict.name.lower()} at "
                       f"order {dec.order}; {dec.reason})")
         dec.verdict, dec.order = Verdict.UNDETERMINED, "undetermined"
-    params = dict(delta=float(delta), delta_ambiguous=ambiguous, method="dense" if dense else "sparse", seed=int(seed),
+    params = dict(boundary=str(packing.boundary),
+                  delta=float(delta), delta_ambiguous=ambiguous, method="dense" if dense else "sparse", seed=int(seed),
                   rank_tol=rank_tol, stress_tol=stress_tol, eig_tol=eig_tol)
     rattler = ~frozen & ~active
     return EllipsoidJammingResult(
