@@ -83,6 +83,8 @@ def test_disks_as_ellipses_in_a_container_match_the_sphere_verifier():
     assert res.network.n_wall_contacts == spheres.network.n_wall_contacts == 9
     assert res.n_backbone_wall_contacts == spheres.statics.n_wall_contacts == 9
     assert res.wall_force == pytest.approx(spheres.statics.wall_force, rel=1e-9)
+    # a wall contact is a contact of one particle: Z = (2 x 15 pairs + 9 walls) / 12 = 3.25 for both
+    assert spheres.statics.z_mean == res.z_mean == pytest.approx(39 / 12, rel=1e-15)
     # contact by contact (walls keyed by particle)
     net, f = res.network, res.contact_forces
     mine = {(int(i), int(j) if w < 0 else -1): v for i, j, w, v in zip(net.i, net.j, net.wall, f)}

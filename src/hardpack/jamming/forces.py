@@ -278,7 +278,7 @@ class Statics:
 
     n_backbone: int
     n_contacts: int  # M_b, self-image contacts once
-    z_mean: float  # 2 M_b / N_b
+    z_mean: float  # (2 M_b - M_w) / N_b: a wall contact counts once
     n_dof_collective: int  # d (N_b - 1); with walls d N_b less the trivial motions
     n_dof_strict: int  # d (N_b - 1) + d(d+1)/2 - 1; with walls (fixed) as collective
     isostaticity_gap: int  # M_b - n_dof_collective - 1  (0 = isostatic in a fixed cell)
@@ -315,7 +315,8 @@ def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: f
     Returns
     -------
     Statics
-        ``n_backbone`` N_b, ``n_contacts`` M_b, ``z_mean`` 2 M_b / N_b, ``n_dof_collective``
+        ``n_backbone`` N_b, ``n_contacts`` M_b, ``z_mean`` (2 M_b - M_w) / N_b (M_w of them with
+        walls, each a contact of one particle), ``n_dof_collective``
         d (N_b - 1), ``n_dof_strict`` (+ d(d+1)/2 - 1), ``isostaticity_gap`` and
         ``isostaticity_gap_strict`` (M_b - N_f - 1), ``pressure_virial`` and ``stress`` (d, d)
         (forces of mean 1; NaN without forces), ``jamming_gap`` mu* and
@@ -336,11 +337,12 @@ def statics(net: ContactNetwork, backbone: np.ndarray, forces: Forces, volume: f
     mu = forces.jamming_gap
     p_fv = nf / (d * n * mu) if forces.exists and mu > 0 else np.inf if forces.exists else np.nan
     wall = contacts & net.is_wall
+    mw = int((mb_mask & net.is_wall).sum())
     return Statics(
-        n_backbone=nb, n_contacts=mb, z_mean=2.0 * mb / nb if nb else np.nan,
+        n_backbone=nb, n_contacts=mb, z_mean=(2.0 * mb - mw) / nb if nb else np.nan,
         n_dof_collective=nf, n_dof_strict=nf_strict,
         isostaticity_gap=mb - nf - 1 if nb else 0, isostaticity_gap_strict=mb - nf_strict - 1 if nb else 0,
         pressure_virial=p_vir, stress=stress, jamming_gap=mu, pressure_free_volume=float(p_fv),
-        n_wall_contacts=int((mb_mask & net.is_wall).sum()),
+        n_wall_contacts=mw,
         wall_force=float(forces.forces[wall].sum()) if forces.exists else np.nan,
     )
