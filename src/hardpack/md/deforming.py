@@ -27,20 +27,23 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
    strains but starves a soft one, along which the stress ratio does not change with the strain
    (the anisotropic cage "fabric" of a glass: a 3D LS packing grown with the fixed 1 / Z rule
    kept a mean |sigma - p I| / p near 0.07 from Z = 1e4 to 1e12 while the cell strained by about
-   15 gaps per decade of Z, and it was collectively but not strictly jammed). So in the
-   shape-only mode (step 4) E is multiplied by a mobility m >= 1: after every MOBILITY_BLOCK
-   windows the mean imbalance of the block is compared with the previous block's; m is multiplied by MOBILITY_GROW when they point the same way (a
-   persistent imbalance: the response is soft) and by MOBILITY_SHRINK otherwise (an overshoot
-   or noise), within [1, Z / alpha] (at the top E = (sigma - p I) / p). With an applied
-   pressure m stays 1: an adaptive m biased the mean volume of an isobaric dilute gas and FCC
-   crystal by 3-5 standard errors. Block means
+   15 gaps per decade of Z, and it was collectively but not strictly jammed). So while the
+   particles grow in the shape-only mode (step 4) E is multiplied by a mobility m >= 1: after
+   every MOBILITY_BLOCK windows the mean imbalance of the block is compared with the previous
+   block's; m is multiplied by MOBILITY_GROW when they point the same way (a persistent
+   imbalance: the response is soft) and by MOBILITY_SHRINK otherwise (an overshoot or noise),
+   within [1, Z / alpha] (at the top E = (sigma - p I) / p). Otherwise m = 1 (Donev's rule,
+   validated by the isobaric dilute-gas and crystal tests): at zero growth there is no growing
+   packing to catch up with, and with an applied pressure the volume follows the same strain,
+   whose mean an adaptive gain on the stress noise would bias. Block means
    rather than single windows, because one window's shear is mostly noise (20 collisions per
    particle give |sigma - p I| / p ~ 0.1 for a perfectly isotropic mean in 3D, N = 30). With
    the shrink factor below the inverse of the growth factor pure noise drives m to 1. F is the
    exponential (Donev's "more correct" constant strain rate, Eq. 3.2), not his linear I + s E:
    the linear map changes the volume at second order, det(I + E) = 1 + tr E - tr(E^2) / 2 + ...,
-   so the noise of the measured shear stress shrank the cell systematically (a dilute gas settled 1.6e-4 below N kT Z / P0, 4 standard
-   errors).
+   so the noise of the measured shear stress shrank the cell systematically (a dilute gas settled
+   1.6e-4 below N kT Z / P0, 4 standard errors). ``adaptive_cell=False`` restores Donev's rule
+   with the fixed 1 / Z mobility and the thermostat's window (step 6).
 3. s <= 1 is the largest step that leaves every pair at least half its gap along the linear
    path (the first root of |r + s E r| = sigma + gap / 2 over the pairs within reach, and every particle's own images
    with contact distance SELF_CONTACT times the largest diameter); after the map the packing is
@@ -61,7 +64,8 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
    about a tenth of alpha per window), besides the thermostat bound of
    :func:`hardpack.md.default_window` (:func:`cell_window`). At the LS rates of a strict-jamming
    run this only shortens the fast stage (Gamma = 0.02: 1 collision per particle instead of
-   4.5 in 3D), where the packing acquires its shape.
+   4.5 in 3D), where the packing acquires its shape. ``adaptive_cell=False`` turns this off,
+   with step 2's adaptive mobility.
 7. Every window the basis is LLL-reduced (:func:`hardpack.geometry.reduction.lll_reduce`;
    Donev suggests re-reducing, untested by him, sec. 3.2.4) so that a sheared cell keeps short
    lattice vectors.
@@ -154,6 +158,11 @@ def check_cell_options(applied_pressure, cell_step) -> None:
         raise InvalidInputError(f"cell_step (alpha) must be in (0, 1], got {cell_step!r}")
 
 
+def _check_adaptive_cell(adaptive_cell) -> None:
+    if not isinstance(adaptive_cell, (bool, np.bool_)):
+        raise InvalidInputError(f"adaptive_cell must be True or False, got {adaptive_cell!r}")
+
+
 def _check_packing(packing: Packing) -> None:
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
@@ -193,13 +202,17 @@ class DeformingSimulation:
         As in :func:`compress_deforming`.
     growing : array_like of bool, shape (N,), optional
         The particles that grow (Donev 2006, sec. 13.5 grows the B disks only); None: all, uniformly.
+    adaptive_cell : bool, default True
+        Adaptive cell mobility while growing in the shape-only mode (module docstring, step 2);
+        False: m = 1 always.
     """
 
     def __init__(self, packing: Packing, velocities: np.ndarray, growth_rate: float,
                  applied_pressure: float | None = None, cell_step: float = CELL_STEP,
-                 overlap_tol: float = DEFAULT_OVERLAP_TOL, growing=None):
+                 overlap_tol: float = DEFAULT_OVERLAP_TOL, growing=None, adaptive_cell: bool = True):
         _check_packing(packing)
         check_cell_options(applied_pressure, cell_step)
+        _check_adaptive_cell(adaptive_cell)
         if growing is not None:
             growing = np.asarray(growing)
             if growing.dtype != bool or growing.shape != (packing.n_particles,):
@@ -246,6 +259,7 @@ class DeformingSimulation:
         self.stress = np.zeros((d, d))
         self.deviatoric: list[np.ndarray] = []
         self.shell = SHELL_START
+        self.adaptive_cell = adaptive_cell
         self.mobility = 1.0
         self.block_sum, self.block_count, self.last_block = 0.0, 0, None
 
@@ -350,8 +364,7 @@ class DeformingSimulation:
             ke = 0.5 * float(np.sum(self.V * self.V))
             self.V *= math.sqrt(d * n / (2.0 * ke))
         if np.isfinite(z):
-            if self.applied_pressure is None:
-                self.update_mobility(sigma, z)
+            self.update_mobility(sigma, z)
             step, frac = self._deform(sigma, z)
         else:
             step, frac = 0.0, 0.0
@@ -384,8 +397,11 @@ class DeformingSimulation:
         return b
 
     def update_mobility(self, sigma: np.ndarray, z: float) -> None:
-        """Adapt the mobility from the mean imbalances of the last two blocks of windows
-        (shape-only mode; module docstring, step 2)."""
+        """Adapt the mobility from the mean imbalances of the last two blocks of windows while
+        the particles grow in the shape-only mode; otherwise m = 1 (module docstring, step 2)."""
+        if not (self.adaptive_cell and self.applied_pressure is None and self.growth_rate > 0):
+            self.mobility, self.block_sum, self.block_count, self.last_block = 1.0, 0.0, 0, None
+            return
         self.block_sum = self.block_sum + self.imbalance(sigma)
         self.block_count += 1
         if self.block_count < MOBILITY_BLOCK:
@@ -448,7 +464,7 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
                        *, applied_pressure: float | None = None, cell_step: float = CELL_STEP,
                        window: float | None = None, final_growth_rate: float | None = None,
                        switch_pressure: float = 1e3, overlap_tol: float = DEFAULT_OVERLAP_TOL,
-                       progress=None) -> CompressResult:
+                       adaptive_cell: bool = True, progress=None) -> CompressResult:
     """LS compression (or, at growth rate 0, an isobaric or shape-relaxing run) in a deforming
     periodic cell (module docstring).
 
@@ -471,11 +487,16 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         alpha of the strain rule, in (0, 1].
     window : float, optional
         Collisions per particle per window (one deformation per window); default
-        :func:`cell_window` of the current stage's rate.
+        :func:`cell_window` of the current stage's rate (:func:`hardpack.md.default_window`
+        with ``adaptive_cell=False``).
     final_growth_rate, switch_pressure : float
         Two-stage protocol as in :func:`hardpack.md.compress`.
     overlap_tol : float
         Relative overlap tolerance checked at every window end.
+    adaptive_cell : bool, default True
+        The adaptive cell mobility while growing in the shape-only mode and the default window
+        :func:`cell_window` (module docstring, steps 2 and 6); False: Donev's rule with the fixed
+        1 / Z mobility and the window :func:`hardpack.md.default_window`.
     progress : callable, optional
         Receives each window's record.
 
@@ -486,19 +507,20 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         time series (with ``volume``, ``pressure``, ``shear`` = |sigma - p I| / p and
         ``strain_step``, ``mobility``, the tensor ``deviatoric``) and stats (protocol
         "lubachevsky_stillinger_deforming_cell", ``applied_pressure``, ``cell_step``, the
-        mobility and window parameters, final ``shear``, ``shear_mean`` (:func:`mean_shear`),
-        volume change).
+        ``adaptive_cell`` switch, the mobility and window parameters, final ``shear``,
+        ``shear_mean`` (:func:`mean_shear`), volume change).
 
     Raises
     ------
     InvalidInputError
         For a packing that is not periodic spheres, too small a cell, overlaps, bad rates,
-        seed, window, applied pressure or cell step, or a target phi.
+        seed, window, applied pressure, cell step or adaptive_cell, or a target phi.
     OverlapError
         If pairs overlap beyond ``overlap_tol`` at a window end (an engine failure).
     """
     _check_packing(packing)
     check_cell_options(applied_pressure, cell_step)
+    _check_adaptive_cell(adaptive_cell)
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
             or not math.isfinite(growth_rate) or growth_rate < 0:
         raise InvalidInputError(f"growth_rate must be a finite number >= 0 with a deforming cell, got {growth_rate!r}")
@@ -514,10 +536,12 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
 
     def stage_window(rate: float) -> float:
-        return cell_window(rate, packing.dim, cell_step) if window is None else float(window)
+        if window is not None:
+            return float(window)
+        return cell_window(rate, packing.dim, cell_step) if adaptive_cell else default_window(rate, packing.dim)
 
     sim = DeformingSimulation(packing, maxwell_boltzmann(packing.n_particles, packing.dim, seed),
-                              growth_rate, applied_pressure, cell_step, overlap_tol)
+                              growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell=adaptive_cell)
     started = time.perf_counter()
     while (reason := _stop_reason(stop, sim, started)) is None:
         budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
@@ -547,7 +571,7 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         "cell_step": float(cell_step),
         "shear": float(rec["shear"][-1]) if rec["shear"] else float("nan"),
         "shear_mean": mean_shear(sim.deviatoric),
-        "mobility_block": MOBILITY_BLOCK, "mobility_grow": MOBILITY_GROW, "mobility_shrink": MOBILITY_SHRINK,
+        "adaptive_cell": bool(adaptive_cell), "mobility_block": MOBILITY_BLOCK, "mobility_grow": MOBILITY_GROW, "mobility_shrink": MOBILITY_SHRINK,
         "cell_lag": CELL_LAG, "final_mobility": float(sim.mobility),
         "volume_ratio": sim.volume / sim.volume0, "mass": 1.0, "kT": 1.0,
     }
