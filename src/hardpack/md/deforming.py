@@ -571,7 +571,8 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         "cell_step": float(cell_step),
         "shear": float(rec["shear"][-1]) if rec["shear"] else float("nan"),
         "shear_mean": mean_shear(sim.deviatoric),
-        "adaptive_cell": bool(adaptive_cell), "mobility_block": MOBILITY_BLOCK, "mobility_grow": MOBILITY_GROW, "mobility_shrink": MOBILITY_SHRINK,
+        "adaptive_cell": bool(adaptive_cell), "mobility_block": MOBILITY_BLOCK,
+        "mobility_grow": MOBILITY_GROW, "mobility_shrink": MOBILITY_SHRINK,
         "cell_lag": CELL_LAG, "final_mobility": float(sim.mobility),
         "volume_ratio": sim.volume / sim.volume0, "mass": 1.0, "kT": 1.0,
     }
