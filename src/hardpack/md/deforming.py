@@ -23,11 +23,27 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
    and deforms the cell during the flight (a quartic contact equation); a fixed W is unstable
    near jamming, where a strain of 1/Z changes the pressure by O(1) (the gaps are ~ D / Z), so
    the step is scaled by 1 / Z: the volume then relaxes by about alpha per window at every
-   density. |E| is capped at MAX_STRAIN. F is the exponential (Donev's "more correct" constant
-   strain rate, Eq. 3.2), not his linear I + s E: the linear map changes the volume at second
-   order, det(I + E) = 1 + tr E - tr(E^2) / 2 + ..., so the noise of the measured shear stress
-   shrank the cell systematically (a dilute gas settled 1.6e-4 below N kT Z / P0, 4 standard
-   errors).
+   density. |E| is capped at MAX_STRAIN. *Adaptive mobility*: the 1 / Z scaling suits stiff
+   strains but starves a soft one, along which the stress ratio does not change with the strain
+   (the anisotropic cage "fabric" of a glass: a 3D LS packing grown with the fixed 1 / Z rule
+   kept a mean |sigma - p I| / p near 0.07 from Z = 1e4 to 1e12 while the cell strained by about
+   15 gaps per decade of Z, and it was collectively but not strictly jammed). So while the
+   particles grow in the shape-only mode (step 4) E is multiplied by a mobility m >= 1: after
+   every MOBILITY_BLOCK windows the mean imbalance of the block is compared with the previous
+   block's; m is multiplied by MOBILITY_GROW when they point the same way (a persistent
+   imbalance: the response is soft) and by MOBILITY_SHRINK otherwise (an overshoot or noise),
+   within [1, Z / alpha] (at the top E = (sigma - p I) / p). Otherwise m = 1 (Donev's rule,
+   validated by the isobaric dilute-gas and crystal tests): at zero growth there is no growing
+   packing to catch up with, and with an applied pressure the volume follows the same strain,
+   whose mean an adaptive gain on the stress noise would bias. Block means
+   rather than single windows, because one window's shear is mostly noise (20 collisions per
+   particle give |sigma - p I| / p ~ 0.1 for a perfectly isotropic mean in 3D, N = 30). With
+   the shrink factor below the inverse of the growth factor pure noise drives m to 1. F is the
+   exponential (Donev's "more correct" constant strain rate, Eq. 3.2), not his linear I + s E:
+   the linear map changes the volume at second order, det(I + E) = 1 + tr E - tr(E^2) / 2 + ...,
+   so the noise of the measured shear stress shrank the cell systematically (a dilute gas settled
+   1.6e-4 below N kT Z / P0, 4 standard errors). ``adaptive_cell=False`` restores Donev's rule
+   with the fixed 1 / Z mobility and the thermostat's window (step 6).
 3. s <= 1 is the largest step that leaves every pair at least half its gap along the linear
    path (the first root of |r + s E r| = sigma + gap / 2 over the pairs within reach, and every particle's own images
    with contact distance SELF_CONTACT times the largest diameter); after the map the packing is
@@ -42,7 +58,15 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
 5. Windows end at a fixed MD time (the previous window's time per collision times the budget),
    not at a collision, so that no pair is left exactly in contact when the cell deforms (such a
    pair would block any strain that pushes it closer).
-6. Every window the basis is LLL-reduced (:func:`hardpack.geometry.reduction.lll_reduce`;
+6. The cell can follow the growth only if the pressure rises slowly per window: near jamming
+   ln Z grows by about 0.6 Gamma w per window of w collisions per particle (measured in 3D), so
+   the default window is at most CELL_LAG * alpha / Gamma collisions per particle (ln Z grows by
+   about a tenth of alpha per window), besides the thermostat bound of
+   :func:`hardpack.md.default_window` (:func:`cell_window`). At the LS rates of a strict-jamming
+   run this only shortens the fast stage (Gamma = 0.02: 1 collision per particle instead of
+   4.5 in 3D), where the packing acquires its shape. ``adaptive_cell=False`` turns this off,
+   with step 2's adaptive mobility.
+7. Every window the basis is LLL-reduced (:func:`hardpack.geometry.reduction.lll_reduce`;
    Donev suggests re-reducing, untested by him, sec. 3.2.4) so that a sheared cell keeps short
    lattice vectors.
 
@@ -79,6 +103,12 @@ from hardpack.md.simulation import OverlapError, maxwell_boltzmann
 CELL_STEP = 0.1
 #: largest Frobenius norm of one window's strain
 MAX_STRAIN = 0.05
+#: adaptive cell mobility (module docstring, step 2): windows per block, and the factors by which
+#: it grows after two blocks whose mean stress imbalances point the same way and shrinks otherwise
+MOBILITY_BLOCK, MOBILITY_GROW, MOBILITY_SHRINK = 10, 2.0, 0.25
+#: the default window is at most CELL_LAG * alpha / Gamma collisions per particle (module
+#: docstring, step 6)
+CELL_LAG = 0.2
 #: halvings of a step that overlapped by round-off before the deformation is skipped
 MAX_HALVINGS = 8
 #: a lattice vector may not become shorter than this many largest diameters (a particle never
@@ -92,7 +122,17 @@ SHELL_START, SHELL_MIN, SHELL_MAX, SHELL_STEP = 0.3, 0.05, 3.0, 1.5
 BUDGET_SLACK = 4
 
 RECORD_FIELDS = ("time", "phi", "Z", "collisions", "kT_mean", "volume", "pressure", "shear",
-                 "strain_step", "step_fraction", "exits", "wall_time", "growth_rate")
+                 "strain_step", "step_fraction", "mobility", "exits", "wall_time", "growth_rate")
+
+
+def cell_window(growth_rate: float, d: int, cell_step: float = CELL_STEP) -> float:
+    """Default collisions per particle per window of the deforming cell (module docstring,
+    step 6): :func:`hardpack.md.default_window`, at most CELL_LAG * cell_step / |growth_rate|
+    and at least 1."""
+    window = default_window(growth_rate, d)
+    if growth_rate == 0:
+        return window
+    return float(min(window, max(1.0, CELL_LAG * cell_step / abs(growth_rate))))
 
 
 def shortest_vector(lattice: np.ndarray) -> float:
@@ -116,6 +156,11 @@ def check_cell_options(applied_pressure, cell_step) -> None:
                                 f"length^d) or None for a free volume, got {applied_pressure!r}")
     if isinstance(cell_step, bool) or not (math.isfinite(cell_step) and 0 < cell_step <= 1):
         raise InvalidInputError(f"cell_step (alpha) must be in (0, 1], got {cell_step!r}")
+
+
+def _check_adaptive_cell(adaptive_cell) -> None:
+    if not isinstance(adaptive_cell, (bool, np.bool_)):
+        raise InvalidInputError(f"adaptive_cell must be True or False, got {adaptive_cell!r}")
 
 
 def _check_packing(packing: Packing) -> None:
@@ -157,13 +202,17 @@ class DeformingSimulation:
         As in :func:`compress_deforming`.
     growing : array_like of bool, shape (N,), optional
         The particles that grow (Donev 2006, sec. 13.5 grows the B disks only); None: all, uniformly.
+    adaptive_cell : bool, default True
+        Adaptive cell mobility while growing in the shape-only mode (module docstring, step 2);
+        False: m = 1 always.
     """
 
     def __init__(self, packing: Packing, velocities: np.ndarray, growth_rate: float,
                  applied_pressure: float | None = None, cell_step: float = CELL_STEP,
-                 overlap_tol: float = DEFAULT_OVERLAP_TOL, growing=None):
+                 overlap_tol: float = DEFAULT_OVERLAP_TOL, growing=None, adaptive_cell: bool = True):
         _check_packing(packing)
         check_cell_options(applied_pressure, cell_step)
+        _check_adaptive_cell(adaptive_cell)
         if growing is not None:
             growing = np.asarray(growing)
             if growing.dtype != bool or growing.shape != (packing.n_particles,):
@@ -208,7 +257,11 @@ class DeformingSimulation:
         self.last_collisions = 0
         self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
         self.stress = np.zeros((d, d))
+        self.deviatoric: list[np.ndarray] = []
         self.shell = SHELL_START
+        self.adaptive_cell = adaptive_cell
+        self.mobility = 1.0
+        self.block_sum, self.block_count, self.last_block = 0.0, 0, None
 
     @property
     def volume(self) -> float:
@@ -310,7 +363,11 @@ class DeformingSimulation:
         if self.growth_rate != 0.0:
             ke = 0.5 * float(np.sum(self.V * self.V))
             self.V *= math.sqrt(d * n / (2.0 * ke))
-        step, frac = self._deform(sigma, z) if np.isfinite(z) else (0.0, 0.0)
+        if np.isfinite(z):
+            self.update_mobility(sigma, z)
+            step, frac = self._deform(sigma, z)
+        else:
+            step, frac = 0.0, 0.0
         self.time += duration
         self.collisions += colls
         self.windows += 1
@@ -320,22 +377,46 @@ class DeformingSimulation:
             "time": self.time, "phi": self.phi(), "Z": z, "collisions": self.collisions,
             "kT_mean": kt_mean, "volume": self.volume, "pressure": p,
             "shear": float(np.linalg.norm(sigma - p * np.eye(d)) / p) if p > 0 else np.nan,
-            "strain_step": step, "step_fraction": frac, "exits": int(iacc[dk.I_EXIT]), "wall_time": self.wall_time,
-            "growth_rate": self.growth_rate,
+            "strain_step": step, "step_fraction": frac, "mobility": self.mobility,
+            "exits": int(iacc[dk.I_EXIT]), "wall_time": self.wall_time, "growth_rate": self.growth_rate,
         }
         for k in RECORD_FIELDS:
             self.records[k].append(record[k])
+        self.deviatoric.append(sigma / p - np.eye(d) if p > 0 else np.full((d, d), np.nan))
         return record
 
-    def strain(self, sigma: np.ndarray, z: float) -> np.ndarray:
-        """The window's strain E (module docstring, step 2), capped at MAX_STRAIN."""
+    def imbalance(self, sigma: np.ndarray) -> np.ndarray:
+        """(sigma - P0 I) / max(p, P0), symmetric; traceless in the shape-only mode."""
         d = self.d
         p = float(np.trace(sigma)) / d
         p0 = p if self.applied_pressure is None else float(self.applied_pressure)
-        e = self.cell_step / max(z, 1.0) * (sigma - p0 * np.eye(d)) / max(p, p0)
-        e = 0.5 * (e + e.T)
+        b = (sigma - p0 * np.eye(d)) / max(p, p0)
+        b = 0.5 * (b + b.T)
         if self.applied_pressure is None:
-            e -= np.trace(e) / d * np.eye(d)
+            b -= np.trace(b) / d * np.eye(d)
+        return b
+
+    def update_mobility(self, sigma: np.ndarray, z: float) -> None:
+        """Adapt the mobility from the mean imbalances of the last two blocks of windows while
+        the particles grow in the shape-only mode; otherwise m = 1 (module docstring, step 2)."""
+        if not (self.adaptive_cell and self.applied_pressure is None and self.growth_rate > 0):
+            self.mobility, self.block_sum, self.block_count, self.last_block = 1.0, 0.0, 0, None
+            return
+        self.block_sum = self.block_sum + self.imbalance(sigma)
+        self.block_count += 1
+        if self.block_count < MOBILITY_BLOCK:
+            return
+        mean = self.block_sum / self.block_count
+        if self.last_block is not None:
+            if float(np.sum(mean * self.last_block)) > 0.0:
+                self.mobility = min(self.mobility * MOBILITY_GROW, max(z, 1.0) / self.cell_step)
+            else:
+                self.mobility = max(self.mobility * MOBILITY_SHRINK, 1.0)
+        self.last_block, self.block_sum, self.block_count = mean, 0.0, 0
+
+    def strain(self, sigma: np.ndarray, z: float) -> np.ndarray:
+        """The window's strain E (module docstring, step 2), capped at MAX_STRAIN."""
+        e = self.cell_step * self.mobility / max(z, 1.0) * self.imbalance(sigma)
         norm = float(np.linalg.norm(e))
         return e * (MAX_STRAIN / norm) if norm > MAX_STRAIN else e
 
@@ -369,11 +450,21 @@ class DeformingSimulation:
         return 0.0, 0.0
 
 
+def mean_shear(deviatoric, fraction: float = 0.25) -> float:
+    """Frobenius norm of the mean of sigma / p - I over the last ``fraction`` of the windows
+    (NaN without windows): the systematic stress anisotropy, which the noise of single windows
+    (the time series' ``shear``) hides."""
+    if not len(deviatoric):
+        return float("nan")
+    tail = np.asarray(deviatoric, dtype=float)[-max(1, int(round(fraction * len(deviatoric)))):]
+    return float(np.linalg.norm(tail.mean(axis=0)))
+
+
 def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria | None = None,
                        *, applied_pressure: float | None = None, cell_step: float = CELL_STEP,
                        window: float | None = None, final_growth_rate: float | None = None,
                        switch_pressure: float = 1e3, overlap_tol: float = DEFAULT_OVERLAP_TOL,
-                       progress=None) -> CompressResult:
+                       adaptive_cell: bool = True, progress=None) -> CompressResult:
     """LS compression (or, at growth rate 0, an isobaric or shape-relaxing run) in a deforming
     periodic cell (module docstring).
 
@@ -396,11 +487,16 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         alpha of the strain rule, in (0, 1].
     window : float, optional
         Collisions per particle per window (one deformation per window); default
-        :func:`hardpack.md.default_window` of the current stage's rate.
+        :func:`cell_window` of the current stage's rate (:func:`hardpack.md.default_window`
+        with ``adaptive_cell=False``).
     final_growth_rate, switch_pressure : float
         Two-stage protocol as in :func:`hardpack.md.compress`.
     overlap_tol : float
         Relative overlap tolerance checked at every window end.
+    adaptive_cell : bool, default True
+        The adaptive cell mobility while growing in the shape-only mode and the default window
+        :func:`cell_window` (module docstring, steps 2 and 6); False: Donev's rule with the fixed
+        1 / Z mobility and the window :func:`hardpack.md.default_window`.
     progress : callable, optional
         Receives each window's record.
 
@@ -409,19 +505,22 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
     CompressResult
         The final packing (its lattice is the deformed cell), velocities, the per-window
         time series (with ``volume``, ``pressure``, ``shear`` = |sigma - p I| / p and
-        ``strain_step``) and stats (protocol "lubachevsky_stillinger_deforming_cell",
-        ``applied_pressure``, ``cell_step``, final ``shear``, volume change).
+        ``strain_step``, ``mobility``, the tensor ``deviatoric``) and stats (protocol
+        "lubachevsky_stillinger_deforming_cell", ``applied_pressure``, ``cell_step``, the
+        ``adaptive_cell`` switch, the mobility and window parameters, final ``shear``,
+        ``shear_mean`` (:func:`mean_shear`), volume change).
 
     Raises
     ------
     InvalidInputError
         For a packing that is not periodic spheres, too small a cell, overlaps, bad rates,
-        seed, window, applied pressure or cell step, or a target phi.
+        seed, window, applied pressure, cell step or adaptive_cell, or a target phi.
     OverlapError
         If pairs overlap beyond ``overlap_tol`` at a window end (an engine failure).
     """
     _check_packing(packing)
     check_cell_options(applied_pressure, cell_step)
+    _check_adaptive_cell(adaptive_cell)
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
             or not math.isfinite(growth_rate) or growth_rate < 0:
         raise InvalidInputError(f"growth_rate must be a finite number >= 0 with a deforming cell, got {growth_rate!r}")
@@ -437,10 +536,12 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
 
     def stage_window(rate: float) -> float:
-        return default_window(rate, packing.dim) if window is None else float(window)
+        if window is not None:
+            return float(window)
+        return cell_window(rate, packing.dim, cell_step) if adaptive_cell else default_window(rate, packing.dim)
 
     sim = DeformingSimulation(packing, maxwell_boltzmann(packing.n_particles, packing.dim, seed),
-                              growth_rate, applied_pressure, cell_step, overlap_tol)
+                              growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell=adaptive_cell)
     started = time.perf_counter()
     while (reason := _stop_reason(stop, sim, started)) is None:
         budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
@@ -469,6 +570,10 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         else float(applied_pressure),
         "cell_step": float(cell_step),
         "shear": float(rec["shear"][-1]) if rec["shear"] else float("nan"),
+        "shear_mean": mean_shear(sim.deviatoric),
+        "adaptive_cell": bool(adaptive_cell), "mobility_block": MOBILITY_BLOCK,
+        "mobility_grow": MOBILITY_GROW, "mobility_shrink": MOBILITY_SHRINK,
+        "cell_lag": CELL_LAG, "final_mobility": float(sim.mobility),
         "volume_ratio": sim.volume / sim.volume0, "mass": 1.0, "kT": 1.0,
     }
     if final_growth_rate is not None:
@@ -478,8 +583,12 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
                  pressure="tr(sigma)/d over the window, units kT_mean / length^d",
                  shear="|sigma - p I| / p over the window (Frobenius)",
                  strain_step="Frobenius norm of the strain applied after the window",
+                 mobility="adaptive cell mobility m used after the window (module docstring, step 2)",
                  step_fraction="s: the fraction of the strain rule's step that kept every gap >= half")
     data = {k: ("window", np.asarray(rec[k], dtype=float), {"description": units[k]}) for k in RECORD_FIELDS}
+    data["deviatoric"] = (("window", "row", "col"), np.asarray(sim.deviatoric, dtype=float).reshape(-1, sim.d, sim.d),
+                          {"description": "sigma / p - I over the window (its mean is the anisotropy; one "
+                                          "window's is mostly noise)"})
     ts = xr.Dataset(data, coords={"window": np.arange(len(rec["time"]))})
     ts.attrs.update({"hardpack_kind": "md_timeseries", "N": sim.n, "d": sim.d, "seed": int(seed),
                      "growth_rate": float(growth_rate), "stop_reason": reason})
