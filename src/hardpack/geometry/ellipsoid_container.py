@@ -38,6 +38,19 @@ from numba import njit
 MAX_ITER = 100
 
 
+@njit(cache=True, inline="always")
+def _hard_case_g(b, a, a2max):
+    """The secular function at mu = a_max^2 over the shorter axes, sum (a_k b_k / (a_max^2 - a_k^2))^2
+    (module docstring): the hard case, no component along the longest axes, holds when it is <= 1."""
+    g = 0.0
+    for k in range(b.shape[0]):
+        a2 = a[k] * a[k]
+        if a2 < a2max:
+            q = a[k] * b[k] / (a2max - a2)
+            g += q * q
+    return g
+
+
 @njit(cache=True)
 def farthest_point_body(b, a, x):
     """rho^2 = max |b + z|^2 over the body-frame ellipsoid sum z_k^2 / a_k^2 <= 1, and the farthest
@@ -59,12 +72,7 @@ def farthest_point_body(b, a, x):
             wmax += t
     # hard case: no component along the longest axes and g(a_max^2) <= 1
     if wmax == 0.0:
-        g = 0.0
-        for k in range(d):
-            a2 = a[k] * a[k]
-            if a2 < a2max:
-                q = a[k] * b[k] / (a2max - a2)
-                g += q * q
+        g = _hard_case_g(b, a, a2max)
         if g <= 1.0:
             rest = a2max * (1.0 - g)
             first = True
@@ -241,15 +249,7 @@ def local_farthest_body(b, a, points):
     for k in range(d):
         if a[k] * a[k] == a2d:
             wd += a2d * b[k] * b[k]
-    hard = wd == 0.0
-    if hard:
-        g = 0.0
-        for k in range(d):
-            a2 = a[k] * a[k]
-            if a2 < a2d:
-                q = a[k] * b[k] / (a2d - a2)
-                g += q * q
-        hard = g <= 1.0
+    hard = wd == 0.0 and _hard_case_g(b, a, a2d) <= 1.0
     for k in range(d):
         points[0, k] = x[k]
     if hard:

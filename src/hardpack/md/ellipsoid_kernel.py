@@ -118,7 +118,7 @@ from hardpack.md.kernel import (
     WindowStatus,
     end_window,
     kinetic_step,
-    prefetch_row,
+    prefetch_next_events,
     update_neighbour_list,
 )
 
@@ -1310,16 +1310,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
                 ec[k] = cnt[partner]
             hsize = heap_set(hkey, heap, hpos, hsize, k, key)
         if hsize > 1:
-            # look ahead (as the sphere kernel): start loading the rows the next event needs, its
-            # particle's and its partner's neighbours
-            q = heap[0]
-            prefetch_row(bs, q)
-            for m in range(nn[q]):
-                prefetch_row(P, nb[q, m] >> cbits)
-            p = ep[q]
-            if p >= 0:
-                prefetch_row(P, p)
-                prefetch_row(nb, p)
+            prefetch_next_events(P, bs, nb, nn, ep, heap, hsize, cbits)
         if iacc[I_COLL] >= coll_target and npred == 2:
             end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS

@@ -184,6 +184,26 @@ def prefetch_row(typingctx, arr, idx):
 
 
 @njit(cache=True, inline="always")
+def prefetch_next_events(P, bs, nb, nn, ep, heap, hsize, cbits):
+    """Look ahead for an event loop (the sphere and ellipsoid kernels; it is memory-latency bound
+    from N ~ 1e4): start loading the rows the next events will need, the particles of the next
+    few events, the next particle's neighbours and its partner's neighbours. A hint only."""
+    for c2 in range(1, min(5, hsize)):
+        q = heap[c2]
+        prefetch_row(P, q)
+        prefetch_row(nb, q)
+    q = heap[0]
+    prefetch_row(bs, q)
+    for m in range(nn[q]):
+        prefetch_row(P, nb[q, m] >> cbits)
+    p = ep[q]
+    if p >= 0:
+        prefetch_row(P, p)
+        for m in range(nn[p]):
+            prefetch_row(P, nb[p, m] >> cbits)
+
+
+@njit(cache=True, inline="always")
 def update_neighbour_list(i, a, P, L, invL, skin, sfac, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of,
                           bs, nb, nn, mark, oldnb, clo, cspan, codo, wmode, walled):
     """Partial near-neighbour-list update of particle i (Donev 2006, Algorithm 10), shared by the
@@ -703,22 +723,7 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
             hsize = heap_set(hkey, heap, hpos, hsize, i, key)
 
         if stage == 2 * n and hsize > 1:
-            # look ahead: start loading the rows the next events will need (their particles, the
-            # next particle's neighbours and its partner's neighbours); the loop is memory-latency
-            # bound from N ~ 1e4
-            for c2 in range(1, min(5, hsize)):
-                q = heap[c2]
-                prefetch_row(P, q)
-                prefetch_row(nb, q)
-            q = heap[0]
-            prefetch_row(bs, q)
-            for m in range(nn[q]):
-                prefetch_row(P, nb[q, m] >> cbits)
-            p = ep[q]
-            if p >= 0:
-                prefetch_row(P, p)
-                for m in range(nn[p]):
-                    prefetch_row(P, nb[p, m] >> cbits)
+            prefetch_next_events(P, bs, nb, nn, ep, heap, hsize, cbits)
         if iacc[I_COLL] >= coll_target and npred == 2:
             end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS
