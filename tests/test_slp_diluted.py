@@ -97,7 +97,9 @@ def test_a_killed_run_resumes_and_ends_identically(tmp_path, monkeypatch, mrj, d
      (dict(fraction=0.005), "removes none per round"),
      (dict(fraction=0.3, rounds=4), "leave -12 of 64"),
      (dict(rounds=0), "rounds must be a positive integer"),
-     (dict(seed=-1), "seed must be a non-negative integer")],
+     (dict(seed=-1), "seed must be a non-negative integer"),
+     (dict(seed=True), "seed must be a non-negative integer, got True"),
+     (dict(seed=1.5), "seed must be a non-negative integer, got 1.5")],
 )
 def test_bad_settings_are_refused(mrj, kwargs, message):
     args = {**dict(fraction=0.03, rounds=2, seed=1, alpha=1.5, bounds=MRJ), **kwargs}

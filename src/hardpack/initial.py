@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from hardpack.distributions import Discrete, Distribution
-from hardpack.errors import InvalidInputError
+from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry.balls import ball_volume, unit_ball_volume
 from hardpack.geometry.boundaries import HardWalls, SphericalContainer
 from hardpack.geometry.neighbours import random_sequential_addition
@@ -41,8 +41,7 @@ def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed:
         raise InvalidInputError(f"d must be an integer in 1..12, got {d!r}")
     if not (np.isfinite(phi) and 0 < phi < 1):
         raise InvalidInputError(f"phi must be in (0, 1), got {phi!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     if not isinstance(distribution, Distribution):
         raise InvalidInputError(f"distribution must be a hardpack Distribution, got {type(distribution).__name__}")
     n, d = int(n), int(d)
@@ -141,8 +140,7 @@ def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=
     d = axes.shape[1]
     if not (np.isfinite(phi) and 0 < phi < 1):
         raise InvalidInputError(f"phi must be in (0, 1), got {phi!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     shape = np.ones(d) if box_shape is None else np.asarray(box_shape, float)
     if shape.shape != (d,) or not (np.isfinite(shape).all() and (shape > 0).all()):
         raise InvalidInputError(f"box_shape must be {d} positive numbers, got {box_shape!r}")

@@ -95,7 +95,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 import xarray as xr
 
-from hardpack.errors import InvalidInputError
+from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry.packing import Packing
 from hardpack.jamming.ellipsoids import (
     EllipsoidContacts,
@@ -927,8 +927,7 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     for name, value in (("rank_tol", rank_tol), ("stress_tol", stress_tol), ("eig_tol", eig_tol)):
         if not (np.isfinite(value) and 0 < value < 1):
             raise InvalidInputError(f"{name} must be in (0, 1), got {value!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     frozen = np.zeros(n, dtype=bool) if frozen is None else np.asarray(frozen)
     if frozen.shape != (n,) or frozen.dtype != bool:
         raise InvalidInputError(f"frozen must be a boolean array of shape ({n},), got {frozen.dtype} {frozen.shape}")

@@ -34,7 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from hardpack.errors import InvalidInputError
+from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
 from hardpack.jamming.contacts import check_delta, contact_network, require_spheres
@@ -208,8 +208,7 @@ def verify(
                                 "method='ideal', which handles wall contacts")
     delta = check_delta((SEQUENTIAL_DELTA if method == "sequential" else DEFAULT_DELTA) if delta is None else delta)
     tests = _check_tests(tests)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     diameter = 2.0 * float(packing.radii.mean())
     sequential = method == "sequential"
     if sequential:

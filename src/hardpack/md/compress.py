@@ -68,7 +68,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from hardpack.errors import InvalidInputError
+from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt, packing_to_dataset, write_dataset
@@ -318,8 +318,7 @@ def _check_run_options(packing: Packing, growth_rate, seed, stop: StopCriteria |
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
             or not math.isfinite(growth_rate):
         raise InvalidInputError(f"growth_rate must be a finite number, got {growth_rate!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     stop = StopCriteria() if stop is None else stop
     stop.check(float(growth_rate), packing.phi)
     _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)

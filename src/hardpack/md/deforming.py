@@ -91,7 +91,7 @@ import time
 import numpy as np
 import xarray as xr
 
-from hardpack.errors import InvalidInputError
+from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
@@ -524,8 +524,7 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
             or not math.isfinite(growth_rate) or growth_rate < 0:
         raise InvalidInputError(f"growth_rate must be a finite number >= 0 with a deforming cell, got {growth_rate!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     stop = StopCriteria() if stop is None else stop
     if stop.target_phi is not None:
         raise InvalidInputError("target_phi is not supported with a deforming cell (phi changes with the "

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from hardpack.errors import InvalidInputError
+from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.io import checkpoint as ckpt
 from hardpack.io import interrupt
@@ -144,8 +144,7 @@ def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int
         On SIGINT or SIGTERM (after the checkpoint is written, when there is one).
     """
     check_packing(packing)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     if int(n_blocks) != n_blocks or n_blocks < 2:
         raise InvalidInputError(f"n_blocks must be an integer >= 2, got {n_blocks!r}")
     if int(n_collisions) != n_collisions or n_collisions < n_blocks:

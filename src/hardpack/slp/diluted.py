@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from hardpack.errors import InvalidInputError
+from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry import ball_volume
 from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
@@ -159,8 +159,7 @@ def run_diluted(packing: Packing, fraction: float, rounds: int, seed: int, alpha
         On SIGINT or SIGTERM, after the checkpoint is written.
     """
     packing.require_periodic_spheres("the diluted-MRJ protocol")
-    if int(seed) != seed or seed < 0:
-        raise InvalidInputError(f"seed must be a non-negative integer, got {seed}")
+    check_seed(seed)
     n_remove = removal_count(packing.n_particles, fraction, rounds)
     fp = ckpt.fingerprint(packing, run="slp_diluted", fraction=float(fraction), seed=int(seed),
                           alpha=float(alpha), bounds=[bounds.strain, bounds.shear, bounds.displacement],
