@@ -59,7 +59,21 @@ def check_delta(delta) -> float:
 
 class ContactArrays:
     """What the contact networks of spheres and of ellipsoids share: contacts (``i``, ``j``) of the
-    particles at ``positions`` (N, d)."""
+    particles at ``positions`` (N, d); ``wall`` (M,) is -1 for a pair and the wall's number for a
+    wall contact (None in the constructor: pairs only)."""
+
+    def __post_init__(self):
+        if self.wall is None:
+            object.__setattr__(self, "wall", np.full(len(self.i), -1, dtype=np.int64))
+
+    @property
+    def is_wall(self) -> np.ndarray:
+        """(M,) True for the wall contacts."""
+        return self.wall >= 0
+
+    @property
+    def n_wall_contacts(self) -> int:
+        return int(np.count_nonzero(self.wall >= 0))
 
     @property
     def n_contacts(self) -> int:
@@ -104,19 +118,9 @@ class ContactNetwork(ContactArrays):
     centre: np.ndarray | None = None  # (d,) centre of a spherical container
 
     def __post_init__(self):
-        if self.wall is None:
-            object.__setattr__(self, "wall", np.full(len(self.i), -1, dtype=np.int64))
+        super().__post_init__()
         if self.periodic is None:
             object.__setattr__(self, "periodic", np.ones(self.positions.shape[1], dtype=bool))
-
-    @property
-    def is_wall(self) -> np.ndarray:
-        """(M,) True for the wall contacts."""
-        return self.wall >= 0
-
-    @property
-    def n_wall_contacts(self) -> int:
-        return int(np.count_nonzero(self.wall >= 0))
 
     @property
     def is_periodic(self) -> bool:

@@ -132,19 +132,6 @@ class EllipsoidContacts(ContactArrays):
     centre: np.ndarray | None = None
     radius: float | None = None
 
-    def __post_init__(self):
-        if self.wall is None:
-            object.__setattr__(self, "wall", np.full(len(self.i), -1, dtype=np.int64))
-
-    @property
-    def is_wall(self) -> np.ndarray:
-        """(M,) True for the contacts with the container wall."""
-        return self.wall >= 0
-
-    @property
-    def n_wall_contacts(self) -> int:
-        return int(np.count_nonzero(self.wall >= 0))
-
     @property
     def gap(self) -> np.ndarray:
         """mu - 1, the relative scale gap of every contact (negative for overlaps)."""
