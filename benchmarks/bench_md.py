@@ -16,7 +16,7 @@ the CPU-time rate is printed too.
    Z = 1e12 (numba compilation excluded: a small run compiles first), plus the collision rate in
    the dense part of the run (Z >= 1e3).
 3. Compile time: first call of the engine in a fresh process with an empty numba cache.
-4. Wide size distribution (issue 6): NVE rate of N = 1e4 spheres in 3D with radii uniform in volume
+4. Wide size distribution: NVE rate of N = 1e4 spheres in 3D with radii uniform in volume
    over a factor omega = 10 (hardpack.distributions.uniform_volume(10), several grid levels) against
    monodisperse spheres, both at phi = 0.5.
 """

@@ -205,7 +205,7 @@ def _strain_continuation(g, h, c, upper, n_pos, factor: float = 10.0, stages: in
     it once took 170 s where the smallest gaps took > 6 min, but the first LPs of the fourth
     and fifth sequences of the full study's test took 39 min and > 2 h from it, and 9 min
     cold for the fifth (the packing moved 4-6e-4 D per sequence, so another sequence's basis
-    carries tens of thousands of negative loads; measured 2026-11-25).
+    carries tens of thousands of negative loads).
 
     A stage whose optimal strain lies strictly inside its bound ends the continuation: the
     stages differ only in the strain bound, so that optimum satisfies the optimality (KKT)

@@ -27,8 +27,8 @@ as B and -B do in Algorithm 13, instead of the neighbourhood of a packing the te
 sheared (a strict sequence at N = 1e4 in 3D moves the particles by ~5e-4 D, the gaps of the
 contacts it opened; the reversed load then mostly undoes it). (b) Speed: at the moved packing
 the smallest gaps no longer mark the contact core: at N = 1e4 in 3D the first LPs of strict
-sequences 2-6 took 530-850 s there, against 45-52 s at the given packing (measured
-2026-11-25). (c) The sequences are independent, so they can run side by side (``workers``).
+sequences 2-6 took 530-850 s there, against 45-52 s at the given packing. (c) The sequences
+are independent, so they can run side by side (``workers``).
 
 The contact list must reach beyond the gaps that matter: step 6 moves no particle by more than
 delta D_min / 2 per LP, so a sequence can never displace anything by more than

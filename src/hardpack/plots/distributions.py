@@ -1,4 +1,4 @@
-"""Figure: sampled radii against the analytic size distribution (foundation issue)."""
+"""Figure: sampled radii against the analytic size distribution."""
 
 from __future__ import annotations
 
