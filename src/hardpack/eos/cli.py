@@ -14,66 +14,11 @@ from __future__ import annotations
 import json
 import logging
 
-import numpy as np
-import xarray as xr
-
-from hardpack.distributions import from_spec
-from hardpack.eos import moments as mo
 from hardpack.eos.study import WIDTH as FAMILIES
+from hardpack.eos.study import equivalents_dataset
 from hardpack.errors import InvalidInputError
 
 log = logging.getLogger(__name__)
-
-
-def equivalents_dataset(kind: str, values, alpha: float | None = None) -> xr.Dataset:
-    """The table for ``kind`` at each parameter value (see module docstring)."""
-    if kind not in FAMILIES:
-        raise InvalidInputError(f"unknown family {kind!r}; choose one of {sorted(FAMILIES)}")
-    if (kind == "power_law") != (alpha is not None):
-        raise InvalidInputError("--alpha is required for power_law and only allowed there")
-    param = FAMILIES[kind]
-    names = (
-        "O1",
-        "O2",
-        "delta",
-        "skewness",
-        "kurtosis",
-        "bi_n1",
-        "bi_R",
-        "tri_n1",
-        "tri_n2",
-        "tri_delta1",
-        "tri_delta2",
-    )
-    table = {name: [] for name in names}
-    radii = []
-    for value in values:
-        spec = {"kind": kind, param: float(value)} | ({"alpha": alpha} if alpha is not None else {})
-        dist = from_spec(spec)
-        bi, tri = mo.equivalent_bidisperse(dist), mo.equivalent_tridisperse(dist)
-        row = (
-            *mo.dimensionless_moments(dist),
-            mo.polydispersity(dist),
-            mo.skewness(dist),
-            mo.kurtosis(dist),
-            bi.n1,
-            bi.R,
-            tri.n1,
-            tri.n2,
-            tri.delta1,
-            tri.delta2,
-        )
-        for name, v in zip(names, row):
-            table[name].append(v)
-        radii.append(tri.radii)
-    coords = {param: np.asarray(values, float), "species": [1, 2, 3]}
-    data = {name: ((param,), np.array(v)) for name, v in table.items()}
-    data["tri_radii"] = ((param, "species"), np.array(radii))
-    ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update(hardpack_kind="eos_equivalents", family=kind, source="Ogarko Tables 3.1, 3.3, 3.4")
-    if alpha is not None:
-        ds.attrs["alpha"] = alpha
-    return ds
 
 
 def cmd_poly_equivalents(args) -> int:

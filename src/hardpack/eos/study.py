@@ -10,6 +10,7 @@ three forms (:data:`SYSTEMS`):
 :func:`jam` grows a random start to jamming with the LS engine (two stages, see :class:`JamProtocol`)
 and :func:`fluid_pressure` measures the equilibrium reduced pressure Z at fixed phi and compares it with
 BMCSL (Eq. 3.9) for the realised radii. Both run in 3D in a periodic cube with masses 1, kT = 1.
+:func:`equivalents_dataset` tabulates the moments and both equivalents over a family's width.
 """
 
 from __future__ import annotations
@@ -246,3 +247,78 @@ def seed_statistics(summary: xr.Dataset) -> xr.Dataset:
                       "crystallinity_large": summary["crystallinity_large"].mean("seed")})
     out.attrs = dict(summary.attrs)
     return out
+
+
+def equivalents_dataset(kind: str, values, alpha: float | None = None) -> xr.Dataset:
+    """Moments and bi-/tridisperse equivalents of a distribution family at each parameter value
+    (Ogarko 2014, Tables 3.1, 3.3 and 3.4).
+
+    Parameters
+    ----------
+    kind : str
+        A family of :data:`WIDTH` (uniform_size, uniform_volume, power_law, lognormal).
+    values : sequence of float
+        The family's width parameter (omega, or sigma for lognormal) at each row.
+    alpha : float, optional
+        The exponent of a power_law family (required for it, refused for the others).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``hardpack_kind = "eos_equivalents"`` over the width parameter: O1, O2, delta, skewness,
+        kurtosis, the bidisperse equivalent (``bi_n1``, ``bi_R``; Table 3.1) and the maximally
+        equivalent tridisperse system (``tri_n1``, ``tri_n2``, ``tri_delta1``, ``tri_delta2`` and
+        ``tri_radii`` a1 >= a2 >= a3 in units of <a>; Tables 3.3-3.4).
+
+    Raises
+    ------
+    InvalidInputError
+        For an unknown family, or ``alpha`` given without power_law or missing with it.
+    """
+    if kind not in WIDTH:
+        raise InvalidInputError(f"unknown family {kind!r}; choose one of {sorted(WIDTH)}")
+    if (kind == "power_law") != (alpha is not None):
+        raise InvalidInputError("--alpha is required for power_law and only allowed there")
+    param = WIDTH[kind]
+    names = (
+        "O1",
+        "O2",
+        "delta",
+        "skewness",
+        "kurtosis",
+        "bi_n1",
+        "bi_R",
+        "tri_n1",
+        "tri_n2",
+        "tri_delta1",
+        "tri_delta2",
+    )
+    table = {name: [] for name in names}
+    radii = []
+    for value in values:
+        spec = {"kind": kind, param: float(value)} | ({"alpha": alpha} if alpha is not None else {})
+        dist = from_spec(spec)
+        bi, tri = mo.equivalent_bidisperse(dist), mo.equivalent_tridisperse(dist)
+        row = (
+            *mo.dimensionless_moments(dist),
+            mo.polydispersity(dist),
+            mo.skewness(dist),
+            mo.kurtosis(dist),
+            bi.n1,
+            bi.R,
+            tri.n1,
+            tri.n2,
+            tri.delta1,
+            tri.delta2,
+        )
+        for name, v in zip(names, row):
+            table[name].append(v)
+        radii.append(tri.radii)
+    coords = {param: np.asarray(values, float), "species": [1, 2, 3]}
+    data = {name: ((param,), np.array(v)) for name, v in table.items()}
+    data["tri_radii"] = ((param, "species"), np.array(radii))
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(hardpack_kind="eos_equivalents", family=kind, source="Ogarko Tables 3.1, 3.3, 3.4")
+    if alpha is not None:
+        ds.attrs["alpha"] = alpha
+    return ds

@@ -8,39 +8,17 @@ from __future__ import annotations
 
 import logging
 
-import numpy as np
-import xarray as xr
-
 from hardpack.hgrid import cost_model as cm
 
 log = logging.getLogger(__name__)
 
 
-def cost_dataset(system: cm.PowerLawSystem, rules, levels, K: float, method: str) -> xr.Dataset:
-    """T/N for every rule at every number of levels."""
-    levels = np.asarray(levels, dtype=int)
-    cost = np.array([cm.cost_vs_levels(system, rule, levels, K, method) for rule in rules])
-    ds = xr.Dataset({"cost": (("rule", "levels"), cost)}, coords={"rule": list(rules), "levels": levels})
-    ds["cost"].attrs["long_name"] = "contact-detection work per particle T/N (Eq. 2.35)"
-    ds.attrs.update(
-        hardpack_kind="hgrid_cost",
-        alpha=system.alpha,
-        omega=system.omega,
-        nu=system.nu,
-        d=system.d,
-        K=K,
-        method=method,
-        linked_cell_cost=system.linked_cell_cost(K),
-    )
-    return ds
-
-
-def cmd_cost(args) -> int:
+def cmd_hgrid_cost(args) -> int:
     """Analytic HGrid cost T/N vs number of levels for power-law radii (Ogarko ch. 2.2, Fig. 2.15)."""
     from hardpack.io import write_dataset
 
     system = cm.PowerLawSystem(args.alpha, args.omega, args.nu, args.d)
-    ds = cost_dataset(system, args.rules, range(1, args.max_levels + 1), args.K, args.method)
+    ds = cm.cost_dataset(system, args.rules, range(1, args.max_levels + 1), args.K, args.method)
     config = {k: getattr(args, k) for k in ("alpha", "omega", "nu", "d", "K", "method", "rules", "max_levels")}
     write_dataset(ds, args.out, config=config)
     for rule in args.rules:
@@ -50,7 +28,7 @@ def cmd_cost(args) -> int:
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("hgrid-cost", help=cmd_cost.__doc__)
+    p = subparsers.add_parser("hgrid-cost", help=cmd_hgrid_cost.__doc__)
     p.add_argument("--alpha", type=float, required=True, help="exponent of f(r) ~ r^alpha (0 US, -3 UV)")
     p.add_argument("--omega", type=float, required=True, help="r_max / r_min")
     p.add_argument("--nu", type=float, default=0.7, help="volume fraction (default 0.7)")
@@ -60,4 +38,4 @@ def register(subparsers) -> None:
     p.add_argument("--rules", nargs="+", choices=cm.CELL_RULES, default=["linear", "exponential", "constant-m"])
     p.add_argument("--max-levels", type=int, default=30, help="levels 1..max (optimal: ~0.5 s per level)")
     p.add_argument("--out", required=True, help="output netCDF file")
-    p.set_defaults(func=cmd_cost)
+    p.set_defaults(func=cmd_hgrid_cost)

@@ -37,6 +37,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 from scipy.optimize import brentq, minimize
 from scipy.special import comb
 
@@ -274,3 +275,43 @@ def best_levels(system: PowerLawSystem, rule: str, L_max: int = 60, K: float = 0
     costs = cost_vs_levels(system, rule, levels, K, method)
     best = int(np.argmin(costs))
     return int(levels[best]), float(costs[best]), cells_for(system, rule, int(levels[best]), K, method)
+
+
+def cost_dataset(system: PowerLawSystem, rules, levels, K: float, method: str) -> xr.Dataset:
+    """The analytic cost T/N (Ogarko 2014, Eq. 2.35) of every cell-size rule at every number of
+    levels, with the single-level (linked-cell) cost for reference.
+
+    Parameters
+    ----------
+    system : PowerLawSystem
+        Power-law radii, volume fraction and dimension.
+    rules : sequence of str
+        Cell-size rules of :data:`CELL_RULES`.
+    levels : sequence of int
+        Numbers of levels.
+    K : float
+        Ratio of the time of a cell access to that of an overlap test.
+    method : str
+        Search method of :data:`METHODS`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``cost(rule, levels)``, ``hardpack_kind = "hgrid_cost"``; the system, K, method and
+        ``linked_cell_cost`` as attributes.
+    """
+    levels = np.asarray(levels, dtype=int)
+    cost = np.array([cost_vs_levels(system, rule, levels, K, method) for rule in rules])
+    ds = xr.Dataset({"cost": (("rule", "levels"), cost)}, coords={"rule": list(rules), "levels": levels})
+    ds["cost"].attrs["long_name"] = "contact-detection work per particle T/N (Eq. 2.35)"
+    ds.attrs.update(
+        hardpack_kind="hgrid_cost",
+        alpha=system.alpha,
+        omega=system.omega,
+        nu=system.nu,
+        d=system.d,
+        K=K,
+        method=method,
+        linked_cell_cost=system.linked_cell_cost(K),
+    )
+    return ds
