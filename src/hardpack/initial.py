@@ -30,10 +30,39 @@ def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed:
                    wall_axes=None) -> Packing:
     """Seeded RSA packing of ``n`` spheres with radii from ``distribution`` at volume fraction ``phi``.
 
-    ``box_shape`` gives relative box lengths (default a cube; not with a spherical container).
-    ``boundary``: "periodic", "hard_walls" (walls on ``wall_axes``, default all) or
-    "spherical_container" (module docstring); phi is over the boundary's volume. Species labels
-    are set for discrete distributions. Raises :class:`InvalidInputError` for impossible requests.
+    Parameters
+    ----------
+    n : int
+        Number of spheres, >= 1.
+    d : int
+        Dimension, 1 to 12.
+    distribution : hardpack.distributions.Distribution
+        Size distribution of the radii (systematic sampling; placed largest first).
+    phi : float
+        Volume fraction in (0, 1) over the boundary's volume; RSA saturates well below jamming.
+    seed : int
+        Seed of ``numpy.random.default_rng`` (radii first, then the positions).
+    box_shape : sequence of d floats, optional
+        Relative box lengths (default a cube; not with a spherical container).
+    max_trials : int, default 100000
+        Trials per sphere before giving up.
+    boundary : {"periodic", "hard_walls", "spherical_container"}
+        A periodic box, hard walls on ``wall_axes`` of the box, or a spherical container (module
+        docstring).
+    wall_axes : sequence of int, optional
+        The walled axes with ``boundary="hard_walls"`` (default all).
+
+    Returns
+    -------
+    Packing
+        The spheres, with species labels for discrete distributions, checked for overlaps and
+        containment by the packing model.
+
+    Raises
+    ------
+    InvalidInputError
+        For a bad n, d, phi, seed, distribution, box shape, boundary or wall axes, a container
+        smaller than the largest sphere, or when RSA cannot place a sphere.
     """
     if int(n) != n or n < 1:
         raise InvalidInputError(f"n must be a positive integer, got {n!r}")
