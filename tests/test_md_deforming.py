@@ -167,6 +167,9 @@ def test_3d_deforming_ls_packing_is_strictly_jammed():
     ({"growth_rate": -0.1}, "growth_rate"),
     ({"stop": StopCriteria(max_pressure=None, target_phi=0.5)}, "target_phi"),
     ({"adaptive_cell": 1}, "adaptive_cell"),
+    ({"seed": True}, "seed must be a non-negative integer"),
+    ({"window": 0.0}, "window must be a positive number"),
+    ({"final_growth_rate": 0.001, "switch_pressure": 0.5}, "switch_pressure must be a finite number > 1"),
 ])
 def test_bad_input_is_refused(kwargs, match):
     start = random_packing(20, 2, monodisperse(), 0.3, 0)

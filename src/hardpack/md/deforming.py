@@ -91,12 +91,12 @@ import time
 import numpy as np
 import xarray as xr
 
-from hardpack.errors import InvalidInputError, check_seed
+from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
 from hardpack.md import deforming_kernel as dk
-from hardpack.md.compress import CompressResult, StopCriteria, _check_final_stage, _stop_reason, default_window
+from hardpack.md.compress import CompressResult, StopCriteria, _check_run_options, _stop_reason, default_window
 from hardpack.md.simulation import OverlapError, maxwell_boltzmann
 
 #: default alpha: relative volume relaxation per window (module docstring, step 2)
@@ -524,15 +524,10 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
     if isinstance(growth_rate, bool) or not isinstance(growth_rate, (int, float, np.floating, np.integer)) \
             or not math.isfinite(growth_rate) or growth_rate < 0:
         raise InvalidInputError(f"growth_rate must be a finite number >= 0 with a deforming cell, got {growth_rate!r}")
-    check_seed(seed)
-    stop = StopCriteria() if stop is None else stop
-    if stop.target_phi is not None:
+    if stop is not None and stop.target_phi is not None:
         raise InvalidInputError("target_phi is not supported with a deforming cell (phi changes with the "
                                 "cell too): stop at a pressure, a collision count or a wall time")
-    stop.check(float(growth_rate), packing.phi)
-    _check_final_stage(float(growth_rate), final_growth_rate, switch_pressure, stop)
-    if window is not None and not (math.isfinite(window) and window > 0):
-        raise InvalidInputError(f"window must be a positive number of collisions per particle, got {window!r}")
+    stop = _check_run_options(packing, growth_rate, seed, stop, final_growth_rate, switch_pressure, window)
 
     def stage_window(rate: float) -> float:
         if window is not None:
