@@ -56,7 +56,7 @@ def test_one_growing_disk_collides_at_the_analytic_time(u, gamma):
     kappa = [gamma / (2 * a), 0.0]  # disk 0 grows at dD/dt = gamma, disk 1 keeps its size
     t, status, X, V, A, colls = _first_collision(pk, v, kappa)
     t_star = gap0 / (u + gamma / 2)
-    assert status == dk.DONE_COLLISIONS and colls == 1
+    assert status == dk.DeformingStatus.DONE_COLLISIONS and colls == 1
     assert t == pytest.approx(t_star, rel=1e-13)
     assert A[0] == pytest.approx(a + gamma / 2 * t_star, rel=1e-13)
     assert A[1] == a  # exactly

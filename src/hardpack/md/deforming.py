@@ -324,17 +324,17 @@ class DeformingSimulation:
                                    kappa, skin, self.bs, nb, self.nn, self.mark, self.cnt, self.ep, self.ei,
                                    self.ec, self.tv, self.hkey, self.heap, self.hpos, self.kin,
                                    self.vir, acc, iacc, int(budget), float(t_cap))
-            if status == dk.OVERFLOW:
+            if status == dk.DeformingStatus.OVERFLOW:
                 self.X[:], self.V[:] = saved
                 self.T[:] = 0.0
                 self.capacity *= 2
                 continue
-            if status == dk.SELF_IMAGE:
+            if status == dk.DeformingStatus.SELF_IMAGE:
                 raise InvalidInputError(
                     f"a particle grew to touch its own periodic image (shortest lattice vector "
                     f"{lmin:.4g}, largest diameter {2 * amax:.4g}): the cell is too small for these "
                     "particles; use more particles")
-            if status == dk.STUCK:
+            if status == dk.DeformingStatus.STUCK:
                 raise RuntimeError("no event can ever happen: no particle moves and none grows")
             break
         duration = float(acc[0])

@@ -32,6 +32,8 @@ is symmetric); sigma = (kin + vir) / (V dt) with m = 1.
 
 from __future__ import annotations
 
+import enum
+
 import numpy as np
 from numba import njit
 
@@ -41,8 +43,18 @@ from hardpack.events.roots import contact_root, exit_root
 EXIT = -1
 NONE = -2
 
-# statuses
-DONE_COLLISIONS, DONE_TIME, OVERFLOW, STUCK, SELF_IMAGE = 0, 1, 2, 3, 4
+
+
+class DeformingStatus(enum.IntEnum):
+    """How the deforming-cell :func:`run_events` ended a window."""
+
+    DONE_COLLISIONS = 0  # the window's collision budget is used up
+    DONE_TIME = 1  # the next event is later than the window's end
+    OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
+    STUCK = 3  # no event can ever happen (nothing moves)
+    SELF_IMAGE = 4  # a bounding sphere reaches its own periodic image: the cell is too small
+
+
 # integer counters
 I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE = 0, 1, 2, 3, 4
 N_COUNTERS = 5
@@ -152,7 +164,7 @@ def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
     od = np.empty(d, dtype=np.int64)
     ri = bs[i, d]
     if 2.0 * ri >= lmin:  # i's bounding sphere would reach its own periodic image
-        return SELF_IMAGE
+        return DeformingStatus.SELF_IMAGE
     for j in range(jstop):
         if j == i:
             continue
@@ -175,7 +187,7 @@ def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
                 od[k] = lo[k]
             if d2 < reach * reach:
                 if nn[i] >= cap or nn[j] >= cap:
-                    return OVERFLOW
+                    return DeformingStatus.OVERFLOW
                 nb[i, nn[i]] = j * m + code
                 nn[i] += 1
                 nb[j, nn[j]] = i * m + (m - 1 - code)
@@ -234,7 +246,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                     t = t_cap
                     break
                 acc[0] = t
-                return STUCK
+                return DeformingStatus.STUCK
             i = heap[0]
             tn = hkey[0]
             if tn > t_cap:
@@ -374,8 +386,8 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 kin[a1, b1] += V[i, a1] * V[i, b1] * w
     acc[1] = 0.5 * np.trace(kin)
     if stage >= n and t == t_cap:
-        return DONE_TIME
-    return DONE_COLLISIONS
+        return DeformingStatus.DONE_TIME
+    return DeformingStatus.DONE_COLLISIONS
 
 
 @njit(cache=True)
