@@ -6,11 +6,10 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import numpy as np
 import scipy
 
 from hardpack.io import checkpoint as ckpt
-from hardpack.io import load_dataset, load_packing, save_packing, write_dataset
+from hardpack.io import load_dataset, load_packing, write_dataset
 from hardpack.slp.diluted import run_diluted
 from hardpack.slp.driver import run_slp
 from hardpack.slp.lp import METHODS, Bounds
@@ -81,14 +80,10 @@ def cmd_slp_dilute(args) -> int:
     for r, rnd in enumerate(rounds, start=1):
         removed += rnd.n_removed
         attrs = dict(args.attr or [])
-        attrs.update(params, init=str(args.init), seed=args.seed, dilution_round=r, n_removed=rnd.n_removed,
-                     n_removed_total=removed, N_start=start.n_particles, phi_start=start.phi,
-                     phi_diluted=rnd.phi_diluted, converged=rnd.converged, n_steps=rnd.n_steps,
-                     n_rejected=rnd.n_rejected, wall_seconds=rnd.wall_seconds, cpu_seconds=rnd.cpu_seconds,
-                     lp_solver=_solver(args))
+        attrs.update(params, init=str(args.init), seed=args.seed, dilution_round=r, n_removed_total=removed,
+                     N_start=start.n_particles, phi_start=start.phi, lp_solver=_solver(args))
         path = out_dir / f"round{r}.nc"
-        save_packing(rnd.packing, path, attrs=_inherit(attrs, args.init), config=params,
-                     extra={"start_index": (("particle",), np.asarray(rnd.start_index))})
+        write_dataset(rnd.to_dataset(**_inherit(attrs, args.init)), path, config=params)
         log.info("diluted round %d: %s, N = %d, phi = %.8f (%d LPs, converged=%s)", r, path,
                  rnd.packing.n_particles, rnd.packing.phi, rnd.n_steps, rnd.converged)
     if args.checkpoint is not None:  # only now that every round is safely written

@@ -43,7 +43,7 @@ from hardpack.errors import InvalidInputError, check_seed
 from hardpack.geometry import ball_volume
 from hardpack.geometry.packing import Packing
 from hardpack.io import checkpoint as ckpt
-from hardpack.io import load_judged_packings
+from hardpack.io import load_judged_packings, packing_to_dataset
 from hardpack.slp.driver import run_slp
 from hardpack.slp.lp import Bounds
 
@@ -85,6 +85,27 @@ class DilutedRound:
     n_rejected: int
     wall_seconds: float
     cpu_seconds: float
+
+    def to_dataset(self, **attrs) -> xr.Dataset:
+        """The re-jammed packing as a Dataset with the round's outcome as attributes.
+
+        Parameters
+        ----------
+        **attrs
+            Further attributes (e.g. the protocol parameters, the start file, the round number).
+
+        Returns
+        -------
+        xarray.Dataset
+            The packing layout of :func:`hardpack.io.packing_to_dataset` with the data variable
+            ``start_index`` and the attributes ``n_removed``, ``phi_diluted``, ``converged``,
+            ``n_steps``, ``n_rejected``, ``wall_seconds``, ``cpu_seconds`` and ``attrs``.
+        """
+        outcome = dict(n_removed=self.n_removed, phi_diluted=self.phi_diluted, converged=self.converged,
+                       n_steps=self.n_steps, n_rejected=self.n_rejected, wall_seconds=self.wall_seconds,
+                       cpu_seconds=self.cpu_seconds)
+        extra = {"start_index": (("particle",), np.asarray(self.start_index))}
+        return packing_to_dataset(self.packing, {**attrs, **outcome}, extra)
 
 
 def removal_count(n_start: int, fraction: float, rounds: int) -> int:
