@@ -278,7 +278,8 @@ def equivalents_dataset(kind: str, values, alpha: float | None = None) -> xr.Dat
     if kind not in WIDTH:
         raise InvalidInputError(f"unknown family {kind!r}; choose one of {sorted(WIDTH)}")
     if (kind == "power_law") != (alpha is not None):
-        raise InvalidInputError("--alpha is required for power_law and only allowed there")
+        raise InvalidInputError(f"the power_law family needs its exponent alpha (--alpha on the command line) and the "
+                                f"others take none; got family {kind!r} with alpha = {alpha!r}")
     param = WIDTH[kind]
     names = (
         "O1",
