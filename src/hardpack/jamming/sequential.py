@@ -154,7 +154,7 @@ class SequentialOutcome:
 def collision_step(net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None) -> float:
     """Largest tau keeping every listed pair apart along x + t dR, Lambda + t eps Lambda, and
     every sphere with a listed wall contact inside its wall (:func:`wall_step`)."""
-    pair = ~net.is_wall
+    pair = ~net.is_wall if net.n_wall_contacts else slice(None)
     w = disp[net.j[pair]] - disp[net.i[pair]]
     if eps is not None:
         w = w + net.image_offset[pair] @ eps.T
