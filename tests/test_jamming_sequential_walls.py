@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_jamming_walls import flower_in_container, honeycomb_in_box
 
 from hardpack.distributions import monodisperse
 from hardpack.geometry.boundaries import HardWalls, SphericalContainer
@@ -19,7 +20,6 @@ from hardpack.jamming import contact_network, verify
 from hardpack.jamming.rigidity import rotation_velocities
 from hardpack.jamming.sequential import APPROACH_SLACK, _mean_size, collision_step
 from hardpack.md import StopCriteria, compress
-from test_jamming_walls import flower_in_container, honeycomb_in_box
 
 
 def test_fig_4_4_honeycomb_in_a_hard_wall_box_unjams_under_sequential_loading():
