@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hardpack.errors import InvalidInputError
 from hardpack.geometry.boundaries import HardWalls, SphericalContainer
 from hardpack.geometry.packing import Packing
 from hardpack.jamming import contact_network, rigidity_matrix, verify
@@ -211,11 +210,6 @@ def test_a_flower_missing_a_petal_unjams():
     r = verify(p)
     assert r.local is False and r.local_rattler.all()
     assert r.collective is False
-
-
-def test_the_sequential_method_refuses_walls_by_name():
-    with pytest.raises(InvalidInputError, match="sequential method handles periodic cells only"):
-        verify(honeycomb_in_box(), method="sequential")
 
 
 def test_wall_contacts_of_the_network():

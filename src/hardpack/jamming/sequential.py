@@ -58,6 +58,19 @@ Round-off: a pair already in contact may approach by the LP feasibility toleranc
 the collision time is therefore computed for a distance (1 - 1e-11) times the smaller of the
 current distance and D_ij, which never lets overlaps grow beyond the packing tolerance.
 
+Hard walls and spherical containers stay fixed (Donev 2006, sec. 4.4.2; only the collective test
+runs, :func:`hardpack.jamming.verify.verify` takes it for the strict one of a closed container). A
+wall contact is a contact with a fixed point of the wall (sec. 4.4.3): in the LP the one-sided
+constraint n . dr_i <= h - r_i, in step 6 the exact wall (:func:`wall_step`). The displacement
+relative to the bulk subtracts the trivial motions of the boundary: the median along the periodic
+axes only, and in a spherical container the least-squares rotation about its centre. A concave
+container wall is a limit of the straight step: a sphere touching it can slide along it only by
+moving inwards at second order, which the linearised LP does not see, so the wall cuts the step a
+few 1e-6 D into the motion. When that cut ends a sequence whose LP motion was beyond beta D, the
+test is undetermined, with the reason: its "jammed" would only say that straight lines hit the wall
+(measured: a 30-sphere container packing with one backbone sphere shrunk by 10 %, floppy by the
+ideal test, moved 4e-6 D per sequence). Flat walls have no such limit.
+
 A test is resumable after any loading sequence (``save`` / ``resume`` of
 :func:`sequential_test`; :func:`hardpack.jamming.verify.verify` keeps them in a checkpoint file):
 at N = 1e4 in 3D a strict loading sequence takes 1-1.5 min (2-3 LPs of 18-41 s).
@@ -85,6 +98,7 @@ from hardpack.jamming.contacts import ContactNetwork, contact_network
 from hardpack.jamming.highs import FALLBACKS, recording_fallbacks
 from hardpack.jamming.ideal import cell_length
 from hardpack.jamming.lp import VolumeIncrease, random_load, random_strain_load, solve_motion
+from hardpack.jamming.rigidity import rotation_velocities
 
 log = logging.getLogger(__name__)
 
@@ -138,21 +152,60 @@ class SequentialOutcome:
 
 
 def collision_step(net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None) -> float:
-    """Largest tau keeping every listed pair apart along x + t dR, Lambda + t eps Lambda."""
-    w = disp[net.j] - disp[net.i]
+    """Largest tau keeping every listed pair apart along x + t dR, Lambda + t eps Lambda, and
+    every sphere with a listed wall contact inside its wall (:func:`wall_step`)."""
+    pair = ~net.is_wall if net.n_wall_contacts else slice(None)
+    w = disp[net.j[pair]] - disp[net.i[pair]]
     if eps is not None:
-        w = w + net.image_offset @ eps.T
-    s0 = net.separation
-    target = (1.0 - APPROACH_SLACK) * np.minimum(net.distance, net.contact_distance)
+        w = w + net.image_offset[pair] @ eps.T
+    s0 = net.separation[pair]
+    distance = net.distance[pair]
+    target = (1.0 - APPROACH_SLACK) * np.minimum(distance, net.contact_distance[pair])
     a = np.einsum("ij,ij->i", w, w)
     b = 2.0 * np.einsum("ij,ij->i", s0, w)
-    c = net.distance**2 - target**2
+    c = distance**2 - target**2
     disc = b * b - 4.0 * a * c
     hit = (b < 0) & (disc >= 0) & (a > 0)
+    step = wall_step(net, disp)
     if not hit.any():
-        return np.inf
+        return step
     root = (2.0 * c[hit]) / (-b[hit] + np.sqrt(disc[hit]))  # smaller root, cancellation-free
-    return float(root.min())
+    return min(float(root.min()), step)
+
+
+def wall_step(net: ContactNetwork, disp: np.ndarray) -> float:
+    """Largest tau keeping the spheres of the listed wall contacts inside their fixed walls along
+    x + t dR (Donev 2006, sec. 4.4.3: the wall stays put; exact, not the linearised contact).
+
+    A wall contact (:mod:`hardpack.jamming.contacts`) of sphere i at centre-wall distance h with
+    outward normal n: a flat wall is reached when n . dr_i t = h - r_i; the wall of a spherical
+    container of radius R about c when |x_i - c + t dr_i| = R - r_i, the positive root of a
+    quadratic (the other is negative: the sphere is inside). The target distance is lowered by
+    APPROACH_SLACK as for the pairs."""
+    wall = net.is_wall
+    if not wall.any():
+        return np.inf
+    i = net.i[wall]
+    v = disp[i]
+    h = net.distance[wall]
+    target = (1.0 - APPROACH_SLACK) * np.minimum(h, net.contact_distance[wall])
+    if net.centre is None:  # flat walls: the distance h - t n . dr_i
+        speed = np.einsum("ij,ij->i", net.normal[wall], v)
+        out = speed > 0
+        return float(((h[out] - target[out]) / speed[out]).min(initial=np.inf))
+    y = net.positions[i] - net.centre
+    reach = np.sqrt(np.einsum("ij,ij->i", y, y)) + h - target  # R - target
+    a = np.einsum("ij,ij->i", v, v)
+    b = 2.0 * np.einsum("ij,ij->i", y, v)
+    c = np.minimum(np.einsum("ij,ij->i", y, y) - reach**2, 0.0)
+    moves = a > 0
+    a, b, c = a[moves], b[moves], c[moves]
+    if not moves.any():
+        return np.inf
+    root = np.sqrt(b * b - 4.0 * a * c)
+    # positive root (-b + root) / 2a, written without cancellation for b > 0
+    tau = np.where(b > 0, -2.0 * c / np.maximum(b + root, np.finfo(float).tiny), (root - b) / (2.0 * a))
+    return float(tau.min())
 
 
 def list_step(net: ContactNetwork, radii: np.ndarray, disp: np.ndarray, eps: np.ndarray | None) -> float:
@@ -222,7 +275,8 @@ def sequential_test(
     Parameters
     ----------
     packing : Packing
-        The periodic sphere packing to load; every loading sequence starts from it.
+        The sphere packing to load (periodic, between hard walls or in a spherical container:
+        ``strict`` needs a periodic cell); every loading sequence starts from it.
     delta : float
         Relative gap tolerance of the contact list; also bounds each LP step by delta r_min.
     strict : bool
@@ -286,7 +340,7 @@ def sequential_test(
     run = partial(_loading_sequence, packing, delta, rattlers, box=box, threshold=threshold,
                   beta=beta, max_steps=max_steps)
     for sequence, result in _in_order(run, todo, workers):
-        _record(out, result, moving, 2.0 * packing.radii.mean())
+        _record(out, result, moving, packing)
         if save is not None:
             save(_state(out, start_rng, sequence + 1, earlier + time.perf_counter() - t0))
         if out.size(-1) >= threshold:
@@ -361,6 +415,7 @@ def _steps(packing: Packing, delta: float, rattlers: np.ndarray, sequence: int, 
             list_step(net, current.radii, mot.displacement, mot.strain),
             volume_step(mot.strain),
         )
+        curved = net.centre is not None and wall_step(net, mot.displacement) <= tau
         if np.isfinite(tau):
             moved = _advance(current, net, mot.displacement, mot.strain, tau)
             if moved is None:
@@ -374,16 +429,22 @@ def _steps(packing: Packing, delta: float, rattlers: np.ndarray, sequence: int, 
         step = tau * mot.displacement
         largest = np.linalg.norm(step[moving], axis=1).max(initial=0.0)
         log.info("%s test, load %s, LP %d: %s, %.1f s; step %.3g: mean %.3g D, largest %.3g D", test, name,
-                 steps, mot.solver, mot.seconds, tau, _mean_size(step, moving, diameter), largest / diameter)
+                 steps, mot.solver, mot.seconds, tau, _mean_size(step, moving, packing), largest / diameter)
         if tau == 0.0:
             break
         total += step
         if strain_total is not None:
             strain_total += tau * mot.strain
         strain_size = 0.0 if strain_total is None else np.linalg.norm(strain_total, 2)
-        if max(_mean_size(total, moving, diameter), strain_size) >= threshold:
+        if max(_mean_size(total, moving, packing), strain_size) >= threshold:
             break  # step 10: unjammed beyond the threshold, the verdict is settled
         if largest <= beta * diameter:
+            lp_largest = np.linalg.norm(mot.displacement[moving], axis=1).max(initial=0.0)
+            if curved and lp_largest > beta * diameter:
+                undetermined = (f"loading sequence {name}, LP {steps}: the container wall cut the step to "
+                                f"{largest / diameter:.3g} D of the LP motion's {lp_largest / diameter:.3g} D; a "
+                                "straight step cannot follow a sphere sliding along the curved wall (it "
+                                "must move inwards at second order), so jamming is not shown")
             break
     if undetermined:
         log.warning("%s test: %s", test, undetermined)
@@ -439,10 +500,10 @@ def _worker_logging(level: int) -> None:
     logging.basicConfig(level=level, format="%(asctime)s %(name)s: %(message)s", datefmt="%H:%M:%S")
 
 
-def _record(out: SequentialOutcome, result: _Sequence, moving: np.ndarray, diameter: float) -> None:
+def _record(out: SequentialOutcome, result: _Sequence, moving: np.ndarray, packing: Packing) -> None:
     """Add one loading sequence's statistics to ``out`` (module docstring)."""
-    rel = _relative(result.total, moving)
-    size = np.linalg.norm(rel, axis=1) / diameter
+    rel = _relative(result.total, moving, packing)
+    size = np.linalg.norm(rel, axis=1) / (2.0 * packing.radii.mean())
     size[~moving] = 0.0
     mean = float(size[moving].mean())
     strain = 0.0 if result.strain is None else float(np.linalg.norm(result.strain, 2))
@@ -500,17 +561,32 @@ def _restore(state: dict, out: SequentialOutcome, packing: Packing, rng: np.rand
     return state["rng"], int(state["next_sequence"]), float(state["seconds"])
 
 
-def _relative(total: np.ndarray, moving: np.ndarray) -> np.ndarray:
-    """Displacements relative to the bulk: the componentwise median over the moving particles
-    subtracted (module docstring)."""
-    return total - np.median(total[moving], axis=0) if moving.any() else total
+def _relative(total: np.ndarray, moving: np.ndarray, packing: Packing) -> np.ndarray:
+    """Displacements less their trivial part (module docstring): the componentwise median over
+    the moving particles along the periodic axes (translations; hard walls leave the walled
+    axes alone), or in a spherical container the least-squares rotation of the moving particles
+    about its centre (at the start positions: the displacements are small)."""
+    if not moving.any():
+        return total
+    if packing.boundary.kind == "spherical_container":
+        arm = packing.positions - np.array(packing.boundary.centre)
+        gens = rotation_velocities(arm[moving])
+        if not gens.size:
+            return total
+        omega = np.linalg.lstsq(gens.T, total[moving].ravel(), rcond=None)[0]
+        return total - (omega @ rotation_velocities(arm)).reshape(total.shape)
+    axes = packing.boundary.periodic_axes(packing.dim)
+    out = total.copy()
+    out[:, axes] -= np.median(total[moving][:, axes], axis=0)
+    return out
 
 
-def _mean_size(total: np.ndarray, moving: np.ndarray, diameter: float) -> float:
+def _mean_size(total: np.ndarray, moving: np.ndarray, packing: Packing) -> float:
     """Mean |dr_i| / D over the moving particles, relative to the bulk (:func:`_relative`)."""
     if not moving.any():
         return 0.0
-    return float(np.linalg.norm(_relative(total, moving)[moving], axis=1).mean() / diameter)
+    rel = _relative(total, moving, packing)[moving]
+    return float(np.linalg.norm(rel, axis=1).mean() / (2.0 * packing.radii.mean()))
 
 
 def _advance(packing: Packing, net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None,

@@ -14,8 +14,9 @@ Steps (Donev 2006, dissertation ch. 4):
    method, a packing without one is not strictly jammed either (strict implies collective,
    sec. 4.2.2) and no strict LP is solved. With hard walls the walls stay fixed: a closed
    container's strict test is its collective test, and one with periodic axes between walls is
-   undetermined when collectively jammed (:func:`_fixed_walls_strict`); the sequential method
-   handles periodic cells only;
+   undetermined when collectively jammed (:func:`_fixed_walls_strict`), with either method (the
+   sequential one moves the spheres against the fixed walls, sec. 4.4.3: a wall contact is a
+   contact with a fixed point of the wall);
 4. self-stress forces, contact number, isostaticity and pressure of the backbone
    (:mod:`hardpack.jamming.forces`); a backbone without a self-stress gets the forces of the
    nearest jamming point (near contacts within ``force_delta`` that close there carry force).
@@ -40,7 +41,7 @@ from hardpack.io import checkpoint as ckpt
 from hardpack.jamming.contacts import check_delta, contact_network, require_spheres
 from hardpack.jamming.forces import jamming_point_forces, self_stress, statics
 from hardpack.jamming.highs import FALLBACKS, recording_fallbacks
-from hardpack.jamming.ideal import ideal_test
+from hardpack.jamming.ideal import TestOutcome, ideal_test
 from hardpack.jamming.near_sphere import ellipse_slope
 from hardpack.jamming.rattlers import remove_rattlers
 from hardpack.jamming.result import CATEGORIES, JammingResult
@@ -187,7 +188,7 @@ def verify(
     ------
     InvalidInputError
         If ``packing`` is not a sphere Packing or overlaps; ``method`` or a test name is
-        unknown; the sequential method is asked for a packing with walls; ``delta``,
+        unknown; ``delta``,
         ``contact_delta`` or ``force_delta`` is not in (0, 1); ``seed`` is not a non-negative
         integer; ``dr_large``, ``box``, ``threshold``, ``beta`` or
         ``md_pressure`` is not a positive finite number; ``n_loads``, ``max_steps`` or
@@ -202,10 +203,6 @@ def verify(
     require_spheres(packing)
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
-    if method == "sequential" and packing.boundary.kind != "periodic":
-        raise InvalidInputError(f"the sequential method handles periodic cells only, not {packing.boundary.name} "
-                                "(its loading sequences move the packing and deform the cell); use "
-                                "method='ideal', which handles wall contacts")
     delta = check_delta((SEQUENTIAL_DELTA if method == "sequential" else DEFAULT_DELTA) if delta is None else delta)
     tests = _check_tests(tests)
     check_seed(seed)
@@ -248,8 +245,12 @@ def verify(
                          dr_large=dr_large, box=box, threshold=threshold, n_loads=n_loads,
                          max_steps=max_steps, beta=beta, workers=workers, checkpoint=checkpoint,
                          seed=int(seed), force_delta=force_delta, md_pressure=md_pressure)
-    for test in (result.collective_test, result.strict_test):
-        fallbacks.update(getattr(test, "fallbacks", {}))  # the sequential test's, from its sequences
+    counted = []  # the sequential tests' own, from their sequences; once for a fixed-wall strict test,
+    for test in (result.collective_test, result.strict_test):  # which is the collective one
+        own = getattr(test, "fallbacks", None)
+        if own is not None and not any(own is seen for seen in counted):
+            fallbacks.update(own)
+            counted.append(own)
     result.fallbacks = {name: int(fallbacks[name]) for name in FALLBACKS}
     return result
 
@@ -301,10 +302,16 @@ def _verify(packing: Packing, tests: tuple, rng: np.random.Generator, *, method:
             packing, run="verify", delta=delta, seed=seed, tests=list(tests), dr_large=dr_large,
             box=box, threshold=threshold, n_loads=n_loads, max_steps=max_steps, beta=beta,
             contact_delta=contact_delta))
-        if "collective" in tests:
-            collective = sequential_test(packing, delta, strict=False, **kwargs, **saved.hooks("collective"))
-            seconds["collective"] = collective.seconds
-        if "strict" in tests:
+        walls = not net.is_periodic  # the walls stay fixed: the strict test needs the collective one
+        if "collective" in tests or (walls and "strict" in tests):
+            fixed = sequential_test(packing, delta, strict=False, **kwargs, **saved.hooks("collective"))
+            if "collective" in tests:
+                collective = fixed
+                seconds["collective"] = collective.seconds
+        if "strict" in tests and walls:
+            strict = _fixed_walls_strict(net, local_active, fixed, dr_large=dr_large, **common)
+            seconds["strict"] = strict.seconds
+        elif "strict" in tests:
             strict = sequential_test(packing, delta, strict=True, **kwargs, **saved.hooks("strict"))
             seconds["strict"] = strict.seconds
         backbone = local_active
@@ -362,14 +369,14 @@ def _fixed_walls_strict(net, local_active, collective, *, dr_large, box, rng):
     axis, or a spherical container) has no boundary deformation and its strict test is the
     collective test (run here if it was not). Walls on some axes with periodic others would need
     the strain of the periodic lattice vectors between fixed walls, which is not implemented:
-    that strict test is undetermined, with the reason."""
+    that strict test is undetermined, with the reason. ``collective`` is the collective test's
+    outcome (ideal or sequential), or None to run the ideal one here."""
+    if collective is None:
+        collective = ideal_test(net, local_active, strict=False, dr_large=dr_large, box=box, rng=rng)
     if not net.periodic.any():
-        out = collective if collective is not None else ideal_test(
-            net, local_active, strict=False, dr_large=dr_large, box=box, rng=rng)
-        return replace(out, test="strict", method="walls fixed: the collective test")
-    out = replace(collective if collective is not None else ideal_test(
-        net, local_active, strict=False, dr_large=dr_large, box=box, rng=rng), test="strict",
-        method="not implemented", n_lp=0, seconds=0.0, loads=[])
+        return replace(collective, test="strict", method="walls fixed: the collective test")
+    cleared = {"loads": []} if isinstance(collective, TestOutcome) else {}
+    out = replace(collective, test="strict", method="not implemented", n_lp=0, seconds=0.0, **cleared)
     if out.jammed:
         out.undetermined = ("strict jamming between hard walls with periodic axes (a periodic cell "
                             "deforming between fixed walls) is not implemented")
