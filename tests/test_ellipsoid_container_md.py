@@ -293,3 +293,32 @@ def test_a_particle_pinned_across_the_container_stays_inside_to_round_off():
         worst = min(worst, _gaps(sim.engine, cont).min())
     assert rec["Z_wall"] > 1e13
     assert worst > -256 * np.finfo(float).eps * radius, worst
+
+
+def test_the_container_grid_of_ellipsoids_is_the_sphere_engines():
+    """In a spherical container every axis is walled, so no periodic image caps the bounding radii
+    (:meth:`hardpack.md.engine.Engine._new_bounds`): the ellipsoid engine builds its cell grid on
+    the packing's own box, exactly the grid the sphere engine builds for spheres of the same
+    bounding radii, and a particle as large as the container still fits under its cap."""
+    from hardpack.initial import random_ellipsoid_packing
+
+    p = random_ellipsoid_packing(200, [1.25, 1.0, 0.8], 0.1, 3, boundary="spherical_container")
+    box = np.diag(p.lattice).copy()
+    n = p.n_particles
+    ell = EllipsoidEngine(p.positions, np.zeros((n, 3)), p.shape.semiaxes, p.shape.orientations,
+                          np.zeros((n, 3)), box, boundary=p.boundary)
+    sph = Engine(p.positions, np.zeros((n, 3)), p.shape.semiaxes.max(axis=1), box, boundary=p.boundary)
+    skin = 0.1
+    ell._new_bounds(skin)
+    sph._new_bounds(skin)
+    np.testing.assert_array_equal(ell.box, box)
+    np.testing.assert_array_equal(ell.ncl, sph.ncl)
+    np.testing.assert_array_equal(ell.rcap, sph.rcap)
+    assert ell.ncl.min() >= 3  # the container is resolved by cells, not one cell for all
+    # one ellipsoid nearly as large as its container: the cap (no periodic quarter-box limit) fits it
+    radius = 1.0
+    one = EllipsoidEngine(np.full((1, 3), radius), np.zeros((1, 3)), np.array([[0.99, 0.5, 0.4]]),
+                          np.array([[1.0, 0, 0, 0]]), np.zeros((1, 3)), np.full(3, 2 * radius),
+                          boundary=SphericalContainer((radius,) * 3, radius))
+    one._new_bounds(skin)
+    assert one.rcap[0] >= 0.99 * (1 + 1e-3)

@@ -15,9 +15,6 @@ from hardpack.md import ellipsoid_kernel as ek
 from hardpack.md.engine import Engine, WindowResult, _aligned_rows
 from hardpack.md.kernel import WindowStatus
 
-#: in a container the cell grid spans at least this many container radii along each axis
-GRID_BOX_RADII = 8.0
-
 
 class EngineStalledError(RuntimeError):
     """The event loop stopped advancing the time (an engine failure, never valid input's fault)."""
@@ -48,10 +45,6 @@ class EllipsoidEngine(Engine):
         self.eps_f = float(eps_f)
         self.box = np.ascontiguousarray(box, dtype=float)
         kind = "periodic" if boundary is None else boundary.kind
-        if kind == "spherical_container":
-            # the box only serves the cell grid (no images), whose bounding-radius caps are at most
-            # a quarter of its side: widen it so that a particle as large as the container fits
-            self.box = np.maximum(self.box, GRID_BOX_RADII * boundary.radius)
         if kind not in ("periodic", "spherical_container"):
             raise ValueError(f"the ellipsoid engine runs periodic cells or spherical containers, not {kind}")
         self.wmode = ek.PERIODIC_MODE if kind == "periodic" else ek.SPHERE_MODE
