@@ -2,8 +2,6 @@
 the disjoint-cell rung of the ladder (independent ellipses in shrinking cells of their own shape)
 and a disk packing seen as round ellipses against its exact simplex."""
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,9 +13,6 @@ from hardpack.freeenergy.isostatic import remove_rattlers
 from hardpack.geometry.neighbours import pairs_within
 from hardpack.geometry.packing import Packing
 from hardpack.geometry.shapes import Ellipsoids
-
-sys.path.insert(0, str(Path(__file__).parent))
-from test_freeenergy_isostatic import LATTICE, POSITIONS, RADII  # noqa: E402
 
 
 def test_disjoint_cells_kinetic_energy_scales_as_the_cell_volume():
@@ -46,8 +41,8 @@ def test_cell_collision_time_is_the_first_root():
 
 
 @pytest.fixture(scope="module")
-def round_ellipses():
-    p = Packing(POSITIONS, RADII, LATTICE)
+def round_ellipses(jammed_disks):
+    p = jammed_disks
     pl = pairs_within(p, rel_gap=1e-9)
     q = remove_rattlers(p, np.bincount(np.r_[pl.i, pl.j], minlength=p.n_particles) < 3)
     return Packing(q.positions, lattice=q.lattice,
@@ -55,9 +50,9 @@ def round_ellipses():
 
 
 def test_round_ellipses_bcmd_matches_the_disk_simplex(round_ellipses):
-    # the 62-disk backbone of test_freeenergy_isostatic as alpha = 1 ellipses (rotations fixed):
+    # the 62-disk backbone of the stored 64-disk packing as alpha = 1 ellipses (rotations fixed):
     # the exact Delta f is the disk simplex's (test_freeenergy_ellipses); BCMD from 100 times the
-    # disjoint-cell point with gamma0 = 0.01, theta = 0.5 (seeds 1 and 2 gave +0.006 and -0.008)
+    # disjoint-cell point with gamma0 = 0.01, theta = 0.5 (seeds 1 and 2 gave +0.0081 and -0.0027 relative)
     # must agree to the 1 % of the disk test
     n = round_ellipses.n_particles
     ds = ellipse_bcmd(round_ellipses, delta=1e-8, contact_tol=1e-9, fixed_translation=[0],

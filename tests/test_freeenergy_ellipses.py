@@ -2,7 +2,6 @@
 et al. 2007, Sec. 2.2 and Appendix C): the cell constant f_c^J of an alpha = 2 ellipse, the
 simplex of ellipses with rotational degrees of freedom against brute force, and the disk limit."""
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,9 +18,6 @@ from hardpack.geometry.contact import inverse_shapes, pair_potentials
 from hardpack.geometry.neighbours import pairs_within
 from hardpack.geometry.packing import Packing
 from hardpack.geometry.shapes import Ellipsoids
-
-sys.path.insert(0, str(Path(__file__).parent))
-from test_freeenergy_isostatic import LATTICE, POSITIONS, RADII  # noqa: E402
 
 
 def test_max_rotation_of_alpha_2_is_4_3():
@@ -131,10 +127,10 @@ def test_single_ellipse_simplex_against_monte_carlo_of_true_overlaps():
     assert ref.delta_f == pytest.approx(ref.log_volume - cell, rel=1e-12)
 
 
-def test_disk_packing_as_round_ellipses_gives_the_disk_value():
-    # the 62-disk isostatic backbone of test_freeenergy_isostatic as alpha = 1 ellipses with their
+def test_disk_packing_as_round_ellipses_gives_the_disk_value(jammed_disks):
+    # the 62-disk isostatic backbone of the stored 64-disk packing as alpha = 1 ellipses with their
     # rotations fixed: the same simplex, so the same exact Delta f as the disk formula
-    p = Packing(POSITIONS, RADII, LATTICE)
+    p = jammed_disks
     pl = pairs_within(p, rel_gap=1e-9)
     q = remove_rattlers(p, np.bincount(np.r_[pl.i, pl.j], minlength=p.n_particles) < 3)
     disk = simplex_reference(q, 1e-8, 1e-9)
