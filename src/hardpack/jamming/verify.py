@@ -188,8 +188,7 @@ def verify(
     ------
     InvalidInputError
         If ``packing`` is not a sphere Packing or overlaps; ``method`` or a test name is
-        unknown; ``delta``,
-        ``contact_delta`` or ``force_delta`` is not in (0, 1); ``seed`` is not a non-negative
+        unknown; ``delta``, ``contact_delta`` or ``force_delta`` is not in (0, 1); ``seed`` is not a non-negative
         integer; ``dr_large``, ``box``, ``threshold``, ``beta`` or
         ``md_pressure`` is not a positive finite number; ``n_loads``, ``max_steps`` or
         ``workers`` is not a positive integer; dr_large >= box; the sequential test could never
