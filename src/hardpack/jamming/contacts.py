@@ -73,7 +73,8 @@ class ContactArrays:
 
     @property
     def n_wall_contacts(self) -> int:
-        return int(np.count_nonzero(self.wall >= 0))
+        """Number of wall contacts."""
+        return int(np.count_nonzero(self.is_wall))
 
     @property
     def n_contacts(self) -> int:

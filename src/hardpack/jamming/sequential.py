@@ -193,15 +193,16 @@ def wall_step(net: ContactNetwork, disp: np.ndarray) -> float:
         speed = np.einsum("ij,ij->i", net.normal[wall], v)
         out = speed > 0
         return float(((h[out] - target[out]) / speed[out]).min(initial=np.inf))
-    y = net.positions[i] - net.centre
-    reach = np.sqrt(np.einsum("ij,ij->i", y, y)) + h - target  # R - target
     a = np.einsum("ij,ij->i", v, v)
-    b = 2.0 * np.einsum("ij,ij->i", y, v)
-    c = np.minimum(np.einsum("ij,ij->i", y, y) - reach**2, 0.0)
     moves = a > 0
-    a, b, c = a[moves], b[moves], c[moves]
     if not moves.any():
         return np.inf
+    y = net.positions[i] - net.centre
+    yy = np.einsum("ij,ij->i", y, y)
+    reach = np.sqrt(yy) + h - target  # R - target
+    b = 2.0 * np.einsum("ij,ij->i", y, v)
+    c = np.minimum(yy - reach**2, 0.0)
+    a, b, c = a[moves], b[moves], c[moves]
     root = np.sqrt(b * b - 4.0 * a * c)
     # positive root (-b + root) / 2a, written without cancellation for b > 0
     tau = np.where(b > 0, -2.0 * c / np.maximum(b + root, np.finfo(float).tiny), (root - b) / (2.0 * a))
