@@ -164,3 +164,23 @@ def test_verdict_fractions_per_shape():
     assert float(first.z_backbone) == pytest.approx(9.5) and float(first.z_backbone_err) == pytest.approx(0.5 / 3**0.5)
     assert float(first.rattler_fraction) == pytest.approx(0.1)
     assert np.isnan(float(out.isel(shape=1).z_backbone_err))
+
+
+@pytest.mark.parametrize("name", ["mm_n80_slow_p1e12", "self_dual_a1.05_n100_slow_p1e12"])
+def test_sparse_path_projects_the_stiffness_like_the_dense_one(name):
+    """LS packings at p = 1e12: M&M-shaped oblate spheroids (alpha = 1.9, N = 80, final rate 1e-3;
+    one floppy mode) and near-sphere ellipsoids (224 floppy modes). The sparse path's floppy space
+    (inertia count, shift-invert eigsh, Rayleigh-Ritz with the near self-stress) gives the dense
+    SVD's counts and lambda_min(K_V). Donev's shifted form k A A^T + K with k = 1e3 |K| / |A A^T|
+    gave -0.024 against the projected -0.0019 on the M&M packing: its smallest nonzero singular
+    value of A^T is 5e-3 of the largest, so k s^2 ~ |K|."""
+    packing = _packing(name)
+    dense = verify_ellipsoids(packing, delta="gaps", method="dense")
+    sparse = verify_ellipsoids(packing, delta="gaps", method="sparse")
+    d, s = dense.collective, sparse.collective
+    assert (s.n_stresses, s.n_floppy, s.n_constraints, s.n_dof) == (d.n_stresses, d.n_floppy, d.n_constraints, d.n_dof)
+    assert d.n_floppy >= 1 and d.n_stresses == 1
+    assert s.lambda_min == pytest.approx(d.lambda_min, rel=1e-6)
+    assert (sparse.verdict, sparse.order) == (dense.verdict, dense.order)
+    assert s.jamming_distance == pytest.approx(d.jamming_distance, rel=1e-3)
+    assert sparse.fallbacks["sparse_eigsh_dense"] == 0

@@ -1,7 +1,7 @@
 """First- and second-order jamming tests of packings of ellipses and ellipsoids.
 
 Donev 2006, dissertation Secs. 5.5.1-5.5.3 (first-order flexes, self-stresses, the stress matrix
-and the test for ideal packings) and Sec. 5.6 (the shifted form for large packings). Contacts,
+and the test for ideal packings) and Sec. 5.6 (packings near their jamming point). Contacts,
 rigidity and stress matrices are those of :mod:`hardpack.jamming.ellipsoids`.
 
 Degrees of freedom. The columns are the particles' translations and rotations, reduced by:
@@ -70,18 +70,15 @@ trivial motion); the same procedure, so a particle held only at second order (Fi
 locally jammed. Particles that are not locally jammed are rattlers and are removed iteratively
 (their contacts dropped), as in the sphere code (Donev 2006, Sec. 4.2.4.1).
 
-Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): Donev's shifted form
-(Sec. 5.6): the smallest eigenvalue of k A A^T + k P_T + K, P_T the projector on the trivial
-motions, k = ``shift`` times |K| / |A A^T|, by scipy.sparse.linalg.eigsh in shift-invert mode
-below the spectrum. For large k it is positive iff K_V is positive definite; whether there are
-nontrivial floppy modes at all comes first, from the smallest eigenvalue of A A^T + P_T. The
-inertia of an LDL^T factorisation (Sylvester's law; Donev used a Cholesky factorisation as a
-certificate, Sec. 5.6) says whether a negative eigenvalue exists, so that the eigsh shift can be
-put below the spectrum (shift-invert returns the eigenvalues nearest the shift); bisection on the
-inertia of the shifted matrix brackets a negative smallest eigenvalue first. N_floppy and
-N_stresses are the numbers of eigenvalues of A A^T + P_T and A^T A below ``rank_tol`` (relative),
-again from the inertia (-1 when a factorisation fails). The search over several self-stresses is
-dense-only, so there a negative eigenvalue gives *undetermined*.
+Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): the same procedure with
+sparse linear algebra (:func:`decide_sparse`). N_stresses and N_floppy come from the inertia of
+LDL^T factorisations of A^T A and A A^T shifted by ``rank_tol`` (relative; Sylvester's law; Donev
+used a Cholesky factorisation as a certificate, Sec. 5.6), the floppy space from eigsh in
+shift-invert mode, and the second order from the projected stiffness K_V, formed from that basis
+(n_floppy columns, at most a few percent of the dof). Donev's shifted form k A A^T + K (Sec. 5.6)
+needs k s^2 >> |K| for the smallest nonzero singular value s of A^T, which LS packings of
+spheroids do not give at moderate k (:func:`decide_sparse`). The search over several
+self-stresses is dense-only, so there a negative eigenvalue gives *undetermined*.
 """
 
 from __future__ import annotations
@@ -115,11 +112,9 @@ __all__ = ["EllipsoidJammingResult", "Decision", "verify_ellipsoids", "first_ord
 
 #: contact tolerance mu - 1 of exact (ideal) packings
 DEFAULT_DELTA = 1e-9
-#: reduced dof above which method="auto" uses the sparse shifted form (measured on this 2-core
+#: reduced dof above which method="auto" uses the sparse path (measured on this 2-core
 #: machine: the dense SVD takes ~8 s at 750 dof, the sparse path 1 s)
 DENSE_LIMIT = 600
-#: sparse path: the smallest eigenvalue of a matrix of scale 1 is bracketed down to -this
-BRACKET_FLOOR = 1e-12
 #: sparse path: matrices up to this size get a dense eigh instead of eigsh
 SMALL_EIGH = 50
 #: symmetric semiaxes: equal to this relative tolerance
@@ -139,7 +134,8 @@ GAP_FLOOR = 1e-16
 ORDER_CODES = {"undetermined": 0, "first": 1, "second": 2}
 #: numerical fallbacks recorded in the result
 FALLBACKS = {
-    "sparse_eigsh_dense": "eigsh did not converge on the shifted matrix; a dense eigh was used",
+    "sparse_eigsh_dense": ("the floppy space's eigsh did not converge or its inertia count failed; a "
+                           "dense eigh was used"),
 }
 
 
@@ -231,7 +227,7 @@ class Decision:
 
     ``verdict``: :class:`Verdict` code; ``order``: "first", "second" or "undetermined";
     ``first_order_rigid``: no nontrivial first-order flex; ``lambda_min``: smallest eigenvalue of
-    the projected stiffness K_V (sparse path: of the shifted form; NaN when not computed), in the
+    the projected stiffness K_V (NaN when not computed), in the
     units of K, whose largest |entry| is ``stiffness_scale``; ``forces``: the LP self-stress (zeros when
     none); ``approx_stress``, ``stress_residual``: the approximate self-stress of a packing near (not
     at) its jamming point, when one was accepted (:func:`approximate_stress`); ``n_stresses`` (-1: not
@@ -257,6 +253,7 @@ class Decision:
     approx_stress: np.ndarray | None = None  # unit approximate self-stress (see approximate_stress)
     stress_residual: float = 0.0  # s_1 / s_max of that stress (0: the self-stresses are exact)
     stress_gap: float = float("nan")  # s_1 / s_2 of that stress (NaN: the self-stresses are exact)
+    jamming_distance: float = 0.0  # Newton distance to the jamming point along the floppy modes (_jamming_distance)
 
 
 def self_stress_lp(a: sp.spmatrix) -> tuple[float, np.ndarray]:
@@ -385,7 +382,7 @@ def _unique_stress(stress: np.ndarray, stress_tol: float) -> tuple[float, np.nda
 
 
 def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, rank_tol: float = 1e-9,
-                 stress_tol: float = 1e-9, eig_tol: float = 1e-9) -> Decision:
+                 stress_tol: float = 1e-9, eig_tol: float = 1e-9, lengths: np.ndarray | None = None) -> Decision:
     """The procedure of the module docstring with dense linear algebra.
 
     Parameters
@@ -400,6 +397,10 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
         Orthonormal trivial motions (translations), t may be 0.
     rank_tol, stress_tol, eig_tol : float
         Relative tolerances of the rank, of the LP's eps*, of lambda_min.
+    lengths : ndarray, shape (n,), optional
+        Length unit of each column (a particle size for a translation, 1 for a rotation): with
+        it, the distance of a packing near its jamming point from that point along the floppy
+        modes is recorded (:func:`_jamming_distance`).
 
     Returns
     -------
@@ -408,6 +409,7 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
     m, n = at.shape
     t = trivial.shape[1]
     dense = at.toarray()
+    measured = dense
     approx, residual, gap = None, 0.0, float("nan")
     if m:
         u, s, vh = np.linalg.svd(dense, full_matrices=True)
@@ -458,14 +460,16 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
     else:
         flex = None
     lam = float(w[0])
-    common.update(stress_margin=eps, lambda_min=lam, stiffness_scale=scale)
-    if lam > eig_tol * scale:
+    distance = _jamming_distance(k, null, measured.T @ forces, lengths)
+    margin = eig_tol * scale
+    common.update(stress_margin=eps, lambda_min=lam, stiffness_scale=scale, jamming_distance=distance)
+    if lam > margin:
         return Decision(Verdict.JAMMED, "second", False,
                         f"{n_floppy} floppy mode(s), all blocked by the stress matrix "
                         f"(lambda_min(K_V) = {lam / scale:.3g} of max |K|){note}: second-order jammed",
                         forces, **common)
     motion = null @ x[:, 0]
-    if lam < -eig_tol * scale and n_stresses == 1:
+    if lam < -margin and n_stresses == 1:
         return Decision(Verdict.NOT_JAMMED, "second", False,
                         "a floppy mode with negative stiffness and a unique self-stress: "
                         "second-order flexible", forces, motion=motion, **common)
@@ -475,7 +479,7 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
                         f"optimum {flex[0]:.3g}): second-order flexible", forces, motion=null @ flex[1],
                         **common)
     why = ("several self-stresses and none blocks every floppy mode, while each mode tried is "
-           "blocked by some self-stress (Donev 2006, Sec. 5.5.2.1: the general case)" if lam < 0 else
+           "blocked by some self-stress (Donev 2006, Sec. 5.5.2.1: the general case)" if lam < -margin else
            "lambda_min(K_V) is zero within the tolerance: higher orders would decide")
     return Decision(Verdict.UNDETERMINED, "undetermined", False, why, forces, motion=motion, **common)
 
@@ -483,6 +487,29 @@ def decide_dense(at: sp.spmatrix, stiffness, quadratic, trivial: np.ndarray, *, 
 def _projected_eigh(k: np.ndarray, null: np.ndarray):
     kv = null.T @ k @ null
     return np.linalg.eigh(0.5 * (kv + kv.T))
+
+
+def _jamming_distance(k, null: np.ndarray, residual: np.ndarray, lengths: np.ndarray | None) -> float:
+    """Distance of the packing from its jamming point along the floppy modes, in particle sizes.
+
+    A packing near its jamming point balances its near self-stress F only approximately: the
+    residual R = A F (Sec. 5.6) lies mostly along the floppy modes, where the only restoring term
+    is the stiffness. The Newton step of the equilibrium K y = R restricted to the floppy space,
+    y = V K_V^-1 V^T R, estimates how far the jamming point lies. It is reported, not used in the
+    verdict: how much lambda_min(K_V) changes over that distance depends on the shape (about |K|
+    |y| / a for the M&M spheroids, a the radius of curvature, but much less for rotations of
+    near-spheres, whose contacts change at O(alpha - 1)). Returns max_k |y_k| / lengths_k
+    (``lengths``: a for a translation column, 1 for a rotation angle), 0 without ``lengths`` or
+    residual, inf when K_V is singular."""
+    if lengths is None or not null.shape[1] or not np.any(residual):
+        return 0.0
+    kv = null.T @ (k @ null)
+    kv = 0.5 * (kv + kv.T)
+    try:
+        y = null @ np.linalg.solve(kv, null.T @ residual)
+    except np.linalg.LinAlgError:
+        return float("inf")
+    return float(np.max(np.abs(y) / lengths))
 
 
 #: iterations of the cutting-plane search of :func:`_best_stress`
@@ -566,44 +593,48 @@ def approximate_stress(at: sp.spmatrix) -> tuple[np.ndarray, float, float] | Non
 
 
 def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: float = 1e-9,
-                  stress_tol: float = 1e-9, eig_tol: float = 1e-9, shift: float = 1e3) -> Decision:
-    """Donev's shifted form (Sec. 5.6) for large packings (module docstring). The counts come from
-    the inertia of LDL^T factorisations: N_floppy = the eigenvalues of A A^T + P_T below rank_tol
-    (relative), N_stresses = those of A^T A; the smallest eigenvalue of k (A A^T + P_T) + K decides
-    the second order."""
+                  stress_tol: float = 1e-9, eig_tol: float = 1e-9, lengths: np.ndarray | None = None) -> Decision:
+    """The procedure of the module docstring with sparse linear algebra (large packings).
+
+    The counts come from the inertia of LDL^T factorisations (N_stresses: the eigenvalues of
+    A^T A below ``rank_tol``, relative); the floppy space is the span of the eigenvectors of
+    A A^T below that tolerance (shift-invert eigsh), orthogonalised against the trivial motions,
+    and the second order is decided by the smallest eigenvalue of the projected stiffness
+    K_V = V^T K V, as in :func:`decide_dense`. Donev 2006, Sec. 5.6 instead takes the smallest
+    eigenvalue of the shifted form k A A^T + K (k = 1e6), which has the sign of lambda_min(K_V)
+    only when k s^2 >> |K| for the smallest nonzero singular value s of A^T. In LS packings of
+    spheroids s / s_max reaches 5e-3 (measured: an N = 80 M&M packing, Z = 9.93), where the
+    shifted form with k = 1e3 |K| / |A A^T| is off by a factor of 12 in lambda; the projection
+    needs no k. Parameters and result as :func:`decide_dense` (``stiffness``: forces -> sparse K).
+    """
     m, n = at.shape
     t = trivial.shape[1]
     common = dict(n_stresses=-1, n_floppy=-1, n_dof=n - t, n_constraints=m)
     gram = (at.T @ at).tocsc()
-    if t:
-        gram = gram + sp.csc_matrix(trivial @ trivial.T)
     gscale = max(abs(gram).max(), 1e-300)
-    n_floppy = _count_below(gram / gscale, rank_tol)
     stresses = (at @ at.T).tocsc()
     n_stresses = _count_below(stresses / max(abs(stresses).max(), 1e-300), rank_tol)
-    common.update(n_floppy=-1 if n_floppy is None else n_floppy,
-                  n_stresses=-1 if n_stresses is None else n_stresses)
-    bias = 0.0
+    common.update(n_stresses=-1 if n_stresses is None else n_stresses)
     near = approximate_stress(at) if n_stresses is not None and n_stresses <= 1 else None
-    if near is not None and n_stresses == 1:
-        # the one exact self-stress: LP 5.9 is its minimum
-        eps, forces, why = _unique_stress(near[0], stress_tol)
-    elif near is not None:
-        # a near self-stress (Sec. 5.6): the packing is near its jamming point, where A f = 0
+    w = np.zeros(n)
+    if near is not None:
+        # a self-stress within rank_tol, or a near one (Sec. 5.6): the packing is near its jamming
+        # point, where A f = 0; A there is A - w f^T
         approx, gap, residual = near
-        w = at.T @ approx  # A f, |w| = s_1: A at the jamming point is A - w f^T
+        w = np.asarray(at.T @ approx).ravel()
+        common.update(approx_stress=approx, stress_residual=residual, stress_gap=gap)
+    if near is not None and n_stresses == 1:
+        # the one self-stress: LP 5.9 is its minimum
+        eps, forces, why = _unique_stress(approx, stress_tol)
+    elif near is not None:
         forces = approx * (m / approx.sum())
         eps = float(forces.min())
-        n_floppy = _count_below(gram / gscale, max(rank_tol, 2.0 * float(w @ w) / gscale))
         n_stresses = 1
-        common.update(n_stresses=1, n_floppy=-1 if n_floppy is None else n_floppy, approx_stress=approx,
-                      stress_residual=residual, stress_gap=gap)
+        common.update(n_stresses=1)
         why = None if eps > stress_tol else (
             "the near self-stress (smallest singular vector of A) is not strictly positive: a strict "
             "first-order flex exists" if eps < -stress_tol else
             "the near self-stress (smallest singular vector of A) is not strict: inconclusive")
-        # the shifted form below uses A A^T; without w w^T its eigenvalues are lower by at most this
-        bias = shift * float(w @ w) / gscale
     elif n_stresses == 0:
         eps, forces = float("-inf"), np.zeros(m)
         why = ("no self-stress (A has full column rank and no near self-stress: LP 5.9 infeasible): a "
@@ -614,34 +645,75 @@ def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: 
         verdict = Verdict.NOT_JAMMED if eps < -stress_tol else Verdict.UNDETERMINED
         return Decision(verdict, "first" if verdict == Verdict.NOT_JAMMED else "undetermined",
                         False, why, forces, stress_margin=eps, **common)
-    fell = 0
-    if n_floppy is None:
-        g_min, fell1 = _smallest_eigenvalue(gram / gscale)
-        fell += int(fell1)
-        floppy = g_min <= rank_tol
-    else:
-        floppy = n_floppy > 0
-    if not floppy:
+    null, fell = _floppy_space(gram / gscale, w / np.sqrt(gscale), trivial, rank_tol)
+    n_floppy = null.shape[1]
+    common.update(n_floppy=n_floppy, stress_margin=eps, fallbacks=fell)
+    if not n_floppy:
         return Decision(Verdict.JAMMED, "first", True,
                         "strict self-stress and no nontrivial floppy mode: first-order rigid",
-                        forces, stress_margin=eps, fallbacks=fell, **common)
-    k = sp.csc_matrix(stiffness(forces))
+                        forces, **common)
+    k = stiffness(forces)
     kscale = max(abs(k).max(), 1e-300)
-    lam, fell2 = _smallest_eigenvalue((shift * kscale / gscale * gram + k) / kscale)
-    common.update(stress_margin=eps, lambda_min=lam * kscale, stiffness_scale=kscale,
-                  fallbacks=fell + int(fell2))
-    if lam - bias > eig_tol:
+    lams, x = _projected_eigh(k, null)
+    lam = float(lams[0])
+    distance = _jamming_distance(k, null, np.asarray(at.T @ forces).ravel(), lengths)
+    margin = eig_tol * kscale
+    common.update(lambda_min=lam, stiffness_scale=kscale, jamming_distance=distance)
+    if lam > margin:
         return Decision(Verdict.JAMMED, "second", False,
-                        f"floppy modes blocked by the stress matrix (smallest eigenvalue of the "
-                        f"shifted form {lam:.3g} of max |K|): second-order jammed", forces, **common)
-    if lam < -eig_tol and n_stresses == 1:
+                        f"{n_floppy} floppy mode(s), all blocked by the stress matrix "
+                        f"(lambda_min(K_V) = {lam / kscale:.3g} of max |K|): second-order jammed",
+                        forces, **common)
+    motion = null @ x[:, 0]
+    if lam < -margin and n_stresses == 1:
         return Decision(Verdict.NOT_JAMMED, "second", False,
-                        "the shifted form has a negative eigenvalue and the self-stress is unique: "
-                        "second-order flexible", forces, **common)
+                        f"a floppy mode with negative stiffness (lambda_min(K_V) = {lam / kscale:.3g} of "
+                        "max |K|) and a unique self-stress: second-order flexible", forces, motion=motion, **common)
     return Decision(Verdict.UNDETERMINED, "undetermined", False,
-                    "the shifted form has a non-positive eigenvalue and the self-stress is not "
-                    "unique (or its count failed); the search over several self-stresses is in "
-                    "the dense method", forces, **common)
+                    "a floppy mode with negative stiffness and several self-stresses (or their count "
+                    "failed); the search over several self-stresses is in the dense method" if lam < -margin else
+                    "lambda_min(K_V) is zero within the tolerance: higher orders would decide",
+                    forces, motion=motion, **common)
+
+
+#: floppy space of the sparse path: eigenpairs beyond the floppy ones computed, to see the gap
+FLOPPY_MARGIN = 4
+
+
+def _floppy_space(gram: sp.csc_matrix, w: np.ndarray, trivial: np.ndarray, rank_tol: float):
+    """(V, fell): an orthonormal basis V (n, n_floppy) of the nontrivial floppy space, the null
+    space of A^T at the jamming point, and whether a dense eigh replaced eigsh.
+
+    ``gram`` = A A^T of scale 1 (as n x n), ``w`` = A f of a near self-stress f on the same scale
+    (zeros without one): A at the jamming point is A - w f^T, whose A A^T is gram - w w^T. The
+    floppy eigenvalues are those below tau = max(rank_tol, 2 |w|^2); their number (trivial
+    motions included) comes from the inertia of gram - tau I, their eigenvectors, with
+    FLOPPY_MARGIN more, from eigsh in shift-invert mode below the spectrum, then a Rayleigh-Ritz
+    step with gram - w w^T in that subspace, and the trivial motions are projected out."""
+    n = gram.shape[0]
+    t = trivial.shape[1]
+    tau = max(rank_tol, 2.0 * float(w @ w))
+    count = _count_below(gram, tau)
+    want = (n if count is None else count) + FLOPPY_MARGIN
+    fell = count is None and n > SMALL_EIGH
+    vals = None
+    if not fell and SMALL_EIGH < n and want < n // 2:
+        try:
+            vals, vecs = spla.eigsh(gram, k=want, sigma=-tau, which="LM")
+        except (spla.ArpackNoConvergence, RuntimeError):
+            fell = True
+    if vals is None:
+        vals, vecs = np.linalg.eigh(gram.toarray())
+    yw = vecs.T @ w
+    vals, rot = np.linalg.eigh(np.diag(vals) - np.outer(yw, yw))
+    floppy = vecs @ rot[:, vals <= tau]
+    if t:
+        floppy = floppy - trivial @ (trivial.T @ floppy)
+    if not floppy.shape[1]:
+        return floppy, fell
+    q, r, _ = sla.qr(floppy, mode="economic", pivoting=True)
+    keep = np.abs(np.diag(r)) > 1e-6 * max(abs(r[0, 0]), 1e-300)
+    return q[:, : int(keep.sum())], fell
 
 
 def _count_below(mat: sp.csc_matrix, tau: float) -> int | None:
@@ -658,41 +730,6 @@ def _count_below(mat: sp.csc_matrix, tau: float) -> int | None:
     if not np.array_equal(lu.perm_r, lu.perm_c):
         return None
     return int((lu.U.diagonal() < 0).sum())
-
-
-def _smallest_eigenvalue(mat: sp.csc_matrix) -> tuple[float, bool]:
-    """(smallest eigenvalue of a sparse symmetric matrix of scale 1, whether a dense eigh gave it
-    after the sparse path failed). eigsh in shift-invert mode returns the eigenvalues nearest the
-    shift, so the shift must lie below the spectrum: at -1e-3 when the inertia (an LDL^T
-    factorisation) shows no negative eigenvalue, else at twice the lower end of the bracket
-    [lo, hi) of the smallest eigenvalue that geometric bisection on the inertia of mat - sigma I
-    finds (spectrum slicing, to a factor of 2: any shift below the smallest eigenvalue makes it
-    the nearest, the bracket only speeds up the iteration)."""
-    if mat.shape[0] <= SMALL_EIGH:
-        return float(np.linalg.eigvalsh(mat.toarray())[0]), False
-    negative = _count_below(mat, 0.0)
-    if negative is None:
-        return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
-    sigma = -1e-3
-    if negative:
-        lo, hi = -float(abs(mat).sum(axis=1).max()) - 1e-3, -BRACKET_FLOOR
-        count = _count_below(mat, hi)
-        if count is None:
-            return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
-        if not count:
-            lo, hi = hi, 0.0
-        while hi < 0.0 and lo / hi > 2.0:  # geometric bisection to a factor of 2: shift-invert refines
-            mid = -np.sqrt(lo * hi)
-            count = _count_below(mat, mid)
-            if count is None:
-                return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
-            lo, hi = (lo, mid) if count else (mid, hi)
-        sigma = 2.0 * lo
-    try:
-        w = spla.eigsh(mat, k=1, sigma=sigma, which="LM", return_eigenvectors=False)
-        return float(w.min()), False
-    except (spla.ArpackNoConvergence, RuntimeError):
-        return float(sla.eigvalsh(mat.toarray(), subset_by_index=[0, 0])[0]), True
 
 
 # ------------------------------------------------------------------------------------- result
@@ -780,7 +817,8 @@ class EllipsoidJammingResult:
                          f"of them in the backbone, total reaction {self.wall_force:.4g} (forces of mean 1)")
         if c.approx_stress is not None:
             lines.append(f"near self-stress (smallest singular vector of A, Donev 2006 Sec. 5.6): |A f| / "
-                         f"(|A| |f|) = {c.stress_residual:.3g}")
+                         f"(|A| |f|) = {c.stress_residual:.3g}; distance from the jamming point along the "
+                         f"floppy modes {c.jamming_distance:.3g} particle sizes")
         for name, count in self.fallbacks.items():
             if count:
                 lines.append(f"numerical fallback {name}: {count}")
@@ -822,6 +860,7 @@ class EllipsoidJammingResult:
             n_local_undetermined=int((self.local == Verdict.UNDETERMINED).sum()),
             approximate_stress=int(c.approx_stress is not None), stress_residual=c.stress_residual,
             stress_gap=c.stress_gap,
+            jamming_distance=c.jamming_distance,
             order_code=ORDER_CODES[self.order], rattler_fraction=float(self.rattler.sum() / max(net.n_particles, 1)),
             hypostatic=int(self.isostaticity_gap < 0), jammed=int(self.verdict == Verdict.JAMMED),
             n_wall_contacts=net.n_wall_contacts, n_backbone_wall_contacts=self.n_backbone_wall_contacts,
@@ -861,6 +900,16 @@ def _submatrices(net, at_full, hess, t_full, owner, contacts, moving, near=None)
         return -np.einsum("cak,cab,cbk->ck", yc, sub_hess, yc) / sub.scale[:, None]
 
     return at, stiffness, stiffness_sparse, quadratic, tm
+
+
+def _column_lengths(tm: sp.spmatrix, net: EllipsoidContacts) -> np.ndarray:
+    """Length unit of each reduced column (``tm``: reduced -> full dof): the smallest semiaxis of
+    the packing for a translation, 1 for a rotation angle (:func:`_jamming_distance`)."""
+    f, d = dof_per_particle(net.dim), net.dim
+    csc = sp.csc_matrix(tm)
+    csc.sort_indices()
+    first = csc.indices[csc.indptr[:-1]] if csc.shape[1] else np.zeros(0, dtype=np.int64)
+    return np.where(first % f < d, float(np.min(net.semiaxes)), 1.0)
 
 
 def _global_near_stress(net, at_full, t_full, owner, frozen):
@@ -997,6 +1046,7 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
         trivial = (trivial_motions(tm, net, active) if not frozen.any() and active.any()
                    else np.zeros((at.shape[1], 0)))
         dense = method == "dense" or (method == "auto" and at.shape[1] <= DENSE_LIMIT)
+        lengths = _column_lengths(tm, net)
         if not active.any():
             second = (local_order == ORDER_CODES["second"]).any()
             dec = Decision(Verdict.NOT_JAMMED, "second" if second else "first", False,
@@ -1005,9 +1055,9 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
                            + " found an unjamming motion of each): nothing is jammed",
                            np.zeros(len(contacts)), 0, 0, 0, len(contacts))
         elif dense:
-            dec = decide_dense(at, stiff, quad, trivial, rank_tol=rank_tol, **tols)
+            dec = decide_dense(at, stiff, quad, trivial, rank_tol=rank_tol, lengths=lengths, **tols)
         else:
-            dec = decide_sparse(at, stiff_sparse, trivial, rank_tol=rank_tol, **tols)
+            dec = decide_sparse(at, stiff_sparse, trivial, rank_tol=rank_tol, lengths=lengths, **tols)
         if active.any() and (dense or dec.n_constraints >= dec.n_dof):
             # (sparse path: a hypostatic backbone has a nontrivial flex by counting; its two large LPs
             # took 370 of 580 s at N = 1000 and would check nothing)
