@@ -33,15 +33,61 @@ def dot_products(a, b):
 
 @njit(cache=True)
 def pair_time(r, u, sig0, g):
-    """First contact time >= 0 of a pair (derivation in :mod:`hardpack.md.kernel`); inf if none. r, u: (d,) arrays."""
+    """First contact time >= 0 of a pair whose contact distance grows linearly; inf if none.
+
+    Solves |r + u t| = sig0 + g t (derivation in :mod:`hardpack.md.kernel`) through
+    :func:`contact_root` with no upper time limit.
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        (d,) separation x_j - x_i now.
+    u : numpy.ndarray
+        (d,) relative velocity v_j - v_i.
+    sig0 : float
+        Contact distance now (r_i + r_j).
+    g : float
+        Growth rate of the contact distance (0 for fixed radii).
+
+    Returns
+    -------
+    float
+        The first contact time t >= 0 (0 for a pair already overlapping and approaching), or
+        inf if the pair never touches.
+    """
     rr, ru, uu = dot_products(r, u)
     return contact_root(rr, ru, uu, sig0, g, np.inf)
 
 
 @njit(cache=True, inline="always")
 def contact_root(rr, ru, uu, sig0, g, tmax):
-    """First contact time in [0, tmax), else inf (derivation in :mod:`hardpack.md.kernel`). When A >= 0 the root is at
-    least C / (-2B), which rejects most pairs before the square root."""
+    """First contact time >= 0 of a pair from its dot products; inf if none, or early.
+
+    The root of A t^2 + 2 B t + C = 0 with A = uu - g^2, B = ru - sig0 g, C = rr - sig0^2
+    (derivation in :mod:`hardpack.md.kernel`). When A >= 0 the root is at least C / (-2B), which
+    rejects most pairs before the square root.
+
+    Parameters
+    ----------
+    rr, ru, uu : float
+        r.r, r.u and u.u of the separation r = x_j - x_i and relative velocity u = v_j - v_i
+        (:func:`dot_products`).
+    sig0 : float
+        Contact distance now (r_i + r_j).
+    g : float
+        Growth rate of the contact distance (0 for fixed radii).
+    tmax : float
+        Horizon: a pair with A >= 0 whose contact cannot come before it gets inf without the
+        square root (inf: no limit).
+
+    Returns
+    -------
+    float
+        The first contact time t >= 0 (0 for an overlapping pair that approaches; the later
+        root, the re-contact, for one that separates more slowly than it grows), or inf if there is
+        none or it was rejected early. Only the early rejection uses ``tmax``: a root found
+        may exceed it.
+    """
     b = ru - sig0 * g
     a = uu - g * g
     if b >= 0.0 and a >= 0.0:
@@ -72,6 +118,24 @@ def exit_time(dr, v, rrem, adot):
     B = dr.v + rrem adot, C = dr.dr - rrem^2 < 0; first root t = -C / (B + sqrt(B^2 - AC))
     (derived here, valid for any sign of A). For shrinking particles (adot < 0) the root is
     genuine because rrem - adot t stays positive.
+
+    Parameters
+    ----------
+    dr : numpy.ndarray
+        (d,) offset of the particle's centre from the centre of its bounding sphere.
+    v : numpy.ndarray
+        (d,) velocity of the particle.
+    rrem : float
+        Bounding radius less the particle's radius, now.
+    adot : float
+        Growth rate of the particle's radius (negative when shrinking).
+
+    Returns
+    -------
+    float
+        The exit time t >= 0: 0 if the particle already touches or crosses its bounding sphere
+        (and, for a growing particle, when round-off leaves no positive root); inf if it never
+        reaches it (a shrinking particle, or one at rest with a fixed radius).
     """
     dd, dv, vv = dot_products(dr, v)
     return exit_root(dd, dv, vv, rrem, adot)
