@@ -20,7 +20,18 @@ from numba import njit
 
 @njit(cache=True, inline="always")
 def dot_products(a, b):
-    """(a.a, a.b, b.b) of two (d,) vectors: the inputs of the ``*_root`` functions."""
+    """The dot products of two vectors: the inputs of the ``*_root`` functions.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray
+        (d,) vectors.
+
+    Returns
+    -------
+    tuple of float
+        (a.a, a.b, b.b).
+    """
     aa = 0.0
     ab = 0.0
     bb = 0.0
@@ -143,6 +154,20 @@ def exit_time(dr, v, rrem, adot):
 
 @njit(cache=True, inline="always")
 def exit_root(dd, dv, vv, rrem, adot):
+    """:func:`exit_time` from the dot products.
+
+    Parameters
+    ----------
+    dd, dv, vv : float
+        dr.dr, dr.v and v.v (:func:`dot_products`).
+    rrem, adot : float
+        As :func:`exit_time`.
+
+    Returns
+    -------
+    float
+        As :func:`exit_time`.
+    """
     c = dd - rrem * rrem
     if c >= 0.0:
         return 0.0
@@ -170,6 +195,22 @@ def container_time(dr, v, rho, adot):
     rho = R - a the container radius less the particle's radius now (Donev 2006, Ch. 7: the wall
     event of a spherical container). Unlike :func:`exit_time` a sphere touching the wall and
     moving away from it (just reflected) gets its NEXT hit, not t = 0.
+
+    Parameters
+    ----------
+    dr : numpy.ndarray
+        (d,) offset of the particle's centre from the container's centre.
+    v : numpy.ndarray
+        (d,) velocity of the particle.
+    rho : float
+        Container radius less the particle's radius, now.
+    adot : float
+        Growth rate of the particle's radius (negative when shrinking).
+
+    Returns
+    -------
+    float
+        The wall time t >= 0 (:func:`container_root`), inf if there is none.
     """
     dd, dv, vv = dot_products(dr, v)
     return container_root(dd, dv, vv, rho, adot)
@@ -189,6 +230,18 @@ def container_root(dd, dv, vv, rho, adot):
     round-off after a reflection): B >= 0 (approach speed n.v + adot >= 0) hits now; B < 0 gets
     the later root (-B + sqrt(B^2 - AC)) / A (a reflection leaves |n.v| > adot, so A > 0).
     Roots that cannot exist give inf (B^2 - AC < 0 for a shrinking sphere; A <= 0 with B < 0).
+
+    Parameters
+    ----------
+    dd, dv, vv : float
+        dr.dr, dr.v and v.v (:func:`dot_products`).
+    rho, adot : float
+        As :func:`container_time`.
+
+    Returns
+    -------
+    float
+        The first wall time t >= 0, inf if there is none.
     """
     c = dd - rho * rho
     b = dv + rho * adot
