@@ -208,7 +208,8 @@ def audit(module_names) -> list[tuple[str, str, list[str]]]:
 
 
 #: modules in which every public function and class is documented, beyond the public API
-DOCUMENTED_MODULES = ("hardpack.distributions", "hardpack.eos.theory", "hardpack.events.heap", "hardpack.events.roots")
+DOCUMENTED_MODULES = ("hardpack.distributions", "hardpack.eos.moments", "hardpack.eos.theory",
+                      "hardpack.events.heap", "hardpack.events.roots")
 
 
 @pytest.mark.parametrize("module_name", DOCUMENTED_MODULES)
