@@ -41,8 +41,16 @@ def _key_value(text: str):
 
 
 def add_checkpoint_options(p: argparse.ArgumentParser, checkpoint_help: str) -> None:
-    """Add ``--checkpoint`` (described by ``checkpoint_help``) and ``--checkpoint-interval`` to a
-    subcommand's parser."""
+    """Add ``--checkpoint`` and ``--checkpoint-interval`` (seconds, default 300) to a
+    subcommand's parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    checkpoint_help : str
+        Help text of ``--checkpoint``.
+    """
     p.add_argument("--checkpoint", help=checkpoint_help)
     p.add_argument("--checkpoint-interval", type=float, default=300.0,
                    help="seconds between checkpoints (default 300)")
@@ -182,6 +190,14 @@ def cmd_combine(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``hardpack`` parser: the core subcommands and those each module of
+    :data:`SUBCOMMAND_MODULES` registers.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser; a parsed subcommand's handler is ``args.func``.
+    """
     parser = argparse.ArgumentParser(prog="hardpack", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"hardpack {__version__}")
     parser.add_argument("-q", "--quiet", action="store_true", help="only print warnings and errors")
@@ -248,7 +264,19 @@ MAX_SEED = 2**63 - 1
 
 def check_arguments(args) -> None:
     """Refuse, before any work, a seed out of range and output (or checkpoint) paths that cannot be
-    written (:func:`hardpack.io.atomic.check_writable`), so that a long run never fails at its end."""
+    written (:func:`hardpack.io.atomic.check_writable`), so that a long run never fails at its end.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        A parsed subcommand; its ``seed`` and the destinations in :data:`OUTPUT_OPTIONS` are
+        checked where present.
+
+    Raises
+    ------
+    InvalidInputError
+        If the seed is outside 0..2**63 - 1 or an output path cannot be written.
+    """
     from hardpack.io.atomic import check_writable
 
     seed = getattr(args, "seed", None)
@@ -268,6 +296,16 @@ def run_command(args) -> int:
     ``hardpack <command>: interrupted: ...`` (after long runs wrote their checkpoint,
     :mod:`hardpack.io.interrupt`) and status 130 or 143; a closed standard output (``hardpack info
     FILE | head -1``) ends quietly with status 141 (128 + SIGPIPE), like other Unix tools.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        A parsed subcommand (:func:`build_parser`), its handler in ``args.func``.
+
+    Returns
+    -------
+    int
+        Exit status: the handler's, or 2, 130, 143 or 141 as above.
     """
     from hardpack.io import interrupt
 
@@ -299,6 +337,18 @@ def run_command(args) -> int:
 
 
 def main(argv=None) -> int:
+    """The ``hardpack`` command: parse, set up logging (``-q``: warnings only) and run.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; default the process's command line.
+
+    Returns
+    -------
+    int
+        Exit status (:func:`run_command`).
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(

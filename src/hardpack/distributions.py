@@ -74,7 +74,22 @@ class Distribution:
 
 @dataclass(frozen=True)
 class Discrete(Distribution):
-    """A finite mixture: radii a_s with number fractions n_s (sum 1)."""
+    """A finite mixture: radii a_s with number fractions n_s (sum 1).
+
+    Parameters
+    ----------
+    radii : sequence of float
+        Species radii a_s, positive and finite; stored sorted ascending.
+    fractions : sequence of float
+        Number fractions n_s of the species, non-negative, summing to 1; stored in the order of
+        the sorted radii.
+
+    Raises
+    ------
+    InvalidInputError
+        If radii and fractions are not 1-d of equal non-zero length, a radius is not positive and
+        finite, or the fractions are negative or do not sum to 1.
+    """
 
     radii: tuple
     fractions: tuple
@@ -123,13 +138,49 @@ class Discrete(Distribution):
 
 
 def monodisperse(radius: float = 1.0) -> Discrete:
-    """All spheres of one radius."""
+    """All spheres of one radius.
+
+    Parameters
+    ----------
+    radius : float, default 1.0
+        The radius, positive and finite.
+
+    Returns
+    -------
+    Discrete
+        A mixture of one species.
+
+    Raises
+    ------
+    InvalidInputError
+        If the radius is not positive and finite.
+    """
     return Discrete((float(radius),), (1.0,))
 
 
 def bidisperse(size_ratio: float, large_fraction: float, mean_radius: float = 1.0) -> Discrete:
-    """Binary mixture: a_large / a_small = ``size_ratio`` >= 1, number fraction ``large_fraction``
-    of the large species (Ogarko's n_1 and R; Donev's kappa and x). Scaled to <a> = mean_radius."""
+    """Binary mixture of a small and a large species (Ogarko's R and n_1; Donev's kappa and x).
+
+    Parameters
+    ----------
+    size_ratio : float
+        a_large / a_small, finite and >= 1.
+    large_fraction : float
+        Number fraction of the large species, in [0, 1].
+    mean_radius : float, default 1.0
+        Mean radius <a> the mixture is scaled to.
+
+    Returns
+    -------
+    Discrete
+        The two species, small first.
+
+    Raises
+    ------
+    InvalidInputError
+        If size_ratio is below 1 or not finite, large_fraction is outside [0, 1], or the scaled
+        radii are not positive and finite (mean_radius).
+    """
     if not (size_ratio >= 1 and math.isfinite(size_ratio)):
         raise InvalidInputError(f"size_ratio must be >= 1 (large / small radius), got {size_ratio}")
     if not 0 <= large_fraction <= 1:
@@ -141,7 +192,23 @@ def bidisperse(size_ratio: float, large_fraction: float, mean_radius: float = 1.
 
 @dataclass(frozen=True)
 class PowerLaw(Distribution):
-    """f(a) = C a^alpha on [a_min, omega a_min], scaled so that <a> = mean_radius (Eq. 2.37)."""
+    """f(a) = C a^alpha on [a_min, omega a_min], scaled so that <a> = mean_radius (Ogarko 2014,
+    Eq. 2.37).
+
+    Parameters
+    ----------
+    omega : float
+        Width a_max / a_min, finite and > 1.
+    alpha : float
+        Exponent, finite (0: uniform in size; -3: uniform volume).
+    mean_radius : float, default 1.0
+        Mean radius <a>, positive.
+
+    Raises
+    ------
+    InvalidInputError
+        If omega is not a finite number > 1, alpha is not finite, or mean_radius is not positive.
+    """
 
     omega: float
     alpha: float
@@ -200,12 +267,48 @@ class PowerLaw(Distribution):
 
 
 def uniform_size(omega: float, mean_radius: float = 1.0) -> PowerLaw:
-    """US: radii uniform on [a_min, omega a_min] (Ogarko ch. 3, Eq. 3.23 for its moments)."""
+    """US: radii uniform on [a_min, omega a_min] (Ogarko 2014, ch. 3, Eq. 3.23 for its moments).
+
+    Parameters
+    ----------
+    omega : float
+        Width a_max / a_min, finite and > 1.
+    mean_radius : float, default 1.0
+        Mean radius <a>, positive.
+
+    Returns
+    -------
+    PowerLaw
+        The power law with alpha = 0.
+
+    Raises
+    ------
+    InvalidInputError
+        As :class:`PowerLaw`.
+    """
     return PowerLaw(omega, 0.0, mean_radius)
 
 
 def uniform_volume(omega: float, mean_radius: float = 1.0) -> PowerLaw:
-    """UV: f(a) ~ a^-3 on [a_min, omega a_min] (Ogarko Eq. 3.43)."""
+    """UV: f(a) ~ a^-3 on [a_min, omega a_min] (Ogarko 2014, Eq. 3.43).
+
+    Parameters
+    ----------
+    omega : float
+        Width a_max / a_min, finite and > 1.
+    mean_radius : float, default 1.0
+        Mean radius <a>, positive.
+
+    Returns
+    -------
+    PowerLaw
+        The power law with alpha = -3.
+
+    Raises
+    ------
+    InvalidInputError
+        As :class:`PowerLaw`.
+    """
     return PowerLaw(omega, -3.0, mean_radius)
 
 
@@ -215,6 +318,18 @@ class LogNormal(Distribution):
 
     The distribution is unbounded; systematic sampling of n radii reaches the quantile
     1 - 1/(2n) at most, so the sampled moments converge from below as n grows.
+
+    Parameters
+    ----------
+    sigma : float
+        Standard deviation of ln a, finite and > 0.
+    mean_radius : float, default 1.0
+        Mean radius <a>, positive.
+
+    Raises
+    ------
+    InvalidInputError
+        If sigma is not a finite number > 0 or mean_radius is not positive.
     """
 
     sigma: float
@@ -256,9 +371,26 @@ class LogNormal(Distribution):
 def from_spec(spec: dict) -> Distribution:
     """Build a distribution from a config mapping such as ``{"kind": "uniform_volume", "omega": 4}``.
 
-    kinds: monodisperse; bidisperse (size_ratio, large_fraction); uniform_size (omega);
-    uniform_volume (omega); power_law (omega, alpha); lognormal (sigma);
-    discrete (radii, fractions). Unknown kinds or keys are refused with the key named.
+    Parameters
+    ----------
+    spec : dict
+        ``kind`` and that kind's keys: monodisperse; bidisperse (size_ratio, large_fraction);
+        uniform_size (omega); uniform_volume (omega); power_law (omega, alpha); lognormal
+        (sigma); discrete (radii, fractions). Values are numbers (lists of numbers for radii and
+        fractions).
+
+    Returns
+    -------
+    Distribution
+        The distribution; mean radius 1 except for discrete, which keeps the radii given
+        (monodisperse of radius 1 for uniform_size or uniform_volume with omega = 1).
+
+    Raises
+    ------
+    InvalidInputError
+        If spec is not a mapping with a known ``kind``, has a key the kind does not take or lacks
+        one it needs (the key is named), a value is not a number (or list of numbers), or the
+        distribution refuses its parameters.
     """
     if not isinstance(spec, dict) or "kind" not in spec:
         raise InvalidInputError(f"a distribution spec must be a mapping with a 'kind', got {spec!r}")

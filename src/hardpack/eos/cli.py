@@ -103,6 +103,14 @@ def cmd_poly_summary(args) -> int:
 
 
 def register(subparsers) -> None:
+    """Add the subcommands ``poly-jam``, ``poly-fluid``, ``poly-summary``, ``poly-equivalents`` to
+    the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     p = subparsers.add_parser("poly-jam", help=cmd_poly_jam.__doc__)
     p.add_argument("--distribution", required=True,
                    help='size distribution as JSON, e.g. \'{"kind": "uniform_volume", "omega": 4}\'')

@@ -64,7 +64,26 @@ def _check_order(kmax):
 
 
 def raw_moment(source, k: float) -> float:
-    """<a^k> (any real k): analytic for a Distribution, the sample mean of a^k for an array."""
+    """<a^k> (any real k): analytic for a Distribution, the sample mean of a^k for an array.
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+    k : float
+        The order.
+
+    Returns
+    -------
+    float
+        <a^k>.
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii.
+    """
     src = _as_source(source)
     if isinstance(src, Distribution):
         return float(src.moment(k))
@@ -72,12 +91,52 @@ def raw_moment(source, k: float) -> float:
 
 
 def raw_moments(source, kmax: int = 5) -> np.ndarray:
-    """<a^k> for k = 0..kmax."""
+    """<a^k> for k = 0..kmax.
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+    kmax : int, default 5
+        Highest order, >= 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        (kmax + 1,) <a^0>..<a^kmax>.
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii, or
+        kmax is not a non-negative integer.
+    """
     return np.array([raw_moment(source, k) for k in range(_check_order(kmax) + 1)])
 
 
 def scaled_moments(source, kmax: int = 5) -> np.ndarray:
-    """M_k = <a^k>/<a>^k for k = 0..kmax (Ogarko 2014, sec. 3.2)."""
+    """M_k = <a^k>/<a>^k for k = 0..kmax (Ogarko 2014, sec. 3.2).
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+    kmax : int, default 5
+        Highest order, >= 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        (kmax + 1,) M_0..M_kmax.
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii, or
+        kmax is not a non-negative integer.
+    """
     mu = raw_moments(source, kmax)
     return mu / raw_moment(source, 1) ** np.arange(kmax + 1)
 
@@ -90,6 +149,25 @@ def central_scaled_moments(source, kmax: int = 5) -> np.ndarray:
     delta^k), so no precision is lost for narrow distributions. Unbounded ones (log-normal) use the
     binomial expansion of the analytic scaled moments, which loses about log10(1/delta^k) digits:
     ~1e-10 relative for delta >= 0.05 and k <= 5.
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+    kmax : int, default 5
+        Highest order, >= 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        (kmax + 1,) M^c_0..M^c_kmax (M^c_0 = 1, M^c_1 = 0 up to round-off).
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii, or
+        kmax is not a non-negative integer.
     """
     kmax = _check_order(kmax)
     src = _as_source(source)
@@ -118,30 +196,118 @@ def central_scaled_moments(source, kmax: int = 5) -> np.ndarray:
 
 
 def dimensionless_moments(source) -> tuple[float, float]:
-    """(O1, O2) = (<a><a^2>/<a^3>, <a^2>^3/<a^3>^2) (Eq. 3.6); 0 < O1 <= 1, O1^2 <= O2 <= O1."""
+    """(O1, O2) = (<a><a^2>/<a^3>, <a^2>^3/<a^3>^2) (Eq. 3.6); 0 < O1 <= 1, O1^2 <= O2 <= O1.
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+
+    Returns
+    -------
+    tuple of float
+        (O1, O2).
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii.
+    """
     m1, m2, m3 = (raw_moment(source, k) for k in (1, 2, 3))
     return m1 * m2 / m3, m2**3 / m3**2
 
 
 def polydispersity(source) -> float:
-    """delta = std(a)/<a> (Ogarko 2014, appendix of sec. 3.1)."""
+    """delta = std(a)/<a> (Ogarko 2014, appendix of sec. 3.1).
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+
+    Returns
+    -------
+    float
+        delta >= 0 (0 for a monodisperse source).
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii.
+    """
     return math.sqrt(max(central_scaled_moments(source, 2)[2], 0.0))
 
 
 def skewness(source) -> float:
-    """M^c_3/(M^c_2)^(3/2); NaN for a monodisperse source (undefined)."""
+    """M^c_3/(M^c_2)^(3/2); NaN for a monodisperse source (undefined).
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+
+    Returns
+    -------
+    float
+        The skewness, NaN for a monodisperse source.
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii.
+    """
     c = central_scaled_moments(source, 3)
     return c[3] / c[2] ** 1.5 if c[2] > 0 else math.nan
 
 
 def kurtosis(source) -> float:
-    """beta2 = M^c_4/(M^c_2)^2 >= 1 (sec. 3.2, Eq. 3.41); 1.8 for uniform size; NaN if monodisperse."""
+    """beta2 = M^c_4/(M^c_2)^2 >= 1 (sec. 3.2, Eq. 3.41); 1.8 for uniform size; NaN if monodisperse.
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+
+    Returns
+    -------
+    float
+        beta2, NaN for a monodisperse source.
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii.
+    """
     c = central_scaled_moments(source, 4)
     return c[4] / c[2] ** 2 if c[2] > 0 else math.nan
 
 
 def mean_diameter(source, p: float, q: float) -> float:
-    """D_pq = 2 (<a^p>/<a^q>)^(1/(p-q)) (Ogarko 2014, sec. 3.1.2); e.g. D_10 = 2<a>, D_32 = Sauter diameter."""
+    """D_pq = 2 (<a^p>/<a^q>)^(1/(p-q)) (Ogarko 2014, sec. 3.1.2); e.g. D_10 = 2<a>, D_32 = Sauter diameter.
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+    p, q : float
+        The orders, p != q.
+
+    Returns
+    -------
+    float
+        D_pq.
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii, or p
+        == q.
+    """
     if p == q:
         raise InvalidInputError(f"D_pq needs p != q, got p = q = {p}")
     return 2.0 * (raw_moment(source, p) / raw_moment(source, q)) ** (1.0 / (p - q))
@@ -178,6 +344,27 @@ def gauss_quadrature(source, n: int) -> tuple[np.ndarray, np.ndarray]:
     sum_i n_i a_i^k = <a^k> for k = 0..2n-1. Raises InvalidInputError if the source has fewer
     than n distinct radii (the quadrature would have coincident nodes) or if the back-substituted
     central moments miss the input by more than MOMENT_RTOL on the scale max(|M^c_k|, delta^k).
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+    n : int
+        Number of nodes, >= 1.
+
+    Returns
+    -------
+    radii : numpy.ndarray
+        (n,) nodes a_i, descending.
+    fractions : numpy.ndarray
+        (n,) number fractions n_i, summing to 1.
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii, n is
+        not a positive integer, or as above.
     """
     if int(n) != n or n < 1:
         raise InvalidInputError(f"number of nodes must be a positive integer, got {n!r}")
@@ -206,7 +393,14 @@ def gauss_quadrature(source, n: int) -> tuple[np.ndarray, np.ndarray]:
 class BidisperseEquivalent:
     """Equivalent bidisperse system (Eqs. 3.20-3.21): same <a^0>..<a^3>, hence same O1, O2, <a>.
 
-    n1: number fraction of the large species; R = a1/a2 >= 1; ``mixture`` has the source's <a>.
+    Attributes
+    ----------
+    mixture : Discrete
+        The two species, with the source's <a>.
+    n1 : float
+        Number fraction of the large species.
+    R : float
+        Size ratio a1 / a2 >= 1.
     """
 
     mixture: Discrete
@@ -220,6 +414,15 @@ class TridisperseEquivalent:
 
     Ogarko's parametrisation (Ogarko 2014, Table 3.2) with a1 >= a2 >= a3: number fractions n1, n2
     (n3 = 1 - n1 - n2) and delta_i = n_i a_i/<a> (so a_i = <a> delta_i / n_i).
+
+    Attributes
+    ----------
+    mixture : Discrete
+        The three species (number fractions n1, n2, n3).
+    n1, n2 : float
+        Number fractions of the largest and the middle species.
+    delta1, delta2 : float
+        delta_i = n_i a_i / <a> of the largest and the middle species.
     """
 
     mixture: Discrete
@@ -240,6 +443,23 @@ def equivalent_bidisperse(source) -> BidisperseEquivalent:
 
     For a monodisperse source it returns R = 1, n1 = 1/2 (Table 3.1, row omega = 1), the narrow
     limit of every smooth distribution (its skewness vanishes).
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+
+    Returns
+    -------
+    BidisperseEquivalent
+        The mixture and its (n1, R).
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii, or
+        the quadrature fails (:func:`gauss_quadrature`).
     """
     src = _as_source(source)
     if central_scaled_moments(src, 2)[2] <= _DEGENERATE:
@@ -252,6 +472,24 @@ def equivalent_tridisperse(source) -> TridisperseEquivalent:
     """Maximally equivalent tridisperse system = 3-node Gauss quadrature (derived here, see the module docstring).
 
     Reproduces Tables 3.3 (UV) and 3.4 (log-normal) and the 5:8:5 US solution (Eqs. 3.39-3.40).
+
+    Parameters
+    ----------
+    source : Distribution or array_like
+        A :class:`hardpack.distributions.Distribution` (analytic moments) or a 1-d array of radii
+        (sample moments).
+
+    Returns
+    -------
+    TridisperseEquivalent
+        The mixture and its (n1, n2, delta1, delta2).
+
+    Raises
+    ------
+    InvalidInputError
+        If source is neither a Distribution nor a non-empty 1-d array of positive finite radii, the
+        source has fewer than 3 distinct radii, or the quadrature misses the moments
+        (:func:`gauss_quadrature`).
     """
     src = _as_source(source)
     radii, frac = gauss_quadrature(src, 3)
@@ -268,6 +506,21 @@ def bidisperse_from_O(O1: float, O2: float) -> tuple[float, float]:
     n1 = 1/2 + (3 O1 O2 - O2 - 2 O1^3)/(2 lambda),
     R = [2 O1^3 + 2 O2^2 + O2 - 4 O1 O2 - O1^2 O2 + (1 - O1) lambda] / [2 (O2 - O1)(O1^2 - O2)].
     Monodisperse (O1 = O2 = 1) returns (1/2, 1) as in Table 3.1.
+
+    Parameters
+    ----------
+    O1, O2 : float
+        The dimensionless moments (Eq. 3.6).
+
+    Returns
+    -------
+    tuple of float
+        (n1, R): number fraction of the large species and size ratio a1 / a2.
+
+    Raises
+    ------
+    InvalidInputError
+        If (O1, O2) is not realisable: 0 < O1 <= 1 and O1^2 <= O2 <= O1 are needed.
     """
     if not (0 < O1 <= 1 + 1e-12 and O1**2 * (1 - 1e-12) <= O2 <= O1 * (1 + 1e-12)):
         raise InvalidInputError(
@@ -301,6 +554,23 @@ def tridisperse_uniform_size(omega: float, mean_radius: float = 1.0) -> Tridispe
     n1 = 5/18, n2 = 8/18, delta1 = (5 + sqrt(15) omega0)/18, delta2 = 8/18 with
     omega0 = (omega - 1)/(omega + 1), i.e. radii <a>(1 + sqrt(3/5) omega0), <a>, <a>(1 - sqrt(3/5) omega0)
     in the ratio 5:8:5 (3-point Gauss-Legendre).
+
+    Parameters
+    ----------
+    omega : float
+        Width a_max / a_min of the US distribution, finite and > 1.
+    mean_radius : float, default 1.0
+        <a> of the mixture.
+
+    Returns
+    -------
+    TridisperseEquivalent
+        The 5:8:5 mixture.
+
+    Raises
+    ------
+    InvalidInputError
+        If omega is not a finite number > 1.
     """
     w0 = _omega0(omega)
     return _tridisperse(5 / 18, 8 / 18, (5 + math.sqrt(15) * w0) / 18, 8 / 18, mean_radius)
@@ -316,6 +586,25 @@ def kurtosis_family(omega: float, beta2: float, mean_radius: float = 1.0) -> Tri
     delta1 = (6 + sqrt(3 beta2))/(12 beta2) as printed. beta2 = 1.8 is the maximally equivalent
     system (Eqs. 3.39-3.40). Allowed: 1 < beta2 < 3/omega0^2 (beta2 = 1 is bidisperse; at the upper
     end the smallest radius reaches 0, beta2 = 12 for omega = 3, sec. 3.2).
+
+    Parameters
+    ----------
+    omega : float
+        Width a_max / a_min of the US distribution, finite and > 1.
+    beta2 : float
+        Kurtosis, 1 < beta2 < 3 / omega0^2.
+    mean_radius : float, default 1.0
+        <a> of the mixture.
+
+    Returns
+    -------
+    TridisperseEquivalent
+        The symmetric mixture.
+
+    Raises
+    ------
+    InvalidInputError
+        If omega is not a finite number > 1 or beta2 is outside (1, 3 / omega0^2).
     """
     w0 = _omega0(omega)
     if not (1 < beta2 < 3 / w0**2):

@@ -47,28 +47,92 @@ def _omoments(O1, O2) -> tuple[np.ndarray, np.ndarray]:
 
 def carnahan_starling(phi):
     """Carnahan-Starling Z_CS = (1 + phi + phi^2 - phi^3)/(1 - phi)^3 = 1 + 4 phi g_CS, with
-    g_CS = (1 - phi/2)/(1 - phi)^3 (Ogarko 2014, below Eq. 3.8). Monodisperse 3D fluid, phi <~ 0.55."""
+    g_CS = (1 - phi/2)/(1 - phi)^3 (Ogarko 2014, below Eq. 3.8). Monodisperse 3D fluid, phi <~ 0.55.
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1).
+    """
     x = _phi(phi)
     return (1 + x + x**2 - x**3) / (1 - x) ** 3
 
 
 def csk(phi):
     """Carnahan-Starling-Kolafa Z_CSK = [1 + phi + phi^2 - 2 phi^3 (1 + phi)/3]/(1 - phi)^3 (sec. 3.1.2).
-    Monodisperse 3D fluid, slightly more accurate than CS near freezing (phi <~ 0.55)."""
+    Monodisperse 3D fluid, slightly more accurate than CS near freezing (phi <~ 0.55).
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1).
+    """
     x = _phi(phi)
     return (1 + x + x**2 - 2 * x**3 * (1 + x) / 3) / (1 - x) ** 3
 
 
 def percus_yevick(phi):
     """Percus-Yevick (compressibility route) Z = (1 + phi + phi^2)/(1 - phi)^3, monodisperse 3D fluid.
-    Overestimates Z; use CS/CSK for accuracy. Not in Ogarko 2014 (standard liquid-state theory)."""
+    Overestimates Z; use CS/CSK for accuracy. Not in Ogarko 2014 (standard liquid-state theory).
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1).
+    """
     x = _phi(phi)
     return (1 + x + x**2) / (1 - x) ** 3
 
 
 def henderson(phi):
     """Henderson's hard-disk EOS Z = (1 + phi^2/8)/(1 - phi)^2 (Mol. Phys. 30, 971 (1975)).
-    Monodisperse 2D fluid only, below the liquid-hexatic transition (phi ~ 0.70)."""
+    Monodisperse 2D fluid only, below the liquid-hexatic transition (phi ~ 0.70).
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1).
+    """
     x = _phi(phi)
     return (1 + x**2 / 8) / (1 - x) ** 2
 
@@ -76,28 +140,108 @@ def henderson(phi):
 def bmcsl(phi, O1=1.0, O2=1.0):
     """Boublik-Mansoori-Carnahan-Starling-Leland, Ogarko 2014, Eq. 3.9:
     Z = 1/(1 - phi) + 3 O1 phi/(1 - phi)^2 + O2 phi^2 (3 - phi)/(1 - phi)^3 = 1 + 4 phi g_eff (Eqs. 3.7-3.8).
-    Polydisperse 3D fluid; within 1 % of simulations for phi < 0.54-0.60 (Fig. 3.1, sec. 3.2)."""
+    Polydisperse 3D fluid; within 1 % of simulations for phi < 0.54-0.60 (Fig. 3.1, sec. 3.2).
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+    O1, O2 : float or array_like, default 1.0
+        Dimensionless moments O1 = <a><a^2>/<a^3> and O2 = <a^2>^3/<a^3>^2 (Ogarko 2014, Eq. 3.6),
+        with 0 < O1 <= 1 and O1^2 <= O2 <= O1; 1 for monodisperse spheres.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1), or (O1, O2) are not the moments of a size
+        distribution.
+    """
     x = _phi(phi)
     o1, o2 = _omoments(O1, O2)
     return 1 / (1 - x) + 3 * o1 * x / (1 - x) ** 2 + o2 * x**2 * (3 - x) / (1 - x) ** 3
 
 
 def scs(phi, O1=1.0, O2=1.0):
-    """Santos et al., CS-based, Eq. 3.10: Z_SCS = Z_BMCSL + (O1 - O2) phi^3/(1 - phi)^3."""
+    """Santos et al., CS-based, Eq. 3.10: Z_SCS = Z_BMCSL + (O1 - O2) phi^3/(1 - phi)^3.
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+    O1, O2 : float or array_like, default 1.0
+        Dimensionless moments O1 = <a><a^2>/<a^3> and O2 = <a^2>^3/<a^3>^2 (Ogarko 2014, Eq. 3.6),
+        with 0 < O1 <= 1 and O1^2 <= O2 <= O1; 1 for monodisperse spheres.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1), or (O1, O2) are not the moments of a size
+        distribution.
+    """
     x = _phi(phi)
     o1, o2 = _omoments(O1, O2)
     return bmcsl(x, o1, o2) + (o1 - o2) * x**3 / (1 - x) ** 3
 
 
 def scsk(phi, O1=1.0, O2=1.0):
-    """Santos et al., CSK-based, Eq. 3.11: Z_SCSK = Z_SCS + (O1 + O2) phi^3 (1 - 2 phi)/(6 (1 - phi)^3)."""
+    """Santos et al., CSK-based, Eq. 3.11: Z_SCSK = Z_SCS + (O1 + O2) phi^3 (1 - 2 phi)/(6 (1 - phi)^3).
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+    O1, O2 : float or array_like, default 1.0
+        Dimensionless moments O1 = <a><a^2>/<a^3> and O2 = <a^2>^3/<a^3>^2 (Ogarko 2014, Eq. 3.6),
+        with 0 < O1 <= 1 and O1^2 <= O2 <= O1; 1 for monodisperse spheres.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1), or (O1, O2) are not the moments of a size
+        distribution.
+    """
     x = _phi(phi)
     o1, o2 = _omoments(O1, O2)
     return scs(x, o1, o2) + (o1 + o2) * x**3 * (1 - 2 * x) / (6 * (1 - x) ** 3)
 
 
 def bcsk(phi, O1=1.0, O2=1.0):
-    """Boublik's CSK extension, Eq. 3.12: Z_BCSK = Z_BMCSL + O2 phi^3 (1 - 2 phi)/(3 (1 - phi)^3)."""
+    """Boublik's CSK extension, Eq. 3.12: Z_BCSK = Z_BMCSL + O2 phi^3 (1 - 2 phi)/(3 (1 - phi)^3).
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+    O1, O2 : float or array_like, default 1.0
+        Dimensionless moments O1 = <a><a^2>/<a^3> and O2 = <a^2>^3/<a^3>^2 (Ogarko 2014, Eq. 3.6),
+        with 0 < O1 <= 1 and O1^2 <= O2 <= O1; 1 for monodisperse spheres.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1), or (O1, O2) are not the moments of a size
+        distribution.
+    """
     x = _phi(phi)
     o1, o2 = _omoments(O1, O2)
     return bmcsl(x, o1, o2) + o2 * x**3 * (1 - 2 * x) / (3 * (1 - x) ** 3)
@@ -105,7 +249,27 @@ def bcsk(phi, O1=1.0, O2=1.0):
 
 def z_ol(phi, O1=1.0, O2=1.0):
     """Ogarko-Luding Z_OL = (Z_SCS + Z_BCSK)/2, Ogarko 2014, Eq. 3.13: better than 0.2 % for
-    0.20 <= phi <= 0.60 in polydisperse fluids (not monodisperse above phi = 0.54)."""
+    0.20 <= phi <= 0.60 in polydisperse fluids (not monodisperse above phi = 0.54).
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+    O1, O2 : float or array_like, default 1.0
+        Dimensionless moments O1 = <a><a^2>/<a^3> and O2 = <a^2>^3/<a^3>^2 (Ogarko 2014, Eq. 3.6),
+        with 0 < O1 <= 1 and O1^2 <= O2 <= O1; 1 for monodisperse spheres.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1), or (O1, O2) are not the moments of a size
+        distribution.
+    """
     return 0.5 * (scs(phi, O1, O2) + bcsk(phi, O1, O2))
 
 
@@ -118,6 +282,25 @@ def binary_contact_z(phi, n1, R):
 
     Equal to BMCSL with the mixture's (O1, O2) (Eq. 3.8); written out independently so that the
     equivalence Z_bi = Z_poly of the bidisperse equivalent (Eqs. 3.20-3.21) can be checked.
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+    n1 : float
+        Number fraction of species 1 (the larger), in [0, 1].
+    R : float
+        Size ratio a1 / a2 >= 1.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z = PV/(N k_B T) at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1), n1 is outside [0, 1] or R < 1.
     """
     x = _phi(phi)
     if not (0 <= n1 <= 1 and R >= 1):
@@ -139,7 +322,27 @@ def free_volume(phi, phi_j, d: int = 3):
     """Free-volume (Salsburg-Wood) EOS near jamming, Eq. 3.14: Z_fv = d/(1 - phi/phi_J).
 
     Valid asymptotically as phi -> phi_J; in ED compressions the data collapse onto it for
-    phi_J - phi <~ 1e-8 (Ogarko 2014, sec. 3.1.3 and Fig. 3.8). Refuses phi >= phi_J."""
+    phi_J - phi <~ 1e-8 (Ogarko 2014, sec. 3.1.3 and Fig. 3.8). Refuses phi >= phi_J.
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, phi_J).
+    phi_j : float
+        Jamming density phi_J, in (0, 1].
+    d : int, default 3
+        Dimension.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Z_fv at each phi.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi_J is outside (0, 1], or phi is not finite or outside [0, phi_J).
+    """
     if not (0 < phi_j <= 1):
         raise InvalidInputError(f"phi_J must lie in (0, 1], got {phi_j}")
     x = _phi(phi, upper=phi_j)
@@ -151,6 +354,25 @@ def phij_estimate(phi, Z, d: int = 3):
 
     The inverse of :func:`free_volume` at each point; phi_J^est -> phi as Z -> infinity, and it is
     constant (a plateau) only where Z follows the free-volume law. Undefined (NaN) where Z <= d.
+
+    Parameters
+    ----------
+    phi : array_like
+        Volume fraction(s), in [0, 1).
+    Z : array_like
+        Reduced pressure(s) at phi, finite.
+    d : int, default 3
+        Dimension.
+
+    Returns
+    -------
+    numpy.ndarray
+        phi_J^est at each point; NaN where Z <= d.
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside [0, 1), or Z is not finite.
     """
     x = _phi(phi)
     z = np.asarray(Z, dtype=float)
@@ -184,7 +406,30 @@ def phij_fit_uniform_size(omega, nu_inf: float = 0.6828, phi_rcp: float = 0.65):
 
     Fitted (within +-0.5 %) for omega >~ 1.2 (no crystallisation) at growth rates 8-16e-6; omega = inf
     allowed (nu_inf = 0.6828 +- 0.0004, sec. 3.1.3). Warns for omega < 1.2. Fig. 3.10 uses
-    nu_inf = 0.679, phi_RCP = 0.647 instead (Fig. 3.10 caption)."""
+    nu_inf = 0.679, phi_RCP = 0.647 instead (Fig. 3.10 caption).
+
+    Parameters
+    ----------
+    omega : array_like
+        Width a_max / a_min >= 1 (inf allowed).
+    nu_inf, phi_rcp : float, default 0.6828, 0.65
+        The limits omega -> inf and omega = 1 of the fit.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        The jamming density nu_max at each omega.
+
+    Raises
+    ------
+    InvalidInputError
+        If omega is NaN or below 1.
+
+    Warns
+    -----
+    UserWarning
+        If omega lies outside the fitted range [1.2, inf].
+    """
     w = _omega(omega)
     _warn_range("phij_fit_uniform_size", w, 1.2, np.inf)
     return nu_inf - (nu_inf - phi_rcp) * (3 / w**2 - 2 / w**3)
@@ -196,7 +441,30 @@ def phij_fit_uniform_volume(omega, nu_inf: float = 0.859, phi_rcp: float = 0.647
 
     The printed "log" is the natural log: only ln gives d nu/d(1/omega) = 0 at omega = 1 as the text
     requires (derived here). Fitted (+-1 %) for 1.2 <= omega <= 10 (rates 8-16e-6); warns outside.
-    Bidisperse equivalents with omega > 10 follow it with phi_RCP and nu_inf swapped (Fig. 3.7(b))."""
+    Bidisperse equivalents with omega > 10 follow it with phi_RCP and nu_inf swapped (Fig. 3.7(b)).
+
+    Parameters
+    ----------
+    omega : array_like
+        Width a_max / a_min >= 1.
+    nu_inf, phi_rcp : float, default 0.859, 0.647
+        The fit's parameters nu_inf and phi_RCP (its value at omega = 1).
+
+    Returns
+    -------
+    numpy.ndarray or float
+        The jamming density nu_max at each omega.
+
+    Raises
+    ------
+    InvalidInputError
+        If omega is NaN or below 1.
+
+    Warns
+    -----
+    UserWarning
+        If omega lies outside the fitted range [1.2, 10].
+    """
     w = _omega(omega)
     _warn_range("phij_fit_uniform_volume", w, 1.2, 10.0)
     return nu_inf - (nu_inf - phi_rcp) * (1 / w - 1 / w**2 + 1 / w**3) * (1 + 2 * np.log(w))
@@ -213,13 +481,59 @@ def _sigma(sigma):
 def phij_fit_lognormal(sigma, nu_inf: float = 0.7990, phi_rcp: float = 0.6373):
     """nu_max(sigma) for log-normal radii, Ogarko 2014, Eq. 3.52: nu_inf - (nu_inf - phi_RCP) exp(-2 sigma^2).
     Fitted (+-0.7 %) for 0 <= sigma <= 1 at the fast rate Gamma = 16e-3 (random close packing);
-    warns outside. exp(-2 sigma^2) = (D32/D43)^2 (Eq. 3.54)."""
+    warns outside. exp(-2 sigma^2) = (D32/D43)^2 (Eq. 3.54).
+
+    Parameters
+    ----------
+    sigma : array_like
+        Standard deviation of ln a, >= 0.
+    nu_inf, phi_rcp : float, default 0.7990, 0.6373
+        The limits sigma -> inf and sigma = 0 of the fit.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        The jamming density nu_max at each sigma.
+
+    Raises
+    ------
+    InvalidInputError
+        If sigma is NaN or negative.
+
+    Warns
+    -----
+    UserWarning
+        If sigma lies outside the fitted range [0, 1].
+    """
     s = _sigma(sigma)
     return nu_inf - (nu_inf - phi_rcp) * np.exp(-2 * s**2)
 
 
 def phij_fit_lognormal_alt(sigma, nu_inf: float = 0.8583, c1: float = -0.3516, c2: float = 0.1332):
     """Alternative log-normal fit, Ogarko 2014, Eq. 3.55: nu_inf + c1 exp(-sigma^2) + c2 exp(-sigma^3).
-    +-0.4 % for 0 <= sigma <= 1 (Gamma = 16e-3); departs from Eq. 3.52 for sigma > 1; warns outside."""
+    +-0.4 % for 0 <= sigma <= 1 (Gamma = 16e-3); departs from Eq. 3.52 for sigma > 1; warns outside.
+
+    Parameters
+    ----------
+    sigma : array_like
+        Standard deviation of ln a, >= 0.
+    nu_inf, c1, c2 : float, default 0.8583, -0.3516, 0.1332
+        The fit's coefficients.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        The jamming density nu_max at each sigma.
+
+    Raises
+    ------
+    InvalidInputError
+        If sigma is NaN or negative.
+
+    Warns
+    -----
+    UserWarning
+        If sigma lies outside the fitted range [0, 1].
+    """
     s = _sigma(sigma)
     return nu_inf + c1 * np.exp(-(s**2)) + c2 * np.exp(-(s**3))

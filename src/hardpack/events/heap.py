@@ -14,9 +14,30 @@ from numba import njit
 
 @njit(cache=True, inline="always")
 def heap_set(hkey, heap, hpos, hsize, i, key):
-    """Give item i the key ``key`` in a 4-ary min-heap whose keys are stored in heap order
-    (``hkey[k]`` is the key of ``heap[k]``, ``hpos[i]`` the slot of i, -1 if absent). An absent
-    item is appended first. Sifts up, then down; returns the new heap size."""
+    """Give item i the key ``key`` in a 4-ary min-heap whose keys are stored in heap order.
+
+    An absent item is appended first. Sifts up, then down; the arrays are updated in place.
+
+    Parameters
+    ----------
+    hkey : numpy.ndarray
+        Keys in heap order: ``hkey[k]`` is the key of ``heap[k]``.
+    heap : numpy.ndarray
+        Integer items in heap order.
+    hpos : numpy.ndarray
+        Slot of each item in ``heap``, -1 if absent.
+    hsize : int
+        Number of items in the heap.
+    i : int
+        The item.
+    key : float
+        Its new key.
+
+    Returns
+    -------
+    int
+        The new heap size (``hsize + 1`` when i was absent, else ``hsize``).
+    """
     pos = hpos[i]
     if pos < 0:
         pos = hsize

@@ -18,6 +18,14 @@ from hardpack.freeenergy.bcmd import FROZEN_MODES, run_bcmd
 
 
 def register(subparsers) -> None:
+    """Add the subcommands ``bcmd``, ``bcmd-simplex``, ``bcmd-ladder``, ``bcmd-ellipse``,
+    ``ellipse-lattice``, ``bcmd-ellipse-ladder`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     p = subparsers.add_parser(
         "bcmd",
         help="Bounding-cell MD free energy of a packing (Donev ch. 6).",

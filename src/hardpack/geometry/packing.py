@@ -59,10 +59,23 @@ SHAPES = (Spheres, Ellipsoids)
 
 @dataclass(frozen=True)
 class OverlapReport:
-    """Result of an overlap check: the worst pair and its relative overlap.
+    """Result of an overlap check (:meth:`Packing.overlap_report`): the worst pair and its
+    relative overlap.
 
-    ``overlap`` = 1 - distance / (r_i + r_j) of the worst pair (positive means overlapping);
-    ``shift`` is the lattice image n with the separation x_j + lattice @ n - x_i.
+    Attributes
+    ----------
+    n_overlapping : int
+        Number of pairs (with every periodic image) whose relative overlap exceeds the tolerance.
+    worst_i, worst_j : int
+        The pair with the largest relative overlap, named even within tolerance; -1 when no pair
+        is in contact range.
+    shift : tuple of int
+        Lattice image n of the worst pair, with separation x_j + lattice @ n - x_i (empty when
+        there is no pair).
+    overlap : float
+        Relative overlap 1 - mu of the worst pair, positive when overlapping: mu = distance /
+        (r_i + r_j) for spheres, sqrt(zeta + 1) of the Perram-Wertheim potential for ellipsoids;
+        -inf when there is no pair.
     """
 
     n_overlapping: int

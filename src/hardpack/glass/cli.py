@@ -188,6 +188,15 @@ def cmd_glass_microsegregated_summary(args) -> int:
 
 
 def register(subparsers) -> None:
+    """Add the subcommands ``glass-crystal``, ``glass-eos``, ``glass-entropy``, ``glass-freezing``,
+    ``glass-labels``, ``glass-labelled-crystal``, ``glass-microsegregated``,
+    ``glass-microsegregated-summary`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     p = subparsers.add_parser("glass-crystal", help=cmd_glass_crystal.__doc__)
     p.add_argument("--nx", type=int, required=True, help="rectangular 2-disk cells along x")
     p.add_argument("--ny", type=int, required=True, help="rectangular 2-disk cells along y")

@@ -28,6 +28,13 @@ def cmd_hgrid_cost(args) -> int:
 
 
 def register(subparsers) -> None:
+    """Add the subcommand ``hgrid-cost`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     p = subparsers.add_parser("hgrid-cost", help=cmd_hgrid_cost.__doc__)
     p.add_argument("--alpha", type=float, required=True, help="exponent of f(r) ~ r^alpha (0 US, -3 UV)")
     p.add_argument("--omega", type=float, required=True, help="r_max / r_min")

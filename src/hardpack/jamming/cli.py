@@ -22,6 +22,13 @@ PRESSURE_ATTRS = ("reduced_pressure", "pressure", "final_pressure", "Z")
 
 
 def register(subparsers) -> None:
+    """Add the subcommand ``verify`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     p = subparsers.add_parser(
         "verify",
         help="LP jamming tests (local/collective/strict), rattlers and contact forces of a packing.",

@@ -97,26 +97,50 @@ class ContactArrays:
 
 @dataclass(frozen=True)
 class ContactNetwork(ContactArrays):
-    """Contacts (i, j, image shift n) of a packing; arrays have length M.
+    """Contacts (i, j, image shift n) of a packing (:func:`contact_network`); arrays have length M.
 
-    ``positions`` are the wrapped centres used to define ``separation``; ``lattice`` has the
-    lattice vectors as columns. ``wall`` (M,) is -1 for a pair and the wall's number for a wall
-    contact (module docstring); ``periodic`` (d,) marks the periodic axes and ``centre`` is the
-    centre of a spherical container (None otherwise). Without them the network is periodic.
+    Without ``wall``, ``periodic`` and ``centre`` the network is periodic.
+
+    Attributes
+    ----------
+    i, j : numpy.ndarray
+        (M,) particle indices of each contact (i <= j; j = i for a wall contact).
+    shift : numpy.ndarray
+        (M, d) integer lattice image n of j (0 for a wall contact).
+    separation : numpy.ndarray
+        (M, d) r_ij = x_j + lattice @ n - x_i; for a wall contact h n, from the centre to the
+        closest point on the wall (module docstring).
+    distance : numpy.ndarray
+        (M,) |r_ij| (h for a wall contact).
+    contact_distance : numpy.ndarray
+        (M,) D_ij = r_i + r_j (r_i for a wall contact).
+    positions : numpy.ndarray
+        (N, d) the wrapped centres that define ``separation``.
+    lattice : numpy.ndarray
+        (d, d) lattice vectors as columns.
+    delta : float
+        The relative gap tolerance the contacts were found with.
+    wall : numpy.ndarray or None
+        (M,) -1 for a pair, the wall's number for a wall contact (module docstring); None in the
+        constructor: pairs only.
+    periodic : numpy.ndarray or None
+        (d,) bool, the periodic axes; None in the constructor: all.
+    centre : numpy.ndarray or None
+        (d,) centre of a spherical container, None otherwise.
     """
 
     i: np.ndarray
     j: np.ndarray
-    shift: np.ndarray  # (M, d) int
-    separation: np.ndarray  # (M, d) r_ij = x_j + lattice @ n - x_i
-    distance: np.ndarray  # (M,)
-    contact_distance: np.ndarray  # (M,) D_ij = r_i + r_j
-    positions: np.ndarray  # (N, d) wrapped centres
-    lattice: np.ndarray  # (d, d)
+    shift: np.ndarray
+    separation: np.ndarray
+    distance: np.ndarray
+    contact_distance: np.ndarray
+    positions: np.ndarray
+    lattice: np.ndarray
     delta: float
-    wall: np.ndarray | None = None  # (M,) wall number of a wall contact, -1 for a pair
-    periodic: np.ndarray | None = None  # (d,) bool, the periodic axes (None: all)
-    centre: np.ndarray | None = None  # (d,) centre of a spherical container
+    wall: np.ndarray | None = None
+    periodic: np.ndarray | None = None
+    centre: np.ndarray | None = None
 
     def __post_init__(self):
         super().__post_init__()

@@ -39,15 +39,46 @@ class Verdict(enum.IntEnum):
 class JammingResult:
     """Everything :func:`verify` measured. ``None`` marks a test that was not run.
 
-    - ``local``/``collective``/``strict``: True when a (sub)packing is jammed in that sense
-      (Donev 2006, sec. 4.2.4.1: a packing with a jammed backbone counts as jammed).
-    - ``rattler``: particles outside the backbone (local rattlers, plus rattling clusters the
-      collective test removed when it found a jammed backbone).
-    - ``network``: all contacts within delta; ``forces.forces`` is the backbone self-stress.
-    - ``undetermined``: the tests that could not decide, with the reason (their verdict is None).
-    - ``fallbacks``: how many times each numerical fallback of :data:`FALLBACKS` happened.
-    - ``ellipse_slope``: for disks with a self-stress, s_phi of the ellipses made from them
-      (:func:`hardpack.jamming.near_sphere.ellipse_slope`, Donev 2006 Eq. 5.29); else None.
+    A packing with a jammed backbone counts as jammed (Donev 2006, sec. 4.2.4.1); the verdicts
+    of the collective and strict tests are the properties :attr:`collective` and :attr:`strict`.
+
+    Attributes
+    ----------
+    params : dict
+        The settings of the run (boundary, method, tolerances, seed, tests, mean diameter; the
+        sequential test's settings or None; ``force_delta`` and ``force_near_contacts`` when the
+        forces come from the nearest jamming point).
+    network : ContactNetwork
+        All contacts within delta; when the forces come from the nearest jamming point, the
+        contacts within delta plus the near contacts that carry force there.
+    local : bool
+        True when the local test leaves a non-empty backbone (locally jammed).
+    local_rattler : numpy.ndarray
+        (N,) bool, the particles the local test removed.
+    local_escape : numpy.ndarray
+        (N,) local escape displacement |dr_i| of each particle tested by an LP, NaN where not
+        measured (:func:`remove_rattlers`).
+    collective_test, strict_test : TestOutcome or SequentialOutcome or None
+        Outcome of the collective and strict tests (ideal, Algorithm 13, or sequential,
+        Algorithm 14); None when not run.
+    rattler : numpy.ndarray
+        (N,) bool, particles outside the backbone (local rattlers, plus rattling clusters the
+        collective test removed when it found a jammed backbone).
+    forces : Forces
+        The backbone self-stress (``forces.forces``, on the contacts of ``network``).
+    statics : Statics
+        Contact numbers, isostaticity and pressures of the backbone (:func:`statics`).
+    volume : float
+        Volume of the cell or container.
+    md_pressure : float or None
+        Reduced pressure PV/(NkT) of the generator, if given to :func:`verify`.
+    ellipse_slope : float or None
+        For periodic disks with a self-stress, s_phi of the ellipses made from them
+        (:func:`hardpack.jamming.near_sphere.ellipse_slope`, Donev 2006 Eq. 5.29); else None.
+    seconds : dict
+        Wall time of each stage (contacts, local, collective, strict, forces).
+    fallbacks : dict
+        How many times each numerical fallback of :data:`FALLBACKS` happened.
     """
 
     params: dict

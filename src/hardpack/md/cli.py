@@ -123,6 +123,13 @@ def cmd_eos(args) -> int:
 
 
 def register(subparsers) -> None:
+    """Add the subcommands ``compress``, ``eos`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     from hardpack.cli import add_checkpoint_options
 
     p = subparsers.add_parser("compress", help=cmd_compress.__doc__)
@@ -181,6 +188,18 @@ def register(subparsers) -> None:
 
 
 def main(argv=None) -> int:
+    """``python -m hardpack.md.cli``: the MD subcommands on their own (:func:`register`).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; default the process's command line.
+
+    Returns
+    -------
+    int
+        Exit status (:func:`hardpack.cli.run_command`).
+    """
     parser = argparse.ArgumentParser(prog="python -m hardpack.md.cli", description=__doc__.splitlines()[0])
     register(parser.add_subparsers(dest="command", required=True))
     args = parser.parse_args(argv)

@@ -114,6 +114,13 @@ def _slp_options(p) -> None:
 
 
 def register(subparsers) -> None:
+    """Add the subcommands ``slp``, ``slp-dilute`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     p = subparsers.add_parser("slp", help=cmd_slp.__doc__)
     p.add_argument("--init", required=True, help="start packing (netCDF), e.g. from `hardpack init`")
     p.add_argument("--out", required=True, help="output packing (netCDF)")

@@ -34,9 +34,25 @@ ACUTE_EPS = 1.0 - 1e-12
 
 @numba.njit(cache=True)
 def apollonius_radius(p1, p2, p3, r1, r2, r3, eps=ACUTE_EPS):
-    """Channel radius of three spheres (centres p_k in any d >= 2, radii r_k), see the module
-    docstring; -1.0 flags a triangle that is not acute (tolerance eps), NaN one without an
-    externally tangent circle (positive root)."""
+    """Channel radius of three spheres: the circle externally tangent to all three in the plane
+    of their centres (Apollonius problem; Ogarko 2014, sec. 4.2; module docstring).
+
+    Parameters
+    ----------
+    p1, p2, p3 : numpy.ndarray
+        (d,) centres, any d >= 2.
+    r1, r2, r3 : float
+        Radii.
+    eps : float, default :data:`ACUTE_EPS`
+        Acute-triangle tolerance: a^2 + b^2 > eps c^2 for all three edge orderings.
+
+    Returns
+    -------
+    float
+        The smallest positive root R whose centre lies inside the triangle, else the smallest
+        positive root; -1.0 if the triangle is not acute (tolerance eps), NaN if there is no
+        positive root.
+    """
     d = p1.size
     a2 = 0.0
     b2 = 0.0

@@ -47,6 +47,13 @@ def cmd_structure(args) -> int:
 
 
 def register(subparsers) -> None:
+    """Add the subcommand ``structure`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     from hardpack.cli import _key_value
 
     p = subparsers.add_parser("structure", help=cmd_structure.__doc__)

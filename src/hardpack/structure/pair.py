@@ -237,7 +237,23 @@ def cumulative_coordination(packing, gap_max: float = 0.5, rattlers=None,
 
 @dataclass(frozen=True)
 class PowerLawFit:
-    """Z(l) = z_contact + amplitude * l^alpha fitted on gaps in [gap_lo, gap_hi]."""
+    """Z(l) = z_contact + amplitude * l^alpha fitted on gaps in (gap_lo, gap_hi]
+    (:func:`fit_power_law`; Donev 2006, Eq. 9.7 with alpha = 1 - alpha_Donev).
+
+    Attributes
+    ----------
+    alpha, alpha_err : float
+        Maximum-likelihood exponent and its standard error (Fisher information; a lower bound,
+        since pairs sharing particles are not independent).
+    amplitude, amplitude_err : float
+        Amplitude a and its standard error.
+    z_contact : float
+        Z_c = Z(gap_lo) - a gap_lo^alpha.
+    n_pairs : int
+        Number of pair gaps in the window.
+    gap_lo, gap_hi : float
+        The fit window.
+    """
 
     alpha: float
     alpha_err: float

@@ -74,7 +74,25 @@ ROW_BUILDERS = {
 
 
 def parse_inputs(items: list[str]) -> dict[str, list[str]]:
-    """``["ls=a.nc", "ls=b.nc", "bcmd=c.nc"]`` -> ``{"ls": ["a.nc", "b.nc"], "bcmd": ["c.nc"]}``."""
+    """Group the NAME=PATH inputs of ``hardpack validate`` by name.
+
+    ``["ls=a.nc", "ls=b.nc", "bcmd=c.nc"]`` -> ``{"ls": ["a.nc", "b.nc"], "bcmd": ["c.nc"]}``.
+
+    Parameters
+    ----------
+    items : list of str
+        NAME=PATH items, NAME one of :data:`ROW_BUILDERS`.
+
+    Returns
+    -------
+    dict
+        name -> paths, in the order given.
+
+    Raises
+    ------
+    InvalidInputError
+        If an item is not NAME=PATH or names an unknown input.
+    """
     grouped: dict[str, list[str]] = {}
     for item in items:
         name, sep, path = item.partition("=")
@@ -87,7 +105,19 @@ def parse_inputs(items: list[str]) -> dict[str, list[str]]:
 
 
 def build_rows(inputs: dict[str, list[str]]) -> list:
-    """Every validation row: the analytic ones and those of each named summary."""
+    """Every validation row: the analytic ones and those of each named summary.
+
+    Parameters
+    ----------
+    inputs : dict
+        name -> paths of summary datasets (:func:`parse_inputs`).
+
+    Returns
+    -------
+    list of Row
+        The analytic rows (moments, hierarchical-grid cost, mixing entropy), then the rows each
+        input's builder in :data:`ROW_BUILDERS` makes from its datasets.
+    """
     rows = moment_table_rows() + hgrid_rows() + smix_rows()
     for name, paths in inputs.items():
         rows += ROW_BUILDERS[name]([load_dataset(p) for p in paths])
@@ -125,6 +155,13 @@ def cmd_validate(args) -> int:
 
 
 def register(subparsers) -> None:
+    """Add the subcommand ``validate`` to the ``hardpack`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The subcommand parsers of :func:`hardpack.cli.build_parser`.
+    """
     p = subparsers.add_parser("validate", help=cmd_validate.__doc__)
     p.add_argument("inputs", nargs="*", metavar="NAME=PATH",
                    help=f"summary datasets by row builder ({', '.join(ROW_BUILDERS)}); repeatable")

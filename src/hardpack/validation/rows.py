@@ -32,7 +32,27 @@ APPLICABLE = (PASS, FAIL, KNOWN, DEVIATION_PASSES)
 
 @dataclass(frozen=True)
 class Row:
-    """One reproduced value beside its target (see the module docstring for ``status``)."""
+    """One reproduced value beside its target (:func:`evaluate`).
+
+    Attributes
+    ----------
+    target, study, kind, quantity, citation : str
+        The target's id, study, kind, quantity and citation (:class:`Target`).
+    published : float
+        The published value (the target's, or the fit it names evaluated for this row).
+    reproduced, uncertainty : float
+        The reproduced value and our uncertainty of it (NaN: none).
+    tolerance : float
+        The absolute tolerance.
+    tolerance_origin, tolerance_note : str
+        Where the tolerance comes from and why (the target's).
+    status : str
+        pass, fail, n/a, known deviation or deviation passes (module docstring).
+    detail : str
+        Notes: why the row is n/a or has no value, what was measured, the known deviation.
+    label : str
+        Which ensemble or parameter the row is for.
+    """
 
     target: str
     study: str

@@ -25,16 +25,29 @@ from hardpack.geometry.neighbours.grid import RANGE_PAD, Grid, build_grid, pair_
 
 @dataclass(frozen=True)
 class PairList:
-    """Pairs within range, sorted by (i, j, shift). ``separation[k] = x_j + lattice @ shift[k] - x_i``
-    (Cartesian, x the wrapped centres of :func:`wrapped_positions`); ``contact[k]`` = r_i + r_j of the
-    bounding radii (the sphere radii for spheres)."""
+    """Pairs within range (:func:`pairs_within`), sorted by (i, j, shift); arrays have length M.
+
+    Attributes
+    ----------
+    i, j : numpy.ndarray
+        (M,) particle indices, i < j, or i == j for a particle and its own image.
+    shift : numpy.ndarray
+        (M, d) integer lattice image n of j.
+    separation : numpy.ndarray
+        (M, d) Cartesian x_j + lattice @ n - x_i, x the wrapped centres of
+        :func:`wrapped_positions`.
+    distance : numpy.ndarray
+        (M,) |separation|.
+    contact : numpy.ndarray
+        (M,) r_i + r_j of the bounding radii (the sphere radii for spheres).
+    """
 
     i: np.ndarray
     j: np.ndarray
-    shift: np.ndarray  # (M, d) integer lattice images
-    separation: np.ndarray  # (M, d)
-    distance: np.ndarray  # (M,)
-    contact: np.ndarray  # (M,) r_i + r_j (bounding radii)
+    shift: np.ndarray
+    separation: np.ndarray
+    distance: np.ndarray
+    contact: np.ndarray
 
     def __len__(self) -> int:
         return len(self.i)
