@@ -3,9 +3,6 @@ numpydoc sections (the project standard: numpydoc docstrings on public functions
 when a function takes parameters, "Returns" (or "Yields") when it returns a value, and for a
 class whose constructor takes parameters "Parameters" or "Attributes". Numba functions are
 checked through their Python source.
-
-Every subpackage is checked in full except those in :data:`FUNCTIONS_ONLY`, whose classes are
-not all documented yet; their functions are checked.
 """
 
 from __future__ import annotations
@@ -22,12 +19,6 @@ from numba import njit
 import hardpack
 from hardpack.md import kernel
 
-#: subpackage -> why only its functions are checked
-FUNCTIONS_ONLY = {
-    "jamming": "EllipsoidJammingResult (hardpack.jamming.second_order) has no Attributes section",
-}
-
-
 def python_function(obj):
     """The Python function of a plain or numba-compiled function, else None."""
     obj = getattr(obj, "py_func", obj)
@@ -43,7 +34,7 @@ def public_api() -> dict[str, object]:
         module = importlib.import_module(f"hardpack.{info.name}")
         for name in getattr(module, "__all__", []):
             obj = getattr(module, name)
-            if python_function(obj) is None and not (inspect.isclass(obj) and info.name not in FUNCTIONS_ONLY):
+            if python_function(obj) is None and not inspect.isclass(obj):
                 continue
             found[f"{obj.__module__}.{name}"] = obj
     found["hardpack.md.kernel.run_events"] = kernel.run_events
@@ -98,15 +89,7 @@ def test_the_public_api_is_found():
                  "hardpack.events.roots.pair_time", "hardpack.geometry.packing.Packing",
                  "hardpack.jamming.contacts.contact_network"):
         assert name in API
-    assert "hardpack.jamming.result.JammingResult" not in API  # FUNCTIONS_ONLY
-
-
-@pytest.mark.parametrize("subpackage", sorted(FUNCTIONS_ONLY))
-def test_functions_only_is_still_needed(subpackage):
-    module = importlib.import_module(f"hardpack.{subpackage}")
-    classes = [getattr(module, name) for name in module.__all__ if inspect.isclass(getattr(module, name))]
-    assert any(missing_sections(c) for c in classes), (
-        f"every class of hardpack.{subpackage} is documented: remove it from FUNCTIONS_ONLY")
+    assert "hardpack.jamming.second_order.EllipsoidJammingResult" in API
 
 
 @pytest.mark.parametrize("name", sorted(API))

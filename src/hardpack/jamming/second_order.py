@@ -737,10 +737,30 @@ def _count_below(mat: sp.csc_matrix, tau: float) -> int | None:
 class EllipsoidJammingResult:
     """What :func:`verify_ellipsoids` found (see the module docstring).
 
-    ``local``: Verdict per particle of the local test (NOT_RUN for frozen particles), decided at
-    ``local_order`` (:data:`ORDER_CODES`: 1 first, 2 second, 0 undetermined or not run);
-    ``rattler``: particles removed by the iterated local test; ``collective``: the
-    :class:`Decision` on the backbone; ``dof``: reduced dof per particle (0 for frozen ones).
+    Attributes
+    ----------
+    params : dict
+        The test's options and the contact tolerance used (``delta``, ``method``, tolerances).
+    network : EllipsoidContacts
+        Every contact within the tolerance.
+    frozen : ndarray of bool, shape (N,)
+        Fixed particles (obstacles).
+    local : ndarray of int, shape (N,)
+        :class:`Verdict` code of each particle's local test (NOT_RUN for frozen particles).
+    local_order : ndarray of int, shape (N,)
+        The order that decided it (:data:`ORDER_CODES`: 1 first, 2 second, 0 undetermined or not run).
+    rattler : ndarray of bool, shape (N,)
+        Particles removed by the iterated local test.
+    collective : Decision
+        The test of the backbone.
+    contacts_used : ndarray of bool, shape (M,)
+        The contacts of the backbone (among ``network``).
+    dof : ndarray of int, shape (N,)
+        Reduced dof per particle (0 for frozen ones).
+    seconds : dict
+        Wall-clock seconds per stage.
+    fallbacks : dict
+        Counts of the numerical fallbacks (:data:`FALLBACKS`).
     """
 
     params: dict
