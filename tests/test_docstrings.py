@@ -19,6 +19,7 @@ from numba import njit
 import hardpack
 from hardpack.md import kernel
 
+
 def python_function(obj):
     """The Python function of a plain or numba-compiled function, else None."""
     obj = getattr(obj, "py_func", obj)
