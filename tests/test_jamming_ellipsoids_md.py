@@ -166,7 +166,7 @@ def test_verdict_fractions_per_shape():
     assert np.isnan(float(out.isel(shape=1).z_backbone_err))
 
 
-@pytest.mark.parametrize("name", ["mm_n80_slow_p1e12", "self_dual_a1.05_n100_slow_p1e12"])
+@pytest.mark.parametrize("name", ["mm_n80_seed1_slow_p1e12", "self_dual_a1.05_n100_slow_p1e12"])
 def test_sparse_path_projects_the_stiffness_like_the_dense_one(name):
     """LS packings at p = 1e12: M&M-shaped oblate spheroids (alpha = 1.9, N = 80, final rate 1e-3;
     one floppy mode) and near-sphere ellipsoids (224 floppy modes). The sparse path's floppy space

@@ -31,8 +31,9 @@ rule ellipsoid_contacts:
 
 rule ellipsoid_verify:
     """First- and second-order jamming tests of one jammed ellipsoid or ellipse packing (Donev 2006,
-    Secs. 5.5.3 and 5.6), contacts from the gap distribution; the verdict states the order that
-    decided it."""
+    Secs. 5.5.3 and 5.6), contacts from the gap distribution, at the jamming point of the contacts
+    when Newton's method reaches it without overlaps (hardpack.jamming.refine); the verdict states
+    the order that decided it."""
     input:
         "results/ellipsoids/{name}/jammed/seed{seed}.nc",
     output:
@@ -50,7 +51,7 @@ rule ellipsoid_verify:
     benchmark:
         "results/benchmarks/ellipsoid_verify/{name}/seed{seed}.tsv"
     shell:
-        "hardpack verify {input} --out {output} --delta gaps --seed {wildcards.seed} {params.attrs} > {log} 2>&1"
+        "hardpack verify {input} --out {output} --delta gaps --refine --seed {wildcards.seed} {params.attrs} > {log} 2>&1"
 
 
 rule ellipsoid_verdict_fractions:

@@ -60,6 +60,10 @@ def register(subparsers) -> None:
                         "(default 1; the result does not depend on it)")
     p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE",
                    help="extra attribute stored in the verdict (repeatable), e.g. alpha=1.5")
+    p.add_argument("--refine", action="store_true",
+                   help="ellipses and ellipsoids near their jamming point (LS packings): test the "
+                        "jamming point of the contacts, found by Newton's method, when it converges "
+                        "with no overlap (hardpack.jamming.refine)")
     p.set_defaults(func=cmd_verify)
 
 
@@ -88,9 +92,11 @@ def _write_verdict(result, out, args) -> int:
 def _verify_ellipsoids(packing, args) -> int:
     """Ellipses and ellipsoids: the first- and second-order tests of
     :func:`hardpack.jamming.second_order.verify_ellipsoids` (the sphere options do not apply)."""
+    from hardpack.jamming.refine import verify_at_jamming_point
     from hardpack.jamming.second_order import verify_ellipsoids
 
-    result = verify_ellipsoids(packing, delta=args.delta, seed=args.seed)
+    test = verify_at_jamming_point if args.refine else verify_ellipsoids
+    result = test(packing, delta=args.delta, seed=args.seed)
     out = result.to_dataset()
     out.attrs["source"] = str(args.packing)
     return _write_verdict(result, out, args)
@@ -103,10 +109,11 @@ def cmd_verify(args) -> int:
     if ds.attrs.get("shape_kind") == "ellipsoid":
         # verify_ellipsoids checks the overlaps itself (with the Perram-Wertheim function)
         return _verify_ellipsoids(dataset_to_packing(ds, source=str(args.packing), allow_overlap=True), args)
-    if args.delta == "gaps":
+    if args.delta == "gaps" or args.refine:
         from hardpack.errors import InvalidInputError
 
-        raise InvalidInputError("--delta gaps is for ellipse and ellipsoid packings; give sphere packings a number")
+        raise InvalidInputError(f"{'--delta gaps' if args.delta == 'gaps' else '--refine'} is for ellipse and "
+                                "ellipsoid packings; sphere packings take neither (--delta a number)")
     packing = dataset_to_packing(ds, source=str(args.packing))
     pressure = next((float(ds.attrs[k]) for k in PRESSURE_ATTRS if k in ds.attrs), None)
     if pressure is not None and not (math.isfinite(pressure) and pressure > 0):

@@ -1,0 +1,121 @@
+"""Refinement of LS ellipsoid packings to the jamming point of their contacts
+(hardpack.jamming.refine): Newton's method on the KKT equations of growing the particles.
+
+Stored packings (tests/data): M&M-shaped oblate spheroids (alpha = 1.9, N = 80, LS at the final
+rate 1e-3 to p = 1e12, seeds 1 and 2) and near-sphere ellipsoids (1 : 1.05^(1/2) : 1.05, N = 100).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hardpack.errors import InvalidInputError
+from hardpack.io import dataset_to_packing, load_dataset
+from hardpack.jamming.ellipsoids import ellipsoid_contacts
+from hardpack.jamming.refine import refine_jamming_point, verify_at_jamming_point
+from hardpack.jamming.result import Verdict
+from hardpack.jamming.second_order import verify_ellipsoids
+
+DATA = Path(__file__).parent / "data"
+
+
+def _packing(name):
+    return dataset_to_packing(load_dataset(DATA / f"{name}.nc"), allow_overlap=True)
+
+
+def test_newton_reaches_the_jamming_point_quadratically():
+    """M&M seed 2: the near self-stress balances to 4e-7; three Newton steps reach gaps and balance
+    of 1e-13. Quadratic convergence checks the Jacobian (the contact Hessians in K and the gap rows)
+    against the Perram-Wertheim function that the iterates are evaluated with; the gaps of the
+    refined packing, read by the independent pair search of Packing.overlap_report, are zero to
+    1e-12 and no other pair overlaps."""
+    packing = _packing("mm_n80_seed2_slow_p1e12")
+    res = verify_ellipsoids(packing, delta="gaps")
+    ref = refine_jamming_point(packing, res)
+    assert ref.converged and ref.iterations <= 5 and ref.overlaps == 0
+    assert ref.balance[0] > 1e-8 and ref.balance[-1] < 1e-12 and ref.gap[-1] < 1e-12
+    # quadratic: each step at most 100 times the square of the previous one (measured: about 12 times;
+    # steps 2.8e-4, 9.2e-7, 1.1e-11 in particle sizes); a linear rate of 0.1 would fail
+    assert ref.steps[-1] < 1e-9 and all(b <= 100 * a**2 + 1e-13 for a, b in zip(ref.steps, ref.steps[1:]))
+    # the first Newton step is the distance the verifier estimated from the floppy modes
+    assert ref.steps[0] == pytest.approx(res.collective.jamming_distance, rel=0.05)
+    report = ref.packing.overlap_report(1e-12)
+    assert report.n_overlapping == 0 and report.overlap > -1e-12  # touching pairs, none overlapping
+    net = ellipsoid_contacts(ref.packing, 1e-9)
+    assert net.n_contacts == res.collective.n_constraints and np.abs(net.gap).max() < 1e-12
+    assert abs(ref.size_change) < 1e-8 and ref.forces.min() > 0
+
+
+def test_verdict_at_the_jamming_point():
+    """The verifier on the refined configuration: the same floppy space, an exact self-stress, and
+    lambda_min(K_V) within 1 % of the packing's (jammed at second order either way)."""
+    packing = _packing("mm_n80_seed2_slow_p1e12")
+    before = verify_ellipsoids(packing, delta="gaps")
+    after = verify_at_jamming_point(packing, delta="gaps")
+    assert after.params["refined"] == 1 and "jamming point" in after.collective.reason
+    assert (after.verdict, after.order) == (before.verdict, before.order) == (Verdict.JAMMED, "second")
+    assert after.collective.n_floppy == before.collective.n_floppy == 3
+    assert after.collective.lambda_min == pytest.approx(before.collective.lambda_min, rel=1e-2)
+    assert after.collective.stress_residual < 1e-12 < before.collective.stress_residual
+    ds = after.to_dataset()
+    assert ds.attrs["refined"] == 1 and ds.attrs["refine_iterations"] <= 5
+
+
+def test_marginal_packing_is_not_refined_and_says_why():
+    """M&M seed 1: one floppy mode with lambda_min(K_V) = -1.7e-4 max |K|, 1.9e-3 particle sizes from
+    the jamming point of its contacts: Newton does not converge (the jamming point is ill-defined at
+    second order), so the verdict is the packing's own, with the reason."""
+    packing = _packing("mm_n80_seed1_slow_p1e12")
+    res = verify_at_jamming_point(packing, delta="gaps")
+    assert res.params["refined"] == 0 and "did not converge" in res.params["refine_note"]
+    assert "did not converge" in res.collective.reason
+    assert res.collective.n_floppy == 1 and res.collective.jamming_distance > 1e-3
+
+
+@pytest.mark.slow
+def test_near_sphere_jamming_point_overlaps_other_pairs():
+    """Near the sphere point the torque rows are O(alpha - 1): the Newton steps turn particles by
+    0.045 rad and converge, but two pairs outside the contact network overlap there: not refined."""
+    packing = _packing("self_dual_a1.05_n100_slow_p1e12")
+    res = verify_ellipsoids(packing, delta="gaps")
+    ref = refine_jamming_point(packing, res)
+    assert ref.converged and ref.overlaps > 0 and ref.steps[0] > 0.01
+    out = verify_at_jamming_point(packing, delta="gaps")
+    assert out.params["refined"] == 0 and "overlap" in out.params["refine_note"]
+    assert (out.verdict, out.order) == (res.verdict, res.order)
+
+
+def test_bad_input_is_refused():
+    packing = _packing("mm_n80_seed2_slow_p1e12")
+    res = verify_ellipsoids(packing, delta="gaps")
+    with pytest.raises(InvalidInputError, match="max_iter"):
+        refine_jamming_point(packing, res, max_iter=0)
+    with pytest.raises(InvalidInputError, match="tol"):
+        refine_jamming_point(packing, res, tol=float("nan"))
+    with pytest.raises(InvalidInputError, match="particles"):
+        refine_jamming_point(_packing("self_dual_a1.05_n100_slow_p1e12"), res)
+    container = _packing("disks_container_n12")
+    with pytest.raises(InvalidInputError, match="periodic"):
+        refine_jamming_point(container, res)
+
+
+def test_cli_refine(tmp_path, capsys):
+    """``hardpack verify --delta gaps --refine`` stores the verdict at the jamming point with the
+    refinement's attributes; sphere packings refuse --refine."""
+    from hardpack.cli import main
+    from hardpack.geometry.lattices import lattice_packing
+    from hardpack.io import save_packing
+
+    out = tmp_path / "verdict.nc"
+    assert main(["verify", str(DATA / "mm_n80_seed2_slow_p1e12.nc"), "--out", str(out), "--delta", "gaps",
+                 "--refine"]) == 0
+    ds = load_dataset(out)
+    assert ds.attrs["refined"] == 1 and ds.attrs["jammed"] == 1 and ds.attrs["order"] == "second"
+    assert "Newton converged" in ds.attrs["refine_note"]
+    spheres = tmp_path / "fcc.nc"
+    save_packing(lattice_packing("fcc", (2, 2, 2)), spheres)
+    assert main(["verify", str(spheres), "--out", str(tmp_path / "v.nc"), "--refine"]) != 0
+    assert "--refine is for ellipse and ellipsoid packings" in capsys.readouterr().err
