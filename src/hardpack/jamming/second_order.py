@@ -613,7 +613,7 @@ def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: 
     gram = (at.T @ at).tocsc()
     gscale = max(abs(gram).max(), 1e-300)
     stresses = (at @ at.T).tocsc()
-    n_stresses = _count_below(stresses / max(abs(stresses).max(), 1e-300), rank_tol)
+    n_stresses = _count_below(stresses / max(abs(stresses).max(), 1e-300), rank_tol)[0]
     common.update(n_stresses=-1 if n_stresses is None else n_stresses)
     near = approximate_stress(at) if n_stresses is not None and n_stresses <= 1 else None
     w = np.zeros(n)
@@ -688,18 +688,19 @@ def _floppy_space(gram: sp.csc_matrix, w: np.ndarray, trivial: np.ndarray, rank_
     (zeros without one): A at the jamming point is A - w f^T, whose A A^T is gram - w w^T. The
     floppy eigenvalues are those below tau = max(rank_tol, 2 |w|^2); their number (trivial
     motions included) comes from the inertia of gram - tau I, their eigenvectors, with
-    FLOPPY_MARGIN more, from eigsh in shift-invert mode below the spectrum, then a Rayleigh-Ritz
+    FLOPPY_MARGIN more, from eigsh in shift-invert mode at tau (the same factorisation), then a Rayleigh-Ritz
     step with gram - w w^T in that subspace, and the trivial motions are projected out."""
     n = gram.shape[0]
     t = trivial.shape[1]
     tau = max(rank_tol, 2.0 * float(w @ w))
-    count = _count_below(gram, tau)
+    count, lu = _count_below(gram, tau)
     want = (n if count is None else count) + FLOPPY_MARGIN
     fell = count is None and n > SMALL_EIGH
     vals = None
     if not fell and SMALL_EIGH < n and want < n // 2:
-        try:
-            vals, vecs = spla.eigsh(gram, k=want, sigma=-tau, which="LM")
+        try:  # shift-invert at tau with the factorisation of the count: the floppy eigenvalues are nearest
+            inverse = spla.LinearOperator(gram.shape, matvec=lu.solve, dtype=float)
+            vals, vecs = spla.eigsh(gram, k=want, sigma=tau, which="LM", OPinv=inverse)
         except (spla.ArpackNoConvergence, RuntimeError):
             fell = True
     if vals is None:
@@ -716,20 +717,20 @@ def _floppy_space(gram: sp.csc_matrix, w: np.ndarray, trivial: np.ndarray, rank_
     return q[:, : int(keep.sum())], fell
 
 
-def _count_below(mat: sp.csc_matrix, tau: float) -> int | None:
-    """Number of eigenvalues of a symmetric sparse matrix below ``tau`` (Sylvester's law of
-    inertia: the negative pivots of the LU factorisation of mat - tau I with a symmetric
-    permutation and no pivoting, P M P^T = L D L^T, U = D L^T). None when the factorisation
-    failed or pivoted."""
+def _count_below(mat: sp.csc_matrix, tau: float):
+    """(number of eigenvalues of a symmetric sparse matrix below ``tau``, the factorisation of
+    mat - tau I) by Sylvester's law of inertia: the negative pivots of the LU factorisation of
+    mat - tau I with a symmetric permutation and no pivoting, P M P^T = L D L^T, U = D L^T.
+    (None, None) when the factorisation failed or pivoted."""
     shifted = (mat - tau * sp.identity(mat.shape[0], format="csc")).tocsc()
     try:
         lu = spla.splu(shifted, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                        options={"SymmetricMode": True})
     except RuntimeError:  # exactly singular
-        return None
+        return None, None
     if not np.array_equal(lu.perm_r, lu.perm_c):
-        return None
-    return int((lu.U.diagonal() < 0).sum())
+        return None, None
+    return int((lu.U.diagonal() < 0).sum()), lu
 
 
 # ------------------------------------------------------------------------------------- result
