@@ -241,9 +241,14 @@ def verify_at_jamming_point(packing: Packing, **options):
                     refine_size_change=ref.size_change)
         if ref.converged and not ref.overlaps:
             refined = verify_ellipsoids(ref.packing, **options)
+            same = (refined.collective.n_constraints == dec.n_constraints
+                    and np.array_equal(refined.rattler, result.rattler))
             refined.params.update(refined=1, refine_note=(
                 f"the jamming point of the contacts: Newton converged in {ref.iterations} steps "
-                f"(largest {info['refine_step']:.3g}), gaps {ref.gap[-1]:.2g}, balance {ref.balance[-1]:.2g}"), **info)
+                f"(largest {info['refine_step']:.3g}), gaps {ref.gap[-1]:.2g}, balance {ref.balance[-1]:.2g}"
+                + ("" if same else f"; the test there found {refined.collective.n_constraints} backbone contacts "
+                   f"and {int(refined.rattler.sum())} rattlers (before: {dec.n_constraints}, "
+                   f"{int(result.rattler.sum())})")), **info)
             refined.collective.reason = f"at the jamming point of the contacts: {refined.collective.reason}"
             return refined
         note = (f"not refined: Newton did not converge in {ref.iterations} steps (balance {ref.balance[-1]:.2g}, "
