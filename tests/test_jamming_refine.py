@@ -3,6 +3,9 @@
 
 Stored packings (tests/data): M&M-shaped oblate spheroids (alpha = 1.9, N = 80, LS at the final
 rate 1e-3 to p = 1e12, seeds 1 and 2) and near-sphere ellipsoids (1 : 1.05^(1/2) : 1.05, N = 100).
+The refined configuration's gaps are checked by the pair search of Packing.overlap_report and
+ellipsoid_contacts, its balance by the verifier's own A F, and Newton's quadratic convergence
+checks the contact Hessians against the Perram-Wertheim function.
 """
 
 from __future__ import annotations
@@ -76,16 +79,26 @@ def test_marginal_packing_is_not_refined_and_says_why():
 
 
 @pytest.mark.slow
-def test_near_sphere_jamming_point_overlaps_other_pairs():
-    """Near the sphere point the torque rows are O(alpha - 1): the Newton steps turn particles by
-    0.045 rad and converge, but two pairs outside the contact network overlap there: not refined."""
+def test_near_sphere_packing_is_jammed_at_its_jamming_point():
+    """Near the sphere point the torque rows are O(alpha - 1): Newton turns particles by 0.045 rad
+    and converges, but at the jamming point of the LS contacts three other pairs overlap (missed
+    contacts, Donev 2006, Sec. 5.6). They join the network (active set) and the next Newton run
+    converges with no overlap (measured: 2 overlapping and 1 touching pair join): there the packing
+    is exactly balanced, still hypostatic (Z < 12),
+    and jammed at second order (Donev 2006, Sec. 5.6: 'second-order jammed, even very close to
+    the sphere point')."""
     packing = _packing("self_dual_a1.05_n100_slow_p1e12")
     res = verify_ellipsoids(packing, delta="gaps")
+    one = refine_jamming_point(packing, res, rounds=1)
+    assert one.converged and one.overlaps > 0 and one.steps[0] > 0.01 and one.added == 0
     ref = refine_jamming_point(packing, res)
-    assert ref.converged and ref.overlaps > 0 and ref.steps[0] > 0.01
+    assert ref.converged and ref.overlaps == 0 and ref.added >= one.overlaps  # overlapping and touching pairs
+    assert ref.balance[-1] < 1e-12 and ref.gap[-1] < 1e-12 and ref.forces.min() > 0
     out = verify_at_jamming_point(packing, delta="gaps")
-    assert out.params["refined"] == 0 and "overlap" in out.params["refine_note"]
-    assert (out.verdict, out.order) == (res.verdict, res.order)
+    assert out.params["refined"] == 1 and out.params["refine_added"] == ref.added
+    assert (out.verdict, out.order) == (Verdict.JAMMED, "second")
+    assert out.isostaticity_gap < 0 and out.z_mean < 12 and not out.rattler.any()
+    assert out.collective.n_constraints == res.collective.n_constraints + ref.added
 
 
 def test_bad_input_is_refused():
@@ -93,6 +106,8 @@ def test_bad_input_is_refused():
     res = verify_ellipsoids(packing, delta="gaps")
     with pytest.raises(InvalidInputError, match="max_iter"):
         refine_jamming_point(packing, res, max_iter=0)
+    with pytest.raises(InvalidInputError, match="rounds"):
+        refine_jamming_point(packing, res, rounds=1.5)
     with pytest.raises(InvalidInputError, match="tol"):
         refine_jamming_point(packing, res, tol=float("nan"))
     with pytest.raises(InvalidInputError, match="particles"):

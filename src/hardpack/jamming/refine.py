@@ -25,8 +25,10 @@ rotation vector of its rotational part (R = exp(W) applied in the lab frame, the
 of the Hessians).
 
 The refined configuration is the jamming point only if no pair outside the contact network
-overlaps there (``overlaps``): a network whose jamming point overlaps other pairs is not the
-network of the packing's jamming point.
+overlaps there: a network whose jamming point overlaps other pairs is not the network of the
+packing's jamming point (Donev 2006, Sec. 5.6: a missed contact makes spurious floppy modes).
+Such pairs join the network and Newton runs again (an active-set iteration, ``rounds``); the
+result counts the pairs still overlapping (``overlaps``) and those added (``added``).
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ from hardpack.jamming.ellipsoids import (
     contact_hessians,
     contacts_of_pairs,
     dof_per_particle,
+    ellipsoid_contacts,
     rigidity_transpose_full,
     stiffness_matrix_full,
 )
@@ -53,6 +56,10 @@ from hardpack.jamming.second_order import dof_basis, trivial_motions
 
 __all__ = ["Refinement", "refine_jamming_point", "verify_at_jamming_point", "REFINE_STEPS"]
 
+#: pairs within this mu - 1 are searched for overlaps at a network's jamming point
+OVERLAP_SEARCH = 1e-2
+#: pairs within this mu - 1 of touching at a converged jamming point are its contacts
+CONTACT_GAP = 1e-9
 #: Newton steps of :func:`verify_at_jamming_point` (it converges in 3-5 when it converges)
 REFINE_STEPS = 12
 
@@ -82,6 +89,9 @@ class Refinement:
     overlaps : int
         Pairs overlapping by more than the packing's ``overlap_tol`` at the last iterate (pairs of
         the contact network included: they overlap when the iteration did not converge).
+    added : int
+        Contacts added to the network over the rounds (pairs that overlapped at the jamming point
+        of the smaller network).
     """
 
     packing: Packing
@@ -93,6 +103,7 @@ class Refinement:
     size_change: float
     forces: np.ndarray
     overlaps: int
+    added: int = 0
 
 
 def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float) -> Packing:
@@ -110,7 +121,8 @@ def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, facto
                    overlap_tol=packing.overlap_tol, allow_overlap=True)
 
 
-def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: float = 1e-12) -> Refinement:
+def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: float = 1e-12,
+                         rounds: int = 3) -> Refinement:
     """Newton's method to the jamming point of a packing's contact network (module docstring).
 
     Parameters
@@ -125,6 +137,9 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         Newton steps at most.
     tol : float, default 1e-12
         Convergence: max |h_c| / a and |A F| / (|A| |F|) both below it.
+    rounds : int, default 3
+        Newton runs at most: after each converged one, the pairs that overlap at the jamming point
+        of the network join it (with the mean force to start) and Newton runs again.
 
     Returns
     -------
@@ -139,8 +154,9 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     """
     if packing.boundary.kind != "periodic":
         raise InvalidInputError("refine_jamming_point handles periodic packings only (no walls)")
-    if not (isinstance(max_iter, int) and max_iter >= 1):
-        raise InvalidInputError(f"max_iter must be a positive integer, got {max_iter!r}")
+    for name, value in (("max_iter", max_iter), ("rounds", rounds)):
+        if not (isinstance(value, int) and value >= 1):
+            raise InvalidInputError(f"{name} must be a positive integer, got {value!r}")
     if not (np.isfinite(tol) and 0 < tol < 1):
         raise InvalidInputError(f"tol must be in (0, 1), got {tol!r}")
     if result.network.n_particles != packing.n_particles:
@@ -151,16 +167,44 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         raise InvalidInputError("the result has no strictly positive self-stress (not jammed at first order): "
                                 "there is no jamming point of its contacts to refine to")
     active = result.backbone
+    present = active | result.frozen
     used = np.flatnonzero(result.contacts_used)
     net = result.network
     pairs = net.i[used], net.j[used], net.shift[used]
-    d, f = packing.dim, dof_per_particle(packing.dim)
     a = float(np.min(packing.shape.semiaxes))
-    m = len(used)
-    x = wrapped_positions(packing)
-    current, factor = packing, 1.0
+    current, factor, added = packing, 1.0, 0
     gaps, balances, steps = [], [], []
-    converged = False
+    for round_ in range(rounds):
+        current, converged, forces, growth = _newton(current, pairs, forces, active, max_iter, tol, a,
+                                                     gaps, balances, steps)
+        factor *= growth
+        if not converged or round_ == rounds - 1:
+            break
+        # pairs outside the network that overlap at its jamming point join it (active set)
+        near = ellipsoid_contacts(current, OVERLAP_SEARCH)
+        keep = (near.gap <= CONTACT_GAP) & present[near.i] & present[near.j] & (active[near.i] | active[near.j])
+        new = int(keep.sum()) - len(pairs[0])
+        if not (near.gap[keep] < -packing.overlap_tol).any() or new <= 0:
+            break
+        old = {(int(i), int(j)): float(v) for i, j, v in zip(pairs[0], pairs[1], forces)}
+        pairs = near.i[keep], near.j[keep], near.shift[keep]
+        forces = np.array([old.get((int(i), int(j)), float(np.mean(forces))) for i, j in zip(*pairs[:2])])
+        forces *= len(forces) / forces.sum()
+        added += new
+    overlaps = current.overlap_report(packing.overlap_tol).n_overlapping
+    return Refinement(packing=current, converged=converged, iterations=len(steps), gap=np.array(gaps),
+                      balance=np.array(balances), steps=np.array(steps), size_change=factor - 1.0,
+                      forces=forces, overlaps=int(overlaps), added=added)
+
+
+def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, steps):
+    """Newton steps on the KKT equations of the contacts ``pairs`` (module docstring), appending
+    the history to ``gaps``, ``balances``, ``steps``. Returns (packing, converged, forces, growth
+    factor of the semiaxes)."""
+    d, f = current.dim, dof_per_particle(current.dim)
+    m = len(pairs[0])
+    x = wrapped_positions(current)
+    factor = 1.0
     for it in range(max_iter + 1):
         net = contacts_of_pairs(current, *pairs, positions=x)
         t, _ = dof_basis(net, active)
@@ -169,8 +213,7 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         gaps.append(float(np.abs(h).max() / a))
         balances.append(float(np.linalg.norm(at.T @ forces) / (spla.norm(at) * np.linalg.norm(forces))))
         if gaps[-1] <= tol and balances[-1] <= tol:
-            converged = True
-            break
+            return current, True, forces, factor
         if it == max_iter:
             break
         k = (t.T @ stiffness_matrix_full(net, forces, contact_hessians(net)) @ t).tocsr()
@@ -189,15 +232,12 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         if not np.all(np.isfinite(sol)):
             break
         dq, forces, ds = sol[:n], sol[n:n + m], float(sol[n + m])
-        move = (t @ dq).reshape(packing.n_particles, f)
+        move = (t @ dq).reshape(current.n_particles, f)
         steps.append(float(max(np.abs(move[:, :d]).max() / a, np.abs(move[:, d:]).max())))
         x = x + move[:, :d]
         factor *= 1.0 + ds
         current = _turned(current, x, move[:, d:], 1.0 + ds)
-    overlaps = current.overlap_report(packing.overlap_tol).n_overlapping
-    return Refinement(packing=current, converged=converged, iterations=len(steps), gap=np.array(gaps),
-                      balance=np.array(balances), steps=np.array(steps), size_change=factor - 1.0,
-                      forces=forces, overlaps=int(overlaps))
+    return current, False, forces, factor
 
 
 def verify_at_jamming_point(packing: Packing, **options):
@@ -210,8 +250,8 @@ def verify_at_jamming_point(packing: Packing, **options):
     overlapping, tests the refined configuration instead, whose balance A F = 0 is exact to
     round-off. The result's ``params`` say what happened: ``refined`` (1: the verdict is that of
     the jamming point; 0: of the packing as given), ``refine_note``, ``refine_iterations``,
-    ``refine_step`` (the largest Newton step, in smallest semiaxes or radians) and
-    ``refine_size_change``.
+    ``refine_step`` (the largest Newton step, in smallest semiaxes or radians),
+    ``refine_size_change`` and ``refine_added`` (contacts added by the active-set rounds).
 
     Parameters
     ----------
@@ -238,7 +278,7 @@ def verify_at_jamming_point(packing: Packing, **options):
     if note is None:
         ref = refine_jamming_point(packing, result, max_iter=REFINE_STEPS)
         info = dict(refine_iterations=ref.iterations, refine_step=float(ref.steps.max(initial=0.0)),
-                    refine_size_change=ref.size_change)
+                    refine_size_change=ref.size_change, refine_added=ref.added)
         if ref.converged and not ref.overlaps:
             refined = verify_ellipsoids(ref.packing, **options)
             same = (refined.collective.n_constraints == dec.n_constraints
@@ -246,6 +286,8 @@ def verify_at_jamming_point(packing: Packing, **options):
             refined.params.update(refined=1, refine_note=(
                 f"the jamming point of the contacts: Newton converged in {ref.iterations} steps "
                 f"(largest {info['refine_step']:.3g}), gaps {ref.gap[-1]:.2g}, balance {ref.balance[-1]:.2g}"
+                + (f"; {ref.added} pair(s) that overlapped at the jamming point of the packing's contacts "
+                   "joined them" if ref.added else "")
                 + ("" if same else f"; the test there found {refined.collective.n_constraints} backbone contacts "
                    f"and {int(refined.rattler.sum())} rattlers (before: {dec.n_constraints}, "
                    f"{int(result.rattler.sum())})")), **info)
