@@ -163,7 +163,9 @@ def test_verdict_fractions_per_shape():
         pytest.approx((1 / 3, 1 / 3, 1 / 3))
     assert float(first.z_backbone) == pytest.approx(9.5) and float(first.z_backbone_err) == pytest.approx(0.5 / 3**0.5)
     assert float(first.rattler_fraction) == pytest.approx(0.1)
-    assert np.isnan(float(out.isel(shape=1).z_backbone_err))
+    assert np.isnan(float(out.isel(shape=1).z_backbone_err)) and np.isnan(float(first.fraction_refined))
+    refined = verdict_fractions(summary.assign(refined=("sample", [1, 0, 0, 1])))
+    assert float(refined.isel(shape=0).fraction_refined) == pytest.approx(1 / 3)
 
 
 @pytest.mark.parametrize("name", ["mm_n80_seed1_slow_p1e12", "self_dual_a1.05_n100_slow_p1e12"])

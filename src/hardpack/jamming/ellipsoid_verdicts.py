@@ -3,7 +3,8 @@
 Input: the verdicts of :func:`hardpack.jamming.second_order.verify_ellipsoids` combined over the
 packings (``hardpack combine --index beta alpha seed``), one sample per packing with the variables
 ``jammed`` (1/0), ``order_code`` (:data:`~hardpack.jamming.second_order.ORDER_CODES`: 1 first,
-2 second, 0 undetermined), ``hypostatic``, ``z_mean`` (backbone) and ``rattler_fraction``.
+2 second, 0 undetermined), ``hypostatic``, ``z_mean`` (backbone) and ``rattler_fraction``, and
+optionally ``refined`` (1: tested at the jamming point of its contacts, :mod:`hardpack.jamming.refine`).
 """
 
 from __future__ import annotations
@@ -31,14 +32,15 @@ def verdict_fractions(summary: xr.Dataset) -> xr.Dataset:
         Dimension ``shape`` with coordinates ``beta``, ``alpha`` and the variables ``n_packings``,
         ``fraction_jammed``, ``fraction_first``, ``fraction_second``, ``fraction_undetermined``,
         ``fraction_hypostatic``, ``z_backbone``, ``z_backbone_err`` (standard error over the
-        packings, NaN for one), ``rattler_fraction``.
+        packings, NaN for one), ``rattler_fraction``, ``fraction_refined`` (NaN without
+        ``refined`` in the summary).
     """
     beta = np.round(np.asarray(summary["beta"].values, float), 12)
     alpha = np.round(np.asarray(summary["alpha"].values, float), 12)
     keys = sorted(set(zip(beta.tolist(), alpha.tolist())))
     rows = {name: [] for name in ("n_packings", "fraction_jammed", "fraction_first", "fraction_second",
                                   "fraction_undetermined", "fraction_hypostatic", "z_backbone",
-                                  "z_backbone_err", "rattler_fraction")}
+                                  "z_backbone_err", "rattler_fraction", "fraction_refined")}
 
     def values(name, mask):
         return np.asarray(summary[name].values, float)[mask]
@@ -58,6 +60,8 @@ def verdict_fractions(summary: xr.Dataset) -> xr.Dataset:
         rows["z_backbone_err"].append(float(finite.std(ddof=1) / np.sqrt(finite.size)) if finite.size > 1
                                       else float("nan"))
         rows["rattler_fraction"].append(float(values("rattler_fraction", mask).mean()))
+        rows["fraction_refined"].append(float(values("refined", mask).mean()) if "refined" in summary
+                                        else float("nan"))
     coords = {"beta": ("shape", [k[0] for k in keys]), "alpha": ("shape", [k[1] for k in keys])}
     return xr.Dataset({name: ("shape", np.asarray(v)) for name, v in rows.items()}, coords=coords,
                       attrs={"hardpack_kind": "ellipsoid_verdict_fractions"})
