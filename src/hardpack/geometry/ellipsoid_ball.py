@@ -42,6 +42,8 @@ from hardpack.geometry.ellipsoid_container import farthest_point_body
 
 #: relative size of the stand-in for an exactly zero component of the disk centre (module docstring)
 TINY = 1e-30
+#: points of the range of slices where their configuration is sampled (3D)
+SAMPLES = 16
 #: default accuracy of the 3D volume, relative to the ellipsoid's volume
 TOLERANCE = 1e-10
 
@@ -156,10 +158,19 @@ def _excess(t, p, q, u, v, r2):
 def ellipse_disk_area(p, q, u, v, r):
     """Area of the ellipse x^2 / p^2 + y^2 / q^2 <= 1 intersected with the disk of radius r about
     (u, v), in closed form to round-off (module docstring)."""
+    return _ellipse_disk(p, q, u, v, r)[0]
+
+
+@njit(cache=True)
+def _ellipse_disk(p, q, u, v, r):
+    """The area of :func:`ellipse_disk_area` and the configuration: 0 disjoint, 1 the ellipse in the
+    disk, 2 the disk in the ellipse, 10 + n when the circle crosses the ellipse at n points."""
     if r <= 0.0 or p <= 0.0 or q <= 0.0:
-        return 0.0
-    if p == q:
-        return lens_area(p, r, np.hypot(u, v))
+        return 0.0, 0
+    if abs(p - q) <= 1e-14 * max(p, q):
+        rad, dist = np.sqrt(p * q), np.hypot(u, v)
+        state = 0 if dist >= rad + r else (12 if dist > abs(rad - r) else (1 if rad <= r else 2))
+        return lens_area(rad, r, dist), state
     r2 = r * r
     stat = np.empty(4)
     ns = _stationary_angles(p, q, u, v, stat)
@@ -197,11 +208,11 @@ def ellipse_disk_area(p, q, u, v, r):
             nr += 1
     if nr < 2:
         if _excess(0.0, p, q, u, v, r2) <= 0.0:  # a point of the ellipse in the disk: the ellipse inside
-            return np.pi * p * q
+            return np.pi * p * q, 1
         x, y = (u + r) / p, v / q
         if x * x + y * y <= 1.0:  # a point of the circle in the ellipse: the disk inside
-            return np.pi * r2
-        return 0.0
+            return np.pi * r2, 2
+        return 0.0, 0
     for k in range(nr):
         roots[k] = roots[k] % (2.0 * np.pi)
     roots[:nr] = np.sort(roots[:nr])
@@ -221,79 +232,185 @@ def ellipse_disk_area(p, q, u, v, r):
         x, y = (u + r * np.cos(fm)) / p, (v + r * np.sin(fm)) / q
         if x * x + y * y < 1.0:
             area += 0.5 * (r2 * (f1 - f0) + u * r * (np.sin(f1) - np.sin(f0)) - v * r * (np.cos(f1) - np.cos(f0)))
-    return area
+    return area, 10 + nr
 
 
 @njit(cache=True)
-def _dual_min(t, a, b, r, k):
-    """D(t): the minimum of x_k over (1 - t) (x^T diag(a^-2) x - 1) + t (|x - b|^2 - r^2) <= 0
-    (+inf when empty); a lower bound of min x_k over the ellipsoid ∩ ball (module docstring)."""
+def _dual_min(t, a, b, r, n):
+    """D(t): the minimum of n.x over (1 - t) (x^T diag(a^-2) x - 1) + t (|x - b|^2 - r^2) <= 0
+    (+inf when empty); a lower bound of min n.x over the ellipsoid ∩ ball (module docstring)."""
     rho2 = (1.0 - t) - t * (np.dot(b, b) - r * r)
     x0 = 0.0
-    mk = 1.0
+    spread = 0.0
     for i in range(a.shape[0]):
         m = (1.0 - t) / (a[i] * a[i]) + t
         rho2 += t * t * b[i] * b[i] / m
-        if i == k:
-            x0, mk = t * b[i] / m, m
+        x0 += n[i] * t * b[i] / m
+        spread += n[i] * n[i] / m
     if rho2 < 0.0:
         return np.inf
-    return x0 - np.sqrt(rho2 / mk)
+    return x0 - np.sqrt(rho2 * spread)
 
 
 @njit(cache=True)
-def intersection_extent(a, b, r, k):
-    """min x_k over the ellipsoid sum x_i^2 / a_i^2 <= 1 intersected with the ball |x - b| <= r:
+def intersection_extent(a, b, r, n):
+    """min n.x over the ellipsoid sum x_i^2 / a_i^2 <= 1 intersected with the ball |x - b| <= r:
     the maximum over t in [0, 1] of the quasi-concave D(t), by golden section (module docstring);
     +inf (or a value above the ellipsoid's) when they do not meet."""
     g = 0.5 * (np.sqrt(5.0) - 1.0)
     lo, hi = 0.0, 1.0
     x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
-    f1, f2 = _dual_min(x1, a, b, r, k), _dual_min(x2, a, b, r, k)
-    best = max(_dual_min(0.0, a, b, r, k), _dual_min(1.0, a, b, r, k))
+    f1, f2 = _dual_min(x1, a, b, r, n), _dual_min(x2, a, b, r, n)
+    best = max(_dual_min(0.0, a, b, r, n), _dual_min(1.0, a, b, r, n))
     for _ in range(90):
         if f1 < f2:
             lo, x1, f1 = x1, x2, f2
             x2 = lo + g * (hi - lo)
-            f2 = _dual_min(x2, a, b, r, k)
+            f2 = _dual_min(x2, a, b, r, n)
         else:
             hi, x2, f2 = x2, x1, f1
             x1 = hi - g * (hi - lo)
-            f1 = _dual_min(x1, a, b, r, k)
+            f1 = _dual_min(x1, a, b, r, n)
     return max(best, f1, f2)
 
 
 @njit(cache=True)
-def _slice_area(z, a, b, r, k, i, j):
-    w = 1.0 - (z / a[k]) ** 2
-    dz = z - b[k]
-    rr = r * r - dz * dz
-    if w <= 0.0 or rr <= 0.0:
-        return 0.0
-    sw = np.sqrt(w)
-    return ellipse_disk_area(a[i] * sw, a[j] * sw, b[i], b[j], np.sqrt(rr))
-
-
-@njit(cache=True, inline="always")
-def _integrand(s, zlo, span, a, b, r, k, i, j):
-    z = zlo + span * 0.5 * (1.0 - np.cos(np.pi * s))
-    return _slice_area(z, a, b, r, k, i, j) * span * 0.5 * np.pi * np.sin(np.pi * s)
+def nearest_direction(a, b):
+    """Unit vector from b to its nearest point on the ellipsoid's surface (body frame): the root
+    mu < a_min^2 of sum_k a_k^2 b_k^2 / (a_k^2 - mu)^2 = 1 (Eberly 2011, "Distance from a point to
+    an ellipse, an ellipsoid, or a hyperellipsoid", Sec. 3), x_k = a_k^2 b_k / (a_k^2 - mu), by
+    geometric bisection in u = a_min^2 - mu; zero components of b as in :func:`_stationary_angles`."""
+    d = a.shape[0]
+    size = a.max()
+    a2min = a.min() ** 2
+    bb = b.copy()
+    w = np.empty(d)
+    wsum = 0.0
+    wmin = 0.0
+    for k in range(d):
+        if abs(bb[k]) < TINY * size:
+            bb[k] = TINY * size
+        w[k] = a[k] * a[k] * bb[k] * bb[k]
+        wsum += w[k]
+        if a[k] * a[k] == a2min:
+            wmin += w[k]
+    lo, hi = np.sqrt(wmin), np.sqrt(wsum)
+    for _ in range(200):
+        mid = np.sqrt(lo * hi)
+        h = 0.0
+        for k in range(d):
+            den = a[k] * a[k] - a2min + mid
+            h += w[k] / (den * den)
+        if h > 1.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-15 * hi:
+            break
+    u = np.sqrt(lo * hi)
+    n = np.empty(d)
+    norm = 0.0
+    for k in range(d):
+        n[k] = a[k] * a[k] * bb[k] / (a[k] * a[k] - a2min + u) - b[k]
+        norm += n[k] * n[k]
+    if norm == 0.0:  # b on the surface: the outward normal
+        for k in range(d):
+            n[k] = b[k] / (a[k] * a[k])
+            norm += n[k] * n[k]
+    return n / np.sqrt(norm)
 
 
 @njit(cache=True)
-def _gk15(s0, s1, zlo, span, a, b, r, k, i, j):
-    """Kronrod and Gauss estimates of int A(z(s)) z'(s) ds over [s0, s1]."""
-    c, h = 0.5 * (s0 + s1), 0.5 * (s1 - s0)
-    fc = _integrand(c, zlo, span, a, b, r, k, i, j)
+def _slice_area(z, geo):
+    """Area of the slice n.x = z of the ellipsoid ∩ ball; ``geo`` (module docstring): h^2, p0, q0,
+    the in-plane shift of the ellipse's centre per unit z (2, principal frame), the ball's in-plane
+    centre (2, principal frame), n.b, r."""
+    h2, p0, q0, sx, sy, bx, by, nb, r = geo[0], geo[1], geo[2], geo[3], geo[4], geo[5], geo[6], geo[7], geo[8]
+    w = 1.0 - z * z / h2
+    dz = z - nb
+    rr = r * r - dz * dz
+    if w <= 0.0 or rr <= 0.0:
+        return 0.0, 0
+    sw = np.sqrt(w)
+    return _ellipse_disk(p0 * sw, q0 * sw, bx - z * sx, by - z * sy, np.sqrt(rr))
+
+
+@njit(cache=True, inline="always")
+def _z_of(s, zlo, span):
+    return zlo + span * 0.5 * (1.0 - np.cos(np.pi * s))
+
+
+@njit(cache=True, inline="always")
+def _integrand(t, sa, sb, zlo, span, geo):
+    """A(z) dz/dt: z(s) maps [0, 1] to the range, s(t) = sa + (sb - sa)(1 - cos pi t) / 2 a piece."""
+    s = sa + (sb - sa) * 0.5 * (1.0 - np.cos(np.pi * t))
+    ds = (sb - sa) * 0.5 * np.pi * np.sin(np.pi * t)
+    return _slice_area(_z_of(s, zlo, span), geo)[0] * span * 0.5 * np.pi * np.sin(np.pi * s) * ds
+
+
+@njit(cache=True)
+def _gk15(t0, t1, sa, sb, zlo, span, geo):
+    """Kronrod and Gauss estimates of the integral over [t0, t1] of a piece [sa, sb]."""
+    c, h = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
+    fc = _integrand(c, sa, sb, zlo, span, geo)
     kron = _WGK[7] * fc
     gauss = _WG[3] * fc
     for m in range(7):
-        f = (_integrand(c - h * _XGK[m], zlo, span, a, b, r, k, i, j)
-             + _integrand(c + h * _XGK[m], zlo, span, a, b, r, k, i, j))
+        f = (_integrand(c - h * _XGK[m], sa, sb, zlo, span, geo)
+             + _integrand(c + h * _XGK[m], sa, sb, zlo, span, geo))
         kron += _WGK[m] * f
         if m % 2 == 1:
             gauss += _WG[m // 2] * f
     return kron * h, gauss * h
+
+
+@njit(cache=True)
+def _piece(sa, sb, zlo, span, geo, budget):
+    """Adaptive Gauss-Kronrod over one piece, each interval accepted at its share of the budget."""
+    stack = np.empty((256, 2))
+    stack[0, 0], stack[0, 1] = 0.0, 1.0
+    top = 1
+    total = 0.0
+    while top > 0:
+        top -= 1
+        t0, t1 = stack[top, 0], stack[top, 1]
+        kron, gauss = _gk15(t0, t1, sa, sb, zlo, span, geo)
+        if abs(kron - gauss) <= budget * (t1 - t0) or t1 - t0 < 1e-12 or top >= 254:
+            total += kron
+        else:
+            mid = 0.5 * (t0 + t1)
+            stack[top, 0], stack[top, 1] = t0, mid
+            stack[top + 1, 0], stack[top + 1, 1] = mid, t1
+            top += 2
+    return total
+
+
+@njit(cache=True)
+def _slice_geometry(a, b, r, n):
+    """The constants of :func:`_slice_area` for slices normal to the unit vector n."""
+    # an orthonormal basis e1, e2 of the plane normal to n
+    k = np.argmin(np.abs(n))
+    e1 = np.zeros(3)
+    e1[k] = 1.0
+    e1 -= np.dot(e1, n) * n
+    e1 /= np.sqrt(np.dot(e1, e1))
+    e2 = np.cross(n, e1)
+    inv = 1.0 / (a * a)
+    pxx, pyy, pxy = np.sum(inv * e1 * e1), np.sum(inv * e2 * e2), np.sum(inv * e1 * e2)
+    # eigenvectors of the in-plane matrix [[pxx, pxy], [pxy, pyy]]
+    ang = 0.5 * np.arctan2(2.0 * pxy, pxx - pyy)
+    c, s = np.cos(ang), np.sin(ang)
+    f1 = c * e1 + s * e2
+    f2 = -s * e1 + c * e2
+    m1, m2 = np.sum(inv * f1 * f1), np.sum(inv * f2 * f2)
+    h2 = np.sum(a * a * n * n)
+    shift = a * a * n / h2 - n  # in-plane shift of the ellipse's centre per unit z
+    geo = np.empty(9)
+    geo[0], geo[1], geo[2] = h2, 1.0 / np.sqrt(m1), 1.0 / np.sqrt(m2)
+    geo[3], geo[4] = np.dot(shift, f1), np.dot(shift, f2)
+    geo[5], geo[6] = np.dot(b, f1), np.dot(b, f2)
+    geo[7], geo[8] = np.dot(b, n), r
+    return geo
 
 
 @njit(cache=True)
@@ -306,36 +423,49 @@ def ellipsoid_ball_volume(a, b, r, tol):
         return 0.0
     if d == 2:
         return ellipse_disk_area(a[0], a[1], b[0], b[1], r)
-    k = 2
-    if a[0] == a[2]:
-        k = 1
-    elif a[1] == a[2] and a[0] != a[1]:
-        k = 0
-    i, j = (1, 2) if k == 0 else ((0, 2) if k == 1 else (0, 1))
-    zlo = intersection_extent(a, b, r, k)
-    bm = b.copy()
-    bm[k] = -b[k]
-    zhi = -intersection_extent(a, bm, r, k)
-    zlo, zhi = max(zlo, -a[k], b[k] - r), min(zhi, a[k], b[k] + r)
+    n = nearest_direction(a, b)
+    zlo = intersection_extent(a, b, r, n)
+    zhi = -intersection_extent(a, b, r, -n)
+    h = np.sqrt(np.sum(a * a * n * n))
+    nb = np.dot(n, b)
+    zlo, zhi = max(zlo, -h, nb - r), min(zhi, h, nb + r)
     if not zlo < zhi:
         return 0.0
+    geo = _slice_geometry(a, b, r, n)
     span = zhi - zlo
     budget = tol * 4.0 / 3.0 * np.pi * a[0] * a[1] * a[2]
-    stack = np.empty((256, 2))
-    stack[0, 0], stack[0, 1] = 0.0, 1.0
-    top = 1
+    # the pieces: between the changes of the slice's configuration seen on SAMPLES points, located
+    # by bisection to round-off
+    breaks = np.empty(4 * SAMPLES + 2)
+    nb_ = 1
+    breaks[0] = 0.0
+    prev = _slice_area(_z_of(0.0, zlo, span), geo)[1]
+    for k in range(1, SAMPLES + 1):
+        s1 = k / SAMPLES
+        end = _slice_area(_z_of(s1, zlo, span), geo)[1]
+        lo, state = (k - 1) / SAMPLES, prev
+        for _ in range(4):
+            if state == end:
+                break
+            hi = s1
+            for _ in range(45):  # to 2^-45 of the sample spacing
+                mid = 0.5 * (lo + hi)
+                if mid <= lo or mid >= hi:
+                    break
+                if _slice_area(_z_of(mid, zlo, span), geo)[1] == state:
+                    lo = mid
+                else:
+                    hi = mid
+            if nb_ < breaks.shape[0] - 1:
+                breaks[nb_] = hi
+                nb_ += 1
+            lo, state = hi, _slice_area(_z_of(hi, zlo, span), geo)[1]
+        prev = end
+    breaks[nb_] = 1.0
     total = 0.0
-    while top > 0:
-        top -= 1
-        s0, s1 = stack[top, 0], stack[top, 1]
-        kron, gauss = _gk15(s0, s1, zlo, span, a, b, r, k, i, j)
-        if abs(kron - gauss) <= budget * (s1 - s0) or s1 - s0 < 1e-12 or top >= 254:
-            total += kron
-        else:
-            mid = 0.5 * (s0 + s1)
-            stack[top, 0], stack[top, 1] = s0, mid
-            stack[top + 1, 0], stack[top + 1, 1] = mid, s1
-            top += 2
+    for k in range(nb_):
+        if breaks[k + 1] > breaks[k]:
+            total += _piece(breaks[k], breaks[k + 1], zlo, span, geo, budget * (breaks[k + 1] - breaks[k]))
     return total
 
 
@@ -357,8 +487,8 @@ def covered_volumes(positions, semiaxes, rotations, centre, radii, tol):
         a = semiaxes[p]
         for m in range(d):
             s = 0.0
-            for l in range(d):
-                s += rotations[p, m, l] * (positions[p, l] - centre[l])
+            for j in range(d):
+                s += rotations[p, m, j] * (positions[p, j] - centre[j])
             rel[m] = s
             ball[m] = -s
         dist = np.sqrt(np.dot(rel, rel))
