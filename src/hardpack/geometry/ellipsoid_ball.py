@@ -18,19 +18,23 @@ pole, so that the point keeps its relative precision; a zero component of c is r
 times the ellipse size (an exact symmetric centre has infinitely many normals otherwise), which moves
 nothing measurable. Equal semiaxes (a circle) take the disk-disk lens.
 
-**3D, slices.** V = int A(z) dz over slices normal to a body axis e_k, A(z) the 2D area of the slice
-ellipse (semiaxes a_i (1 - z^2 / a_k^2)^(1/2), centred on the axis) with the slice disk (centre
-(b_i, b_j), radius (r^2 - (z - b_k)^2)^(1/2)). The axis is that of the distinct semiaxis of a
-spheroid (circular slices: the lens formula), else e_3. The range of z is the exact extent of the
-convex body K = E ∩ B along e_k: min x_k over K equals max_t D(t) (Lagrange duality of this convex
-problem with two quadratic constraints), D(t) the minimum of x_k over the ellipsoid
-(1 - t) g_E(x) + t g_B(x) <= 0 (closed form: its matrix (1 - t) diag(a^-2) + t I is diagonal);
-D is quasi-concave (its superlevel sets are the angles of rays meeting a convex set), so golden
-section finds the maximum, and every D(t) is a lower bound (weak duality). On that range A(z) is
-continuous (sqrt A is concave, Brunn-Minkowski) and smooth except where the slice circle is tangent
-to the slice ellipse ((z - z*)^(3/2) terms); the integral is taken by adaptive Gauss-Kronrod
-(7-15 points) in s with z = z_lo + (z_hi - z_lo)(1 - cos pi s) / 2, which makes the end behaviour
-polynomial, each interval accepted when |K15 - G7| <= tol V_E (its share of [0, 1]).
+**3D, slices.** V = int A(z) dz over the slices n.x = z, n the unit vector from b to its nearest
+point on the ellipsoid (near-tangent contacts then sit at the ends of the range). A slice of the
+ellipsoid is the ellipse y^T X_P y <= 1 - z^2 / h^2 (X_P = diag(a^-2) restricted to the plane,
+h^2 = n^T diag(a^2) n) centred at z diag(a^2) n / h^2; the slice of the ball is the disk of radius
+(r^2 - (z - n.b)^2)^(1/2) about the projection of b; A(z) is their exact 2D area. The range of z is
+the exact extent of the convex body K = E ∩ B along n: min n.x over K equals max_t D(t) (Lagrange
+duality of this convex problem with two quadratic constraints), D(t) the minimum of n.x over the
+ellipsoid (1 - t) g_E(x) + t g_B(x) <= 0 (closed form: its matrix (1 - t) diag(a^-2) + t I is
+diagonal); D is quasi-concave (its superlevel sets are the angles of rays meeting a convex set),
+so golden section finds the maximum, and every D(t) is a lower bound (weak duality). On that range
+A(z) is continuous (sqrt A is concave, Brunn-Minkowski) and smooth except where the configuration
+of the slice changes (the circle tangent to the ellipse, or, for coaxial circles, crossing it all
+at once): the configuration (disjoint, one inside the other, or the number of crossings) is
+sampled at SAMPLES points of the range and every change located by bisection; each piece is
+integrated by adaptive Gauss-Kronrod (7-15 points) after the substitution
+z = z_0 + (z_1 - z_0)(1 - cos pi t) / 2, which makes the end behaviour polynomial, an interval
+accepted when |K15 - G7| <= tol V_E times its share of the range.
 """
 
 from __future__ import annotations
