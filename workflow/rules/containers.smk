@@ -195,8 +195,8 @@ rule fig_container_windows:
 
 # Ellipsoids in spherical containers (Donev 2006, Sec. 7.3.2.1 and Fig. 7.6), one ensemble per shape
 # (M&M spheroids, ollipsoids): a dilute random start inside the container, LS compression by the
-# generic compress job, the radial density profile and core density of each packing (the
-# tangent-plane approximation of Sec. 7.3.1.2), the Eq. 7.2 extrapolation of the average density
+# generic compress job, the radial density profile and core density of each packing (exact
+# ellipsoid-ball intersection volumes), the Eq. 7.2 extrapolation of the average density
 # over (N, seed), and the profiles of the largest containers after Fig. 7.5.
 
 
@@ -227,7 +227,7 @@ rule ellipsoid_container_init:
 
 
 rule ellipsoid_container_profile:
-    """phi(r) in shells of shell_width a (tangent-plane approximation), the average density, a/R
+    """phi(r) in shells of shell_width a (exact intersection volumes), the average density, a/R
     and the core density (r <= R - core_margin a) of one jammed ellipsoid packing in a container."""
     input:
         "results/ellipsoid_containers/{name}/jammed/seed{seed}.nc",

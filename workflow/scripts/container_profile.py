@@ -1,6 +1,6 @@
 """Snakemake script: radial density profile phi(r), average density, a/R and core density of one
 jammed packing in a spherical container (Donev 2006, Sec. 7.3, Figs. 7.5-7.6): exact for spheres,
-the tangent-plane approximation for ellipsoids."""
+exact to 1e-10 of a particle's volume for ellipsoids."""
 
 import logging
 import math

@@ -43,11 +43,10 @@ def plot_radial_profile(profiles):
 
 def plot_ellipsoid_radial_profiles(profiles):
     """phi(r) of ellipsoids in spherical containers against the distance from the wall (R - r) / a,
-    one panel per shape (after Donev 2006, Fig. 7.5): each packing's profile (tangent-plane
-    approximation, Sec. 7.3.1.2), its core density (dotted) and core average phi_avg(r) =
-    3 int_0^r x^2 phi dx / r^3 (thin dashed, Sec. 7.3.2.3), Donev's bulk density of the shape
-    (Sec. 7.3.2.1: 0.700 for the M&M and 0.741 for the ollipsoid shape, dashed), and, shaded, the
-    centre r < 2a where the tangent plane is a poor stand-in for the ball.
+    one panel per shape (after Donev 2006, Fig. 7.5): each packing's profile (exact
+    intersection volumes), its core density (dotted) and core average phi_avg(r) =
+    3 int_0^r x^2 phi dx / r^3 (thin dashed, Sec. 7.3.2.3) and Donev's bulk density of the shape
+    (Sec. 7.3.2.1: 0.700 for the M&M and 0.741 for the ollipsoid shape, dashed).
 
     Parameters
     ----------
@@ -69,8 +68,6 @@ def plot_ellipsoid_radial_profiles(profiles):
         label, published, _ = DONEV_ELLIPSOID_PHI0.get(name, (name, np.nan, np.nan))
         if np.isfinite(published):
             ax.axhline(published, color="k", ls="--", lw=1, label=rf"Donev 2006: $\phi_0$ = {published:.3f}")
-        centre = max(p.attrs["radius"] / p.attrs["a"] for p in group)
-        ax.axvspan(centre - 2, centre, color="0.85", lw=0, label="r < 2a (tangent plane poor)")
         ax.set_title(label, fontsize=9)
         ax.legend(fontsize=6, loc="lower right")
     return fig

@@ -11,10 +11,10 @@
 - :func:`core_density`, :func:`container_summary`: the per-packing numbers of a container study
   (average density, delta = a / R, the density of the core away from the wall) over (N, seed),
   with the Eq. 7.2 extrapolation.
-- :func:`ellipsoid_radial_density_profile`: phi(r) of ellipsoids by the tangent-plane
-  approximation of the footnote to Sec. 7.3.1.2 (each particle cut by the plane tangent to the
-  ball along its radial direction, exact in closed form: :func:`half_space_fraction`), with its
-  error bounds; :func:`core_density` uses it for ellipsoids.
+- :func:`ellipsoid_radial_density_profile`: phi(r) of ellipsoids (ellipses), exact to a stated
+  tolerance: each particle contributes its intersection volume with the ball of radius r
+  (:func:`hardpack.geometry.ellipsoid_ball.ellipsoid_ball_volume`); :func:`core_density` uses it
+  for ellipsoids.
 - :func:`ellipsoid_container_summary`: the same extrapolation for ellipsoids in containers (the
   M&M-shaped spheroids of Sec. 7.3.2.1), from the packings' average densities, with their core
   densities when given their profiles.
@@ -37,6 +37,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import ball_volume
+from hardpack.geometry.ellipsoid_ball import TOLERANCE, covered_volumes
 
 
 def ball_intersection_volume(big, small, dist, d: int = 3) -> np.ndarray:
@@ -298,9 +299,8 @@ def core_density(packing, margin: float) -> float:
     -------
     float
         The covered fraction of the core ball: exact sphere-ball intersections for spheres, the
-        tangent-plane approximation of :func:`ellipsoid_radial_density_profile` for ellipsoids
-        (an upper bound, too high by about (3/5) phi (a/r)^2 in a uniform core of radius r, e.g.
-        0.004 for phi = 0.7 and r = 8a).
+        ellipsoid-ball intersection volumes of :func:`ellipsoid_radial_density_profile` for
+        ellipsoids (each to 1e-10 of its particle's volume).
 
     Raises
     ------
@@ -319,7 +319,7 @@ def core_density(packing, margin: float) -> float:
         raise InvalidInputError(f"core margin {margin!r} (in units of a = {a:.4g}) must be >= 0 and leave a "
                                 f"core inside the container of radius {packing.boundary.radius:.4g}")
     if packing.shape.kind == "ellipsoid":
-        return float(_tangent_plane_covered(packing, [radius])[0][0] / ball_volume(radius, packing.dim))
+        return float(_covered(packing, [radius])[0] / ball_volume(radius, packing.dim))
     dist = np.linalg.norm(packing.positions - np.asarray(packing.boundary.centre), axis=1)
     covered = ball_intersection_volume(radius, packing.radii, dist, packing.dim).sum()
     return float(covered / ball_volume(radius, packing.dim))
@@ -681,36 +681,6 @@ def _profile_core(profile: xr.Dataset, n: int, seed: int) -> tuple[float, float]
     return float(profile.attrs["phi_core"]), wall_layer_density(profile)
 
 
-def half_space_fraction(u, d: int = 3) -> np.ndarray:
-    """Fraction of an ellipsoid (d = 3) or ellipse (d = 2) on the near side n.x <= s + u h of a
-    plane, for the plane at u half-widths h from its centre (u clipped to [-1, 1]).
-
-    The affine map that makes the ellipsoid a unit ball keeps volume fractions and takes the plane
-    at signed distance u h from the centre along n, with h = sqrt(n^T Q^T O^2 Q n) the support
-    function (the half-width along n), to the plane at distance u from the ball's centre: the
-    fraction is the unit ball's, 1 minus the cap above height u, (1 + u)^2 (2 - u) / 4 in 3D and
-    (pi / 2 + arcsin u + u sqrt(1 - u^2)) / pi in 2D.
-
-    Parameters
-    ----------
-    u : array_like
-        Signed distance of the plane from the centre in half-widths.
-    d : int, default 3
-        Dimension, 2 or 3.
-
-    Returns
-    -------
-    numpy.ndarray
-        The fractions, 0 for u <= -1 and 1 for u >= 1.
-    """
-    u = np.clip(np.asarray(u, float), -1.0, 1.0)
-    if d == 3:
-        return (1.0 + u) ** 2 * (2.0 - u) / 4.0
-    if d == 2:
-        return (np.pi / 2 + np.arcsin(u) + u * np.sqrt(1.0 - u * u)) / np.pi
-    raise InvalidInputError(f"half-space fractions are implemented for d = 2 and 3, got d = {d}")
-
-
 def _ellipsoid_container_check(packing, user: str) -> None:
     if packing.shape.kind != "ellipsoid" or packing.boundary.kind != "spherical_container":
         raise InvalidInputError(f"{user} handles ellipsoids (d = 2 or 3) in a spherical container, got "
@@ -720,74 +690,29 @@ def _ellipsoid_container_check(packing, user: str) -> None:
         raise InvalidInputError(f"{user}: the packing has non-finite positions or semiaxes")
 
 
-def _tangent_plane_covered(packing, radii) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Covered volume inside the balls of ``radii`` about the container centre: the tangent-plane
-    value capped by the ball's volume (an upper bound), a lower bound, and where the cap acted
-    (:func:`ellipsoid_radial_density_profile`)."""
-    d = packing.dim
+def _covered(packing, radii) -> np.ndarray:
+    """Volume of the particles inside each ball of ``radii`` about the container centre."""
     shape = packing.shape
-    rel = packing.positions - np.asarray(packing.boundary.centre)
-    dist = np.linalg.norm(rel, axis=1)
-    normal = np.zeros_like(rel)
-    normal[:, 0] = 1.0  # a particle centred in the container: any direction (the ball bound rules there)
-    moved = dist > 0
-    normal[moved] = rel[moved] / dist[moved, None]
-    body = np.einsum("nij,nj->ni", shape.rotations(), normal)
-    half = np.sqrt(np.einsum("ni,ni->n", shape.semiaxes**2, body**2))
-    reach = shape.semiaxes.max(axis=1)
-    volume = shape.volumes(d)
-    r = np.asarray(radii, float)[:, None]
-    upper = (volume * half_space_fraction((r - dist) / half, d)).sum(axis=1)
-    # the ball r contains the particle's part below the plane n.x = r - t, t the sagitta of the
-    # ball over the particle's widest reach a_max, when that part lies within a_max of the axis
-    # and no farther than r - t behind the centre; and the whole particle when dist + a_max <= r
-    with np.errstate(invalid="ignore"):
-        sag = r - np.sqrt(np.maximum(r * r - reach * reach, 0.0))
-    usable = (r > reach) & (half - dist <= r - sag)
-    below = np.where(usable, volume * half_space_fraction((r - sag - dist) / half, d), 0.0)
-    lower = np.maximum(below, np.where(dist + reach <= r, volume, 0.0)).sum(axis=1)
-    ball = ball_volume(np.asarray(radii, float), d)
-    return np.minimum(upper, ball), lower, upper > ball
+    covered, _ = covered_volumes(np.ascontiguousarray(packing.positions, dtype=float),
+                                 np.ascontiguousarray(shape.semiaxes, dtype=float),
+                                 np.ascontiguousarray(shape.rotations(), dtype=float),
+                                 np.asarray(packing.boundary.centre, dtype=float),
+                                 np.ascontiguousarray(radii, dtype=float), TOLERANCE)
+    return covered
 
 
 def ellipsoid_radial_density_profile(packing, n_shells: int = 200) -> xr.Dataset:
-    """phi(r) of ellipsoids (or ellipses) about the centre of their spherical container, by the
-    tangent-plane approximation of Donev 2006, Sec. 7.3.1.2 (Fig. 7.5 and its footnote).
+    """phi(r) of ellipsoids (or ellipses) about the centre of their spherical container (Donev 2006,
+    Sec. 7.3.1.2, Fig. 7.5), from exact intersection volumes.
 
-    The covered volume inside the ball of radius r is the sum over particles of the part of each
-    particle on the near side of the plane tangent to the ball at the point where the ray from the
-    container centre through the particle's centre meets it (the plane n.x = r, n the unit radial
-    direction of the centre): with s the centre's distance and h = sqrt(n^T Q^T O^2 Q n) the
-    particle's half-width along n, that part is V F((r - s) / h) exactly
-    (:func:`half_space_fraction`). phi of the shell [r_k, r_k+1] is the difference of the covered
-    volumes over the shell's volume. The covered volume is capped by the ball's volume (the
-    half-space holds the ball, so the plane value is an upper bound of the true one; the cap
-    acts near the centre only, r below about one particle size, and ``ball_bound_radius`` records
-    the largest radius where it acted). A particle centred exactly in the container takes n = e_1.
-
-    Approximation and its error. The plane value exceeds the true covered volume by the particle
-    volume between the plane and the sphere, about the cut section times the sagitta rho^2 / 2r: for
-    a sphere of radius a cut through its centre, (3/16)(a/r) of its volume, and pi (a^2 - z^2)^2 /
-    4r when cut at z from its centre (to first order in a/r). The output brackets the true covered
-    volume: ``phi_core_average_lower`` is a rigorous lower bound of the true core average (the
-    particle part below the plane moved in by the sagitta r - sqrt(r^2 - a_max^2), which the ball
-    contains), and ``phi_error_bound`` bounds |phi - phi_true| of each shell (the larger bracket
-    width of its two edges over the shell's volume; loose for thin shells, where the errors of the
-    two edges largely cancel). To first order in a/r the shell error of equal spheres is at most
-    (sqrt(3)/2) a/r: the derivative of pi (a^2 - z^2)^2 / 4r is at most 2 pi a^3 / (3 sqrt(3) r),
-    its sign is that of s - r, and at most 9 r^2 / a^2 non-overlapping spheres have their centres on
-    one side of r within a. Measured on jammed sphere packings given as ellipsoids (N = 50 to 5000,
-    a/R = 0.22 to 0.05) against the exact :func:`radial_density_profile` in shells of 0.1 a: the
-    largest shell error next to the wall is 0.31 to 0.43 a/R (0.015 at a/R = 0.05); beyond r = 3a
-    every shell's error is below 0.3 a/r, and below 0.1 a/r in the core r = 3a to 10a of N = 5000
-    (errors follow the layering); within about 2a of the centre the plane is a poor stand-in for the ball (errors
-    of order 1, Donev's "rather accurate for sufficiently large r"). The core average of a uniform
-    packing is too high by (3/5) phi (a/r)^2 to first order (the sagitta term integrated over the
-    centres within a of r; 0.38 (a/r)^2 at phi = 0.64), measured 0.3 to 0.45 (a/r)^2 for r = 2a to
-    10a on the same packings. The profile's integral is exact: d R^-d int_0^R r^(d-1) phi dr (the
-    covered fraction of the container) equals the packing's phi to round-off, because every particle
-    inside the container lies wholly on the near side of its plane at r = R, and the cap makes the
-    covered volume at r = 0 zero.
+    The covered volume inside the ball of radius r is the sum over particles of each particle's
+    intersection volume with the ball (:func:`hardpack.geometry.ellipsoid_ball.ellipsoid_ball_volume`:
+    closed form in 2D, adaptive quadrature of closed-form slice areas in 3D, to 1e-10 of the
+    particle's volume; particles wholly inside or outside the ball, or holding it, are classified
+    exactly without quadrature); phi of the shell [r_k, r_k+1] is the difference of the covered
+    volumes over the shell's volume. Donev evaluated phi(r) with the plane tangent to the ball in
+    place of the ball (the footnote to Fig. 7.5), which overcounts by about (3/5) phi (a/r)^2 in a
+    uniform core of radius r; the exact volumes have no such bias, also near the centre.
 
     Parameters
     ----------
@@ -800,12 +725,11 @@ def ellipsoid_radial_density_profile(packing, n_shells: int = 200) -> xr.Dataset
     -------
     xarray.Dataset
         The variables of :func:`radial_density_profile`: ``phi`` on dimension ``r`` (shell
-        mid-radii), ``r_inner`` / ``r_outer``, and ``phi_core_average`` = 3 int_0^r x^2 phi(x) dx / r^3
-        at the shell's outer radius (Donev 2006, Sec. 7.3.2.3, the core average); and
-        ``phi_core_average_lower`` and ``phi_error_bound`` (above). Attributes ``radius``, the
-        length unit ``a`` (the geometric mean semiaxis (O_1 O_2 O_3)^(1/3), averaged over the
-        particles; Donev 2006, Sec. 7.3.1.2), ``centre``, ``N``, ``d``, ``method``
-        "tangent_plane" and ``ball_bound_radius``.
+        mid-radii), ``r_inner`` / ``r_outer``, and ``phi_core_average`` = d int_0^r x^(d-1) phi(x) dx / r^d
+        at the shell's outer radius (Donev 2006, Sec. 7.3.2.3, the core average). Attributes
+        ``radius``, the length unit ``a`` (the geometric mean semiaxis (O_1 O_2 O_3)^(1/3), averaged
+        over the particles; Donev 2006, Sec. 7.3.1.2), ``centre``, ``N``, ``d``, ``method``
+        "exact" and ``tolerance`` (of each particle's volume).
 
     Raises
     ------
@@ -819,25 +743,18 @@ def ellipsoid_radial_density_profile(packing, n_shells: int = 200) -> xr.Dataset
     d = packing.dim
     radius = packing.boundary.radius
     edges = np.linspace(0.0, radius, int(n_shells) + 1)
-    covered, lower, capped = _tangent_plane_covered(packing, edges)
+    covered = _covered(packing, edges)
     ball = ball_volume(edges, d)
-    shell = np.diff(ball)
-    width = covered - np.minimum(lower, covered)
     mid = 0.5 * (edges[1:] + edges[:-1])
     a = length_unit(packing)
     return xr.Dataset(
-        {"phi": ("r", np.diff(covered) / shell,
-                 {"description": "fraction of the shell covered by particles (tangent-plane approximation)"}),
+        {"phi": ("r", np.diff(covered) / np.diff(ball), {"description": "fraction of the shell covered by particles"}),
          "phi_core_average": ("r", covered[1:] / ball[1:],
-                              {"description": "fraction of the ball of radius r_outer covered (tangent plane)"}),
-         "phi_core_average_lower": ("r", lower[1:] / ball[1:],
-                                    {"description": "rigorous lower bound of the true core average"}),
-         "phi_error_bound": ("r", np.maximum(width[1:], width[:-1]) / shell,
-                             {"description": "bound on |phi - phi_true| of the shell"}),
+                              {"description": "fraction of the ball of radius r_outer covered"}),
          "r_inner": ("r", edges[:-1]), "r_outer": ("r", edges[1:])},
         coords={"r": mid},
         attrs={"hardpack_kind": "radial_density_profile", "radius": float(radius), "a": a,
                "centre": list(packing.boundary.centre), "N": packing.n_particles, "d": d,
-               "method": "tangent_plane", "ball_bound_radius": float(edges[capped].max(initial=0.0)),
-               "source": "Donev 2006, Ch. 7, Fig. 7.5 (phi(r)); the tangent-plane approximation of its footnote"},
+               "method": "exact", "tolerance": TOLERANCE,
+               "source": "Donev 2006, Ch. 7, Fig. 7.5 (phi(r)); exact ellipsoid-ball intersection volumes"},
     )
