@@ -105,7 +105,7 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
-from hardpack.geometry.contact import contact_point, pw_contact_into, pw_rate
+from hardpack.geometry.contact import pw_contact_into
 from hardpack.geometry.ellipsoid_container import farthest_point_body
 from hardpack.md.kernel import (
     A_T,
@@ -309,7 +309,12 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     n = ws[5, :d]
     zeta, lam, _ = pw_contact_into(r, wm[0], wm[1], lam0, n)
     ws[10, 0] += 1.0
-    contact_point(xa, wm[0], lam, n, rc)
+    mu = 1.0 - lam
+    for k in range(d):  # the contact point (:func:`hardpack.geometry.contact.contact_point`)
+        acc = 0.0
+        for m in range(d):
+            acc += wm[0, k, m] * n[m]
+        rc[k] = xa[k] + mu * acc
     rn = 0.0
     nn = 0.0
     nv = 0.0
@@ -322,10 +327,21 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     ws[10, 2] = nv / nn
     ws[10, 3] = support_rate_bound(P, i, d) * _spin_across(P, i, n, nn) \
         + support_rate_bound(P, j, d) * _spin_across(P, j, n, nn)
-    nw = 3 if d == 3 else 1
+    # zeta_dot = 2 lam (1 - lam) n . v_C (Donev 2006, Eq. 2.21; :func:`hardpack.geometry.contact.pw_rate`)
     g = kappa / (1.0 + kappa * t)
-    zdot = pw_rate(lam, n, xa, xb, rc, P[i, cv:cv + d], P[j, cv:cv + d], P[i, cw:cw + nw],
-                   P[j, cw:cw + nw], g, g)
+    if d == 2:
+        vc = P[j, cw] * ((rc[0] - xb[0]) * n[1] - (rc[1] - xb[1]) * n[0]) \
+            - P[i, cw] * ((rc[0] - xa[0]) * n[1] - (rc[1] - xa[1]) * n[0])
+    else:
+        b0, b1, b2 = rc[0] - xb[0], rc[1] - xb[1], rc[2] - xb[2]
+        a0, a1, a2 = rc[0] - xa[0], rc[1] - xa[1], rc[2] - xa[2]
+        wb0, wb1, wb2 = P[j, cw], P[j, cw + 1], P[j, cw + 2]
+        wa0, wa1, wa2 = P[i, cw], P[i, cw + 1], P[i, cw + 2]
+        vc = (n[0] * (wb1 * b2 - wb2 * b1) + n[1] * (wb2 * b0 - wb0 * b2) + n[2] * (wb0 * b1 - wb1 * b0)) \
+            - (n[0] * (wa1 * a2 - wa2 * a1) + n[1] * (wa2 * a0 - wa0 * a2) + n[2] * (wa0 * a1 - wa1 * a0))
+    for k in range(d):
+        vc += n[k] * (P[j, cv + k] - P[i, cv + k] + g * (rc[k] - xb[k]) - g * (rc[k] - xa[k]))
+    zdot = 2.0 * lam * (1.0 - lam) * vc
     return zeta, zdot, lam
 
 
