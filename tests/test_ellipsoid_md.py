@@ -244,7 +244,7 @@ def test_safe_time_is_a_lower_bound_on_the_contact_time(d, seed):
     lower, now = ek.pair_start(eng.P, 0, 1, sh, t, 0.0, kappa, ws, wm, np.empty(ek.PAIR_STATE))
     assert not now and lower > 0
     # the cheap bound of the search (a slab normal to a guessed direction) is one too
-    ek._pose(eng.P, 0, t, kappa, ws[8, :d], ws[0, :d], wm[0], ws[2], ws[6, :d], wm[2])
+    ek._pose(eng.P, 0, t, kappa, ws[8], ws, 0, wm, 0)
     screen = ek._screen_time(eng.P, 0, 1, sh, t, kappa, ws, wm)
     assert screen >= 0
     horizon = min(max(lower, screen), 20.0)

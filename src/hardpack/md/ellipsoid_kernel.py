@@ -105,7 +105,7 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
-from hardpack.geometry.contact import contact_point, pw_contact_into, pw_rate, shape_inverse_into
+from hardpack.geometry.contact import pw_contact_into
 from hardpack.geometry.ellipsoid_container import farthest_point_body
 from hardpack.md.kernel import (
     A_T,
@@ -238,18 +238,51 @@ def work_arrays(d):
 
 
 @njit(cache=True, inline="always")
-def _pose(P, i, t, kappa, shift, x, xinv, o, ax, q):
-    """Centre (plus ``shift``) and inverse shape matrix of particle i at window time t (``q``:
-    (d, d) scratch)."""
-    d = x.shape[0]
-    cv, ct, _, cax, _, _, _, _ = columns(d)
+def _pose(P, i, t, kappa, shift, ws, row, wm, mi):
+    """Centre (plus ``shift``) of particle i at window time t into ws[row, :d] and its inverse
+    shape matrix X^-1 into wm[mi]: :func:`orientation_at` and
+    :func:`hardpack.geometry.contact.shape_inverse_into` on scalars (no scratch arrays)."""
+    d = 2 if P.shape[1] == 11 else 3
+    cv, ct, _, cax, cor, cw, _, _ = columns(d)
     dt = t - P[i, ct]
     grow = 1.0 + kappa * t
     for k in range(d):
-        x[k] = P[i, k] + P[i, cv + k] * dt + shift[k]
-        ax[k] = P[i, cax + k] * grow
-    orientation_at(P, i, t, o)
-    shape_inverse_into(ax, o, xinv, q)
+        ws[row, k] = P[i, k] + P[i, cv + k] * dt + shift[k]
+    if d == 2:
+        phi = P[i, cor] + P[i, cw] * dt
+        c, s = np.cos(phi), np.sin(phi)
+        a0, a1 = P[i, cax] * grow, P[i, cax + 1] * grow
+        a2, b2 = a0 * a0, a1 * a1
+        wm[mi, 0, 0] = c * c * a2 + s * s * b2
+        wm[mi, 1, 1] = s * s * a2 + c * c * b2
+        wm[mi, 0, 1] = wm[mi, 1, 0] = c * s * (a2 - b2)
+        return
+    s, p1, p2, p3 = P[i, cor], P[i, cor + 1], P[i, cor + 2], P[i, cor + 3]
+    w0, w1, w2 = P[i, cw], P[i, cw + 1], P[i, cw + 2]
+    wn = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    if wn != 0.0 and dt != 0.0:
+        half = 0.5 * wn * dt
+        c = np.cos(half)
+        f = np.sin(half) / wn
+        a1, a2, a3 = f * w0, f * w1, f * w2
+        # [c, a] [s, p] = [c s - a.p, c p + s a + a x p]  (Donev 2006, Eq. 1.9)
+        s, p1, p2, p3 = (c * s - (a1 * p1 + a2 * p2 + a3 * p3), c * p1 + s * a1 + (a2 * p3 - a3 * p2),
+                         c * p2 + s * a2 + (a3 * p1 - a1 * p3), c * p3 + s * a3 + (a1 * p2 - a2 * p1))
+    diag = s * s - 0.5
+    q00, q01, q02 = 2 * (p1 * p1 + diag), 2 * (p1 * p2 + s * p3), 2 * (p1 * p3 - s * p2)
+    q10, q11, q12 = 2 * (p2 * p1 - s * p3), 2 * (p2 * p2 + diag), 2 * (p2 * p3 + s * p1)
+    q20, q21, q22 = 2 * (p3 * p1 + s * p2), 2 * (p3 * p2 - s * p1), 2 * (p3 * p3 + diag)
+    e0, e1, e2 = P[i, cax] * grow, P[i, cax + 1] * grow, P[i, cax + 2] * grow
+    a0, a1, a2 = e0 * e0, e1 * e1, e2 * e2
+    u00, u01, u02 = a0 * q00, a0 * q01, a0 * q02
+    u10, u11, u12 = a1 * q10, a1 * q11, a1 * q12
+    u20, u21, u22 = a2 * q20, a2 * q21, a2 * q22
+    wm[mi, 0, 0] = q00 * u00 + q10 * u10 + q20 * u20
+    wm[mi, 1, 1] = q01 * u01 + q11 * u11 + q21 * u21
+    wm[mi, 2, 2] = q02 * u02 + q12 * u12 + q22 * u22
+    wm[mi, 0, 1] = wm[mi, 1, 0] = q00 * u01 + q10 * u11 + q20 * u21
+    wm[mi, 0, 2] = wm[mi, 2, 0] = q00 * u02 + q10 * u12 + q20 * u22
+    wm[mi, 1, 2] = wm[mi, 2, 1] = q01 * u02 + q11 * u12 + q21 * u22
 
 
 @njit(cache=True)
@@ -267,17 +300,21 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     :func:`_safe_time`)."""
     d = shift.shape[0]
     cv, _, _, _, _, cw, _, _ = columns(d)
-    xa, xb, oa, ob, rc = ws[0, :d], ws[1, :d], ws[2], ws[3], ws[4, :d]
-    ax = ws[6, :d]
-    _pose(P, i, t, kappa, ws[8, :d], xa, wm[0], oa, ax, wm[2])
-    _pose(P, j, t, kappa, shift, xb, wm[1], ob, ax, wm[2])
+    xa, xb, rc = ws[0, :d], ws[1, :d], ws[4, :d]
+    _pose(P, i, t, kappa, ws[8], ws, 0, wm, 0)
+    _pose(P, j, t, kappa, shift, ws, 1, wm, 1)
     r = ws[7, :d]
     for k in range(d):
         r[k] = xb[k] - xa[k]
     n = ws[5, :d]
     zeta, lam, _ = pw_contact_into(r, wm[0], wm[1], lam0, n)
     ws[10, 0] += 1.0
-    contact_point(xa, wm[0], lam, n, rc)
+    mu = 1.0 - lam
+    for k in range(d):  # the contact point (:func:`hardpack.geometry.contact.contact_point`)
+        acc = 0.0
+        for m in range(d):
+            acc += wm[0, k, m] * n[m]
+        rc[k] = xa[k] + mu * acc
     rn = 0.0
     nn = 0.0
     nv = 0.0
@@ -290,10 +327,21 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     ws[10, 2] = nv / nn
     ws[10, 3] = support_rate_bound(P, i, d) * _spin_across(P, i, n, nn) \
         + support_rate_bound(P, j, d) * _spin_across(P, j, n, nn)
-    nw = 3 if d == 3 else 1
+    # zeta_dot = 2 lam (1 - lam) n . v_C (Donev 2006, Eq. 2.21; :func:`hardpack.geometry.contact.pw_rate`)
     g = kappa / (1.0 + kappa * t)
-    zdot = pw_rate(lam, n, xa, xb, rc, P[i, cv:cv + d], P[j, cv:cv + d], P[i, cw:cw + nw],
-                   P[j, cw:cw + nw], g, g)
+    if d == 2:
+        vc = P[j, cw] * ((rc[0] - xb[0]) * n[1] - (rc[1] - xb[1]) * n[0]) \
+            - P[i, cw] * ((rc[0] - xa[0]) * n[1] - (rc[1] - xa[1]) * n[0])
+    else:
+        b0, b1, b2 = rc[0] - xb[0], rc[1] - xb[1], rc[2] - xb[2]
+        a0, a1, a2 = rc[0] - xa[0], rc[1] - xa[1], rc[2] - xa[2]
+        wb0, wb1, wb2 = P[j, cw], P[j, cw + 1], P[j, cw + 2]
+        wa0, wa1, wa2 = P[i, cw], P[i, cw + 1], P[i, cw + 2]
+        vc = (n[0] * (wb1 * b2 - wb2 * b1) + n[1] * (wb2 * b0 - wb0 * b2) + n[2] * (wb0 * b1 - wb1 * b0)) \
+            - (n[0] * (wa1 * a2 - wa2 * a1) + n[1] * (wa2 * a0 - wa0 * a2) + n[2] * (wa0 * a1 - wa1 * a0))
+    for k in range(d):
+        vc += n[k] * (P[j, cv + k] - P[i, cv + k] + g * (rc[k] - xb[k]) - g * (rc[k] - xa[k]))
+    zdot = 2.0 * lam * (1.0 - lam) * vc
     return zeta, zdot, lam
 
 
@@ -404,7 +452,7 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
     d = shift.shape[0]
     cv, _, cr, _, _, _, _, _ = columns(d)
     xi, mi, xj, mj = ws[0, :d], wm[0], ws[1, :d], wm[1]
-    _pose(P, j, t, kappa, shift, xj, mj, ws[3], ws[6, :d], wm[2])
+    _pose(P, j, t, kappa, shift, ws, 1, wm, 1)
     r = ws[7, :d]
     for k in range(d):
         r[k] = xj[k] - xi[k]
@@ -1047,7 +1095,7 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     for m in range(m_n):
         if tins[m] == 0.0 and t < min(best, horizon):
             if not posed:
-                _pose(P, i, t, kappa, ws[8, :d], ws[0, :d], wm[0], ws[2], ws[6, :d], wm[2])
+                _pose(P, i, t, kappa, ws[8], ws, 0, wm, 0)
                 posed = True
             e = nb[i, m]
             for k in range(d):
