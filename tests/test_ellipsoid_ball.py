@@ -24,7 +24,7 @@ def _volume(a, b, r):
 
 def test_spheres_equal_the_lens_formula():
     rng = np.random.default_rng(0)
-    for _ in range(300):
+    for _ in range(80):
         a, r = rng.uniform(0.2, 2.0, 2)
         direction = rng.standard_normal(3)
         b = direction / np.linalg.norm(direction) * rng.uniform(0.0, a + r + 0.1)
@@ -123,7 +123,7 @@ def _surface_measure_inside(a, b, r, n):
 @pytest.mark.parametrize("d", [3, 2])
 def test_derivative_is_the_sphere_inside_and_the_limits(d):
     rng = np.random.default_rng(3)
-    for a, b, _ in _cases(d, 6, seed=10 + d):
+    for a, b, _ in _cases(d, 3 if d == 3 else 6, seed=10 + d):
         # nearest and farthest distances from b to the particle on a fine surface grid
         m = 400_000
         y = rng.standard_normal((m, d))
