@@ -52,7 +52,7 @@ from hardpack.jamming.ellipsoids import (
     rigidity_transpose_full,
     stiffness_matrix_full,
 )
-from hardpack.jamming.second_order import dof_basis, trivial_motions
+from hardpack.jamming.second_order import dof_basis, trivial_motions, verify_ellipsoids
 
 __all__ = ["Refinement", "refine_jamming_point", "verify_at_jamming_point", "REFINE_STEPS"]
 
@@ -264,8 +264,6 @@ def verify_at_jamming_point(packing: Packing, **options):
     -------
     EllipsoidJammingResult
     """
-    from hardpack.jamming.second_order import verify_ellipsoids
-
     result = verify_ellipsoids(packing, **options)
     dec = result.collective
     note = None
