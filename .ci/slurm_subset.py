@@ -3,36 +3,87 @@
 The whole smoke DAG through SLURM costs about 6 s of Snakemake start-up per SLURM job on top of
 the work, which made CI too long. Instead, the SLURM directory starts from a copy of the local
 run's results, from which this script deletes the validation outputs and, for every rule of the
-DAG, the outputs of one of its jobs (the first in `snakemake --summary`). It prints those files:
-named as targets beside `all`, they make Snakemake run each rule once under SLURM, plus the jobs
-downstream of the deleted files (combines, summaries, figures, the validation report and gate).
-The SLURM validation dataset is then rebuilt from SLURM outputs and local ones, and must equal the
-local dataset.
+DAG, the outputs of one of its jobs. It prints those files: named as targets beside `all`, they
+make Snakemake run each rule once under SLURM, plus the jobs downstream of the deleted files
+(combines, summaries, figures, the validation report and gate). The SLURM validation dataset is
+then rebuilt from SLURM outputs and local ones, and must equal the local dataset.
 
-    python .ci/slurm_subset.py SUMMARY_TSV SLURM_DIR > targets.txt
+The job of each rule is the one whose rerun costs least: its own wall time in the local run plus
+that of every job downstream of it, from Snakemake's records of the local run
+(.snakemake/metadata: each output's job, inputs, start and end). Without records, the first job
+of the rule in `snakemake --summary` is taken.
+
+    python .ci/slurm_subset.py SUMMARY_TSV SLURM_DIR [METADATA_DIR] > targets.txt
 """
 
+import base64
+import binascii
 import csv
+import json
 import shutil
 import sys
+from collections import defaultdict
 from pathlib import Path
 
 
-def one_output_per_rule(summary_tsv: str) -> dict[str, str]:
-    """First output file of every rule in a `snakemake --summary` table (tab-separated)."""
+def local_jobs(metadata_dir: Path) -> tuple[dict[str, tuple], dict[tuple, float], dict[str, set]]:
+    """Snakemake's records of the local run: the job of each output file, each job's wall time,
+    and the jobs that read each file."""
+    job_of: dict[str, tuple] = {}
+    seconds: dict[tuple, float] = {}
+    readers: dict[str, set] = defaultdict(set)
+    for record in metadata_dir.glob("*"):
+        try:
+            output = base64.urlsafe_b64decode(record.name).decode()
+            meta = json.loads(record.read_text())
+            job = (meta["rule"], meta.get("job_hash"), meta["endtime"])  # the same for all its outputs
+            seconds[job] = float(meta["endtime"]) - float(meta["starttime"])
+        except (OSError, ValueError, KeyError, TypeError, binascii.Error):
+            continue  # a record split over directories (very long paths) or of another format
+        job_of[output] = job
+        for path in meta.get("input") or ():
+            readers[path].add(job)
+    return job_of, seconds, readers
+
+
+def rerun_cost(output: str, job_of, seconds, readers) -> float:
+    """Wall time of the local jobs that run again when ``output`` is deleted: its job and every
+    job downstream of it (infinite when the job is not recorded)."""
+    if output not in job_of:
+        return float("inf")
+    outputs_of: dict[tuple, list] = defaultdict(list)
+    for path, job in job_of.items():
+        outputs_of[job].append(path)
+    todo, seen = [job_of[output]], set()
+    while todo:
+        job = todo.pop()
+        if job in seen:
+            continue
+        seen.add(job)
+        for path in outputs_of[job]:
+            todo.extend(readers.get(path, ()))
+    return sum(seconds[job] for job in seen)
+
+
+def one_output_per_rule(summary_tsv: str, metadata_dir: Path = Path(".snakemake/metadata")) -> dict[str, str]:
+    """For every rule in a `snakemake --summary` table (tab-separated), an output file of the job
+    that is cheapest to run again (:func:`rerun_cost`); its first job when none is recorded."""
     with open(summary_tsv, newline="") as fh:
         rows = list(csv.DictReader(fh, delimiter="\t"))
     if not rows or "rule" not in rows[0] or "output_file" not in rows[0]:
         raise SystemExit(f"{summary_tsv}: not a `snakemake --summary` table")
-    first: dict[str, str] = {}
+    records = local_jobs(metadata_dir)
+    best: dict[str, tuple[float, str]] = {}
     for row in rows:
-        first.setdefault(row["rule"], row["output_file"])
-    return first
+        cost = rerun_cost(row["output_file"], *records)
+        if row["rule"] not in best or cost < best[row["rule"]][0]:
+            best[row["rule"]] = (cost, row["output_file"])
+    return {rule: output for rule, (_, output) in best.items()}
 
 
-def main(summary_tsv: str, slurm_dir: str) -> None:
+def main(summary_tsv: str, slurm_dir: str, metadata_dir: str = ".snakemake/metadata") -> None:
     root = Path(slurm_dir)
-    picks = one_output_per_rule(summary_tsv)
+    picks = one_output_per_rule(summary_tsv, Path(metadata_dir))
     shutil.rmtree(root / "results" / "validation", ignore_errors=True)
     for rule, output in sorted(picks.items()):
         path = root / output
@@ -45,6 +96,6 @@ def main(summary_tsv: str, slurm_dir: str) -> None:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 4):
         raise SystemExit(__doc__)
     main(*sys.argv[1:])

@@ -2,6 +2,7 @@
 
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -96,9 +97,41 @@ def test_slurm_subset_deletes_one_output_per_rule_and_the_validation(tmp_path):
                  "validation/report.md"):
         (run / "results" / name).parent.mkdir(parents=True, exist_ok=True)
         (run / "results" / name).write_text("x")
-    out = subprocess.run(["python", str(ROOT / ".ci" / "slurm_subset.py"), str(summary), str(run)],
+    no_records = tmp_path / "metadata"
+    out = subprocess.run(["python", str(ROOT / ".ci" / "slurm_subset.py"), str(summary), str(run), str(no_records)],
                          capture_output=True, text=True, check=True).stdout.split()
     assert out == ["results/a/init/seed1.nc", "results/a/jammed/seed1.nc", "results/validation/gate.txt"]
     assert not (run / "results" / "validation").exists()
     assert not (run / "results/a/init/seed1.nc").exists() and not (run / "results/a/jammed/seed1.nc").exists()
     assert (run / "results/a/init/seed2.nc").exists()
+
+
+def test_slurm_subset_picks_the_job_cheapest_to_run_again_with_what_it_feeds(tmp_path):
+    """With Snakemake's records of the local run, each rule's job is the one whose rerun (its own
+    time plus every job downstream of it) is shortest: the quick init whose compression is slow
+    loses to the slower init whose compression is quick."""
+    import base64
+    import json
+
+    sys.path.insert(0, str(ROOT / ".ci"))
+    try:
+        import slurm_subset
+    finally:
+        sys.path.pop(0)
+    jobs = {  # output: (rule, start, end, inputs)
+        "results/a/init/seed1.nc": ("init", 0.0, 1.0, []),
+        "results/a/init/seed2.nc": ("init", 0.0, 2.0, []),
+        "results/a/jammed/seed1.nc": ("compress", 2.0, 102.0, ["results/a/init/seed1.nc"]),
+        "results/a/jammed/seed2.nc": ("compress", 2.0, 12.0, ["results/a/init/seed2.nc"]),
+    }
+    metadata = tmp_path / "metadata"
+    metadata.mkdir()
+    for output, (rule, start, end, inputs) in jobs.items():
+        record = metadata / base64.urlsafe_b64encode(output.encode()).decode()
+        record.write_text(json.dumps({"rule": rule, "starttime": start, "endtime": end, "input": inputs,
+                                      "job_hash": hash(output)}))
+    summary = tmp_path / "summary.tsv"
+    summary.write_text("output_file\tdate\trule\n" + "".join(f"{o}\t-\t{j[0]}\n" for o, j in jobs.items()))
+    picks = slurm_subset.one_output_per_rule(str(summary), metadata)
+    assert picks == {"init": "results/a/init/seed2.nc", "compress": "results/a/jammed/seed2.nc"}
+    assert slurm_subset.rerun_cost("results/a/init/seed1.nc", *slurm_subset.local_jobs(metadata)) == 101.0

@@ -1,6 +1,8 @@
 """The hardpack command line: init, info, combine, and its error messages."""
 
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -115,3 +117,39 @@ def test_init_refuses_bad_boundaries(tmp_path, capsys, extra, message):
     assert main(["init", "--n", "20", "--d", "3", "--phi", "0.2", "--seed", "1", "--out", str(out), *extra]) == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_subcommand_table_names_every_registered_command_and_only_those():
+    """`SUBCOMMANDS` (which module registers each command) must match what the modules register:
+    a missing entry would make the command load every module, a wrong one would lose it."""
+    import argparse
+
+    from hardpack import cli
+
+    registered = {}
+    for module_name in cli.SUBCOMMAND_MODULES:
+        sub = argparse.ArgumentParser().add_subparsers()
+        __import__(module_name, fromlist=["register"]).register(sub)
+        registered.update(dict.fromkeys(sub.choices, module_name))
+    assert registered == cli.SUBCOMMANDS
+    full = cli.build_parser()._subparsers._group_actions[0].choices
+    assert set(full) == set(cli.CORE_SUBCOMMANDS) | set(cli.SUBCOMMANDS)
+    for command in full:
+        assert command in cli.build_parser(command)._subparsers._group_actions[0].choices
+
+
+def test_a_command_imports_only_its_own_module():
+    """A job's start-up: `hardpack compress` must not import the validation, glass or free-energy
+    command modules (they cost seconds of imports per job of the DAG)."""
+    code = ("import sys; from hardpack.cli import build_parser; build_parser('compress'); "
+            "print(sorted(m for m in sys.modules if m.endswith('.cli')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert eval(out) == ["hardpack.cli", "hardpack.md.cli"]
+
+
+def test_help_and_unknown_commands_still_list_every_command():
+    out = subprocess.run([sys.executable, "-m", "hardpack.cli", "--help"], capture_output=True, text=True)
+    assert out.returncode == 0 and "glass-entropy" in out.stdout and "compress" in out.stdout
+    bad = subprocess.run([sys.executable, "-m", "hardpack.cli", "-q", "no-such-command"], capture_output=True,
+                         text=True)
+    assert bad.returncode == 2 and "invalid choice" in bad.stderr and "bcmd-ladder" in bad.stderr

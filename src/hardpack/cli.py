@@ -17,10 +17,29 @@ import numpy as np
 from hardpack import __version__
 from hardpack.errors import InvalidInputError
 
-SUBCOMMAND_MODULES: tuple[str, ...] = (
-    "hardpack.md.cli", "hardpack.eos.cli", "hardpack.hgrid.cli", "hardpack.slp.cli", "hardpack.validation.cli",
-    "hardpack.structure.cli", "hardpack.jamming.cli", "hardpack.freeenergy.cli", "hardpack.glass.cli",
-)
+#: the subcommands of this module
+CORE_SUBCOMMANDS = ("init", "lattice", "laminate", "info", "combine")
+#: the module that registers each subcommand beyond the core ones (its ``register(subparsers)``);
+#: a command line imports only its own command's module, which keeps a job's start-up short
+SUBCOMMANDS: dict[str, str] = {
+    "compress": "hardpack.md.cli", "eos": "hardpack.md.cli",
+    "poly-jam": "hardpack.eos.cli", "poly-fluid": "hardpack.eos.cli", "poly-summary": "hardpack.eos.cli",
+    "poly-equivalents": "hardpack.eos.cli",
+    "hgrid-cost": "hardpack.hgrid.cli",
+    "slp": "hardpack.slp.cli", "slp-dilute": "hardpack.slp.cli",
+    "validate": "hardpack.validation.cli",
+    "structure": "hardpack.structure.cli",
+    "verify": "hardpack.jamming.cli",
+    "bcmd": "hardpack.freeenergy.cli", "bcmd-simplex": "hardpack.freeenergy.cli",
+    "bcmd-ladder": "hardpack.freeenergy.cli", "bcmd-ellipse": "hardpack.freeenergy.cli",
+    "ellipse-lattice": "hardpack.freeenergy.cli", "bcmd-ellipse-ladder": "hardpack.freeenergy.cli",
+    "glass-crystal": "hardpack.glass.cli", "glass-eos": "hardpack.glass.cli", "glass-entropy": "hardpack.glass.cli",
+    "glass-freezing": "hardpack.glass.cli", "glass-labels": "hardpack.glass.cli",
+    "glass-labelled-crystal": "hardpack.glass.cli", "glass-microsegregated": "hardpack.glass.cli",
+    "glass-microsegregated-summary": "hardpack.glass.cli",
+}
+#: every module of :data:`SUBCOMMANDS`, in the order of ``hardpack --help``
+SUBCOMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(SUBCOMMANDS.values()))
 
 
 def _json_arg(text: str):
@@ -189,9 +208,18 @@ def cmd_combine(args) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The ``hardpack`` parser: the core subcommands and those each module of
     :data:`SUBCOMMAND_MODULES` registers.
+
+    Parameters
+    ----------
+    command : str, optional
+        A subcommand: only the core subcommands (:data:`CORE_SUBCOMMANDS`) and the module of
+        ``command`` in :data:`SUBCOMMANDS` are imported and registered, so that a command does
+        not pay for the imports of all the others. By default, or for any other name, every
+        module is (``hardpack --help`` lists them all, and argparse's error for an unknown
+        command names every choice).
 
     Returns
     -------
@@ -250,7 +278,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--attr", type=_key_value, action="append", metavar="KEY=VALUE")
     p.set_defaults(func=cmd_combine)
 
-    for module_name in SUBCOMMAND_MODULES:
+    if command in CORE_SUBCOMMANDS:
+        modules = ()
+    elif command in SUBCOMMANDS:
+        modules = (SUBCOMMANDS[command],)
+    else:
+        modules = SUBCOMMAND_MODULES
+    for module_name in modules:
         module = __import__(module_name, fromlist=["register"])
         module.register(sub)
     return parser
@@ -349,8 +383,9 @@ def main(argv=None) -> int:
     int
         Exit status (:func:`run_command`).
     """
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    command = next((word for word in argv if not word.startswith("-")), None)
+    args = build_parser(command).parse_args(argv)
     logging.basicConfig(
         level=logging.WARNING if args.quiet else logging.INFO,
         format="%(asctime)s %(name)s: %(message)s", datefmt="%H:%M:%S",

@@ -29,7 +29,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import special, stats
+from scipy import special
 
 from hardpack.errors import InvalidInputError
 
@@ -352,6 +352,8 @@ class LogNormal(Distribution):
         return self.a0**k * math.exp(0.5 * k * k * self.sigma**2)
 
     def _dist(self):
+        from scipy import stats  # scipy.stats takes ~1 s to import: only when a frozen law is asked for
+
         return stats.lognorm(s=self.sigma, scale=self.a0)
 
     def pdf(self, a):
