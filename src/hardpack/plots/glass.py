@@ -58,7 +58,7 @@ def plot_glass_entropy(binary, mono):
     ----------
     binary, mono : xarray.Dataset
         The entropy datasets of the binary and monodisperse systems
-    (:func:`hardpack.glass.study.entropy_dataset`).
+        (:func:`hardpack.glass.study.entropy_dataset`).
 
     Returns
     -------
