@@ -295,8 +295,8 @@ def polish(a: sp.csr_matrix, f: np.ndarray, iterations: int = 4) -> np.ndarray:
 
     Parameters
     ----------
-    a : scipy.sparse.csr_matrix, shape (N d, M)
-        The equilibrium matrix A.
+    a : scipy.sparse.csr_matrix, shape (n, M)
+        The equilibrium matrix A (coordinates by contacts, e.g. :func:`backbone_rows`).
     f : numpy.ndarray of float, shape (M,)
         Non-negative forces.
     iterations : int, optional

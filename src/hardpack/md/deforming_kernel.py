@@ -285,16 +285,16 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
         Bounding spheres, centre then radius.
     nb : numpy.ndarray of int64, shape (N, cap)
         Neighbour lists, entries j * m + image code.
-    nn : numpy.ndarray of int32, shape (N,)
+    nn : numpy.ndarray of int64, shape (N,)
         List lengths (reset here).
-    mark : numpy.ndarray, shape (N,)
+    mark : numpy.ndarray of int8, shape (N,)
         Scratch of the list updates (reset here).
-    cnt, ep, ei, ec : numpy.ndarray of int, shape (N,)
+    cnt, ep, ei, ec : numpy.ndarray of int64, shape (N,)
         Collision counters, the partner, image code and partner's counter of each predicted event.
     tv : numpy.ndarray of float64, shape (N,)
         Time up to which each particle's kinetic-tensor integral is closed (reset here).
     hkey, heap, hpos : numpy.ndarray, shape (N,)
-        Event heap: keys, particles in heap order, heap slot of each particle.
+        Event heap: keys (float64), particles in heap order and heap slot of each particle (int64).
     kin, vir : numpy.ndarray of float64, shape (d, d)
         Outputs (zeroed here): time integral of sum_i v_i v_i^T and the collisional virial
         sum r_ij J_ij^T.

@@ -565,8 +565,8 @@ def pair_histograms(x, radii, lattice, n_cells, strides, cell_start, order, offs
         Particle radii.
     lattice : numpy.ndarray of float, shape (d, d)
         Cell, lattice vectors as columns.
-    n_cells, strides : numpy.ndarray of int64, shape (1, d)
-        Level-0 cells per lattice direction and strides.
+    n_cells, strides : numpy.ndarray of int64, shape (d,)
+        Cells per lattice direction and flat-index strides of level 0 (rows 0 of the grid's).
     cell_start : numpy.ndarray of int64, shape (n_total + 1,)
         Start of every cell's points in ``order``.
     order : numpy.ndarray of int64, shape (N,)
@@ -666,10 +666,10 @@ def window_counts(centres_frac, x, lattice, inv_heights, n_cells, strides, cell_
         Cell, lattice vectors as columns.
     inv_heights : numpy.ndarray of float, shape (d,)
         1 / h_k.
-    n_cells, strides : numpy.ndarray of int64, shape (1, d)
-        Level-0 cells per lattice direction and strides.
-    cell_offset : numpy.ndarray of int64, shape (2,)
-        Flat index offsets.
+    n_cells, strides : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction and flat-index strides of every level (level 0 is used).
+    cell_offset : numpy.ndarray of int64, shape (L + 1,)
+        First flat index of every level.
     cell_start : numpy.ndarray of int64, shape (n_total + 1,)
         Start of every cell's points in ``order``.
     order : numpy.ndarray of int64, shape (N,)
