@@ -76,7 +76,18 @@ def add_checkpoint_options(p: argparse.ArgumentParser, checkpoint_help: str) -> 
 
 
 def cmd_init(args) -> int:
-    """Random sequential addition start configuration, written as a packing netCDF."""
+    """Random sequential addition start configuration, written as a packing netCDF.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack init``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.distributions import from_spec
     from hardpack.initial import random_ellipsoid_packing, random_packing
     from hardpack.io import save_packing
@@ -119,6 +130,16 @@ def cmd_info(args) -> int:
     """Summary of a hardpack netCDF file: N, d, phi, particle shapes, boundary and provenance.
 
     A diagnostic: it also reads packings whose particles overlap, and reports the overlaps.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack info``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
     """
     from hardpack.io import load_dataset
 
@@ -165,7 +186,18 @@ def cmd_info(args) -> int:
 
 
 def cmd_lattice(args) -> int:
-    """A crystal packing (spheres of radius 1/2 at contact), e.g. the FCC input of BCMD."""
+    """A crystal packing (spheres of radius 1/2 at contact), e.g. the FCC input of BCMD.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack lattice``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.geometry.lattices import lattice_packing
     from hardpack.io import save_packing
 
@@ -176,7 +208,18 @@ def cmd_lattice(args) -> int:
 
 
 def cmd_laminate(args) -> int:
-    """The laminate crystals of spheroids vs aspect ratio (Donev 2006, Sec. 8.2, Fig. 8.2)."""
+    """The laminate crystals of spheroids vs aspect ratio (Donev 2006, Sec. 8.2, Fig. 8.2).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack laminate``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.geometry.ellipsoid_crystals import DENSEST_ALPHA, laminate_family
     from hardpack.io import write_dataset
 
@@ -199,7 +242,18 @@ def cmd_laminate(args) -> int:
 
 
 def cmd_combine(args) -> int:
-    """Combine per-seed packings into one ensemble Dataset indexed by protocol parameters."""
+    """Combine per-seed packings into one ensemble Dataset indexed by protocol parameters.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack combine``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.io import combine_ensemble, write_dataset
 
     ds = combine_ensemble(args.files, index=tuple(args.index), variables=tuple(args.variable or ()))
@@ -231,7 +285,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument("-q", "--quiet", action="store_true", help="only print warnings and errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("init", help=cmd_init.__doc__)
+    p = sub.add_parser("init", help=cmd_init.__doc__.split("\n\n")[0])
     p.add_argument("--n", type=int, required=True, help="number of particles")
     p.add_argument("--d", type=int, required=True, help="dimension (2..6 and beyond)")
     p.add_argument("--phi", type=float, required=True, help="initial volume fraction (below RSA saturation)")
@@ -253,24 +307,24 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
                    help="extra attribute stored in the file (repeatable), e.g. ensemble=mono3d")
     p.set_defaults(func=cmd_init)
 
-    p = sub.add_parser("lattice", help=cmd_lattice.__doc__)
+    p = sub.add_parser("lattice", help=cmd_lattice.__doc__.split("\n\n")[0])
     p.add_argument("--name", required=True,
                    help="fcc, hcp, bcc, sc, diamond, triangular, square, honeycomb, kagome, D<d>, hypercubic<d>")
     p.add_argument("--reps", type=int, nargs="+", default=[1], help="unit cells along each lattice vector")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_lattice)
 
-    p = sub.add_parser("laminate", help=cmd_laminate.__doc__)
+    p = sub.add_parser("laminate", help=cmd_laminate.__doc__.split("\n\n")[0])
     p.add_argument("--alpha-max", type=float, default=3.0, help="largest aspect ratio, >= 1 (default 3)")
     p.add_argument("--alpha-step", type=float, default=0.05, help="step in alpha from 1 (default 0.05)")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.set_defaults(func=cmd_laminate)
 
-    p = sub.add_parser("info", help=cmd_info.__doc__.splitlines()[0])
+    p = sub.add_parser("info", help=cmd_info.__doc__.split("\n\n")[0])
     p.add_argument("file", help="a netCDF file written by hardpack")
     p.set_defaults(func=cmd_info)
 
-    p = sub.add_parser("combine", help=cmd_combine.__doc__)
+    p = sub.add_parser("combine", help=cmd_combine.__doc__.split("\n\n")[0])
     p.add_argument("files", nargs="+", help="packing files")
     p.add_argument("--index", nargs="+", default=["seed"], help="attributes indexing the samples")
     p.add_argument("--variable", action="append", help="extra numeric attribute to tabulate")

@@ -22,7 +22,18 @@ log = logging.getLogger(__name__)
 
 
 def cmd_poly_equivalents(args) -> int:
-    """Moments, O1/O2 and bi-/tridisperse equivalents of a distribution family (Ogarko Tables 3.1-3.4)."""
+    """Moments, O1/O2 and bi-/tridisperse equivalents of a distribution family (Ogarko Tables 3.1-3.4).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack poly-equivalents``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.io import write_dataset
 
     ds = equivalents_dataset(args.kind, args.values, args.alpha)
@@ -48,7 +59,18 @@ def _check_outputs(systems, outputs, checkpoint=None):
 
 
 def cmd_poly_jam(args) -> int:
-    """Jam a distribution and/or its bi- and tridisperse equivalents (two-stage LS compression)."""
+    """Jam a distribution and/or its bi- and tridisperse equivalents (two-stage LS compression).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack poly-jam``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.eos.study import JamProtocol, jam
     from hardpack.io import checkpoint as ckpt
 
@@ -71,7 +93,18 @@ def cmd_poly_jam(args) -> int:
 
 
 def cmd_poly_fluid(args) -> int:
-    """Equilibrium Z(phi) of a distribution and its equivalents against BMCSL (one netCDF file)."""
+    """Equilibrium Z(phi) of a distribution and its equivalents against BMCSL (one netCDF file).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack poly-fluid``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.eos.study import fluid_dataset, fluid_pressure
     from hardpack.io import write_dataset
 
@@ -91,7 +124,18 @@ def cmd_poly_fluid(args) -> int:
 
 def cmd_poly_summary(args) -> int:
     """Combine the study's jammed packings (one family; ``jam``: the equivalence runs,
-    ``crystallisation``: the slow runs) or fluid files into one summary Dataset."""
+    ``crystallisation``: the slow runs) or fluid files into one summary Dataset.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack poly-summary``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.eos.study import fluid_summary, jam_summary
     from hardpack.io import load_dataset, write_dataset
 
@@ -111,7 +155,7 @@ def register(subparsers) -> None:
     subparsers : argparse._SubParsersAction
         The subcommand parsers of :func:`hardpack.cli.build_parser`.
     """
-    p = subparsers.add_parser("poly-jam", help=cmd_poly_jam.__doc__)
+    p = subparsers.add_parser("poly-jam", help=cmd_poly_jam.__doc__.split("\n\n")[0])
     p.add_argument("--distribution", required=True,
                    help='size distribution as JSON, e.g. \'{"kind": "uniform_volume", "omega": 4}\'')
     p.add_argument("--systems", nargs="+", default=["poly", "bi", "tri"], choices=["poly", "bi", "tri"])
@@ -127,7 +171,7 @@ def register(subparsers) -> None:
                    "every 5 min, resumed if present, removed at the end")
     p.set_defaults(func=cmd_poly_jam)
 
-    p = subparsers.add_parser("poly-fluid", help=cmd_poly_fluid.__doc__)
+    p = subparsers.add_parser("poly-fluid", help=cmd_poly_fluid.__doc__.split("\n\n")[0])
     p.add_argument("--distribution", required=True, help="size distribution as JSON")
     p.add_argument("--systems", nargs="+", default=["poly", "bi", "tri"], choices=["poly", "bi", "tri"])
     p.add_argument("--phi", type=float, nargs="+", required=True, help="volume fractions (< 0.6)")
@@ -137,14 +181,14 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="output netCDF (system x phi)")
     p.set_defaults(func=cmd_poly_fluid)
 
-    p = subparsers.add_parser("poly-summary", help=cmd_poly_summary.__doc__)
+    p = subparsers.add_parser("poly-summary", help=cmd_poly_summary.__doc__.split("\n\n")[0])
     p.add_argument("--kind", choices=["jam", "crystallisation", "fluid"], required=True,
                    help="jam: equivalence runs; crystallisation: slow runs (same files); fluid: poly-fluid files")
     p.add_argument("files", nargs="+", help="poly-jam packings of one family, or poly-fluid files")
     p.add_argument("--out", required=True, help="summary netCDF")
     p.set_defaults(func=cmd_poly_summary)
 
-    p = subparsers.add_parser("poly-equivalents", help=cmd_poly_equivalents.__doc__)
+    p = subparsers.add_parser("poly-equivalents", help=cmd_poly_equivalents.__doc__.split("\n\n")[0])
     p.add_argument("--kind", required=True, choices=sorted(FAMILIES), help="distribution family")
     p.add_argument("--values", type=float, nargs="+", required=True, help="omega (or sigma for lognormal) values")
     p.add_argument("--alpha", type=float, help="exponent of the power_law family")

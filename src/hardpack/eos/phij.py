@@ -33,9 +33,18 @@ PLATEAU_SIGMAS = 3.0
 class FreeVolumeFit:
     """Result of :func:`fit_free_volume`.
 
-    phi_j, stderr: fitted jamming density and its standard error; phi_range, z_range, n_points: the
-    points used; chi2_red: reduced chi^2 of the constant model (about 1 if sigma_z was right);
-    drift, drift_err: change of the linear trend of phi_J^est(ln Z) across the fit range and its error.
+    Attributes
+    ----------
+    phi_j, stderr : float
+        Fitted jamming density and its standard error.
+    phi_range, z_range : tuple of (float, float)
+        Ranges of phi and Z of the points used.
+    n_points : int
+        Number of points used.
+    chi2_red : float
+        Reduced chi^2 of the constant model (about 1 if sigma_z was right).
+    drift, drift_err : float
+        Change of the linear trend of phi_J^est(ln Z) across the fit range, and its error.
     """
 
     phi_j: float
@@ -72,6 +81,31 @@ def fit_free_volume(phi, Z, d: int = 3, decades: float = 2.0, z_min: float | Non
     z_min: additional lower bound on Z; sigma_z: standard errors of Z (scalar or per point; default:
     equal relative errors, scaled by the scatter). Needs at least 3 points with Z > d in range.
     Returns a :class:`FreeVolumeFit`.
+
+    Parameters
+    ----------
+    phi : array_like of float, shape (n,)
+        Volume fractions of one compression run.
+    Z : array_like of float, shape (n,)
+        Reduced pressures Z = pV/(NkT).
+    d : int, optional
+        Dimension.
+    decades : float, optional
+        Decades of Z below its maximum that are fitted.
+    z_min : float, optional
+        Additional lower bound on Z.
+    sigma_z : float or array_like of float, optional
+        Standard errors of Z.
+
+    Returns
+    -------
+    FreeVolumeFit
+        The fit.
+
+    Raises
+    ------
+    InvalidInputError
+        For bad arrays or fewer than 3 usable points.
     """
     x, z = np.asarray(phi, dtype=float), np.asarray(Z, dtype=float)
     if x.ndim != 1 or x.shape != z.shape:

@@ -33,14 +33,40 @@ WIDTH = {"uniform_size": "omega", "uniform_volume": "omega", "power_law": "omega
 
 
 def width_of(spec: dict) -> tuple[str, float]:
-    """(family, width) of a distribution spec, e.g. ("uniform_volume", 10.0)."""
+    """(family, width) of a distribution spec, e.g. ("uniform_volume", 10.0).
+
+    Parameters
+    ----------
+    spec : dict
+        Distribution spec (:func:`hardpack.distributions.from_spec`).
+
+    Returns
+    -------
+    family : str
+        The distribution kind.
+    width : float
+        Its width parameter.
+    """
     if not isinstance(spec, dict) or spec.get("kind") not in WIDTH:
         raise InvalidInputError(f"the study needs a distribution of kind {sorted(WIDTH)}, got {spec!r}")
     return spec["kind"], float(spec[WIDTH[spec["kind"]]])
 
 
 def system_distribution(spec: dict, system: str) -> Distribution:
-    """The distribution ``spec`` as the ``system`` (poly, bi or tri), all with the same <a>."""
+    """The distribution ``spec`` as the ``system`` (poly, bi or tri), all with the same <a>.
+
+    Parameters
+    ----------
+    spec : dict
+        Distribution spec.
+    system : str
+        "poly", "bi" or "tri".
+
+    Returns
+    -------
+    Distribution
+        The distribution itself, or its bi- or tridisperse equivalent mixture (Ogarko 2014, ch. 3).
+    """
     if system not in SYSTEMS:
         raise InvalidInputError(f"system must be one of {SYSTEMS}, got {system!r}")
     dist = from_spec(spec)
@@ -60,6 +86,21 @@ class JamProtocol:
     Ogarko grows at one constant rate (Ogarko 2014, sec. 3.1.3); the jamming density depends on the rate (it rises
     by <= 1 % as Gamma decreases, inset of Fig. 3.7(a)), so poly and equivalent systems are compared at the
     same protocol and N only.
+
+    Attributes
+    ----------
+    n : int
+        Number of particles, >= 2.
+    init_phi : float
+        Volume fraction of the RSA start.
+    growth_rate : float
+        Gamma of the first stage.
+    switch_pressure : float
+        Reduced pressure ending the first stage.
+    final_growth_rate : float
+        Gamma of the second stage.
+    max_pressure : float
+        Reduced pressure ending the compression.
     """
 
     n: int = 1000
@@ -83,7 +124,20 @@ class JamProtocol:
 
 def large_species_crystallinity(packing, solid: np.ndarray) -> float:
     """Fraction of solid-like particles among those larger than the mean radius (the large species of
-    a bidisperse mixture; crystallisation of that species breaks the bidisperse equivalence, sec. 3.1.3)."""
+    a bidisperse mixture; crystallisation of that species breaks the bidisperse equivalence, sec. 3.1.3).
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing.
+    solid : numpy.ndarray of bool, shape (N,)
+        Solid-like particles (:func:`hardpack.structure.order.crystallinity`).
+
+    Returns
+    -------
+    float
+        The fraction (NaN without particles above the mean radius).
+    """
     large = packing.radii > packing.radii.mean()
     return float(solid[large].mean()) if large.any() else math.nan
 
@@ -98,6 +152,26 @@ def jam(spec: dict, system: str, seed: int, protocol: JamProtocol = JamProtocol(
     Returns the :class:`hardpack.md.CompressResult` with ``stats`` extended by the study's attributes
     (family, width, system, O1, O2, cpu_time, crystallinity and that of the large particles;
     cpu_time counts this process only, ``wall_time`` the whole run, resumed parts included).
+
+    Parameters
+    ----------
+    spec : dict
+        Distribution spec.
+    system : str
+        "poly", "bi" or "tri".
+    seed : int
+        Seed of the start and the velocities.
+    protocol : JamProtocol, optional
+        The compression.
+    checkpoint : str or os.PathLike, optional
+        Checkpoint file.
+    keep_checkpoint : bool, optional
+        Keep the checkpoint at the end.
+
+    Returns
+    -------
+    hardpack.md.CompressResult
+        As above.
     """
     from hardpack.initial import random_packing
     from hardpack.md import StopCriteria, compress
@@ -129,6 +203,33 @@ def fluid_pressure(spec: dict, system: str, phi: float, seed: int, n: int = 500,
     :func:`hardpack.md.equilibrate` over ``collisions`` collisions (a quarter more are discarded first).
     BMCSL (Eq. 3.9) uses O1, O2 of the realised radii, so the comparison is free of sampling error;
     Ogarko finds Z within 1 % of BMCSL for phi < 0.54 (Ogarko 2014, sec. 3.1.3 and Fig. 3.1; sec. 3.2).
+
+    Parameters
+    ----------
+    spec : dict
+        Distribution spec.
+    system : str
+        "poly", "bi" or "tri".
+    phi : float
+        Volume fraction, in (0, 0.6).
+    seed : int
+        Random seed.
+    n : int, optional
+        Number of particles.
+    collisions : int, optional
+        Collisions of the measurement.
+    prep_rate : float, optional
+        Gamma of the preparation.
+
+    Returns
+    -------
+    dict
+        family, width, system, phi, Z, Z_err, Z_bmcsl, rel_dev, O1, O2, N, seed, collisions, cpu_time.
+
+    Raises
+    ------
+    InvalidInputError
+        For phi outside (0, 0.6).
     """
     from hardpack.initial import random_packing
     from hardpack.md import StopCriteria, compress, equilibrate
@@ -164,7 +265,25 @@ def jam_summary(packings, study: str = "jam") -> xr.Dataset:
     (width, system, seed): phi_J (the final phi; phi_J - phi ~ 3 phi / Z <= 1e-11 at Z = 1e12) and
     the run statistics. Missing combinations are NaN. ``study`` (attribute) tells the validation
     what the runs test: "jam", the equivalence of the mixtures at one protocol, or
-    "crystallisation", the slow runs for the large-species crystallisation of Ogarko 2014, sec. 3.1.3."""
+    "crystallisation", the slow runs for the large-species crystallisation of Ogarko 2014, sec. 3.1.3.
+
+    Parameters
+    ----------
+    packings : iterable of xarray.Dataset
+        Jammed packings of one family.
+    study : str, optional
+        "jam" or "crystallisation".
+
+    Returns
+    -------
+    xarray.Dataset
+        Over (width, system, seed).
+
+    Raises
+    ------
+    InvalidInputError
+        For an unknown study, no packings or several families.
+    """
     if study not in JAM_STUDIES:
         raise InvalidInputError(f"study must be one of {JAM_STUDIES}, got {study!r}")
     packings = list(packings)
@@ -193,7 +312,23 @@ def jam_summary(packings, study: str = "jam") -> xr.Dataset:
 
 
 def fluid_dataset(rows: list[dict]) -> xr.Dataset:
-    """Fluid runs of one distribution (dicts from :func:`fluid_pressure`) over (system, phi)."""
+    """Fluid runs of one distribution (dicts from :func:`fluid_pressure`) over (system, phi).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Results of :func:`fluid_pressure`.
+
+    Returns
+    -------
+    xarray.Dataset
+        Z, Z_err, Z_bmcsl, O1, O2, cpu_time and rel_dev over (system, phi).
+
+    Raises
+    ------
+    InvalidInputError
+        Without runs.
+    """
     if not rows:
         raise InvalidInputError("no fluid runs given")
     systems = [s for s in SYSTEMS if any(r["system"] == s for r in rows)]
@@ -213,7 +348,23 @@ def fluid_dataset(rows: list[dict]) -> xr.Dataset:
 
 def fluid_summary(datasets) -> xr.Dataset:
     """Fluid datasets of several distributions as one Dataset over (case, system, phi); case labels
-    are "family:width"."""
+    are "family:width".
+
+    Parameters
+    ----------
+    datasets : iterable of xarray.Dataset
+        Fluid datasets (:func:`fluid_dataset`), one per distribution.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over (case, system, phi).
+
+    Raises
+    ------
+    InvalidInputError
+        Without datasets or with duplicate cases.
+    """
     datasets = list(datasets)
     if not datasets:
         raise InvalidInputError("fluid_summary needs at least one fluid dataset")
@@ -234,7 +385,19 @@ def fluid_summary(datasets) -> xr.Dataset:
 def seed_statistics(summary: xr.Dataset) -> xr.Dataset:
     """Mean and standard error over seeds of phi_J per (width, system), and the relative deviation of
     each system from the polydisperse one, dev = phi_J(system)/phi_J(poly) - 1 (ratio of seed means;
-    errors added in quadrature). Seeds of different systems are independent runs (different radii)."""
+    errors added in quadrature). Seeds of different systems are independent runs (different radii).
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        A jam summary (:func:`jam_summary`).
+
+    Returns
+    -------
+    xarray.Dataset
+        phi_J_mean, phi_J_sem, n_seeds, dev, dev_sem, crystallinity_large over (width, system); the
+        summary's attributes.
+    """
     phi = summary["phi_J"]
     count = phi.count("seed")
     mean = phi.mean("seed")

@@ -54,7 +54,21 @@ class Neighbours:
     """Static CSR neighbour list: for particle i, entries start[i]:start[i+1] hold the partner j,
     the cell-centre vector D_ij = R_j^0 (image) - R_i^0, the contact distance R_i + R_j and
     ratio = |D_ij| / (R_i + R_j), sorted by ratio within each row (so the pairs whose cells still
-    overlap at Delta mu, ratio <= 1 + Delta mu, are a prefix of the row: :meth:`active_end`)."""
+    overlap at Delta mu, ratio <= 1 + Delta mu, are a prefix of the row: :meth:`active_end`).
+
+    Attributes
+    ----------
+    start : numpy.ndarray of int64, shape (N + 1,)
+        Row starts.
+    j : numpy.ndarray of int64, shape (P,)
+        Partner of every entry.
+    disp : numpy.ndarray of float, shape (P, d)
+        D_ij.
+    sig : numpy.ndarray of float, shape (P,)
+        R_i + R_j.
+    ratio : numpy.ndarray of float, shape (P,)
+        |D_ij| / (R_i + R_j).
+    """
 
     start: np.ndarray
     j: np.ndarray
@@ -72,7 +86,25 @@ class Neighbours:
 
 def cell_neighbours(packing: Packing, dmu_max: float) -> Neighbours:
     """Pairs whose cells of radius (1 + dmu_max) R overlap, both directions, self-images
-    dropped (a particle and its own image move together and never collide)."""
+    dropped (a particle and its own image move together and never collide).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing (the cell centres R^0 and radii R).
+    dmu_max : float
+        Largest relative cell size Delta mu.
+
+    Returns
+    -------
+    Neighbours
+        The neighbour list.
+
+    Raises
+    ------
+    InvalidInputError
+        Unless the packing holds spheres in a periodic cell.
+    """
     packing.require_periodic_spheres("BCMD")
     pl = pairs_within(packing, rel_gap=dmu_max)
     keep = pl.i != pl.j
@@ -91,7 +123,18 @@ def cell_neighbours(packing: Packing, dmu_max: float) -> Neighbours:
 
 
 def disjoint_dmu(nb: Neighbours) -> float:
-    """Largest Delta mu at which all cells are pairwise disjoint: min |D_ij| / (R_i + R_j) - 1."""
+    """Largest Delta mu at which all cells are pairwise disjoint: min |D_ij| / (R_i + R_j) - 1.
+
+    Parameters
+    ----------
+    nb : Neighbours
+        The neighbour list.
+
+    Returns
+    -------
+    float
+        Delta mu_d (inf without pairs).
+    """
     if nb.j.size == 0:
         return np.inf
     return float(np.min(nb.ratio) - 1.0)

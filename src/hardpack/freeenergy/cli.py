@@ -142,6 +142,19 @@ def _add_schedule_and_seed(p, *, gamma0: float, theta: float) -> None:
 
 
 def cmd_ellipse_lattice(args) -> int:
+    """Start of the isostatic ellipse packing: lattice disks turned into ellipses (Donev 2006,
+    sec. 6.4.3), written to ``args.out``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack ellipse-lattice``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.freeenergy.ellipses import lattice_ellipses
     from hardpack.io import save_packing
 
@@ -152,6 +165,19 @@ def cmd_ellipse_lattice(args) -> int:
 
 
 def cmd_bcmd_ellipse_ladder(args) -> int:
+    """Independent ellipses in shrinking cells of their own shape: BCMD against 3 ln(dmu0/dmu1)
+    (:func:`hardpack.freeenergy.ellipse_bcmd.disjoint_cells_check`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack bcmd-ellipse-ladder``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.freeenergy.ellipse_bcmd import disjoint_cells_check
     from hardpack.io import write_dataset
 
@@ -162,6 +188,19 @@ def cmd_bcmd_ellipse_ladder(args) -> int:
 
 
 def cmd_bcmd_ellipse(args) -> int:
+    """Exact simplex and BCMD free energy of a jammed ellipse packing made isostatic by frozen
+    centroids (Donev 2006, sec. 6.4.3).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack bcmd-ellipse``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     import dataclasses
 
     import numpy as np
@@ -204,6 +243,19 @@ def cmd_bcmd_ellipse(args) -> int:
 
 
 def cmd_bcmd_ladder(args) -> int:
+    """The cheap BCMD checks against exact values
+    (:func:`hardpack.freeenergy.ladder.ladder_dataset`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack bcmd-ladder``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.freeenergy.ladder import ladder_dataset
     from hardpack.io import write_dataset
 
@@ -217,6 +269,19 @@ def cmd_bcmd_ladder(args) -> int:
 
 
 def cmd_bcmd_simplex(args) -> int:
+    """BCMD of a jammed packing's rattler-free backbone against its exact simplex (Donev 2006,
+    Table 6.1; :func:`hardpack.freeenergy.isostatic.simplex_test`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack bcmd-simplex``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.freeenergy.isostatic import simplex_test
     from hardpack.io import load_dataset, load_packing, write_dataset
 
@@ -257,6 +322,18 @@ def _sized(packing, phi, delta):
 
 
 def cmd_bcmd(args) -> int:
+    """Bounding-cell MD free energy of a stored packing (module docstring; Donev 2006, ch. 6).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack bcmd``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.io import load_packing, write_dataset
 
     packing = _sized(load_packing(args.packing), args.phi, args.delta)

@@ -35,36 +35,118 @@ JAMMING_CONSTANT = 2.160  # Donev 2006, sec. 6.4.1
 
 
 def disjoint_dmu(phi):
-    """Disjoint-cell point of lattice-centred FCC cells, (phi_cp / phi)^(1/3) - 1."""
+    """Disjoint-cell point of lattice-centred FCC cells, (phi_cp / phi)^(1/3) - 1.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        Delta mu_d(phi).
+    """
     return (PHI_CP / np.asarray(phi, float)) ** (1.0 / 3.0) - 1.0
 
 
 def distance_to_jamming(phi):
     """delta = (phi_cp / phi)^(1/3) - 1: the relative growth of the diameters that jams FCC at
-    density phi (the crystal's free energy behaves as -3 ln delta - f_J as delta -> 0)."""
+    density phi (the crystal's free energy behaves as -3 ln delta - f_J as delta -> 0).
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        delta(phi).
+    """
     return (PHI_CP / np.asarray(phi, float)) ** (1.0 / 3.0) - 1.0
 
 
 def cell_offset(phi):
-    """c(phi) = f_c(Delta mu_d) - f_ideal = 1 - ln phi - 3 ln Delta mu_d(phi): excess = c - Delta f."""
+    """c(phi) = f_c(Delta mu_d) - f_ideal = 1 - ln phi - 3 ln Delta mu_d(phi): excess = c - Delta f.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        c(phi), per particle in units of kT.
+    """
     phi = np.asarray(phi, float)
     return 1.0 - np.log(phi) - 3.0 * np.log(disjoint_dmu(phi))
 
 
 def cell_limit_excess(phi, constant=JAMMING_CONSTANT):
-    """Excess free energy of the cell limit, c(phi) - [f_J - f_c^J]."""
+    """Excess free energy of the cell limit, c(phi) - [f_J - f_c^J].
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+    constant : float, optional
+        f_J - f_c^J (Donev 2006, sec. 6.4.1: 2.160 for FCC).
+
+    Returns
+    -------
+    numpy.ndarray of float
+        Excess free energy per particle, units of kT.
+    """
     return cell_offset(phi) - constant
 
 
 def free_volume_z(phi):
-    """Z_fv = 1 / (1 - (phi/phi_cp)^(1/3)), the cell model's pressure."""
+    """Z_fv = 1 / (1 - (phi/phi_cp)^(1/3)), the cell model's pressure.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions, below phi_cp.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        Z_fv.
+    """
     return 1.0 / (1.0 - (np.asarray(phi, float) / PHI_CP) ** (1.0 / 3.0))
 
 
 def eos_excess(phi, z, phi0=MELTING_PHI, excess0=MELTING_EXCESS, at=None):
     """Excess free energy by integrating the measured Z(phi) from phi0 (the smallest of the
     measured densities) with excess(phi0) = excess0 (module docstring); evaluated at the measured
-    densities, or at ``at`` (within their range)."""
+    densities, or at ``at`` (within their range).
+
+    Parameters
+    ----------
+    phi : array_like of float, shape (k,)
+        Distinct measured volume fractions (k >= 3), the smallest equal to ``phi0``.
+    z : array_like of float, shape (k,)
+        Reduced pressures Z = pV/(NkT) at them.
+    phi0 : float, optional
+        Start of the integration.
+    excess0 : float, optional
+        Excess free energy per particle at phi0 (units of kT).
+    at : array_like of float, optional
+        Where to evaluate (default: the measured densities, in their order).
+
+    Returns
+    -------
+    numpy.ndarray of float
+        Excess free energy per particle, units of kT.
+
+    Raises
+    ------
+    InvalidInputError
+        For fewer than 3 densities, none at phi0, densities at or above close packing or ``at``
+        outside the measured range.
+    """
     phi = np.asarray(phi, float)
     z = np.asarray(z, float)
     order = np.argsort(phi)

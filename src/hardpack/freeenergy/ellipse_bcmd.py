@@ -304,6 +304,17 @@ def disjoint_cells_check(seeds=(1, 2, 3), n: int = 10, dmu0: float = 1e-2, dmu1:
     (3/2) ln(K/K0) = 3 ln(dmu0/dmu1) up to the adiabatic error (the energy of a billiard in a
     homothetically shrinking domain scales as its inverse squared size, ergodic or not).
 
+    Parameters
+    ----------
+    seeds : sequence of int, optional
+        One sample per seed.
+    n : int, optional
+        Ellipses per sample.
+    dmu0, dmu1 : float, optional
+        Start and end cell size Delta mu.
+    gamma : float, optional
+        Shrink rate of the cells.
+
     Returns
     -------
     xarray.Dataset

@@ -74,7 +74,23 @@ ROUND_TOL = 1e-9  # |alpha - 1| below this is a disk
 def max_rotation(alpha: float) -> float:
     """Largest rotation of an ellipse of aspect ratio ``alpha`` > 1 at fixed centroid in its cell
     of size Delta mu = 1: min over the boundary of n.r_C / |r_C x n| = 2 alpha / (alpha^2 - 1)
-    (Donev 2006, sec. 6.3.4.2: 4/3 for alpha = 2)."""
+    (Donev 2006, sec. 6.3.4.2: 4/3 for alpha = 2).
+
+    Parameters
+    ----------
+    alpha : float
+        Aspect ratio, > 1.
+
+    Returns
+    -------
+    float
+        The largest rotation angle in radians at Delta mu = 1 (it scales with Delta mu).
+
+    Raises
+    ------
+    InvalidInputError
+        For alpha <= 1 (a disk).
+    """
     alpha = float(alpha)
     if not alpha > 1.0 + ROUND_TOL:
         raise InvalidInputError(f"a disk (alpha = {alpha}) rotates freely in its cell; alpha must be > 1")
@@ -246,7 +262,27 @@ class LinearModel:
 
 def linear_model(packing: Packing, delta: float, contact_tol: float) -> LinearModel:
     """Contacts, gaps and the disjoint-cell point of ``packing`` shrunk by (1 - delta)
-    (module docstring); the arguments are those of :func:`ellipse_simplex_reference`."""
+    (module docstring); the arguments are those of :func:`ellipse_simplex_reference`.
+
+    Parameters
+    ----------
+    packing : Packing
+        A jammed ellipse packing.
+    delta : float
+        Relative shrink of the semiaxes.
+    contact_tol : float
+        Contact tolerance on mu - 1.
+
+    Returns
+    -------
+    LinearModel
+        The linearised contacts of the shrunk packing.
+
+    Raises
+    ------
+    InvalidInputError
+        If an ellipse touches its own periodic image.
+    """
     net0 = ellipsoid_contacts(packing, contact_tol)
     if np.any(net0.i == net0.j):
         raise InvalidInputError("an ellipse touches its own periodic image: use a larger cell")

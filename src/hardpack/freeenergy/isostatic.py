@@ -38,7 +38,25 @@ from hardpack.jamming.rigidity import rigidity_transpose
 
 
 def remove_rattlers(packing: Packing, rattler) -> Packing:
-    """The packing without the particles flagged in ``rattler`` (boolean mask of length N)."""
+    """The packing without the particles flagged in ``rattler`` (boolean mask of length N).
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing.
+    rattler : array_like of bool, shape (N,)
+        Rattler mask (of the jamming verdict of this packing).
+
+    Returns
+    -------
+    Packing
+        The backbone packing.
+
+    Raises
+    ------
+    InvalidInputError
+        For a mask of the wrong length, or fewer than 2 particles left.
+    """
     mask = np.asarray(rattler, dtype=bool)
     if mask.shape != (packing.n_particles,):
         raise InvalidInputError(
@@ -92,7 +110,25 @@ class SimplexReference:
 
 def check_shrink_gap(delta, contact_tol) -> float:
     """The relative shrink gap delta as a float, refused outside (0, 0.01) (the jamming simplex is
-    linear only there), and the contact tolerance, refused outside (0, delta)."""
+    linear only there), and the contact tolerance, refused outside (0, delta).
+
+    Parameters
+    ----------
+    delta : float
+        Relative shrink gap.
+    contact_tol : float
+        Contact tolerance.
+
+    Returns
+    -------
+    float
+        delta.
+
+    Raises
+    ------
+    InvalidInputError
+        For values out of range.
+    """
     delta = float(delta)
     if not 0.0 < delta < 1e-2:
         raise InvalidInputError(f"delta = {delta!r} must be in (0, 0.01): the simplex is linear")

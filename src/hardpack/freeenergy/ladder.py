@@ -26,7 +26,26 @@ from hardpack.geometry.lattices import lattice_packing
 def disjoint_cells(name="fcc", reps=(2, 2, 2), frozen="particle", seed=3) -> tuple[BCMDResult, float]:
     """BCMD of half-size lattice spheres from dmu = 0.5 to 0.05 (cells disjoint throughout) at
     constant rate gamma = 2e-3 (wall speed ~1e-3 of the thermal speed); returns the result and
-    the exact Delta f = d ln 10."""
+    the exact Delta f = d ln 10.
+
+    Parameters
+    ----------
+    name : str, optional
+        Lattice name (:func:`hardpack.geometry.lattices.lattice_packing`).
+    reps : tuple of int, optional
+        Unit cells along each axis.
+    frozen : str, optional
+        What is frozen to fix the translations ("particle" or "cm").
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    result : BCMDResult
+        The BCMD run.
+    exact : float
+        d ln 10.
+    """
     p = lattice_packing(name, reps)
     p = p.replace(radii=p.radii * 0.5)
     res = run_bcmd(p, dmu_max=0.5, dmu_min=0.05, gamma0=2e-3, theta=0.0, frozen=frozen, seed=seed)
@@ -35,7 +54,24 @@ def disjoint_cells(name="fcc", reps=(2, 2, 2), frozen="particle", seed=3) -> tup
 
 def random_simplex(n: int, rng) -> tuple[np.ndarray, np.ndarray, float]:
     """A random non-degenerate simplex around the origin: (A, b) with A x <= b (one facet per
-    row, from qhull) and qhull's volume of its n + 1 vertices."""
+    row, from qhull) and qhull's volume of its n + 1 vertices.
+
+    Parameters
+    ----------
+    n : int
+        Dimension.
+    rng : numpy.random.Generator
+        Random source.
+
+    Returns
+    -------
+    a : numpy.ndarray of float, shape (n + 1, n)
+        Facet normals.
+    b : numpy.ndarray of float, shape (n + 1,)
+        Facet offsets.
+    volume : float
+        qhull's volume.
+    """
     while True:
         verts = rng.normal(size=(n + 1, n))
         verts -= verts.mean(axis=0)
@@ -48,7 +84,26 @@ def random_simplex(n: int, rng) -> tuple[np.ndarray, np.ndarray, float]:
 
 def billiard_simplex(n=3, wall_ratio=1e-5, seed=5) -> tuple[float, float, int]:
     """BCMD volume of a random n-simplex (ball centred at the centroid, shrunk from containing
-    the simplex to inscribed in it): (estimate, exact Eq. 6.5 volume, number of bounces)."""
+    the simplex to inscribed in it): (estimate, exact Eq. 6.5 volume, number of bounces).
+
+    Parameters
+    ----------
+    n : int, optional
+        Dimension.
+    wall_ratio : float, optional
+        As in :func:`hardpack.freeenergy.billiard.volume_estimate`.
+    seed : int, optional
+        Seed of the billiard.
+
+    Returns
+    -------
+    estimate : float
+        BCMD volume.
+    exact : float
+        Eq. 6.5 volume.
+    bounces : int
+        Wall bounces.
+    """
     rng = np.random.default_rng(n)
     a, b, _ = random_simplex(n, rng)
     verts_dist = np.max(np.linalg.norm(_vertices(a, b), axis=1))
@@ -66,7 +121,22 @@ def _vertices(a, b):
 
 
 def simplex_formula_error(dims=(2, 3, 4, 5, 6), per_dim=3, seed=0) -> float:
-    """Largest relative difference between Eq. 6.5 and qhull's volume over random simplices."""
+    """Largest relative difference between Eq. 6.5 and qhull's volume over random simplices.
+
+    Parameters
+    ----------
+    dims : sequence of int, optional
+        Dimensions.
+    per_dim : int, optional
+        Simplices per dimension.
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    float
+        The largest relative difference.
+    """
     rng = np.random.default_rng(seed)
     worst = 0.0
     for n in dims:
@@ -90,6 +160,16 @@ def ladder_dataset(seeds=tuple(range(3, 13))) -> xr.Dataset:
     - disjoint cells: p_c / (mu / dmu) - 1, over every segment of those runs;
     - point billiard: volume / exact - 1 of a random 3-simplex, over ``seeds``;
     - simplex formula: the worst |Eq. 6.5 / qhull - 1| (an identity: no error, one sample).
+
+    Parameters
+    ----------
+    seeds : sequence of int, optional
+        Seeds of the sampled checks.
+
+    Returns
+    -------
+    xarray.Dataset
+        Variables value, error, n_samples, seconds over ``check``.
     """
     t = time.perf_counter()
     runs = [disjoint_cells(seed=s) for s in seeds]

@@ -306,7 +306,23 @@ BOUNDARY_KINDS = ("periodic", "hard_walls", "spherical_container")
 
 
 def as_boundary(value):
-    """A boundary object from ``value``: one of the classes above, or the string ``"periodic"``."""
+    """A boundary object from ``value``: one of the classes above, or the string ``"periodic"``.
+
+    Parameters
+    ----------
+    value : Periodic, HardWalls, SphericalContainer or str
+        The boundary, or "periodic".
+
+    Returns
+    -------
+    Periodic, HardWalls or SphericalContainer
+        The boundary object.
+
+    Raises
+    ------
+    InvalidInputError
+        For anything else.
+    """
     if isinstance(value, (Periodic, HardWalls, SphericalContainer)):
         return value
     if isinstance(value, str) and value == "periodic":

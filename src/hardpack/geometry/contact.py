@@ -82,7 +82,19 @@ def shape_inverse(semiaxes, orientation_row, out):
 @numba.njit(cache=True, inline="always")
 def shape_inverse_into(semiaxes, orientation_row, out, q):
     """:func:`shape_inverse` with a (d, d) scratch array ``q`` for the rotation (no allocation:
-    the event-driven MD calls it in its innermost loop)."""
+    the event-driven MD calls it in its innermost loop).
+
+    Parameters
+    ----------
+    semiaxes : numpy.ndarray of float, shape (d,)
+        Body-frame semiaxes, d = 2 or 3.
+    orientation_row : numpy.ndarray of float, shape (4,) in 3D or (1,) in 2D
+        Unit quaternion or angle, as in :func:`shape_inverse`.
+    out : numpy.ndarray of float, shape (d, d)
+        Receives X^-1.
+    q : numpy.ndarray of float, shape (d, d)
+        Scratch (unused in 2D).
+    """
     d = semiaxes.shape[0]
     if d == 2:
         c, s = np.cos(orientation_row[0]), np.sin(orientation_row[0])
@@ -161,7 +173,24 @@ def pw_contact_into(r_ab, a_inv, b_inv, lam0, n):
     """:func:`pw_contact` without allocation: the normal goes into ``n`` (d,). Returns (zeta, lam,
     number of iterations). The iteration runs on scalars, one routine per dimension
     (:func:`_pw_newton2`, :func:`_pw_newton3`; only the upper triangles of the symmetric
-    matrices are read)."""
+    matrices are read).
+
+    Parameters
+    ----------
+    r_ab, a_inv, b_inv, lam0
+        As in :func:`pw_contact`.
+    n : numpy.ndarray of float, shape (d,)
+        Receives the unnormalised contact normal Y^-1 r_ab.
+
+    Returns
+    -------
+    zeta : float
+        mu^2 - 1 (-1 for coincident centres).
+    lam : float
+        The maximiser Lambda.
+    iterations : int
+        Newton iterations used.
+    """
     d = r_ab.shape[0]
     if not (lam0 >= 0.0 and lam0 <= 1.0):
         raise ValueError("pw_contact: the initial guess lam0 must be in [0, 1]")

@@ -65,7 +65,20 @@ _WG = np.array([0.129484966168869693270611432679082, 0.2797053914892766679014677
 
 @njit(cache=True)
 def lens_area(r1, r2, s):
-    """Area of the intersection of two disks of radii r1, r2 with centres s apart."""
+    """Area of the intersection of two disks of radii r1, r2 with centres s apart.
+
+    Parameters
+    ----------
+    r1, r2 : float
+        Disk radii.
+    s : float
+        Distance of the centres.
+
+    Returns
+    -------
+    float
+        The lens area (0 if they do not meet, pi min(r1, r2)^2 if one holds the other).
+    """
     if r1 <= 0.0 or r2 <= 0.0 or s >= r1 + r2:
         return 0.0
     lo, hi = min(r1, r2), max(r1, r2)
@@ -161,7 +174,22 @@ def _excess(t, p, q, u, v, r2):
 @njit(cache=True)
 def ellipse_disk_area(p, q, u, v, r):
     """Area of the ellipse x^2 / p^2 + y^2 / q^2 <= 1 intersected with the disk of radius r about
-    (u, v), in closed form to round-off (module docstring)."""
+    (u, v), in closed form to round-off (module docstring).
+
+    Parameters
+    ----------
+    p, q : float
+        Semiaxes of the ellipse along x and y.
+    u, v : float
+        Disk centre.
+    r : float
+        Disk radius.
+
+    Returns
+    -------
+    float
+        The area of the intersection.
+    """
     return _ellipse_disk(p, q, u, v, r)[0]
 
 
@@ -260,7 +288,24 @@ def _dual_min(t, a, b, r, n):
 def intersection_extent(a, b, r, n):
     """min n.x over the ellipsoid sum x_i^2 / a_i^2 <= 1 intersected with the ball |x - b| <= r:
     the maximum over t in [0, 1] of the quasi-concave D(t), by golden section (module docstring);
-    +inf (or a value above the ellipsoid's) when they do not meet."""
+    +inf (or a value above the ellipsoid's) when they do not meet.
+
+    Parameters
+    ----------
+    a : numpy.ndarray of float, shape (d,)
+        Semiaxes (body frame).
+    b : numpy.ndarray of float, shape (d,)
+        Ball centre (body frame).
+    r : float
+        Ball radius.
+    n : numpy.ndarray of float, shape (d,)
+        Unit direction.
+
+    Returns
+    -------
+    float
+        The lower end of the intersection along n.
+    """
     g = 0.5 * (np.sqrt(5.0) - 1.0)
     lo, hi = 0.0, 1.0
     x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
@@ -283,7 +328,20 @@ def nearest_direction(a, b):
     """Unit vector from b to its nearest point on the ellipsoid's surface (body frame): the root
     mu < a_min^2 of sum_k a_k^2 b_k^2 / (a_k^2 - mu)^2 = 1 (Eberly 2011, "Distance from a point to
     an ellipse, an ellipsoid, or a hyperellipsoid", Sec. 3), x_k = a_k^2 b_k / (a_k^2 - mu), by
-    geometric bisection in u = a_min^2 - mu; zero components of b as in :func:`_stationary_angles`."""
+    geometric bisection in u = a_min^2 - mu; zero components of b as in :func:`_stationary_angles`.
+
+    Parameters
+    ----------
+    a : numpy.ndarray of float, shape (d,)
+        Semiaxes (body frame).
+    b : numpy.ndarray of float, shape (d,)
+        A point (body frame).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (d,)
+        The unit vector.
+    """
     d = a.shape[0]
     size = a.max()
     a2min = a.min() ** 2
@@ -421,7 +479,24 @@ def _slice_geometry(a, b, r, n):
 def ellipsoid_ball_volume(a, b, r, tol):
     """Volume of the ellipsoid sum x_i^2 / a_i^2 <= 1 (d = 3; the area of the ellipse, d = 2)
     intersected with the ball |x - b| <= r, to ``tol`` times the particle's volume in 3D and to
-    round-off in 2D (module docstring). ``a``, ``b``: body frame, length d."""
+    round-off in 2D (module docstring). ``a``, ``b``: body frame, length d.
+
+    Parameters
+    ----------
+    a : numpy.ndarray of float, shape (d,)
+        Semiaxes (body frame), d = 2 or 3.
+    b : numpy.ndarray of float, shape (d,)
+        Ball centre relative to the particle centre (body frame).
+    r : float
+        Ball radius.
+    tol : float
+        Relative tolerance of the 3D quadrature.
+
+    Returns
+    -------
+    float
+        The volume (area in 2D) of the intersection.
+    """
     d = a.shape[0]
     if r <= 0.0:
         return 0.0
@@ -480,7 +555,30 @@ def covered_volumes(positions, semiaxes, rotations, centre, radii, tol):
 
     ``rotations`` (N, d, d) lab to body. A particle lies wholly inside the ball when its farthest
     surface point from the centre does (:func:`farthest_point_body`), wholly outside when
-    r <= |c| - a_max, and holds the ball when |c| + r <= a_min; the others are integrated."""
+    r <= |c| - a_max, and holds the ball when |c| + r <= a_min; the others are integrated.
+
+    Parameters
+    ----------
+    positions : numpy.ndarray of float, shape (N, d)
+        Particle centres.
+    semiaxes : numpy.ndarray of float, shape (N, d)
+        Semiaxes.
+    rotations : numpy.ndarray of float, shape (N, d, d)
+        Lab-to-body rotations Q.
+    centre : numpy.ndarray of float, shape (d,)
+        Ball centre.
+    radii : numpy.ndarray of float, shape (n_radii,)
+        Ball radii.
+    tol : float
+        Relative tolerance of each quadrature (:func:`ellipsoid_ball_volume`).
+
+    Returns
+    -------
+    volumes : numpy.ndarray of float, shape (n_radii,)
+        Particle volume inside each ball.
+    work : int
+        Particle-radius pairs integrated.
+    """
     n, d = positions.shape
     out = np.zeros(radii.shape[0])
     rel = np.empty(d)

@@ -54,7 +54,22 @@ def _hard_case_g(b, a, a2max):
 @njit(cache=True)
 def farthest_point_body(b, a, x):
     """rho^2 = max |b + z|^2 over the body-frame ellipsoid sum z_k^2 / a_k^2 <= 1, and the farthest
-    point x = b + z (body frame, into ``x``) (module docstring). ``b``, ``a``, ``x``: length d."""
+    point x = b + z (body frame, into ``x``) (module docstring). ``b``, ``a``, ``x``: length d.
+
+    Parameters
+    ----------
+    b : numpy.ndarray of float, shape (d,)
+        Particle centre relative to the container centre (body frame).
+    a : numpy.ndarray of float, shape (d,)
+        Semiaxes.
+    x : numpy.ndarray of float, shape (d,)
+        Receives the farthest point.
+
+    Returns
+    -------
+    float
+        rho^2.
+    """
     d = b.shape[0]
     a2max = 0.0
     a2min = np.inf
@@ -141,7 +156,26 @@ def farthest_point_body(b, a, x):
 @njit(cache=True)
 def farthest_points(positions, semiaxes, rotations, centre):
     """rho (N,) and the farthest surface points (N, d) (lab frame) of N ellipsoids from ``centre``
-    (module docstring); ``rotations`` (N, d, d) lab to body (Q)."""
+    (module docstring); ``rotations`` (N, d, d) lab to body (Q).
+
+    Parameters
+    ----------
+    positions : numpy.ndarray of float, shape (N, d)
+        Particle centres.
+    semiaxes : numpy.ndarray of float, shape (N, d)
+        Semiaxes.
+    rotations : numpy.ndarray of float, shape (N, d, d)
+        Lab-to-body rotations Q.
+    centre : numpy.ndarray of float, shape (d,)
+        Container centre.
+
+    Returns
+    -------
+    rho : numpy.ndarray of float, shape (N,)
+        Largest distance of each particle's surface from the centre.
+    points : numpy.ndarray of float, shape (N, d)
+        The farthest points (lab frame).
+    """
     n, d = positions.shape
     rho = np.empty(n)
     pts = np.empty((n, d))
@@ -228,6 +262,20 @@ def local_farthest_body(b, a, points):
     farthest points: -1.
 
     Exact case: a prolate spheroid centred in the container has the two tips x = +-a_max e_d.
+
+    Parameters
+    ----------
+    b : numpy.ndarray of float, shape (d,)
+        Particle centre relative to the container centre (body frame).
+    a : numpy.ndarray of float, shape (d,)
+        Semiaxes.
+    points : numpy.ndarray of float, shape (MAX_LOCAL, d)
+        Receives the local maxima.
+
+    Returns
+    -------
+    int
+        Their number (0, 1 or 2), or -1 for a continuum.
     """
     d = b.shape[0]
     kd = 0

@@ -60,12 +60,34 @@ def _zeta(offset, a_inv, b_inv) -> float:
 
 def square_side(alpha: float) -> float:
     """Side L of the face-centred square layer: Eq. 8.1, or 2 alpha beyond sqrt(3), where the
-    neighbours along the long axis touch."""
+    neighbours along the long axis touch.
+
+    Parameters
+    ----------
+    alpha : float
+        Aspect ratio of the spheroids (long over short semiaxis).
+
+    Returns
+    -------
+    float
+        L, in units of the short semiaxis.
+    """
     return max(4 * alpha / math.sqrt(1 + alpha**2), 2 * alpha)
 
 
 def layer_spacing(alpha: float) -> float:
-    """Smallest height z between crossed layers at which no spheroids overlap (root of zeta = 0)."""
+    """Smallest height z between crossed layers at which no spheroids overlap (root of zeta = 0).
+
+    Parameters
+    ----------
+    alpha : float
+        Aspect ratio of the spheroids.
+
+    Returns
+    -------
+    float
+        z, in units of the short semiaxis.
+    """
     side = square_side(alpha)
     along_x = _inverse((alpha, 1.0, 1.0), _IDENTITY)  # layer B: long axis along x
     along_y = _inverse((alpha, 1.0, 1.0), _LONG_Y)  # layer A: long axis along y
@@ -111,6 +133,16 @@ def stretched_alpha(s: float) -> float:
     """In-plane aspect ratio of the densest laminate stretched by ``s`` along (1, 1, 0) (Eq. 8.3).
 
     alpha^2 = [(2 + s^2 + 2 s^4) + 2 (1 + s^2) sqrt(1 - s^2 + s^4)] / (3 s^2).
+
+    Parameters
+    ----------
+    s : float
+        Stretch factor, s >= 1.
+
+    Returns
+    -------
+    float
+        alpha(s).
     """
     root = math.sqrt(1 - s**2 + s**4)
     return math.sqrt(((2 + s**2 + 2 * s**4) + 2 * (1 + s**2) * root) / (3 * s**2))
@@ -163,7 +195,23 @@ def stretched_laminate(s: float) -> Packing:
 
 def stretch_for(alpha: float) -> float:
     """The stretch s >= 1 of the densest laminate that gives in-plane aspect ratio ``alpha`` >= sqrt(3)
-    (the inverse of :func:`stretched_alpha`, increasing in s)."""
+    (the inverse of :func:`stretched_alpha`, increasing in s).
+
+    Parameters
+    ----------
+    alpha : float
+        In-plane aspect ratio, >= sqrt(3).
+
+    Returns
+    -------
+    float
+        s.
+
+    Raises
+    ------
+    InvalidInputError
+        For alpha below sqrt(3) or not finite.
+    """
     if not (math.isfinite(alpha) and alpha >= DENSEST_ALPHA):
         raise InvalidInputError(f"stretch_for: alpha must be a finite number >= sqrt(3), got {alpha!r}")
     if alpha == DENSEST_ALPHA:

@@ -22,7 +22,17 @@ from hardpack.geometry.neighbours import PairList, pairs_within
 @dataclass(frozen=True)
 class PotentialPairs:
     """Candidate pairs (``pairs``, a :class:`PairList` of the bounding spheres) with their
-    Perram-Wertheim potential ``zeta`` = mu^2 - 1 and maximiser ``lam`` (Donev 2006, Eqs. 2.10-2.11)."""
+    Perram-Wertheim potential ``zeta`` = mu^2 - 1 and maximiser ``lam`` (Donev 2006, Eqs. 2.10-2.11).
+
+    Attributes
+    ----------
+    pairs : PairList
+        The candidate pairs (i, j, lattice image), M of them.
+    zeta : numpy.ndarray of float, shape (M,)
+        mu^2 - 1 of every pair (> 0 disjoint).
+    lam : numpy.ndarray of float, shape (M,)
+        The maximiser Lambda in (0, 1).
+    """
 
     pairs: PairList
     zeta: np.ndarray

@@ -50,6 +50,23 @@ class EllipsoidContacts:
     ``rattler``: the particles removed; ``backbone_degree``: contacts per particle among the
     backbone (0 for rattlers); ``passes``: removal passes until no particle had fewer than
     ``min_contacts``.
+
+    Attributes
+    ----------
+    contacts : PotentialPairs
+        The touching pairs.
+    degree : numpy.ndarray of int, shape (N,)
+        Contacts per particle.
+    rattler : numpy.ndarray of bool, shape (N,)
+        The particles removed.
+    backbone_degree : numpy.ndarray of int, shape (N,)
+        Contacts per particle among the backbone (0 for rattlers).
+    passes : int
+        Removal passes.
+    tol : float
+        Contact tolerance on mu - 1.
+    min_contacts : int
+        Fewest contacts a backbone particle has.
     """
 
     contacts: PotentialPairs
@@ -196,7 +213,21 @@ def nematic_order(packing) -> tuple[float, np.ndarray]:
 
 @dataclass(frozen=True)
 class NearSphereLaw:
-    """Fit of the contact number near the sphere point (Donev 2006, Eq. 5.30)."""
+    """Fit of the contact number near the sphere point (Donev 2006, Eq. 5.30).
+
+    Attributes
+    ----------
+    z_alpha : float
+        Z_alpha of Z = 2d + Z_alpha sqrt(alpha - 1).
+    z_alpha_err : float
+        Its standard error (NaN with one point).
+    rms_sqrt : float
+        RMS residual of the square-root law.
+    rms_linear : float
+        RMS residual of the best linear law Z = 2d + c (alpha - 1), for comparison.
+    n : int
+        Packings in the fit.
+    """
 
     z_alpha: float        #: Z_alpha of Z = 2d + Z_alpha sqrt(alpha - 1)
     z_alpha_err: float    #: its standard error (NaN with one point)

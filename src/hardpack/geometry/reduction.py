@@ -16,6 +16,23 @@ def lll_reduce(lattice: np.ndarray, delta: float = 0.75) -> tuple[np.ndarray, np
     """LLL-reduce the basis whose **columns** are the lattice vectors.
 
     Returns (reduced, U) with reduced = lattice @ U and U an integer matrix with det +-1.
+
+    Lenstra, Lenstra & Lovasz (1982), with the Lovasz condition
+    |b*_k|^2 >= (delta - mu_{k,k-1}^2) |b*_{k-1}|^2.
+
+    Parameters
+    ----------
+    lattice : numpy.ndarray of float, shape (d, d)
+        The basis, lattice vectors as columns.
+    delta : float, optional
+        Lovasz parameter in (1/4, 1].
+
+    Returns
+    -------
+    reduced : numpy.ndarray of float, shape (d, d)
+        The reduced basis, columns.
+    U : numpy.ndarray of int64, shape (d, d)
+        Unimodular matrix with reduced = lattice @ U.
     """
     b = np.array(lattice, dtype=float).T.copy()  # rows are basis vectors
     d = b.shape[0]

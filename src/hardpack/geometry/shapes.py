@@ -47,7 +47,27 @@ ELLIPSOID_DIMS = (2, 3)
 
 
 def as_finite_array(name: str, value, shape_hint: str) -> np.ndarray:
-    """``value`` as a new float array; refuses non-numeric and non-finite entries, naming ``name``."""
+    """``value`` as a new float array; refuses non-numeric and non-finite entries, naming ``name``.
+
+    Parameters
+    ----------
+    name : str
+        Name of the argument, for the error message.
+    value : array_like
+        The value.
+    shape_hint : str
+        Expected shape, for the error message.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        A copy of ``value``.
+
+    Raises
+    ------
+    InvalidInputError
+        For non-numeric or non-finite entries.
+    """
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:

@@ -21,7 +21,18 @@ log = logging.getLogger(__name__)
 
 
 def cmd_glass_crystal(args) -> int:
-    """Monodisperse triangular crystal in an orthorhombic periodic box at a given phi."""
+    """Monodisperse triangular crystal in an orthorhombic periodic box at a given phi.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-crystal``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.study import triangular_crystal
     from hardpack.io import save_packing
 
@@ -36,7 +47,18 @@ def _branch_name(rate: float) -> str:
 
 
 def cmd_glass_eos(args) -> int:
-    """Binned EOS of a system's compressions (one branch per growth rate) and decompression."""
+    """Binned EOS of a system's compressions (one branch per growth rate) and decompression.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-eos``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.study import eos_dataset
     from hardpack.glass.thermo import second_virial_slope
     from hardpack.io import load_dataset, write_dataset
@@ -68,7 +90,18 @@ def cmd_glass_eos(args) -> int:
 
 
 def cmd_glass_entropy(args) -> int:
-    """s_c - s_mix of the SOC glasses (Donev 2006, Eq. 13.5, Fig. 13.12)."""
+    """s_c - s_mix of the SOC glasses (Donev 2006, Eq. 13.5, Fig. 13.12).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-entropy``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.study import entropy_dataset
     from hardpack.io import load_dataset, write_dataset
 
@@ -92,7 +125,18 @@ def cmd_glass_entropy(args) -> int:
 
 
 def cmd_glass_freezing(args) -> int:
-    """Freezing density of the mixture and its large-disk precipitate (Donev 2006, Eq. 13.2)."""
+    """Freezing density of the mixture and its large-disk precipitate (Donev 2006, Eq. 13.2).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-freezing``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.study import freezing_dataset
     from hardpack.io import load_dataset, write_dataset
 
@@ -109,7 +153,18 @@ def cmd_glass_freezing(args) -> int:
 
 
 def cmd_glass_labels(args) -> int:
-    """Level-cut Matérn GRF labels and their window entropies s_{n,m} (Donev 2006, sec. 13.5)."""
+    """Level-cut Matérn GRF labels and their window entropies s_{n,m} (Donev 2006, sec. 13.5).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-labels``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.segregated import check_window, count_a, label_study, matern
     from hardpack.io import write_dataset
 
@@ -130,7 +185,18 @@ def cmd_glass_labels(args) -> int:
 
 
 def cmd_glass_labelled_crystal(args) -> int:
-    """Triangular crystal of equal disks carrying one realisation of glass-labels (species 0 = A, 1 = B)."""
+    """Triangular crystal of equal disks carrying one realisation of glass-labels (species 0 = A, 1 = B).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-labelled-crystal``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.segregated import labelled_crystal
     from hardpack.io import load_dataset, save_packing
 
@@ -148,7 +214,18 @@ def cmd_glass_labelled_crystal(args) -> int:
 
 
 def cmd_glass_microsegregated(args) -> int:
-    """Micro-segregated packing: B growth at constant pressure, then LS to jamming (Donev 2006, sec. 13.5)."""
+    """Micro-segregated packing: B growth at constant pressure, then LS to jamming (Donev 2006, sec. 13.5).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-microsegregated``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.microsegregated import microsegregated_packing
     from hardpack.io import load_dataset, write_dataset
     from hardpack.io.atomic import check_writable
@@ -174,7 +251,18 @@ def cmd_glass_microsegregated(args) -> int:
 
 
 def cmd_glass_microsegregated_summary(args) -> int:
-    """phi_J and s_c per label ensemble of micro-segregated packings (Donev 2006, Figs. 13.16-13.17)."""
+    """phi_J and s_c per label ensemble of micro-segregated packings (Donev 2006, Figs. 13.16-13.17).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-microsegregated-summary``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.glass.microsegregated import summary_dataset
     from hardpack.io import load_dataset, write_dataset
 
@@ -197,14 +285,14 @@ def register(subparsers) -> None:
     subparsers : argparse._SubParsersAction
         The subcommand parsers of :func:`hardpack.cli.build_parser`.
     """
-    p = subparsers.add_parser("glass-crystal", help=cmd_glass_crystal.__doc__)
+    p = subparsers.add_parser("glass-crystal", help=cmd_glass_crystal.__doc__.split("\n\n")[0])
     p.add_argument("--nx", type=int, required=True, help="rectangular 2-disk cells along x")
     p.add_argument("--ny", type=int, required=True, help="rectangular 2-disk cells along y")
     p.add_argument("--phi", type=float, required=True, help="volume fraction (< pi/sqrt(12))")
     p.add_argument("--out", required=True, help="packing netCDF")
     p.set_defaults(func=cmd_glass_crystal)
 
-    p = subparsers.add_parser("glass-eos", help=cmd_glass_eos.__doc__)
+    p = subparsers.add_parser("glass-eos", help=cmd_glass_eos.__doc__.split("\n\n")[0])
     p.add_argument("files", nargs="+", help="compression / decompression time series of one system")
     p.add_argument("--system", required=True, help="system name (stored)")
     p.add_argument("--kappa", type=float, default=1.0, help="diameter ratio (1: monodisperse)")
@@ -219,13 +307,13 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="EOS summary netCDF")
     p.set_defaults(func=cmd_glass_eos)
 
-    p = subparsers.add_parser("glass-entropy", help=cmd_glass_entropy.__doc__)
+    p = subparsers.add_parser("glass-entropy", help=cmd_glass_entropy.__doc__.split("\n\n")[0])
     p.add_argument("--eos", required=True, help="the system's glass-eos summary")
     p.add_argument("bcmd", nargs="+", help="BCMD results of the glass snapshots")
     p.add_argument("--out", required=True, help="entropy summary netCDF")
     p.set_defaults(func=cmd_glass_entropy)
 
-    p = subparsers.add_parser("glass-freezing", help=cmd_glass_freezing.__doc__)
+    p = subparsers.add_parser("glass-freezing", help=cmd_glass_freezing.__doc__.split("\n\n")[0])
     p.add_argument("--mono", required=True, help="glass-eos summary of monodisperse disks (with a decompression)")
     p.add_argument("--mixture", required=True, help="glass-eos summary of the mixture")
     p.add_argument("--plus", help="glass-eos summary at x_A + dx (x_large - dx)")
@@ -238,7 +326,7 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="freezing netCDF")
     p.set_defaults(func=cmd_glass_freezing)
 
-    p = subparsers.add_parser("glass-labels", help=cmd_glass_labels.__doc__)
+    p = subparsers.add_parser("glass-labels", help=cmd_glass_labels.__doc__.split("\n\n")[0])
     p.add_argument("--shape", type=int, nargs=2, default=[64, 64], metavar=("ROWS", "COLS"),
                    help="periodic lattice (default 64 64)")
     p.add_argument("--R", type=float, required=True, help="Matérn correlation length (> 0, lattice units)")
@@ -251,14 +339,14 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="labels netCDF")
     p.set_defaults(func=cmd_glass_labels)
 
-    p = subparsers.add_parser("glass-labelled-crystal", help=cmd_glass_labelled_crystal.__doc__)
+    p = subparsers.add_parser("glass-labelled-crystal", help=cmd_glass_labelled_crystal.__doc__.split("\n\n")[0])
     p.add_argument("--labels", required=True, help="glass-labels netCDF")
     p.add_argument("--realisation", type=int, default=0, help="which realisation (default 0)")
     p.add_argument("--phi", type=float, required=True, help="volume fraction (< pi/sqrt(12))")
     p.add_argument("--out", required=True, help="packing netCDF")
     p.set_defaults(func=cmd_glass_labelled_crystal)
 
-    p = subparsers.add_parser("glass-microsegregated", help=cmd_glass_microsegregated.__doc__)
+    p = subparsers.add_parser("glass-microsegregated", help=cmd_glass_microsegregated.__doc__.split("\n\n")[0])
     p.add_argument("--labels", required=True, help="glass-labels netCDF (its window entropy is s_c)")
     p.add_argument("--realisation", type=int, default=0, help="which label realisation (default 0)")
     p.add_argument("--ensemble", default="", help="name of the label ensemble (\"random\": the MRJ reference)")
@@ -275,7 +363,8 @@ def register(subparsers) -> None:
     p.add_argument("--growth-timeseries", help="time series of the growth (Fig. 13.14)")
     p.set_defaults(func=cmd_glass_microsegregated)
 
-    p = subparsers.add_parser("glass-microsegregated-summary", help=cmd_glass_microsegregated_summary.__doc__)
+    p = subparsers.add_parser("glass-microsegregated-summary",
+                              help=cmd_glass_microsegregated_summary.__doc__.split("\n\n")[0])
     p.add_argument("files", nargs="+", help="jammed packings of glass-microsegregated")
     p.add_argument("--out", required=True, help="summary netCDF")
     p.set_defaults(func=cmd_glass_microsegregated_summary)

@@ -28,7 +28,26 @@ PUBLISHED_ALPHA = 0.133
 
 def estimated_jamming_density(phi, z, z_err=None, d: int = 2):
     """phi~_J = phi / (1 - d/Z) (Donev 2006, Eq. 1.2, the free-volume EOS inverted) and its error
-    |d phi~_J / dZ| z_err = phi d / (Z - d)^2 z_err. Z <= d gives NaN (no finite estimate)."""
+    |d phi~_J / dZ| z_err = phi d / (Z - d)^2 z_err. Z <= d gives NaN (no finite estimate).
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+    z : array_like of float
+        Reduced pressures Z = pV/(NkT), same shape.
+    z_err : array_like of float, optional
+        Standard errors of Z (default 0).
+    d : int, optional
+        Dimension.
+
+    Returns
+    -------
+    estimate : numpy.ndarray of float
+        phi~_J.
+    error : numpy.ndarray of float
+        Its standard error.
+    """
     phi, z = np.asarray(phi, float), np.asarray(z, float)
     z_err = np.zeros_like(z) if z_err is None else np.asarray(z_err, float)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -39,26 +58,81 @@ def estimated_jamming_density(phi, z, z_err=None, d: int = 2):
 
 
 def cubic_phij(phi, coefficients=PUBLISHED_CUBIC):
-    """Eq. 13.3 evaluated at ``phi`` (default: the published coefficients)."""
+    """Eq. 13.3 evaluated at ``phi`` (default: the published coefficients).
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+    coefficients : sequence of 4 float, optional
+        c0..c3, lowest power first.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        phi~_J(phi).
+    """
     c = np.asarray(coefficients, float)
     phi = np.asarray(phi, float)
     return c[0] + c[1] * phi + c[2] * phi**2 + c[3] * phi**3
 
 
 def glass_phij(phi, phi_j, alpha=PUBLISHED_ALPHA):
-    """Eq. 13.4: phi~_J = (1 + alpha) phi_J - alpha phi."""
+    """Eq. 13.4: phi~_J = (1 + alpha) phi_J - alpha phi.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+    phi_j : float
+        Jamming density phi_J of the glass.
+    alpha : float, optional
+        Slope parameter.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        phi~_J(phi).
+    """
     return (1.0 + alpha) * phi_j - alpha * np.asarray(phi, float)
 
 
 def pressure_from_phij(phi, phij, d: int = 2):
-    """Z = d / (1 - phi / phi~_J), the free-volume form behind both fits."""
+    """Z = d / (1 - phi / phi~_J), the free-volume form behind both fits.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+    phij : array_like of float
+        Estimated jamming densities phi~_J.
+    d : int, optional
+        Dimension.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        Z.
+    """
     phi = np.asarray(phi, float)
     return d / (1.0 - phi / np.asarray(phij, float))
 
 
 @dataclass(frozen=True)
 class LinearFit:
-    """Weighted least-squares coefficients (lowest power first) with their covariance."""
+    """Weighted least-squares coefficients (lowest power first) with their covariance.
+
+    Attributes
+    ----------
+    coefficients : numpy.ndarray of float, shape (degree + 1,)
+        Coefficients, lowest power first.
+    covariance : numpy.ndarray of float, shape (degree + 1, degree + 1)
+        Their covariance (module docstring).
+    chi2 : float
+        Weighted sum of squared residuals.
+    dof : int
+        Points less coefficients.
+    """
 
     coefficients: np.ndarray
     covariance: np.ndarray
@@ -85,6 +159,16 @@ def weighted_polyfit(x, y, y_err, degree: int) -> LinearFit:
         Standard errors of y; None or non-positive entries give unit weights to all points.
     degree : int
         Polynomial degree (>= 0); needs more points than coefficients.
+
+    Returns
+    -------
+    LinearFit
+        The fit.
+
+    Raises
+    ------
+    InvalidInputError
+        With too few finite points.
     """
     x, y = np.asarray(x, float), np.asarray(y, float)
     err = np.ones_like(y) if y_err is None else np.asarray(y_err, float)
@@ -106,7 +190,24 @@ def weighted_polyfit(x, y, y_err, degree: int) -> LinearFit:
 
 
 def fit_liquid_cubic(phi, phij, phij_err=None, phi_max: float = 0.8) -> LinearFit:
-    """Eq. 13.3: the cubic phi~_J(phi) fitted to the points with phi <= ``phi_max``."""
+    """Eq. 13.3: the cubic phi~_J(phi) fitted to the points with phi <= ``phi_max``.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+    phij : array_like of float
+        Estimated jamming densities phi~_J.
+    phij_err : array_like of float, optional
+        Their standard errors.
+    phi_max : float, optional
+        Largest phi fitted.
+
+    Returns
+    -------
+    LinearFit
+        The cubic.
+    """
     phi = np.asarray(phi, float)
     sel = phi <= phi_max
     err = None if phij_err is None else np.asarray(phij_err, float)[sel]
@@ -115,7 +216,21 @@ def fit_liquid_cubic(phi, phij, phij_err=None, phi_max: float = 0.8) -> LinearFi
 
 @dataclass(frozen=True)
 class GlassFit:
-    """Eq. 13.4 fitted: alpha and phi_J with standard errors and their correlation."""
+    """Eq. 13.4 fitted: alpha and phi_J with standard errors and their correlation.
+
+    Attributes
+    ----------
+    alpha : float
+        Slope parameter alpha.
+    alpha_err : float
+        Its standard error.
+    phi_j : float
+        Jamming density phi_J.
+    phi_j_err : float
+        Its standard error.
+    line : LinearFit
+        The fitted line phi~_J = a + b phi.
+    """
 
     alpha: float
     alpha_err: float
@@ -127,7 +242,29 @@ class GlassFit:
 def fit_glass_branch(phi, phij, phij_err=None, phi_min: float = 0.8) -> GlassFit:
     """Eq. 13.4 fitted to the points with phi >= ``phi_min``: the line phi~_J = a + b phi gives
     alpha = -b and phi_J = a / (1 + alpha), errors by first-order propagation of the line's
-    covariance (d phi_J / da = 1/(1+alpha), d phi_J / db = a/(1+alpha)^2)."""
+    covariance (d phi_J / da = 1/(1+alpha), d phi_J / db = a/(1+alpha)^2).
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions.
+    phij : array_like of float
+        Estimated jamming densities phi~_J.
+    phij_err : array_like of float, optional
+        Their standard errors.
+    phi_min : float, optional
+        Smallest phi fitted.
+
+    Returns
+    -------
+    GlassFit
+        The fit.
+
+    Raises
+    ------
+    InvalidInputError
+        If the slope is >= 1.
+    """
     phi = np.asarray(phi, float)
     sel = phi >= phi_min
     err = None if phij_err is None else np.asarray(phij_err, float)[sel]

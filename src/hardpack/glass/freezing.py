@@ -39,7 +39,17 @@ Function = Callable[[float], float]
 
 @dataclass(frozen=True)
 class Phase:
-    """An EOS as functions of phi on [phi_lo, phi_hi]: Z(phi) and Delta f(phi)."""
+    """An EOS as functions of phi on [phi_lo, phi_hi]: Z(phi) and Delta f(phi).
+
+    Attributes
+    ----------
+    z : callable
+        phi -> reduced pressure Z.
+    excess : callable
+        phi -> excess free energy per particle Delta f (units of kT).
+    phi_lo, phi_hi : float
+        The range of phi.
+    """
 
     z: Function
     excess: Function
@@ -50,7 +60,17 @@ class Phase:
 @dataclass(frozen=True)
 class Mixture:
     """A binary disk mixture: diameter ratio kappa (large / small), number fraction x_B of the
-    large disks, dimension d."""
+    large disks, dimension d.
+
+    Attributes
+    ----------
+    kappa : float
+        Diameter ratio, >= 1.
+    x_large : float
+        Number fraction of the large disks, in (0, 1).
+    d : int
+        Dimension.
+    """
 
     kappa: float
     x_large: float
@@ -69,12 +89,44 @@ class Mixture:
 
 
 def mu_pure(phase: Phase, phi_b: float, mix: Mixture) -> float:
-    """mu_B of the pure large-disk phase at phi_B (module docstring)."""
+    """mu_B of the pure large-disk phase at phi_B (module docstring).
+
+    Parameters
+    ----------
+    phase : Phase
+        EOS of the pure large-disk crystal.
+    phi_b : float
+        Its volume fraction.
+    mix : Mixture
+        The mixture (kappa, d).
+
+    Returns
+    -------
+    float
+        mu_B in units of kT (the common -ln v_A dropped).
+    """
     return (math.log(phi_b) - mix.d * math.log(mix.kappa) - 1.0 + phase.excess(phi_b) + phase.z(phi_b))
 
 
 def mu_mixture(phase: Phase, phi: float, mix: Mixture, mu_tilde: Function) -> float:
-    """mu_B of the large disks in the mixture at phi (module docstring)."""
+    """mu_B of the large disks in the mixture at phi (module docstring).
+
+    Parameters
+    ----------
+    phase : Phase
+        EOS of the mixture.
+    phi : float
+        Its volume fraction.
+    mix : Mixture
+        The mixture.
+    mu_tilde : callable
+        phi -> mu~_B(phi) (:func:`composition_derivative`).
+
+    Returns
+    -------
+    float
+        mu_AB in units of kT (the common -ln v_A dropped).
+    """
     v = mix.mean_volume
     x_a = 1.0 - mix.x_large
     return (math.log(phi) + math.log(mix.x_large / v) + phase.excess(phi)
@@ -95,7 +147,19 @@ def _phi_at(phase: Phase, target: float, scale: float) -> float:
 @dataclass(frozen=True)
 class Freezing:
     """The freezing point: the mixture's phi_F and the precipitate's phi_B at pressure pi
-    (P v_A / kT), with the chemical potential there."""
+    (P v_A / kT), with the chemical potential there.
+
+    Attributes
+    ----------
+    phi_freeze : float
+        Volume fraction phi_F of the mixture.
+    phi_precipitate : float
+        Volume fraction phi_B of the precipitate.
+    pressure : float
+        P v_A / kT.
+    mu : float
+        mu_B = mu_AB there.
+    """
 
     phi_freeze: float
     phi_precipitate: float
@@ -104,7 +168,26 @@ class Freezing:
 
 
 def mu_difference(pressure: float, pure: Phase, mixture: Phase, mix: Mixture, mu_tilde: Function) -> float:
-    """mu_AB - mu_B at equal pressure ``pressure`` = P v_A / kT."""
+    """mu_AB - mu_B at equal pressure ``pressure`` = P v_A / kT.
+
+    Parameters
+    ----------
+    pressure : float
+        P v_A / kT.
+    pure : Phase
+        EOS of the pure large-disk crystal.
+    mixture : Phase
+        EOS of the mixture.
+    mix : Mixture
+        The mixture.
+    mu_tilde : callable
+        phi -> mu~_B(phi).
+
+    Returns
+    -------
+    float
+        mu_AB - mu_B in units of kT.
+    """
     phi_b = _phi_at(pure, pressure, mix.kappa**mix.d)
     phi = _phi_at(mixture, pressure, mix.mean_volume)
     return mu_mixture(mixture, phi, mix, mu_tilde) - mu_pure(pure, phi_b, mix)
@@ -158,7 +241,20 @@ def freezing_point(pure: Phase, mixture: Phase, mix: Mixture, mu_tilde: Function
 
 def composition_derivative(excess_plus: Function, excess_minus: Function, dx: float) -> Function:
     """mu~_B(phi) = (d Delta f_AB / d x_A)_phi by the central difference of two mixtures at
-    x_A +- dx (thermodynamic integration at slightly different compositions, Donev 2006, sec. 13.2)."""
+    x_A +- dx (thermodynamic integration at slightly different compositions, Donev 2006, sec. 13.2).
+
+    Parameters
+    ----------
+    excess_plus, excess_minus : callable
+        phi -> Delta f of the mixtures at x_A + dx and x_A - dx.
+    dx : float
+        Composition step, > 0.
+
+    Returns
+    -------
+    callable
+        phi -> mu~_B(phi).
+    """
     if not dx > 0:
         raise InvalidInputError(f"dx must be > 0, got {dx}")
     return lambda phi: (excess_plus(phi) - excess_minus(phi)) / (2.0 * dx)
@@ -167,7 +263,22 @@ def composition_derivative(excess_plus: Function, excess_minus: Function, dx: fl
 def tabulated_phase(phi, z, excess) -> Phase:
     """A Phase from tabulated phi (increasing), Z and Delta f, interpolated linearly (Z) and by
     integrating the linear interpolant of (Z - 1)/phi between the points (Delta f, consistent
-    with :func:`hardpack.glass.thermo.excess_free_energy`)."""
+    with :func:`hardpack.glass.thermo.excess_free_energy`).
+
+    Parameters
+    ----------
+    phi : array_like of float, shape (k,)
+        Strictly increasing volume fractions.
+    z : array_like of float, shape (k,)
+        Reduced pressures.
+    excess : array_like of float, shape (k,)
+        Delta f at the points.
+
+    Returns
+    -------
+    Phase
+        The interpolated phase on [phi[0], phi[-1]].
+    """
     phi, z, excess = (np.asarray(a, float) for a in (phi, z, excess))
     if phi.size < 2 or np.any(np.diff(phi) <= 0):
         raise InvalidInputError("a tabulated phase needs >= 2 strictly increasing phi")

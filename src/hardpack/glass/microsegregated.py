@@ -56,7 +56,20 @@ GROWTH_FIELDS = ("time", "phi", "Z", "pressure_error", "size_ratio", "phi_J_est"
 
 
 def start_phi(pressure: float, d: int = 2) -> float:
-    """phi_max (1 - d / p): the free-volume density of the triangular crystal at reduced pressure p."""
+    """phi_max (1 - d / p): the free-volume density of the triangular crystal at reduced pressure p.
+
+    Parameters
+    ----------
+    pressure : float
+        Reduced pressure p, > d.
+    d : int, optional
+        Dimension.
+
+    Returns
+    -------
+    float
+        The volume fraction.
+    """
     if not (math.isfinite(pressure) and pressure > d):
         raise InvalidInputError(f"the reduced pressure must be a finite number > {d}, got {pressure!r}")
     return PHI_MAX * (1.0 - d / pressure)
@@ -303,7 +316,27 @@ def _fit_attrs(phi_j, s_c) -> dict:
 @dataclass(frozen=True)
 class ExponentialFit:
     """s_c(phi_J) = s_ref exp[-decay (phi_J - phi_ref)] fitted by :func:`fit_sc_exponential`, with
-    the standard errors and the correlation of the two fitted parameters (phi_ref is fixed)."""
+    the standard errors and the correlation of the two fitted parameters (phi_ref is fixed).
+
+    Attributes
+    ----------
+    s_ref : float
+        s_c at phi_ref.
+    s_ref_err : float
+        Its standard error.
+    decay : float
+        Decay rate in phi_J.
+    decay_err : float
+        Its standard error.
+    correlation : float
+        Correlation of the two fitted parameters.
+    phi_ref : float
+        The fixed reference density.
+    n_points : int
+        Ensembles fitted.
+    rms_residual : float
+        RMS residual of the fit.
+    """
 
     s_ref: float
     s_ref_err: float

@@ -33,6 +33,16 @@ def triangular_crystal(nx: int, ny: int, phi: float) -> Packing:
         Rectangular cells along x and y (>= 1; nx = 2 ny gives a nearly square box).
     phi : float
         Volume fraction in (0, pi / sqrt(12)).
+
+    Returns
+    -------
+    Packing
+        The crystal.
+
+    Raises
+    ------
+    InvalidInputError
+        For nx or ny below 1, or phi outside (0, pi / sqrt(12)).
     """
     if nx < 1 or ny < 1:
         raise InvalidInputError(f"nx and ny must be >= 1, got {nx}, {ny}")
@@ -48,7 +58,20 @@ def triangular_crystal(nx: int, ny: int, phi: float) -> Packing:
 
 
 def window_points(ts: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
-    """(phi at each window's mid point, Z of the window) of an MD time series."""
+    """(phi at each window's mid point, Z of the window) of an MD time series.
+
+    Parameters
+    ----------
+    ts : xarray.Dataset
+        MD time series (variables phi and Z over ``window``).
+
+    Returns
+    -------
+    phi : numpy.ndarray of float, shape (n_windows,)
+        Mid-window volume fractions.
+    z : numpy.ndarray of float, shape (n_windows,)
+        Reduced pressures.
+    """
     phi_end = ts["phi"].values
     start = float(ts.attrs.get("phi_start", phi_end[0]))
     phi_start = np.concatenate([[start], phi_end[:-1]])
@@ -58,6 +81,13 @@ def window_points(ts: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
 def bin_runs(runs: list[list[xr.Dataset]], edges: np.ndarray) -> dict[str, np.ndarray]:
     """Mean Z per phi bin of each run (a run: its time series, e.g. consecutive segments), then
     the mean and standard error over runs (module docstring).
+
+    Parameters
+    ----------
+    runs : list of list of xarray.Dataset
+        Per run, its MD time series in order.
+    edges : numpy.ndarray of float, shape (nb + 1,)
+        phi bin edges.
 
     Returns
     -------
@@ -129,6 +159,11 @@ def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float 
         phi ranges of the Eq. 13.3 and Eq. 13.4 fits.
     attrs : dict, optional
         Attributes to add (system, kappa, x_large, N, ...).
+
+    Returns
+    -------
+    xarray.Dataset
+        The EOS summary over (branch, phi bin centre), kind ``glass_eos``, fits as attributes.
     """
     names = list(branches)
     if not names:
@@ -202,7 +237,24 @@ def _add_fits(ds: xr.Dataset, liquid_range, glass_range) -> None:
 def liquid_excess_at(eos: xr.Dataset, phi: float, branch: str | None = None) -> tuple[float, float]:
     """Delta f_L and its error at ``phi`` by the EOS integral of ``branch`` (default: the
     slowest compression), i.e. the trapezoid integral continued to ``phi`` from the nearest bin
-    below it with the straight line of (Z - 1)/phi between the bins."""
+    below it with the straight line of (Z - 1)/phi between the bins.
+
+    Parameters
+    ----------
+    eos : xarray.Dataset
+        The EOS summary (:func:`eos_dataset`).
+    phi : float
+        Volume fraction.
+    branch : str, optional
+        The branch.
+
+    Returns
+    -------
+    excess : float
+        Delta f_L (NaN outside the branch's bins).
+    error : float
+        Its error.
+    """
     if branch is None:
         branch = eos.attrs.get("cubic_branch")
     row = eos.sel(branch=branch)
@@ -267,7 +319,22 @@ def entropy_dataset(eos: xr.Dataset, bcmd: list[xr.Dataset], *, x_large: float,
 def joint_branch(eos: xr.Dataset, low: str, high: str, phi_join: float):
     """(phi, Z, Z_err) of one smooth EOS: branch ``low`` below ``phi_join`` and ``high`` from it
     up (monodisperse disks: the liquid compression and the crystal decompression, treated as one
-    phase, Donev 2006, sec. 13.2), empty bins dropped."""
+    phase, Donev 2006, sec. 13.2), empty bins dropped.
+
+    Parameters
+    ----------
+    eos : xarray.Dataset
+        The EOS summary (:func:`eos_dataset`).
+    low, high : str
+        The branches below and above ``phi_join``.
+    phi_join : float
+        Volume fraction where they join.
+
+    Returns
+    -------
+    phi, z, z_err : numpy.ndarray of float
+        The joined EOS, sorted by phi.
+    """
     lo, hi = eos.sel(branch=low), eos.sel(branch=high)
     take_lo = (lo["phi_mean"].values < phi_join) & np.isfinite(lo["Z"].values)
     take_hi = (hi["phi_mean"].values >= phi_join) & np.isfinite(hi["Z"].values)
@@ -286,7 +353,30 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
     ``phi_join`` and the decompression of the crystal above; the mixture's EOS is its slowest
     compression; mu~_B from the mixtures at x_A +- dx (``plus``: x_A + dx, i.e. x_large - dx),
     or 0 without them (recorded in ``mu_tilde``). Data that do not allow a solution (too few
-    points, no sign change) give NaN with the reason in ``status``."""
+    points, no sign change) give NaN with the reason in ``status``.
+
+    Parameters
+    ----------
+    mono : xarray.Dataset
+        EOS summary of the monodisperse system.
+    mixture : xarray.Dataset
+        EOS summary of the mixture.
+    plus, minus : xarray.Dataset or None
+        EOS summaries at x_A + dx and x_A - dx.
+    kappa : float
+        Diameter ratio.
+    x_large : float
+        Number fraction of the large disks.
+    dx : float
+        Composition step of ``plus`` and ``minus``.
+    phi_join : float
+        Where the monodisperse compression and decompression join.
+
+    Returns
+    -------
+    xarray.Dataset
+        Scalars phi_freeze, phi_precipitate, pressure, mu; attributes status and mu_tilde.
+    """
     attrs = {"hardpack_kind": "glass_freezing", "kappa": kappa, "x_large": x_large, "phi_join": phi_join,
              "n_particles": int(mixture.attrs.get("N", 0))}
     try:

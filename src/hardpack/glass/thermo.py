@@ -42,6 +42,16 @@ def mixing_entropy(x) -> float:
     ----------
     x : float
         Number fraction in [0, 1] (0 and 1 give 0: a pure system).
+
+    Returns
+    -------
+    float
+        The entropy per particle, units of k.
+
+    Raises
+    ------
+    InvalidInputError
+        For x outside [0, 1].
     """
     x = float(x)
     if not 0.0 <= x <= 1.0:
@@ -57,6 +67,20 @@ def second_virial_slope(d: int = 2, size_ratio: float = 1.0, large_fraction: flo
     Z = 1 + B_2 rho with B_2 = (|B_d| / 2) sum_ij x_i x_j D_ij^d, D_ij = (D_i + D_j) / 2, and
     phi = rho |B_d| <D^d> / 2^d, so (Z - 1) / phi -> 2^(d-1) <D_ij^d> / <D^d> (derived here;
     2 for monodisperse disks, 4 for spheres; for disks 1 + <D>^2 / <D^2>).
+
+    Parameters
+    ----------
+    d : int, optional
+        Dimension, >= 1.
+    size_ratio : float, optional
+        Diameter ratio large / small, > 0.
+    large_fraction : float, optional
+        Number fraction of the large particles, in [0, 1].
+
+    Returns
+    -------
+    float
+        The slope.
     """
     if d < 1:
         raise InvalidInputError(f"dimension d must be >= 1, got {d}")
@@ -163,7 +187,20 @@ def integrate_eos(z_of_phi, phi, *, phi0: float = 0.0, f0: float = 0.0, slope0: 
 
 def henderson_excess(phi):
     """Exact EOS integral of Henderson's hard-disk EOS Z = (1 + phi^2/8)/(1 - phi)^2:
-    Delta f = (9/8) phi / (1 - phi) - (7/8) ln(1 - phi) (derived here; a closed-form check)."""
+    Delta f = (9/8) phi / (1 - phi) - (7/8) ln(1 - phi) (derived here; a closed-form check).
+
+    Henderson (1975) equation of state.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Volume fractions, < 1.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        Delta f per disk, units of kT.
+    """
     phi = np.asarray(phi, float)
     return 9.0 / 8.0 * phi / (1.0 - phi) - 7.0 / 8.0 * np.log1p(-phi)
 

@@ -14,7 +14,18 @@ log = logging.getLogger(__name__)
 
 
 def cmd_hgrid_cost(args) -> int:
-    """Analytic HGrid cost T/N vs number of levels for power-law radii (Ogarko ch. 2.2, Fig. 2.15)."""
+    """Analytic HGrid cost T/N vs number of levels for power-law radii (Ogarko ch. 2.2, Fig. 2.15).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack hgrid-cost``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.io import write_dataset
 
     system = cm.PowerLawSystem(args.alpha, args.omega, args.nu, args.d)
@@ -35,7 +46,7 @@ def register(subparsers) -> None:
     subparsers : argparse._SubParsersAction
         The subcommand parsers of :func:`hardpack.cli.build_parser`.
     """
-    p = subparsers.add_parser("hgrid-cost", help=cmd_hgrid_cost.__doc__)
+    p = subparsers.add_parser("hgrid-cost", help=cmd_hgrid_cost.__doc__.split("\n\n")[0])
     p.add_argument("--alpha", type=float, required=True, help="exponent of f(r) ~ r^alpha (0 US, -3 UV)")
     p.add_argument("--omega", type=float, required=True, help="r_max / r_min")
     p.add_argument("--nu", type=float, default=0.7, help="volume fraction (default 0.7)")

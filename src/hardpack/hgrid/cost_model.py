@@ -49,7 +49,18 @@ METHODS = ("top-down", "bottom-up")
 
 def n_neighbour_cells(d: int) -> int:
     """n_c = (3^d - 1)/2 neighbour cells visited per cell with the half stencil (Ogarko 2014, sec. 2.2.3,
-    below Eq. 2.23)."""
+    below Eq. 2.23).
+
+    Parameters
+    ----------
+    d : int
+        Dimension.
+
+    Returns
+    -------
+    int
+        n_c.
+    """
     return (3**d - 1) // 2
 
 
@@ -63,7 +74,19 @@ def _power_integral(p: float, lo, hi):
 
 @dataclass(frozen=True)
 class PowerLawSystem:
-    """Radius pdf f ~ r^alpha on [1, omega] (units of r_min), volume fraction nu, dimension d."""
+    """Radius pdf f ~ r^alpha on [1, omega] (units of r_min), volume fraction nu, dimension d.
+
+    Attributes
+    ----------
+    alpha : float
+        Exponent of the radius pdf.
+    omega : float
+        r_max / r_min, >= 1.
+    nu : float
+        Volume fraction, in (0, 1).
+    d : int
+        Dimension.
+    """
 
     alpha: float
     omega: float
@@ -169,13 +192,39 @@ def _check_levels(L):
 
 
 def linear_cells(L: int, omega: float) -> np.ndarray:
-    """s_h = 2 r_min (1 + h (omega - 1)/L), h = 0..L (Eq. 2.42)."""
+    """s_h = 2 r_min (1 + h (omega - 1)/L), h = 0..L (Eq. 2.42).
+
+    Parameters
+    ----------
+    L : int
+        Number of levels, >= 1.
+    omega : float
+        r_max / r_min.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (L + 1,)
+        s_0..s_L in units of r_min.
+    """
     L = _check_levels(L)
     return 2.0 * (1 + np.arange(L + 1) * (omega - 1) / L)
 
 
 def exponential_cells(L: int, omega: float) -> np.ndarray:
-    """s_h = 2 r_min omega^(h/L), h = 0..L (Eqs. 2.43-2.44)."""
+    """s_h = 2 r_min omega^(h/L), h = 0..L (Eqs. 2.43-2.44).
+
+    Parameters
+    ----------
+    L : int
+        Number of levels, >= 1.
+    omega : float
+        r_max / r_min.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (L + 1,)
+        s_0..s_L in units of r_min.
+    """
     L = _check_levels(L)
     return 2.0 * omega ** (np.arange(L + 1) / L)
 
@@ -185,6 +234,20 @@ def constant_m_cells(system: PowerLawSystem, L: int, q: float = 1.0) -> np.ndarr
 
     Solved by shooting: for a trial m_1 each s_h follows from s_h^d [F(s_h/2) - F(s_{h-1}/2)] = c q^(h-1)
     (monotone in s_h), and m_1 is adjusted until s_L = 2 omega.
+
+    Parameters
+    ----------
+    system : PowerLawSystem
+        The radius distribution (polydisperse).
+    L : int
+        Number of levels, >= 1.
+    q : float, optional
+        Ratio of the particles per cell of successive levels, > 0.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (L + 1,)
+        s_0..s_L in units of r_min.
     """
     L = _check_levels(L)
     if not (q > 0):
@@ -238,6 +301,22 @@ def optimal_cells(system: PowerLawSystem, L: int, K: float = 0.2, method: str = 
 
     The constraint s_{h+1} >= s_h with fixed ends is built in by writing the L log-increments as
     ln(omega) times a softmax of L-1 free parameters; BFGS with numerical gradients.
+
+    Parameters
+    ----------
+    system : PowerLawSystem
+        The radius distribution.
+    L : int
+        Number of levels, >= 1.
+    K : float, optional
+        Cost ratio of a cell visit to a distance test.
+    method : str, optional
+        Search method of the cost model, "top-down" or "bottom-up".
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (L + 1,)
+        s_0..s_L in units of r_min.
     """
     L = _check_levels(L)
     if L == 1:
@@ -252,7 +331,31 @@ CELL_RULES = ("linear", "exponential", "constant-m", "optimal")
 
 
 def cells_for(system: PowerLawSystem, rule: str, L: int, K: float = 0.2, method: str = "top-down"):
-    """Boundaries s_0..s_L of the named cell-size rule (one of CELL_RULES; constant-m uses q = 1)."""
+    """Boundaries s_0..s_L of the named cell-size rule (one of CELL_RULES; constant-m uses q = 1).
+
+    Parameters
+    ----------
+    system : PowerLawSystem
+        The radius distribution.
+    rule : str
+        One of CELL_RULES.
+    L : int
+        Number of levels, >= 1.
+    K : float, optional
+        Cost ratio (rule "optimal").
+    method : str, optional
+        Search method (rule "optimal").
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (L + 1,)
+        s_0..s_L in units of r_min.
+
+    Raises
+    ------
+    InvalidInputError
+        For an unknown rule.
+    """
     if rule == "linear":
         return linear_cells(L, system.omega)
     if rule == "exponential":
@@ -265,12 +368,54 @@ def cells_for(system: PowerLawSystem, rule: str, L: int, K: float = 0.2, method:
 
 
 def cost_vs_levels(system: PowerLawSystem, rule: str, levels, K: float = 0.2, method: str = "top-down") -> np.ndarray:
-    """T/N for each L in ``levels`` with the named cell-size rule (the curves of Figs. 2.12 and 2.15)."""
+    """T/N for each L in ``levels`` with the named cell-size rule (the curves of Figs. 2.12 and 2.15).
+
+    Parameters
+    ----------
+    system : PowerLawSystem
+        The radius distribution.
+    rule : str
+        One of CELL_RULES.
+    levels : iterable of int
+        Numbers of levels.
+    K : float, optional
+        Cost ratio of a cell visit to a distance test.
+    method : str, optional
+        "top-down" or "bottom-up".
+
+    Returns
+    -------
+    numpy.ndarray of float
+        T/N for each L.
+    """
     return np.array([system.cost(cells_for(system, rule, L, K, method), K, method) for L in levels])
 
 
 def best_levels(system: PowerLawSystem, rule: str, L_max: int = 60, K: float = 0.2, method: str = "top-down"):
-    """(L*, T*/N, cells) minimising T/N over 1 <= L <= L_max for the named rule (Figs. 2.10-2.15)."""
+    """(L*, T*/N, cells) minimising T/N over 1 <= L <= L_max for the named rule (Figs. 2.10-2.15).
+
+    Parameters
+    ----------
+    system : PowerLawSystem
+        The radius distribution.
+    rule : str
+        One of CELL_RULES.
+    L_max : int, optional
+        Most levels tried.
+    K : float, optional
+        Cost ratio of a cell visit to a distance test.
+    method : str, optional
+        "top-down" or "bottom-up".
+
+    Returns
+    -------
+    levels : int
+        L*.
+    cost : float
+        T*/N.
+    cells : numpy.ndarray of float, shape (L* + 1,)
+        Its cell boundaries.
+    """
     levels = np.arange(1, _check_levels(L_max) + 1)
     costs = cost_vs_levels(system, rule, levels, K, method)
     best = int(np.argmin(costs))

@@ -37,6 +37,18 @@ def atomic_path(path, fsync: bool = True):
     """Yield a temporary path next to ``path``; on success flush it and rename it onto ``path``.
 
     Missing parent folders are created.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination.
+    fsync : bool, optional
+        Flush the file to disk before the rename.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary path to write (removed if the block raises).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -56,7 +68,15 @@ def atomic_path(path, fsync: bool = True):
 
 
 def write_text(path, text: str) -> None:
-    """Atomically write a text file."""
+    """Atomically write a text file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The destination.
+    text : str
+        The contents.
+    """
     with atomic_path(path) as tmp:
         tmp.write_text(text)
 
@@ -69,6 +89,13 @@ def check_writable(path, what: str = "output") -> None:
     creates and removes a temporary file there, so it also catches read-only file systems and
     permissions that ``os.access`` does not see. Raises :class:`InvalidInputError` naming ``what``
     (e.g. the command-line option) and the path.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output path.
+    what : str, optional
+        What the path is, for the message.
     """
     path = Path(path)
     if path.is_dir():

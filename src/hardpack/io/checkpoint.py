@@ -31,7 +31,20 @@ FORMAT = 2
 
 
 def fingerprint(packing, **params) -> str:
-    """SHA-256 over the start packing's arrays and the run parameters that shape the trajectory."""
+    """SHA-256 over the start packing's arrays and the run parameters that shape the trajectory.
+
+    Parameters
+    ----------
+    packing : Packing
+        The start packing.
+    **params
+        The run parameters (JSON-serialisable, others by ``str``).
+
+    Returns
+    -------
+    str
+        Hexadecimal digest.
+    """
     h = hashlib.sha256()
     for arr in (packing.positions, packing.radii, packing.lattice):
         h.update(np.ascontiguousarray(arr, dtype=float).tobytes())
@@ -40,14 +53,42 @@ def fingerprint(packing, **params) -> str:
 
 
 def save(path, fp: str, state: dict) -> None:
-    """Atomically write ``state`` (arrays and scalars) with fingerprint ``fp`` to ``path``."""
+    """Atomically write ``state`` (arrays and scalars) with fingerprint ``fp`` to ``path``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The checkpoint file.
+    fp : str
+        Fingerprint of the run (:func:`fingerprint`).
+    state : dict of str to array_like
+        The run state.
+    """
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez(fh, fingerprint=np.array(fp), format=np.array(FORMAT), **state)
 
 
 def load(path, fp: str) -> dict | None:
     """The saved state, or None if ``path`` does not exist. A checkpoint of a different run (other
-    start packing or parameters) is refused rather than silently continued."""
+    start packing or parameters) is refused rather than silently continued.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The checkpoint file.
+    fp : str
+        Fingerprint of the run (:func:`fingerprint`).
+
+    Returns
+    -------
+    dict of str to numpy.ndarray or None
+        The state.
+
+    Raises
+    ------
+    InvalidInputError
+        For an unreadable checkpoint or one of a different run.
+    """
     path = Path(path)
     if not path.exists():
         return None
@@ -66,4 +107,11 @@ def load(path, fp: str) -> dict | None:
 
 
 def remove(path) -> None:
+    """Delete a checkpoint file if it exists.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The checkpoint file.
+    """
     Path(path).unlink(missing_ok=True)

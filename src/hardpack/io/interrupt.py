@@ -29,7 +29,15 @@ _owner: int | None = None
 
 
 class Interrupted(KeyboardInterrupt):
-    """A run stopped by a signal; ``str(exc)`` says whether a checkpoint was written."""
+    """A run stopped by a signal; ``str(exc)`` says whether a checkpoint was written.
+
+    Parameters
+    ----------
+    signum : int
+        The signal number.
+    message : str
+        What happened and how to resume.
+    """
 
     def __init__(self, signum: int, message: str):
         super().__init__(message)
@@ -63,7 +71,12 @@ def _handler(signum, frame) -> None:
 @contextlib.contextmanager
 def installed():
     """Within, SIGINT and SIGTERM raise :class:`Interrupted` (main thread only; the previous
-    handlers are restored on exit)."""
+    handlers are restored on exit).
+
+    Yields
+    ------
+    None
+    """
     global _owner
     previous = {}
     if threading.current_thread() is threading.main_thread():
@@ -80,13 +93,24 @@ def installed():
 
 
 def requested() -> int | None:
-    """The signal received inside :func:`deferred`, or None."""
+    """The signal received inside :func:`deferred`, or None.
+
+    Returns
+    -------
+    int or None
+        The signal number.
+    """
     return _pending
 
 
 @contextlib.contextmanager
 def deferred():
-    """Within, SIGINT and SIGTERM set :func:`requested` instead of stopping the run at once."""
+    """Within, SIGINT and SIGTERM set :func:`requested` instead of stopping the run at once.
+
+    Yields
+    ------
+    None
+    """
     global _depth, _pending, _owner
     previous = {}
     if _depth == 0 and threading.current_thread() is threading.main_thread():
@@ -107,7 +131,20 @@ def deferred():
 
 
 def stop(checkpoint, where: str) -> Interrupted:
-    """The exception a polling loop raises after writing ``checkpoint`` (None: no checkpoint)."""
+    """The exception a polling loop raises after writing ``checkpoint`` (None: no checkpoint).
+
+    Parameters
+    ----------
+    checkpoint : str or os.PathLike or None
+        The checkpoint written.
+    where : str
+        Where the run stopped, for the message.
+
+    Returns
+    -------
+    Interrupted
+        The exception.
+    """
     signum = _pending if _pending is not None else signal.SIGINT
     if checkpoint is None:
         text = (f"stopped by {_name(signum)} at {where}; no checkpoint file was given, so the run "

@@ -103,6 +103,19 @@ def _verify_ellipsoids(packing, args) -> int:
 
 
 def cmd_verify(args) -> int:
+    """Jamming verdict of a stored packing (module docstring): writes the verdict dataset to
+    ``args.out`` and prints its summary.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack verify``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.io import dataset_to_packing, load_dataset
 
     ds = load_dataset(args.packing, kind="packing")

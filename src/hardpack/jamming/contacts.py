@@ -42,7 +42,23 @@ from hardpack.geometry.packing import Packing
 
 
 def check_delta(delta) -> float:
-    """Validate the relative gap tolerance: a finite number with 0 < delta < 1."""
+    """Validate the relative gap tolerance: a finite number with 0 < delta < 1.
+
+    Parameters
+    ----------
+    delta : object
+        The tolerance as given (converted with ``float``).
+
+    Returns
+    -------
+    float
+        The tolerance.
+
+    Raises
+    ------
+    InvalidInputError
+        If it is not a number in (0, 1).
+    """
     try:
         value = float(delta)
     except (TypeError, ValueError):
@@ -265,7 +281,18 @@ def contact_network(packing: Packing, delta: float) -> ContactNetwork:
 
 
 def require_spheres(packing: Packing) -> None:
-    """Refuse anything but hard spheres (periodic, between hard walls or in a container)."""
+    """Refuse anything but hard spheres (periodic, between hard walls or in a container).
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing to test.
+
+    Raises
+    ------
+    InvalidInputError
+        If its particles are not spheres.
+    """
     if packing.shape.kind != "sphere":
         raise InvalidInputError(f"{packing.shape.name} are not supported by the jamming tests yet; they "
                                 "handle hard spheres only (ellipsoids: hardpack.jamming.verify_ellipsoids)")

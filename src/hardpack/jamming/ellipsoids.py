@@ -85,12 +85,34 @@ __all__ = [
 
 
 def dof_per_particle(d: int) -> int:
-    """d + d(d-1)/2: translations and rotations of one particle (3 in 2D, 6 in 3D)."""
+    """d + d(d-1)/2: translations and rotations of one particle (3 in 2D, 6 in 3D).
+
+    Parameters
+    ----------
+    d : int
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    int
+        Degrees of freedom d_f of one rigid particle.
+    """
     return d + d * (d - 1) // 2
 
 
 def generators(d: int) -> np.ndarray:
-    """The infinitesimal rotations E_a (E_a v = e_a x v; in 2D the rotation by +90 degrees), (k, d, d)."""
+    """The infinitesimal rotations E_a (E_a v = e_a x v; in 2D the rotation by +90 degrees), (k, d, d).
+
+    Parameters
+    ----------
+    d : int
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (d(d-1)/2, d, d)
+        The generators E_a (one in 2D, three in 3D).
+    """
     if d == 2:
         return np.array([[[0.0, -1.0], [1.0, 0.0]]])
     e = np.zeros((3, 3, 3))
@@ -110,6 +132,39 @@ class EllipsoidContacts(ContactArrays):
     particle's X^-1 (N, d, d). ``wall`` is -1 for a pair and 0 for a contact with the container
     wall (module docstring: j = i, lam NaN, scale 1, lever_j 0, separation p - c); ``centre`` and
     ``radius`` describe the container (None in a periodic cell).
+
+    Attributes
+    ----------
+    i, j : numpy.ndarray of int, shape (M,)
+        The particles of each contact (j = i for a wall contact).
+    shift : numpy.ndarray of int, shape (M, d)
+        Lattice image n of j.
+    separation : numpy.ndarray of float, shape (M, d)
+        x_j + L n - x_i (for a wall contact p - c, above).
+    zeta, lam : numpy.ndarray of float, shape (M,)
+        Perram-Wertheim overlap potential mu^2 - 1 and its maximiser (Donev 2006, sec. 2.2.2.1).
+    normal, raw_normal : numpy.ndarray of float, shape (M, d)
+        Unit contact normal u from i to j, and the unnormalised n = Y^-1 r.
+    lever_i, lever_j : numpy.ndarray of float, shape (M, d)
+        Lever arms from the centres to the contact point.
+    scale : numpy.ndarray of float, shape (M,)
+        2 lam (1 - lam) |n|.
+    positions : numpy.ndarray of float, shape (N, d)
+        Particle centres.
+    lattice : numpy.ndarray of float, shape (d, d)
+        Cell, lattice vectors as columns.
+    shape_inv : numpy.ndarray of float, shape (N, d, d)
+        X^-1 of every particle.
+    semiaxes : numpy.ndarray of float, shape (N, d)
+        Semiaxes of every particle.
+    delta : float
+        Contact tolerance on mu - 1.
+    wall : numpy.ndarray of int, shape (M,), or None
+        -1 for a pair, 0 for a contact with the container wall.
+    centre : numpy.ndarray of float, shape (d,), or None
+        Container centre (None in a periodic cell).
+    radius : float or None
+        Container radius.
     """
 
     i: np.ndarray
@@ -372,7 +427,18 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> Ellipsoi
 
 
 def check_ellipsoid_packing(packing) -> None:
-    """Refuse anything but a packing of ellipses or ellipsoids, periodic or in a spherical container."""
+    """Refuse anything but a packing of ellipses or ellipsoids, periodic or in a spherical container.
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing to test.
+
+    Raises
+    ------
+    InvalidInputError
+        If it is not a packing of ellipses or ellipsoids in a periodic cell or spherical container.
+    """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
             f"expected a hardpack Packing, got {type(packing).__name__}; build one with "
@@ -392,7 +458,18 @@ def check_ellipsoid_packing(packing) -> None:
 
 def rigidity_transpose_full(net: EllipsoidContacts) -> sp.csr_matrix:
     """A^T (M, N d_f): row c is the gap rate of contact c (module docstring), all particle dof; a
-    wall contact has its particle's block only."""
+    wall contact has its particle's block only.
+
+    Parameters
+    ----------
+    net : EllipsoidContacts
+        The contact network.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (M, N d_f)
+        A^T; the dof of particle i are (x_i, omega_i), d_f = :func:`dof_per_particle`.
+    """
     m, d, n = net.n_contacts, net.dim, net.n_particles
     f = dof_per_particle(d)
     u = net.normal
@@ -528,7 +605,18 @@ def zeta_hessian(r_ab, a_inv, b_inv, lam) -> np.ndarray:
 def contact_hessians(net: EllipsoidContacts) -> np.ndarray:
     """Hess zeta of every contact, (M, 2 d_f, 2 d_f) in the order (r_i, omega_i, r_j, omega_j)
     (:func:`zeta_hessian`); for a wall contact the Hessian of its gap h (:func:`wall_gap_hessian`)
-    in the (r_i, omega_i) block and zeros elsewhere."""
+    in the (r_i, omega_i) block and zeros elsewhere.
+
+    Parameters
+    ----------
+    net : EllipsoidContacts
+        The contact network.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (M, 2 d_f, 2 d_f)
+        The Hessian of every contact.
+    """
     gens = generators(net.dim)
     pair = np.flatnonzero(net.wall < 0)
     if pair.size == net.n_contacts:

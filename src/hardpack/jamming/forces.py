@@ -66,7 +66,21 @@ from hardpack.jamming.workingset import solve_working_set
 
 @dataclass(frozen=True)
 class Forces:
-    """Self-stress of the backbone: ``forces`` (M,) is 0 off the backbone, mean 1 on it."""
+    """Self-stress of the backbone: ``forces`` (M,) is 0 off the backbone, mean 1 on it.
+
+    Attributes
+    ----------
+    forces : numpy.ndarray of float, shape (M,)
+        Contact forces, 0 off the backbone, mean 1 on it.
+    min_force : float
+        Optimum t of LP 5.9 (the smallest force relative to the mean).
+    jamming_gap : float
+        mu* of the jamming-gap LP.
+    imbalance : numpy.ndarray of float, shape (N, d)
+        Net contact force on each particle (0 off the backbone).
+    exists : bool
+        False when the backbone admits no non-negative self-stress.
+    """
 
     forces: np.ndarray
     min_force: float  # optimum t of LP 5.9 (relative to the mean force)
@@ -76,7 +90,22 @@ class Forces:
 
 
 def backbone_rows(net: ContactNetwork, backbone: np.ndarray, contacts: np.ndarray) -> sp.csr_matrix:
-    """A restricted to the backbone particles' rows and the given contact columns, (N_b d, M_b)."""
+    """A restricted to the backbone particles' rows and the given contact columns, (N_b d, M_b).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network (M contacts).
+    backbone : numpy.ndarray of bool, shape (N,)
+        Backbone particles.
+    contacts : numpy.ndarray of bool, shape (M,) or int indices
+        The contact columns kept.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (N_b d, M_b)
+        The rigidity matrix block.
+    """
     at = rigidity_transpose(net)[contacts]
     dofs = np.flatnonzero(np.repeat(backbone, net.dim))
     return at[:, dofs].T.tocsr()
@@ -182,6 +211,22 @@ def jamming_point_forces(net: ContactNetwork, backbone: np.ndarray, contact_delt
     Returns the network of the contacts within ``contact_delta`` plus the near contacts that
     carry force, and the forces on it (mean 1 over its backbone contacts), or None if the LP
     fails or no self-stress exists even on ``net`` (the growth reaches the LP box).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        Contacts within a tolerance larger than ``contact_delta`` (the first coordination shell).
+    backbone : numpy.ndarray of bool, shape (N,)
+        Backbone particles.
+    contact_delta : float
+        Relative gap tolerance of the contacts proper.
+    box : float
+        Bound on every displacement component of the LP.
+
+    Returns
+    -------
+    tuple of (ContactNetwork, Forces) or None
+        As above.
     """
     d = net.dim
     contacts = net.among(backbone)
@@ -247,6 +292,21 @@ def polish(a: sp.csr_matrix, f: np.ndarray, iterations: int = 4) -> np.ndarray:
     Solves (A_S A_S^T + lam I) y = A_S f_S and sets f_S -= A_S^T y, repeated (iterative
     refinement); lam = 1e-12 times the mean diagonal only regularises floppy directions (and
     makes the matrix positive definite, so it is factorised without pivoting).
+
+    Parameters
+    ----------
+    a : scipy.sparse.csr_matrix, shape (n, M)
+        The equilibrium matrix A (coordinates by contacts, e.g. :func:`backbone_rows`).
+    f : numpy.ndarray of float, shape (M,)
+        Non-negative forces.
+    iterations : int, optional
+        Refinement steps at most.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (M,)
+        The projected forces, or ``f`` unchanged when the projection does not reduce the
+        imbalance |A f| or makes a force negative.
     """
     f = f.copy()
     start = f.copy()
@@ -274,7 +334,37 @@ def polish(a: sp.csr_matrix, f: np.ndarray, iterations: int = 4) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Statics:
-    """Counting and pressure of a backbone with forces (see the module docstring)."""
+    """Counting and pressure of a backbone with forces (see the module docstring).
+
+    Attributes
+    ----------
+    n_backbone : int
+        N_b, particles in the backbone.
+    n_contacts : int
+        M_b, backbone contacts (self-image contacts once).
+    z_mean : float
+        Mean coordination (2 M_b - M_w) / N_b (a wall contact counts once).
+    n_dof_collective : int
+        d (N_b - 1); with walls d N_b less the trivial motions.
+    n_dof_strict : int
+        d (N_b - 1) + d(d+1)/2 - 1; with walls (fixed) as collective.
+    isostaticity_gap : int
+        M_b - n_dof_collective - 1 (0: isostatic in a fixed cell).
+    isostaticity_gap_strict : int
+        M_b - n_dof_strict - 1.
+    pressure_virial : float
+        sum f |r| / (d V), forces normalised to mean 1.
+    stress : numpy.ndarray of float, shape (d, d)
+        Virial stress tensor, same units.
+    jamming_gap : float
+        mu* = sum f h / sum f D.
+    pressure_free_volume : float
+        Reduced pressure PV/(NkT) = N_f / (d N mu*) ((N_b - 1) / (N mu*) in a periodic cell).
+    n_wall_contacts : int
+        Backbone contacts with walls, among the M_b.
+    wall_force : float
+        Sum of the wall reactions.
+    """
 
     n_backbone: int
     n_contacts: int  # M_b, self-image contacts once

@@ -48,7 +48,13 @@ _RECORD: ContextVar[Counter | None] = ContextVar("hardpack_jamming_fallbacks", d
 def recording_fallbacks() -> Iterator[Counter]:
     """Count the :data:`FALLBACKS` noted inside the block into the Counter it yields. Blocks
     nest: a fallback goes to the innermost one only (a loading sequence of the sequential test
-    records its own, which its outcome carries, also from a worker process)."""
+    records its own, which its outcome carries, also from a worker process).
+
+    Yields
+    ------
+    collections.Counter
+        Fallback name -> count within the block.
+    """
     counter = Counter()
     token = _RECORD.set(counter)
     try:
@@ -58,7 +64,18 @@ def recording_fallbacks() -> Iterator[Counter]:
 
 
 def note_fallback(name: str) -> None:
-    """Count one fallback ``name`` (a key of :data:`FALLBACKS`) in the innermost record."""
+    """Count one fallback ``name`` (a key of :data:`FALLBACKS`) in the innermost record.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`FALLBACKS`.
+
+    Raises
+    ------
+    KeyError
+        For an unknown name.
+    """
     if name not in FALLBACKS:
         raise KeyError(f"unknown fallback {name!r}")
     counter = _RECORD.get()
@@ -74,7 +91,30 @@ def solve_lp(c, *, method: str = "highs-ds", options: dict | None = None, **kwar
     LP 4.15 of an SLP crystal, for which dr = 0 is feasible; tests/test_jamming_highs.py).
     Returns the optimal result; raises LPFailure for a confirmed infeasible or unbounded LP or
     after the last attempt. A result found only with HiGHS's default tolerances is noted as the
-    fallback "lp_default_tolerances" (:func:`note_fallback`)."""
+    fallback "lp_default_tolerances" (:func:`note_fallback`).
+
+    Parameters
+    ----------
+    c : array_like of float, shape (n,)
+        Objective coefficients (minimised).
+    method : str, optional
+        The first HiGHS method tried ("highs-ds" or "highs-ipm").
+    options : dict, optional
+        Extra solver options.
+    **kwargs
+        The constraints and bounds of :func:`scipy.optimize.linprog` (A_ub, b_ub, A_eq, b_eq,
+        bounds).
+
+    Returns
+    -------
+    scipy.optimize.OptimizeResult
+        The optimal result (status 0).
+
+    Raises
+    ------
+    LPFailure
+        As above.
+    """
     attempts = [(m, o) for m, o in ATTEMPTS if m == method] + [a for a in ATTEMPTS if a[0] != method]
     res = None
     for m, base in attempts:

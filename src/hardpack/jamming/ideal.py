@@ -46,7 +46,33 @@ log = logging.getLogger(__name__)
 class TestOutcome:
     """Result of one jamming test (collective or strict). ``jammed`` is False also when
     ``undetermined`` holds a reason (an LP whose strain violates the volume constraint beyond
-    the LP's accuracy, :class:`hardpack.jamming.lp.VolumeIncrease`: neither a motion nor a proof)."""
+    the LP's accuracy, :class:`hardpack.jamming.lp.VolumeIncrease`: neither a motion nor a proof).
+
+    Attributes
+    ----------
+    test : str
+        "collective" or "strict".
+    jammed : bool
+        The verdict.
+    backbone : numpy.ndarray of bool, shape (N,)
+        Particles of the jammed subpacking (all False if not jammed).
+    displacement : numpy.ndarray of float, shape (N,)
+        Largest relative |dr_i| seen over all loads (NaN: untested).
+    motion : numpy.ndarray of float, shape (N, d)
+        First unjamming motion found (zeros if none).
+    strain : numpy.ndarray of float, shape (d, d), or None
+        Strain of that motion (strict test).
+    n_lp : int
+        Number of LPs solved.
+    seconds : float
+        Wall time.
+    method : str
+        The test's algorithm.
+    loads : list of dict
+        Per LP: max, mean, removed, strain.
+    undetermined : str
+        Why the test could not decide ("" when it did).
+    """
 
     test: str
     jammed: bool
@@ -71,7 +97,18 @@ class TestOutcome:
 
 
 def cell_length(lattice: np.ndarray) -> float:
-    """Length of the longest lattice vector (scale of the boundary displacement eps * L)."""
+    """Length of the longest lattice vector (scale of the boundary displacement eps * L).
+
+    Parameters
+    ----------
+    lattice : numpy.ndarray of float, shape (d, d)
+        Cell, lattice vectors as columns.
+
+    Returns
+    -------
+    float
+        max_k |lattice[:, k]|.
+    """
     return float(np.linalg.norm(lattice, axis=0).max())
 
 
@@ -79,7 +116,24 @@ def relative_displacement(net: ContactNetwork, moving: np.ndarray, disp: np.ndar
                           eps: np.ndarray | None) -> np.ndarray:
     """Non-affine displacement dr_i - eps x_i less its trivial part over ``moving``: the
     componentwise median along the periodic axes (translations), or in a spherical container
-    the least-squares rotation about its centre."""
+    the least-squares rotation about its centre.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network (positions, boundary).
+    moving : numpy.ndarray of bool, shape (N,)
+        Particles with displacement variables.
+    disp : numpy.ndarray of float, shape (N, d)
+        Displacements dr.
+    eps : numpy.ndarray of float, shape (d, d), or None
+        Strain of the cell (None: fixed cell).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N, d)
+        The relative displacements (0 for particles not moving).
+    """
     rel = disp - (net.positions @ eps.T if eps is not None else 0.0)
     rel = np.where(moving[:, None], rel, 0.0)
     if not moving.any():

@@ -51,7 +51,27 @@ MAX_SELF_STRESSES = 12
 
 @dataclass
 class RigidBackbone:
-    """LU factorisation and self-stress basis of a rigid backbone (module docstring)."""
+    """LU factorisation and self-stress basis of a rigid backbone (module docstring).
+
+    Attributes
+    ----------
+    free : numpy.ndarray of bool, shape (N d,)
+        Coordinates with variables (backbone less the gauge, :func:`hardpack.jamming.rigidity.gauge_dofs`).
+    contacts : numpy.ndarray of bool, shape (M,)
+        The backbone contacts.
+    a : scipy.sparse.csc_matrix, shape (N_f, M_b)
+        A' restricted to the free coordinates and backbone contacts.
+    lu : scipy.sparse.linalg.SuperLU
+        LU factorisation of A' without the columns ``removed``.
+    removed : numpy.ndarray of int, shape (K,)
+        The K removed column indices R.
+    null : numpy.ndarray of float, shape (M_b, K)
+        Basis of the self-stresses.
+    f0 : numpy.ndarray of float, shape (M_b,)
+        Most uniform strictly positive self-stress, mean 1.
+    h : numpy.ndarray of float, shape (M_b,)
+        Contact gaps.
+    """
 
     free: np.ndarray  # (N d,) coordinates with variables (backbone less the gauge, rigidity.gauge_dofs)
     contacts: np.ndarray  # (N_contacts,) mask of the backbone contacts

@@ -74,7 +74,25 @@ class VolumeIncrease(LPFailure):
 
 @dataclass(frozen=True)
 class Motion:
-    """Solution of the displacement LP."""
+    """Solution of the displacement LP.
+
+    Attributes
+    ----------
+    displacement : numpy.ndarray of float, shape (N, d)
+        Displacements dr; zero for particles without variables.
+    strain : numpy.ndarray of float, shape (d, d), or None
+        Symmetric strain of the cell (strict test), None in the collective test.
+    forces : numpy.ndarray of float, shape (M,)
+        Duals of the impenetrability rows (0 for unused contacts).
+    objective : float
+        Optimal value of the LP.
+    seconds : float
+        Wall time of the solve.
+    warm : WarmStart or None
+        Basis of this LP, to warm-start the next one (working set).
+    solver : str
+        "working-set" or "highs".
+    """
 
     displacement: np.ndarray  # (N, d); zero for particles without variables
     strain: np.ndarray | None  # (d, d) symmetric, or None (collective test)
@@ -107,6 +125,37 @@ def solve_motion(
     test). ``box`` bounds each displacement component and ``box / cell_length`` each strain
     component. ``warm``: the basis of a similar LP (``Motion.warm``) to start from; a strict LP
     without one goes through the strain continuation, from the smallest gaps.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network (M contacts).
+    moving : numpy.ndarray of bool, shape (N,)
+        Particles with displacement variables.
+    load : numpy.ndarray of float, shape (N, d)
+        Forces b on the particles.
+    fixed : numpy.ndarray of bool, shape (N,), optional
+        Particles present but held fixed.
+    strain_load : numpy.ndarray of float, shape (d(d+1)/2,), optional
+        Load on the strain components (strict test).
+    box : float
+        Bound on every displacement component (lengths of the packing).
+    cell_length : float
+        Scale L of the strain bounds box / L (:func:`hardpack.jamming.ideal.cell_length`).
+    working_set : bool, optional
+        Solve by the working-set method (:mod:`hardpack.jamming.workingset`) before HiGHS.
+    warm : WarmStart, optional
+        Basis to start from.
+
+    Returns
+    -------
+    Motion
+        The optimal displacement, strain and contact forces.
+
+    Raises
+    ------
+    InvalidInputError
+        For a strict LP outside a periodic cell.
     """
     t0 = time.perf_counter()
     n, d = net.n_particles, net.dim
@@ -243,7 +292,22 @@ def _highs_motion(g: sp.csc_matrix, h: np.ndarray, c: np.ndarray, upper: np.ndar
 
 
 def random_load(rng: np.random.Generator, mask: np.ndarray, d: int) -> np.ndarray:
-    """Gaussian load on the particles in ``mask`` with zero net force (as Donev 2006, sec. 4.3.2, suggests)."""
+    """Gaussian load on the particles in ``mask`` with zero net force (as Donev 2006, sec. 4.3.2, suggests).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Random source.
+    mask : numpy.ndarray of bool, shape (N,)
+        Loaded particles.
+    d : int
+        Dimension.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N, d)
+        Standard normal forces less their mean on ``mask``, zeros elsewhere.
+    """
     load = np.zeros((mask.size, d))
     k = int(mask.sum())
     if k:
@@ -255,7 +319,22 @@ def random_load(rng: np.random.Generator, mask: np.ndarray, d: int) -> np.ndarra
 def random_strain_load(rng: np.random.Generator, d: int, cell_length: float) -> np.ndarray:
     """Gaussian load on the strain components, scaled by the cell length so that its virtual
     work for a strain eps is comparable to a unit force times the boundary displacement
-    eps * L. Off-diagonal components count twice in eps : sigma, hence the factor 2."""
+    eps * L. Off-diagonal components count twice in eps : sigma, hence the factor 2.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Random source.
+    d : int
+        Dimension.
+    cell_length : float
+        Cell length L (lengths of the packing).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (d(d+1)/2,)
+        Load on the strain components, ordered by :func:`hardpack.jamming.rigidity.strain_pairs`.
+    """
     scale = np.array([1.0 if p == q else 2.0 for p, q in strain_pairs(d)])
     return rng.standard_normal(n_strain(d)) * scale * cell_length
 

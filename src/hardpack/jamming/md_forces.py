@@ -25,7 +25,23 @@ from hardpack.jamming.contacts import ContactNetwork
 @dataclass(frozen=True)
 class ForceComparison:
     """Scale s, LP-virial / MD-collisional-pressure ratio, relative RMS force difference over the
-    matched contacts (in units of the mean MD force), and the matching counts."""
+    matched contacts (in units of the mean MD force), and the matching counts.
+
+    Attributes
+    ----------
+    scale : float
+        Least-squares factor s with s f_LP ~ f_MD.
+    pressure_ratio : float
+        LP virial s sum f |r| over the MD collisional virial.
+    rms_relative : float
+        RMS of s f_LP - f_MD over the matched contacts, in units of the mean MD force.
+    n_matched : int
+        LP backbone contacts found in the MD record.
+    n_lp_contacts : int
+        LP backbone contacts.
+    md_virial_fraction : float
+        Share of the MD collisional virial carried by the matched contacts.
+    """
 
     scale: float
     pressure_ratio: float
@@ -49,7 +65,24 @@ def _keys(i, j, shift, n: int) -> list[tuple]:
 def compare_md_forces(net: ContactNetwork, lp_forces: np.ndarray, backbone_contacts: np.ndarray,
                       md) -> ForceComparison:
     """Compare LP forces (on the backbone contacts) with an MD contact-force Dataset ``md`` holding
-    md_contact_{i, j, shift, force, virial} (module docstring)."""
+    md_contact_{i, j, shift, force, virial} (module docstring).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network of the LP.
+    lp_forces : numpy.ndarray of float, shape (M,)
+        LP contact forces.
+    backbone_contacts : numpy.ndarray of bool, shape (M,)
+        Contacts compared.
+    md : xarray.Dataset
+        Packing dataset with the MD contact-force variables.
+
+    Returns
+    -------
+    ForceComparison
+        The comparison (NaN entries when no contact matches).
+    """
     n = net.n_particles
     md_index = {k: m for m, k in enumerate(_keys(md["md_contact_i"].values, md["md_contact_j"].values,
                                                    md["md_contact_shift"].values, n))}

@@ -30,7 +30,22 @@ from hardpack.jamming.lp import solve_lp
 
 
 def neighbours_of(net: ContactNetwork, mask: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """Active particles touching a particle in ``mask``."""
+    """Active particles touching a particle in ``mask``.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network.
+    mask : numpy.ndarray of bool, shape (N,)
+        The particles whose neighbours are wanted.
+    active : numpy.ndarray of bool, shape (N,)
+        Particles still in the packing.
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (N,)
+        The active particles in contact with one in ``mask``.
+    """
     keep = net.among(active | mask)
     out = np.zeros(net.n_particles, dtype=bool)
     out[net.j[keep & mask[net.i]]] = True
@@ -42,7 +57,26 @@ def local_displacements(
     net: ContactNetwork, active: np.ndarray, tested: np.ndarray, load: np.ndarray, box: float
 ) -> np.ndarray:
     """Largest escape |dr_i| of each ``tested`` particle under the loads +b_i and -b_i, with all
-    other ``active`` particles fixed (LP 4.15); NaN for untested particles."""
+    other ``active`` particles fixed (LP 4.15); NaN for untested particles.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network.
+    active : numpy.ndarray of bool, shape (N,)
+        Particles still in the packing.
+    tested : numpy.ndarray of bool, shape (N,)
+        Particles tested (each with all others fixed).
+    load : numpy.ndarray of float, shape (N, d)
+        Loads b_i.
+    box : float
+        Bound on every displacement component (lengths of the packing).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N,)
+        max(|dr_i(+b_i)|, |dr_i(-b_i)|) for the tested particles, NaN elsewhere.
+    """
     n, d = net.n_particles, net.dim
     keep = net.among(active)
     i, j, u, h = net.i[keep], net.j[keep], net.normal[keep], net.gap[keep]

@@ -47,11 +47,36 @@ def strain_pairs(d: int) -> list[tuple[int, int]]:
 
 
 def n_strain(d: int) -> int:
+    """Number of independent strain components.
+
+    Parameters
+    ----------
+    d : int
+        Dimension.
+
+    Returns
+    -------
+    int
+        d (d + 1) / 2.
+    """
     return d * (d + 1) // 2
 
 
 def strain_tensor(eps_hat: np.ndarray, d: int) -> np.ndarray:
-    """The symmetric d x d tensor from its independent components (order of strain_pairs)."""
+    """The symmetric d x d tensor from its independent components (order of strain_pairs).
+
+    Parameters
+    ----------
+    eps_hat : array_like of float, shape (d(d+1)/2,)
+        Independent components.
+    d : int
+        Dimension.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (d, d)
+        The symmetric strain tensor.
+    """
     eps = np.zeros((d, d))
     for value, (p, q) in zip(eps_hat, strain_pairs(d)):
         eps[p, q] = eps[q, p] = value
@@ -59,7 +84,18 @@ def strain_tensor(eps_hat: np.ndarray, d: int) -> np.ndarray:
 
 
 def strain_coefficients(net: ContactNetwork) -> np.ndarray:
-    """(M, d(d+1)/2) derivatives of each contact length with respect to the strain components."""
+    """(M, d(d+1)/2) derivatives of each contact length with respect to the strain components.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network (M contacts).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (M, d(d+1)/2)
+        Zero for contacts that do not cross the boundary.
+    """
     u, w = net.normal, net.image_offset
     cols = []
     for p, q in strain_pairs(net.dim):
@@ -69,7 +105,20 @@ def strain_coefficients(net: ContactNetwork) -> np.ndarray:
 
 def rigidity_transpose(net: ContactNetwork, strain: bool = False) -> sp.csr_matrix:
     """A^T as a CSR matrix of shape (M, N d [+ d(d+1)/2]): row k is the gradient of contact k's
-    length with respect to (positions, strain)."""
+    length with respect to (positions, strain).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network (M contacts).
+    strain : bool, optional
+        Append the strain columns (:func:`strain_coefficients`).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (M, N d) or (M, N d + d(d+1)/2)
+        A^T.
+    """
     m, d, n = net.n_contacts, net.dim, net.n_particles
     u = net.normal
     rows = np.repeat(np.arange(m), 2 * d)
@@ -101,6 +150,18 @@ def gauge_dofs(net: ContactNetwork, moving: np.ndarray) -> np.ndarray:
     container: d(d-1)/2 coordinates on which the rotations about the centre act regularly,
     chosen by a pivoted QR of the rotation velocities; every motion is one of these coordinates
     left at zero plus a rotation, so fixing them removes exactly the rotations.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network (boundary and positions).
+    moving : numpy.ndarray of bool, shape (N,)
+        Particles with displacement variables.
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (N d,)
+        The coordinates held fixed.
     """
     d, n = net.dim, net.n_particles
     fixed = np.zeros(n * d, dtype=bool)
@@ -123,7 +184,18 @@ def gauge_dofs(net: ContactNetwork, moving: np.ndarray) -> np.ndarray:
 
 def rotation_velocities(rel: np.ndarray) -> np.ndarray:
     """(d(d-1)/2, K d) velocities of K points at ``rel`` (K, d) from the centre under the unit
-    rotations in the planes (p, q), p < q: x_p e_q - x_q e_p."""
+    rotations in the planes (p, q), p < q: x_p e_q - x_q e_p.
+
+    Parameters
+    ----------
+    rel : numpy.ndarray of float, shape (K, d)
+        Points relative to the centre of rotation.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (d(d-1)/2, K d)
+        One row per rotation plane.
+    """
     d = rel.shape[1]
     gens = []
     for p in range(d):
@@ -138,7 +210,24 @@ def anchored_transpose(net: ContactNetwork, backbone: np.ndarray,
                        contacts: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
     """(free, rows ``contacts`` of A^T restricted to the ``free`` degrees of freedom): the (N d,)
     mask of the coordinates of the ``backbone`` particles less those :func:`gauge_dofs` holds
-    fixed (the first particle in a periodic cell)."""
+    fixed (the first particle in a periodic cell).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact network (M contacts).
+    backbone : numpy.ndarray of bool, shape (N,)
+        Backbone particles.
+    contacts : numpy.ndarray of bool, shape (M,)
+        The contact rows kept.
+
+    Returns
+    -------
+    free : numpy.ndarray of bool, shape (N d,)
+        The free coordinates.
+    at : scipy.sparse.csr_matrix, shape (M_c, N_free)
+        Rows ``contacts`` of A^T, columns ``free``.
+    """
     free = np.repeat(backbone, net.dim) & ~gauge_dofs(net, backbone)
     return free, rigidity_transpose(net)[contacts][:, np.flatnonzero(free)]
 

@@ -141,7 +141,21 @@ FALLBACKS = {
 
 # ------------------------------------------------------------------------------------- dof basis
 def rotation_basis(semiaxes: np.ndarray, shape_inv: np.ndarray) -> list[np.ndarray]:
-    """Per particle, an orthonormal basis (k, r_i) of its nontrivial rotations (module docstring)."""
+    """Per particle, an orthonormal basis (k, r_i) of its nontrivial rotations (module docstring).
+
+    Parameters
+    ----------
+    semiaxes : numpy.ndarray of float, shape (N, d)
+        Semiaxes of every particle.
+    shape_inv : numpy.ndarray of float, shape (N, d, d)
+        X^-1 of every particle (eigenvalues a_k^2).
+
+    Returns
+    -------
+    list of numpy.ndarray
+        Per particle a (k, r_i) array, k = d(d-1)/2 rotation components and r_i the nontrivial
+        rotations (0 for a sphere or circle, 2 for a spheroid, k otherwise).
+    """
     d = semiaxes.shape[1]
     out = []
     for axes, inv in zip(semiaxes, shape_inv):
@@ -164,7 +178,22 @@ def rotation_basis(semiaxes: np.ndarray, shape_inv: np.ndarray) -> list[np.ndarr
 
 def dof_basis(net: EllipsoidContacts, moving: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
     """(T, dof per particle): T maps the reduced dof of the ``moving`` particles to all N d_f
-    columns (frozen particles and trivial spins removed)."""
+    columns (frozen particles and trivial spins removed).
+
+    Parameters
+    ----------
+    net : EllipsoidContacts
+        The contact network.
+    moving : numpy.ndarray of bool, shape (N,)
+        Particles with degrees of freedom.
+
+    Returns
+    -------
+    t : scipy.sparse.csr_matrix, shape (N d_f, n_red)
+        The map from reduced to full dof.
+    counts : numpy.ndarray of int64, shape (N,)
+        Reduced dof of each particle (0 for frozen ones).
+    """
     d, n = net.dim, net.n_particles
     f = dof_per_particle(d)
     rot = rotation_basis(net.semiaxes, net.shape_inv)
@@ -186,7 +215,22 @@ def dof_basis(net: EllipsoidContacts, moving: np.ndarray) -> tuple[sp.csr_matrix
 
 
 def trivial_translations(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray) -> np.ndarray:
-    """Orthonormal (n_red, d) uniform translations of the ``moving`` particles in reduced dof."""
+    """Orthonormal (n_red, d) uniform translations of the ``moving`` particles in reduced dof.
+
+    Parameters
+    ----------
+    t : scipy.sparse.csr_matrix, shape (N d_f, n_red)
+        Map from reduced to full dof (:func:`dof_basis`).
+    net : EllipsoidContacts
+        The contact network.
+    moving : numpy.ndarray of bool, shape (N,)
+        Particles with degrees of freedom.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (n_red, d)
+        Unit columns, one per axis.
+    """
     d, n = net.dim, net.n_particles
     f = dof_per_particle(d)
     full = np.zeros((n * f, d))
@@ -200,7 +244,22 @@ def trivial_motions(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray
     """Orthonormal trivial motions of the ``moving`` particles in reduced dof (module docstring):
     the uniform translations in a periodic cell, the rigid rotations about the centre in a
     container (those that vanish in the reduced dof, e.g. spins of spheres at the centre, are
-    dropped: (n_red, t) with t <= d(d-1)/2)."""
+    dropped: (n_red, t) with t <= d(d-1)/2).
+
+    Parameters
+    ----------
+    t : scipy.sparse.csr_matrix, shape (N d_f, n_red)
+        Map from reduced to full dof (:func:`dof_basis`).
+    net : EllipsoidContacts
+        The contact network.
+    moving : numpy.ndarray of bool, shape (N,)
+        Particles with degrees of freedom.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (n_red, t)
+        Orthonormal columns.
+    """
     if net.centre is None:
         return trivial_translations(t, net, moving)
     d, n = net.dim, net.n_particles
@@ -225,14 +284,48 @@ def trivial_motions(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray
 class Decision:
     """Outcome of the procedure of the module docstring on one (sub)packing.
 
-    ``verdict``: :class:`Verdict` code; ``order``: "first", "second" or "undetermined";
-    ``first_order_rigid``: no nontrivial first-order flex; ``lambda_min``: smallest eigenvalue of
-    the projected stiffness K_V (NaN when not computed), in the
-    units of K, whose largest |entry| is ``stiffness_scale``; ``forces``: the LP self-stress (zeros when
-    none); ``approx_stress``, ``stress_residual``: the approximate self-stress of a packing near (not
-    at) its jamming point, when one was accepted (:func:`approximate_stress`); ``n_stresses`` (-1: not
-    computed), ``n_floppy`` (nontrivial; -1: not computed), ``n_dof`` (reduced, minus trivial),
-    ``n_constraints`` (M); ``reason``: why, in words.
+    Attributes
+    ----------
+    verdict : Verdict
+        The verdict code (:class:`hardpack.jamming.result.Verdict`).
+    order : str
+        "first", "second" or "undetermined".
+    first_order_rigid : bool
+        No nontrivial first-order flex.
+    reason : str
+        Why, in words.
+    forces : numpy.ndarray of float, shape (M,)
+        The LP self-stress (Donev 2006, Eq. 5.9; zeros when none).
+    n_stresses : int
+        Number of independent self-stresses (-1: not computed).
+    n_floppy : int
+        Number of nontrivial floppy modes (-1: not computed).
+    n_dof : int
+        Reduced degrees of freedom less the trivial motions.
+    n_constraints : int
+        Number of contacts M.
+    stress_margin : float
+        Optimum eps* of LP 5.9, the smallest force of the self-stress with mean 1.
+    lambda_min : float
+        Smallest eigenvalue of the projected stiffness K_V (NaN when not computed), in the units
+        of K.
+    stiffness_scale : float
+        Largest |entry| of K.
+    motion : numpy.ndarray of float, shape (n,), or None
+        A second-order flex in reduced dof, when one was found.
+    lp_flex : bool or None
+        The randomised LP's answer (:func:`first_order_lp`), collective test only.
+    fallbacks : int
+        Dense eigh after eigsh failed (sparse path).
+    approx_stress : numpy.ndarray of float, shape (M,), or None
+        The unit approximate self-stress of a packing near (not at) its jamming point, when one
+        was accepted (:func:`approximate_stress`).
+    stress_residual : float
+        s_1 / s_max of that stress (0: the self-stresses are exact).
+    stress_gap : float
+        s_1 / s_2 of that stress (NaN: the self-stresses are exact).
+    jamming_distance : float
+        Newton distance to the jamming point along the floppy modes (:func:`_jamming_distance`).
     """
 
     verdict: Verdict
@@ -258,7 +351,20 @@ class Decision:
 
 def self_stress_lp(a: sp.spmatrix) -> tuple[float, np.ndarray]:
     """Donev 2006, Eq. 5.9: max eps s.t. A F = 0, F >= eps, sum F = M. Returns (eps*, F); eps* is
-    -inf (and F zeros) when no F with A F = 0 and sum F = M exists."""
+    -inf (and F zeros) when no F with A F = 0 and sum F = M exists.
+
+    Parameters
+    ----------
+    a : scipy.sparse matrix, shape (n, M)
+        The equilibrium matrix A (reduced dof by contacts).
+
+    Returns
+    -------
+    eps : float
+        The optimum eps*, the smallest force of the best self-stress of mean 1.
+    forces : numpy.ndarray of float, shape (M,)
+        Its forces F.
+    """
     nrow, m = a.shape
     if m == 0:
         return float("-inf"), np.zeros(0)
@@ -289,7 +395,28 @@ def first_order_lp(at: sp.spmatrix, trivial: np.ndarray, rng: np.random.Generato
     Returns (a nontrivial first-order flex exists, the two optima) with optima relative to |B|_1.
     With an approximate self-stress f (``stress``, :func:`approximate_stress`) the flexes must also
     keep f^T A^T Qdot = 0, i.e. A is taken at the nearby jamming point where f is exact: the flex
-    strict on the contacts by |A f| alone is not counted."""
+    strict on the contacts by |A f| alone is not counted.
+
+    Parameters
+    ----------
+    at : scipy.sparse matrix, shape (M, n)
+        A^T in reduced dof.
+    trivial : numpy.ndarray of float, shape (n, t)
+        Orthonormal trivial motions.
+    rng : numpy.random.Generator
+        Source of the Gaussian load.
+    tol : float, optional
+        Optimum above which a flex counts.
+    stress : numpy.ndarray of float, shape (M,), optional
+        Approximate self-stress f.
+
+    Returns
+    -------
+    flexible : bool
+        A nontrivial first-order flex exists.
+    strict_optimum, random_optimum : float
+        The two optima over |B|_1.
+    """
     m, n = at.shape
     at = sp.csr_matrix(at)
     eq = {} if stress is None else dict(A_eq=sp.csr_matrix((at.T @ stress)[None, :]), b_eq=np.zeros(1))
@@ -569,7 +696,18 @@ def approximate_stress(at: sp.spmatrix) -> tuple[np.ndarray, float, float] | Non
     and a torque imbalance of the same order must not pass for a near self-stress.
 
     Returns (unit stress with a positive sum, s_1 / s_2, s_1 / s_max) of the scaled A, or None when
-    A has fewer rows than columns (M > n: exact self-stresses exist) or s_1 is not separated."""
+    A has fewer rows than columns (M > n: exact self-stresses exist) or s_1 is not separated.
+
+    Parameters
+    ----------
+    at : scipy.sparse matrix, shape (M, n)
+        A^T in reduced dof.
+
+    Returns
+    -------
+    tuple of (numpy.ndarray of float, shape (M,), float, float) or None
+        As above.
+    """
     m, n = at.shape
     if m < 2 or m > n:
         return None
@@ -606,6 +744,24 @@ def decide_sparse(at: sp.spmatrix, stiffness, trivial: np.ndarray, *, rank_tol: 
     spheroids s / s_max reaches 5e-3 (measured: an N = 80 M&M packing, Z = 9.93), where the
     shifted form with k = 1e3 |K| / |A A^T| is off by a factor of 12 in lambda; the projection
     needs no k. Parameters and result as :func:`decide_dense` (``stiffness``: forces -> sparse K).
+
+    Parameters
+    ----------
+    at : scipy.sparse matrix, shape (M, n)
+        A^T in reduced dof.
+    stiffness : callable
+        forces (M,) -> sparse (n, n) stiffness K in reduced dof.
+    trivial : numpy.ndarray of float, shape (n, t)
+        Orthonormal trivial motions, t may be 0.
+    rank_tol, stress_tol, eig_tol : float, optional
+        Relative tolerances of the rank, of the LP's eps*, of lambda_min.
+    lengths : numpy.ndarray of float, shape (n,), optional
+        Length unit of each column, as in :func:`decide_dense`.
+
+    Returns
+    -------
+    Decision
+        The outcome.
     """
     m, n = at.shape
     t = trivial.shape[1]

@@ -120,7 +120,45 @@ class SequentialOutcome:
     """Result of one sequential test. ``jammed`` is False also when ``undetermined`` holds a
     reason: no sequence reached the threshold, but one of them could not go on (a step that
     round-off kept overlapping, or an LP whose strain violates the volume constraint), so
-    jamming is not shown either."""
+    jamming is not shown either.
+
+    Attributes
+    ----------
+    test : str
+        "collective" or "strict".
+    jammed : bool
+        The verdict.
+    threshold : float
+        Size above which a loading sequence unjams the packing.
+    mean_displacement : list of float
+        Per sequence, the mean |dr_i| over the mean diameter.
+    strain_norm : list of float
+        Per sequence, |sum tau eps|_2.
+    max_displacement : list of float
+        Per sequence, the largest |dr_i| over the mean diameter.
+    steps : list of int
+        LPs per sequence.
+    displacement : numpy.ndarray of float, shape (N,), or None
+        Largest |dr_i| / D over the sequences.
+    motion : numpy.ndarray of float, shape (N, d), or None
+        Displacements of the sequence with the largest mean displacement.
+    strain : numpy.ndarray of float, shape (d, d), or None
+        Total strain of that sequence.
+    final : Packing or None
+        The packing at the end of the last loading sequence.
+    n_lp : int
+        LPs solved.
+    n_lp_highs : int
+        LPs HiGHS solved (the others: :mod:`hardpack.jamming.workingset`).
+    seconds : float
+        Wall time.
+    method : str
+        "sequential".
+    undetermined : str
+        Why the test could not decide ("" when it did).
+    fallbacks : collections.Counter
+        Numerical fallbacks used (:data:`hardpack.jamming.highs.FALLBACKS`).
+    """
 
     test: str
     jammed: bool
@@ -153,7 +191,22 @@ class SequentialOutcome:
 
 def collision_step(net: ContactNetwork, disp: np.ndarray, eps: np.ndarray | None) -> float:
     """Largest tau keeping every listed pair apart along x + t dR, Lambda + t eps Lambda, and
-    every sphere with a listed wall contact inside its wall (:func:`wall_step`)."""
+    every sphere with a listed wall contact inside its wall (:func:`wall_step`).
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact list.
+    disp : numpy.ndarray of float, shape (N, d)
+        Direction dR of the particles.
+    eps : numpy.ndarray of float, shape (d, d), or None
+        Strain rate of the cell (None: fixed cell).
+
+    Returns
+    -------
+    float
+        The step tau (inf if nothing limits it).
+    """
     pair = ~net.is_wall if net.n_wall_contacts else slice(None)
     w = disp[net.j[pair]] - disp[net.i[pair]]
     if eps is not None:
@@ -181,7 +234,20 @@ def wall_step(net: ContactNetwork, disp: np.ndarray) -> float:
     outward normal n: a flat wall is reached when n . dr_i t = h - r_i; the wall of a spherical
     container of radius R about c when |x_i - c + t dr_i| = R - r_i, the positive root of a
     quadratic (the other is negative: the sphere is inside). The target distance is lowered by
-    APPROACH_SLACK as for the pairs."""
+    APPROACH_SLACK as for the pairs.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact list.
+    disp : numpy.ndarray of float, shape (N, d)
+        Direction dR of the particles.
+
+    Returns
+    -------
+    float
+        The step tau (inf without wall contacts or motion towards a wall).
+    """
     wall = net.is_wall
     if not wall.any():
         return np.inf
@@ -214,6 +280,22 @@ def list_step(net: ContactNetwork, radii: np.ndarray, disp: np.ndarray, eps: np.
 
     A pair's relative velocity is dr_j - dr_i + eps Lambda n; for a pair within reach,
     |Lambda n| <= |r_ij| + |x_j - x_i| <= (1 + delta) 2 r_max + sum of the lattice vector lengths.
+
+    Parameters
+    ----------
+    net : ContactNetwork
+        The contact list (tolerance delta).
+    radii : numpy.ndarray of float, shape (N,)
+        Particle radii.
+    disp : numpy.ndarray of float, shape (N, d)
+        Direction dR of the particles.
+    eps : numpy.ndarray of float, shape (d, d), or None
+        Strain rate of the cell (None: fixed cell).
+
+    Returns
+    -------
+    float
+        The step tau (inf if nothing moves).
     """
     speed = 2.0 * np.linalg.norm(disp, axis=1).max(initial=0.0)
     if eps is not None:
@@ -226,6 +308,16 @@ def volume_step(eps: np.ndarray | None) -> float:
     """Largest tau with det(I + t eps) <= 1 for all t in [0, tau] (strict test only).
 
     det(I + t eps) - 1 = prod_k (1 + t lambda_k) - 1 = t q(t); the first positive root of q.
+
+    Parameters
+    ----------
+    eps : numpy.ndarray of float, shape (d, d), or None
+        Symmetric strain rate (None: fixed cell).
+
+    Returns
+    -------
+    float
+        The step tau (inf if the volume never grows back to 1).
     """
     if eps is None:
         return np.inf

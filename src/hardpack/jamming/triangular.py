@@ -57,7 +57,13 @@ def _backward(indptr, indices, data, diagonal, x):
 
 class BlockSolver:
     """A^{-1} B for dense blocks B, from a SuperLU factorisation ``lu`` of A (scipy's
-    ``splu`` object: its L, U, perm_r and perm_c)."""
+    ``splu`` object: its L, U, perm_r and perm_c).
+
+    Parameters
+    ----------
+    lu : scipy.sparse.linalg.SuperLU
+        Factorisation of the square matrix A.
+    """
 
     def __init__(self, lu):
         lower, upper = sp.csc_matrix(lu.L), sp.csc_matrix(lu.U)

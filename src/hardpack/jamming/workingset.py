@@ -102,6 +102,24 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class WorkingSetSolution:
+    """Optimum of :func:`solve_working_set`.
+
+    Attributes
+    ----------
+    x : numpy.ndarray of float, shape (n,)
+        Optimal motion.
+    forces : numpy.ndarray of float, shape (M,)
+        Dual values (forces) of the contact columns.
+    objective : float
+        c^T x.
+    basis : numpy.ndarray of int, shape (n,)
+        Unified column indices of the optimal basis (warm start of the next LP).
+    working : numpy.ndarray of int
+        Unified indices of the other columns the LP worked with.
+    rounds : int
+        Rounds of the working-set loop.
+    """
+
     x: np.ndarray  # (n,) optimal motion
     forces: np.ndarray  # (M,) forces on the (non-box) columns
     objective: float  # c^T x
@@ -113,7 +131,19 @@ class WorkingSetSolution:
 @dataclass(frozen=True)
 class WarmStart:
     """Basis and working set of a previous LP, by column identity (``keys`` rows of the given
-    columns; box columns by their offset from M), to start the next LP of the same variables."""
+    columns; box columns by their offset from M), to start the next LP of the same variables.
+
+    Attributes
+    ----------
+    basis_keys : numpy.ndarray of int, shape (k, 2 + d)
+        Keys (i, j, lattice image n) of the contact columns in the basis.
+    basis_box : numpy.ndarray of int
+        Box columns in the basis as signed variable numbers: -(k+1) for -e_k, k+1 for +e_k.
+    working_keys : numpy.ndarray of int, shape (w, 2 + d)
+        Keys of the contact columns in the working set.
+    working_box : numpy.ndarray of int
+        Box columns in the working set, signed as ``basis_box``.
+    """
 
     basis_keys: np.ndarray
     basis_box: np.ndarray
@@ -278,7 +308,18 @@ def _row_scale(a: sp.csc_matrix) -> np.ndarray:
 
 def structurally_regular(a: sp.spmatrix) -> bool:
     """True when the pattern of the square matrix ``a`` has a perfect matching of its rows and
-    columns (structural rank n), the condition under which SuperLU may be given it."""
+    columns (structural rank n), the condition under which SuperLU may be given it.
+
+    Parameters
+    ----------
+    a : scipy.sparse matrix, shape (n, n)
+        The matrix.
+
+    Returns
+    -------
+    bool
+        Whether the structural rank is n.
+    """
     return bool(np.all(_matching(a) >= 0))
 
 
@@ -386,6 +427,32 @@ def solve_working_set(
     When the working set would exceed ``max_working`` columns (default 100 + n / 20), the
     basis moves to the current optimum instead (new LU) and the working set restarts from the
     columns closest to entering plus the violated ones.
+
+    Parameters
+    ----------
+    g : scipy.sparse.csc_matrix, shape (n, M)
+        Constraint columns.
+    h : numpy.ndarray of float, shape (M,)
+        Gaps (right-hand sides).
+    c : numpy.ndarray of float, shape (n,)
+        Objective.
+    upper : numpy.ndarray of float, shape (n,)
+        Box bound of each variable.
+    start : tuple of two int arrays, optional
+        (basis, working set) to start from.
+    boxed : numpy.ndarray of int, optional
+        Variables whose box columns are always worked with.
+    max_working : int, optional
+        Working-set size that triggers a restart.
+    max_rounds : int, optional
+        Rounds before giving up.
+    tol : float, optional
+        Feasibility tolerance (default 1e-10 max(upper)).
+
+    Returns
+    -------
+    WorkingSetSolution or None
+        The optimum, or None if the method gives up.
     """
     t0 = time.perf_counter()
     g = sp.csc_matrix(g)

@@ -30,7 +30,18 @@ def _optional_float(text: str):
 
 def cmd_compress(args) -> int:
     """LS compression of a start packing to jamming (event-driven MD with growing spheres, or
-    ellipsoids and ellipses with rotation)."""
+    ellipsoids and ellipses with rotation).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack md compress``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.errors import InvalidInputError
     from hardpack.io import checkpoint as ckpt
     from hardpack.io import load_packing
@@ -101,7 +112,18 @@ def _deforming_options(args, ellipsoids: bool) -> dict | None:
 
 
 def cmd_eos(args) -> int:
-    """Equilibrium reduced pressure Z = pV/(NkT) with a block error bar at fixed phi."""
+    """Equilibrium reduced pressure Z = pV/(NkT) with a block error bar at fixed phi.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack md eos``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.io import checkpoint as ckpt
     from hardpack.io import load_packing, write_dataset
     from hardpack.md import StopCriteria, compress, equilibrate
@@ -132,7 +154,7 @@ def register(subparsers) -> None:
     """
     from hardpack.cli import add_checkpoint_options
 
-    p = subparsers.add_parser("compress", help=cmd_compress.__doc__)
+    p = subparsers.add_parser("compress", help=cmd_compress.__doc__.split("\n\n")[0])
     p.add_argument("--init", required=True, help="start packing (netCDF), e.g. from 'hardpack init'")
     p.add_argument("--out", required=True, help="final packing (netCDF)")
     p.add_argument("--timeseries", help="per-window time series (netCDF)")
@@ -172,7 +194,7 @@ def register(subparsers) -> None:
                    help="with --deforming-cell: alpha of the strain rule, in (0, 1] (default 0.1)")
     p.set_defaults(func=cmd_compress)
 
-    p = subparsers.add_parser("eos", help=cmd_eos.__doc__)
+    p = subparsers.add_parser("eos", help=cmd_eos.__doc__.split("\n\n")[0])
     p.add_argument("--init", required=True, help="start packing (netCDF)")
     p.add_argument("--out", required=True, help="output netCDF with Z, Z_err and block values")
     p.add_argument("--phi", type=float, help="compress (or expand) to this phi first")

@@ -239,7 +239,21 @@ def default_window(growth_rate: float, d: int) -> float:
 
 
 def timeseries_dataset(sim: Simulation, attrs: dict) -> xr.Dataset:
-    """The window records as an xarray Dataset with dimension ``window``."""
+    """The window records as an xarray Dataset with dimension ``window``.
+
+    Parameters
+    ----------
+    sim : Simulation
+        The run whose ``records`` (one entry per window for each of ``sim.fields``) are converted.
+    attrs : dict
+        Attributes of the dataset (run statistics).
+
+    Returns
+    -------
+    xarray.Dataset
+        One variable per recorded field on dimension ``window``, each with a description; attribute
+        ``hardpack_kind = "md_timeseries"``.
+    """
     units = {
         "time": "MD time (m = kT = 1, lengths of the packing)", "phi": "volume fraction at the end",
         "Z": "reduced pressure pV/(NkT) over the window", "phi_J_est": "phi / (1 - d/Z)",
@@ -265,7 +279,18 @@ def stop_pressure(records: dict) -> float:
     """The reduced pressure that ends a compression at ``max_pressure``: the collision-virial Z of
     the last window, or, in a window without pair collisions (Z = 1 exactly: a particle alone in
     a container, or particles held apart only by hard walls), the pressure on the walls Z_wall,
-    which diverges when such a packing jams."""
+    which diverges when such a packing jams.
+
+    Parameters
+    ----------
+    records : dict of list of float
+        The per-window records of a run (keys "Z" and, with hard walls, "Z_wall").
+
+    Returns
+    -------
+    float
+        The reduced pressure Z = pV/(NkT) compared with ``max_pressure``.
+    """
     z = records["Z"][-1]
     if z == 1.0 and records.get("Z_wall"):
         z_wall = records["Z_wall"][-1]
@@ -342,6 +367,23 @@ def jamming_backbone(packing: Packing, gap: float = BACKBONE_GAP) -> float:
     (every particle a rattler after a growth much faster than the thermal speed; a chain of hard
     rods in d = 1, which jam only at phi = 1) means the end state is not jammed, whatever the
     pressure measured in the last window.
+
+    Parameters
+    ----------
+    packing : Packing
+        A sphere packing.
+    gap : float, optional
+        Largest relative gap of a contact.
+
+    Returns
+    -------
+    float
+        Volume fraction of the particles in the backbone, in [0, 1].
+
+    Raises
+    ------
+    InvalidInputError
+        For non-spherical particles.
     """
     from hardpack.geometry.balls import ball_volume
     from hardpack.geometry.neighbours import pairs_within

@@ -40,7 +40,17 @@ def _reduce(key: np.ndarray, vals: np.ndarray, count: np.ndarray):
 
 
 class ContactAccumulator:
-    """Impulse sums of the last ``windows`` windows, one table per window (module docstring)."""
+    """Impulse sums of the last ``windows`` windows, one table per window (module docstring).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    d : int
+        Dimension.
+    windows : int
+        Number of most recent windows kept.
+    """
 
     def __init__(self, n: int, d: int, windows: int):
         self.n, self.d, self.windows = n, d, int(windows)

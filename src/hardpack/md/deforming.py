@@ -128,7 +128,22 @@ RECORD_FIELDS = ("time", "phi", "Z", "collisions", "kT_mean", "volume", "pressur
 def cell_window(growth_rate: float, d: int, cell_step: float = CELL_STEP) -> float:
     """Default collisions per particle per window of the deforming cell (module docstring,
     step 6): :func:`hardpack.md.default_window`, at most CELL_LAG * cell_step / |growth_rate|
-    and at least 1."""
+    and at least 1.
+
+    Parameters
+    ----------
+    growth_rate : float
+        Relative growth rate of the radii per unit time (0: none).
+    d : int
+        Dimension.
+    cell_step : float, optional
+        Relative cell step alpha per window.
+
+    Returns
+    -------
+    float
+        Collisions per particle per window.
+    """
     window = default_window(growth_rate, d)
     if growth_rate == 0:
         return window
@@ -137,7 +152,18 @@ def cell_window(growth_rate: float, d: int, cell_step: float = CELL_STEP) -> flo
 
 def shortest_vector(lattice: np.ndarray) -> float:
     """Length of the shortest non-zero lattice vector |H n| (exhaustive over the n that can beat
-    the shortest basis vector: |n_k| <= l / h_k)."""
+    the shortest basis vector: |n_k| <= l / h_k).
+
+    Parameters
+    ----------
+    lattice : numpy.ndarray of float, shape (d, d)
+        The cell H, lattice vectors as columns.
+
+    Returns
+    -------
+    float
+        min over integer n != 0 of |H n|.
+    """
     best = float(np.linalg.norm(lattice, axis=0).min())
     heights = 1.0 / np.linalg.norm(np.linalg.inv(lattice), axis=1)
     ranges = [range(-int(best / h), int(best / h) + 1) for h in heights]
@@ -149,7 +175,20 @@ def shortest_vector(lattice: np.ndarray) -> float:
 
 
 def check_cell_options(applied_pressure, cell_step) -> None:
-    """Refuse a non-positive or non-finite applied pressure or cell step (alpha)."""
+    """Refuse a non-positive or non-finite applied pressure or cell step (alpha).
+
+    Parameters
+    ----------
+    applied_pressure : float or None
+        Applied pressure in kT / length^d, or None for a free volume.
+    cell_step : float
+        Relative cell step alpha, in (0, 1].
+
+    Raises
+    ------
+    InvalidInputError
+        If either is out of range.
+    """
     if applied_pressure is not None and (isinstance(applied_pressure, bool) or
                                          not math.isfinite(applied_pressure) or applied_pressure <= 0):
         raise InvalidInputError(f"applied_pressure must be a positive finite number (units kT / "
@@ -453,7 +492,20 @@ class DeformingSimulation:
 def mean_shear(deviatoric, fraction: float = 0.25) -> float:
     """Frobenius norm of the mean of sigma / p - I over the last ``fraction`` of the windows
     (NaN without windows): the systematic stress anisotropy, which the noise of single windows
-    (the time series' ``shear``) hides."""
+    (the time series' ``shear``) hides.
+
+    Parameters
+    ----------
+    deviatoric : array_like of float, shape (n_windows, d, d)
+        sigma / p - I of every window.
+    fraction : float, optional
+        Trailing fraction of the windows averaged.
+
+    Returns
+    -------
+    float
+        Frobenius norm of the mean, NaN without windows.
+    """
     if not len(deviatoric):
         return float("nan")
     tail = np.asarray(deviatoric, dtype=float)[-max(1, int(round(fraction * len(deviatoric)))):]

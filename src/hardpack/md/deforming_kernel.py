@@ -62,14 +62,40 @@ N_COUNTERS = 5
 
 def image_ranges(lattice: np.ndarray, reach: float) -> np.ndarray:
     """M_k = 1 + ceil(reach / h_k): the image range that holds every pair within ``reach`` when
-    both fractional coordinates lie in [0, 1)."""
+    both fractional coordinates lie in [0, 1).
+
+    Parameters
+    ----------
+    lattice : numpy.ndarray of float, shape (d, d)
+        The cell H, lattice vectors as columns.
+    reach : float
+        Largest pair distance that must be covered (length units).
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (d,)
+        M_k for every lattice vector k (h_k = 1 / |row k of H^-1| the cell height).
+    """
     heights = 1.0 / np.linalg.norm(np.linalg.inv(lattice), axis=1)
     return (1 + np.ceil(reach / heights)).astype(np.int64)
 
 
 @njit(cache=True)
 def image_table(H, M):
-    """Cartesian image vectors H n for n_k in [-M_k, M_k] (axis 0 fastest), shape (m, d)."""
+    """Cartesian image vectors H n for n_k in [-M_k, M_k] (axis 0 fastest), shape (m, d).
+
+    Parameters
+    ----------
+    H : numpy.ndarray of float64, shape (d, d)
+        The cell, lattice vectors as columns.
+    M : numpy.ndarray of int64, shape (d,)
+        Image range along each lattice vector (:func:`image_ranges`).
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (prod_k (2 M_k + 1), d)
+        Row ``code`` is H n of the code's integer vector n; the image -n has code m - 1 - code.
+    """
     d = H.shape[0]
     m = 1
     for k in range(d):
@@ -88,7 +114,15 @@ def image_table(H, M):
 
 @njit(cache=True)
 def wrap_into_cell(X, H, Hinv):
-    """Move every position into the cell (fractional coordinates in [0, 1))."""
+    """Move every position into the cell (fractional coordinates in [0, 1)).
+
+    Parameters
+    ----------
+    X : numpy.ndarray of float64, shape (N, d)
+        Cartesian positions, modified in place (shifted by whole lattice vectors).
+    H, Hinv : numpy.ndarray of float64, shape (d, d)
+        The cell (lattice vectors as columns) and its inverse.
+    """
     n, d = X.shape
     s = np.empty(d)
     for i in range(n):
@@ -144,7 +178,24 @@ def pair_sigma(ai, aj, ki, kj, t):
     frame of the growing surfaces), so a pair in which only one particle grows moves apart after a
     collision at the speed the LS rule gives it, with that one rate (Donev 2006, sec. 13.5 grows one
     species only). Equal rates use (A_i + A_j)(1 + kappa t) and (A_i + A_j) kappa: the arithmetic of
-    uniform growth, so that path is unchanged bit for bit."""
+    uniform growth, so that path is unchanged bit for bit.
+
+    Parameters
+    ----------
+    ai, aj : float
+        Radii A_i, A_j at window time 0.
+    ki, kj : float
+        Relative growth rates kappa_i, kappa_j.
+    t : float
+        Window time.
+
+    Returns
+    -------
+    sigma : float
+        Contact distance a_i(t) + a_j(t).
+    rate : float
+        Its time derivative A_i kappa_i + A_j kappa_j.
+    """
     if ki == kj:
         s = ai + aj
         return s * (1.0 + ki * t), s * ki
@@ -206,6 +257,60 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
     uniform LS growth, zero for particles that keep their size); skin: bounding-sphere skin (N,) (R_i = a_i(t) +
     skin_i at the list's time); kin, vir : (d, d) accumulators (zeroed here); acc: (0) end time,
     (1) time integral of the kinetic energy; iacc: counters. Returns a status.
+
+    Parameters
+    ----------
+    X, V : numpy.ndarray of float64, shape (N, d)
+        Positions (wrapped into the cell by the caller) and velocities at the particles' own times;
+        modified in place.
+    T : numpy.ndarray of float64, shape (N,)
+        Each particle's own update time (all 0 at entry); modified in place.
+    A : numpy.ndarray of float64, shape (N,), read-only
+        Radii at window time 0.
+    H, Hinv : numpy.ndarray of float64, shape (d, d), read-only
+        The cell (lattice vectors as columns) and its inverse.
+    M : numpy.ndarray of int64, shape (d,), read-only
+        Image range of the table ``img`` (:func:`image_ranges`).
+    img : numpy.ndarray of float64, shape (m, d), read-only
+        Image vectors H n (:func:`image_table`).
+    cfac : numpy.ndarray of float64, shape (d,), read-only
+        Row norms of H^-1, 1 / h_k.
+    lmin : float
+        Length of the shortest lattice vector (:func:`hardpack.md.deforming.shortest_vector`).
+    kappa : numpy.ndarray of float64, shape (N,), read-only
+        Relative growth rate of every radius.
+    skin : numpy.ndarray of float64, shape (N,), read-only
+        Bounding-sphere skin of every particle.
+    bs : numpy.ndarray of float64, shape (N, d + 1)
+        Bounding spheres, centre then radius.
+    nb : numpy.ndarray of int64, shape (N, cap)
+        Neighbour lists, entries j * m + image code.
+    nn : numpy.ndarray of int64, shape (N,)
+        List lengths (reset here).
+    mark : numpy.ndarray of int8, shape (N,)
+        Scratch of the list updates (reset here).
+    cnt, ep, ei, ec : numpy.ndarray of int64, shape (N,)
+        Collision counters, the partner, image code and partner's counter of each predicted event.
+    tv : numpy.ndarray of float64, shape (N,)
+        Time up to which each particle's kinetic-tensor integral is closed (reset here).
+    hkey, heap, hpos : numpy.ndarray, shape (N,)
+        Event heap: keys (float64), particles in heap order and heap slot of each particle (int64).
+    kin, vir : numpy.ndarray of float64, shape (d, d)
+        Outputs (zeroed here): time integral of sum_i v_i v_i^T and the collisional virial
+        sum r_ij J_ij^T.
+    acc : numpy.ndarray of float64, shape (2,)
+        Outputs: (0) the window's end time, (1) the time integral of the kinetic energy.
+    iacc : numpy.ndarray of int64, shape (N_COUNTERS,)
+        Outputs: counters I_COLL, I_EVENTS, I_STALE, I_EXIT, I_GRAZE (added to).
+    coll_target : int
+        Stop after this many collisions.
+    t_cap : float
+        Stop before the first event later than this window time.
+
+    Returns
+    -------
+    int
+        A :class:`DeformingStatus`.
     """
     n, d = X.shape
     m = img.shape[0]
@@ -392,7 +497,21 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
 
 @njit(cache=True)
 def synchronise(X, V, T, A, t, kappa):
-    """Advance all particles to window time t, radii to A_i (1 + kappa_i t), time origin to t."""
+    """Advance all particles to window time t, radii to A_i (1 + kappa_i t), time origin to t.
+
+    Parameters
+    ----------
+    X, V : numpy.ndarray of float64, shape (N, d)
+        Positions (advanced in place) and velocities.
+    T : numpy.ndarray of float64, shape (N,)
+        Own update times, set to 0.
+    A : numpy.ndarray of float64, shape (N,)
+        Radii at window time 0, set to their values at t.
+    t : float
+        Window time of the synchronisation.
+    kappa : numpy.ndarray of float64, shape (N,)
+        Relative growth rate of every radius.
+    """
     n, d = X.shape
     for i in range(n):
         dt = t - T[i]
@@ -411,6 +530,28 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
 
     Along the path r(s) = r + s strain r the first s with |r(s)| = sigma + gap / 2 is the
     contact root of a pair with relative velocity strain r (:func:`hardpack.events.roots.contact_root`).
+
+    Parameters
+    ----------
+    X : numpy.ndarray of float64, shape (N, d)
+        Positions, wrapped into the cell.
+    A : numpy.ndarray of float64, shape (N,)
+        Radii.
+    H, Hinv : numpy.ndarray of float64, shape (d, d)
+        The cell (lattice vectors as columns) and its inverse.
+    strain : numpy.ndarray of float64, shape (d, d)
+        The proposed deformation; the map is x -> (I + s strain) x.
+    reach : float
+        Pairs farther apart than this are ignored.
+    self_sigma : float
+        Contact distance of a particle with its own images.
+
+    Returns
+    -------
+    smax : float
+        Largest admissible s in [0, 1].
+    gmin : float
+        Smallest relative gap (|r| - sigma) / sigma among the pairs within reach (inf if none).
     """
     n, d = X.shape
     cfac = np.empty(d)

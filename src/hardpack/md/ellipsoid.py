@@ -38,7 +38,18 @@ log = logging.getLogger("hardpack.md")
 
 def check_ellipsoid_packing(packing: Packing) -> None:
     """Refuse packings the ellipsoid engine cannot run (other shapes, hard flat walls, sheared
-    cells, fewer than 2 particles in a periodic cell, overlaps, particles outside a container)."""
+    cells, fewer than 2 particles in a periodic cell, overlaps, particles outside a container).
+
+    Parameters
+    ----------
+    packing : Packing
+        The start packing.
+
+    Raises
+    ------
+    InvalidInputError
+        If the ellipsoid engine cannot run it.
+    """
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
     if packing.shape.kind != "ellipsoid":
@@ -56,7 +67,24 @@ def check_ellipsoid_packing(packing: Packing) -> None:
 def random_angular_velocities(n: int, d: int, inertia: np.ndarray, seed) -> np.ndarray:
     """Maxwell-Boltzmann angular velocities at kT = 1 (omega_k ~ N(0, 1/I)), zero total angular
     momentum not enforced (a periodic box does not conserve it, a container exchanges none with the
-    particles but need not start without); (n, 3) in 3D, (n,) in 2D."""
+    particles but need not start without); (n, 3) in 3D, (n,) in 2D.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    d : int
+        Dimension, 2 or 3.
+    inertia : numpy.ndarray of float, shape (n,)
+        Moments of inertia (:func:`hardpack.md.ellipsoid_engine.moments_of_inertia`).
+    seed : int or numpy.random.SeedSequence or None
+        Seed of :func:`numpy.random.default_rng`.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (n, 3) in 3D, (n,) in 2D
+        Lab-frame angular velocities.
+    """
     rng = np.random.default_rng(seed)
     w = rng.standard_normal((n, rotational_dof(d))) / np.sqrt(inertia)[:, None]
     return w[:, 0] if d == 2 else w
@@ -64,7 +92,23 @@ def random_angular_velocities(n: int, d: int, inertia: np.ndarray, seed) -> np.n
 
 class EllipsoidSimulation(Simulation):
     """State of one ellipsoid run (the sphere :class:`hardpack.md.simulation.Simulation` with the
-    ellipsoid engine, its temperature and its packing)."""
+    ellipsoid engine, its temperature and its packing).
+
+    Parameters
+    ----------
+    packing : Packing
+        The start packing of ellipsoids or ellipses (:func:`check_ellipsoid_packing`).
+    velocities : numpy.ndarray of float, shape (N, d)
+        Start velocities in the packing's order (m = 1).
+    angular_velocities : numpy.ndarray of float, shape (N, 3) in 3D, (N,) in 2D
+        Start angular velocities in the lab frame.
+    growth_rate : float
+        Growth rate of the semiaxes, as the sphere Simulation's.
+    overlap_tol : float, optional
+        Relative overlap above which a window's end state is refused.
+    eps_f : float, optional
+        Trace tolerance of the engine.
+    """
 
     def __init__(self, packing: Packing, velocities: np.ndarray, angular_velocities: np.ndarray,
                  growth_rate: float, overlap_tol: float = DEFAULT_OVERLAP_TOL, eps_f: float = EPS_F):
@@ -125,7 +169,21 @@ class EllipsoidSimulation(Simulation):
 @dataclass
 class EllipsoidCompressResult:
     """Final ellipsoid packing, final velocities and angular velocities (m = 1, kT = 1), the
-    per-window time series and the run stats."""
+    per-window time series and the run stats.
+
+    Attributes
+    ----------
+    packing : Packing
+        The final packing.
+    velocities : numpy.ndarray of float, shape (N, d)
+        Final velocities.
+    angular_velocities : numpy.ndarray of float, shape (N, 3) in 3D, (N,) in 2D
+        Final lab-frame angular velocities.
+    timeseries : xarray.Dataset
+        One record per window (:func:`hardpack.md.compress.timeseries_dataset`).
+    stats : dict
+        Run statistics (phi, Z, stop reason, collisions, ...).
+    """
 
     packing: Packing
     velocities: np.ndarray

@@ -23,20 +23,62 @@ class EngineStalledError(RuntimeError):
 def moments_of_inertia(semiaxes: np.ndarray) -> np.ndarray:
     """Spherically symmetric moment of inertia of unit-mass ellipsoids (N, 3) or ellipses (N, 2):
     (2/15)(a^2 + b^2 + c^2), the mean principal moment (exact for spheres), or (a^2 + b^2)/4
-    (module docstring of :mod:`hardpack.md.ellipsoid_kernel`)."""
+    (module docstring of :mod:`hardpack.md.ellipsoid_kernel`).
+
+    Parameters
+    ----------
+    semiaxes : numpy.ndarray of float, shape (N, d), d = 2 or 3
+        Semiaxes of each particle.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N,)
+        Moment of inertia I of each particle (mass 1).
+    """
     sq = np.einsum("ij,ij->i", semiaxes, semiaxes)
     return sq / 4.0 if semiaxes.shape[1] == 2 else 2.0 * sq / 15.0
 
 
 def rotational_dof(d: int) -> int:
-    """Rotational degrees of freedom of one particle: 1 in 2D, 3 in 3D."""
+    """Rotational degrees of freedom of one particle: 1 in 2D, 3 in 3D.
+
+    Parameters
+    ----------
+    d : int
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    int
+        1 in 2D, 3 in 3D.
+    """
     return 1 if d == 2 else 3
 
 
 class EllipsoidEngine(Engine):
     """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box, or in a spherical
     container (``boundary``, a :class:`hardpack.geometry.boundaries.SphericalContainer` inside the
-    box, which then only serves the cell grid)."""
+    box, which then only serves the cell grid).
+
+    Parameters
+    ----------
+    positions, velocities : numpy.ndarray of float, shape (N, d)
+        Centres (inside the box) and velocities (unit masses).
+    semiaxes : numpy.ndarray of float, shape (N, d)
+        Semiaxes at window time 0.
+    orientations : numpy.ndarray of float, shape (N, 4) in 3D, (N,) in 2D
+        Unit quaternions (s, p_1, p_2, p_3), or angles of the first semiaxis with the x axis.
+    angular_velocities : numpy.ndarray of float, shape (N, 3) in 3D, (N,) in 2D
+        Lab-frame angular velocities.
+    box : numpy.ndarray of float, shape (d,)
+        Box side lengths.
+    capacity : int, optional
+        Initial neighbour-list capacity (doubled on overflow).
+    eps_f : float, optional
+        Trace tolerance (:data:`hardpack.md.ellipsoid_kernel.EPS_F`).
+    boundary : SphericalContainer or None, optional
+        A spherical container inside the box; None = periodic.
+    """
 
     def __init__(self, positions, velocities, semiaxes, orientations, angular_velocities, box,
                  capacity: int = 32, eps_f: float = ek.EPS_F, boundary=None):

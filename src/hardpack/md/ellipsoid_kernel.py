@@ -172,7 +172,18 @@ EPS = np.finfo(np.float64).eps
 @njit(cache=True, inline="always")
 def columns(d):
     """Column offsets of a row of P: (velocity, time, bounding radius, semiaxes, orientation,
-    angular velocity, inverse inertia, width)."""
+    angular velocity, inverse inertia, width).
+
+    Parameters
+    ----------
+    d : int
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    tuple of 8 int
+        Offsets cv, ct, cr, cax, cor, cw, cii and the row width ``ncol(d)``.
+    """
     no = 4 if d == 3 else 1
     nw = 3 if d == 3 else 1
     cax = 2 * d + 2
@@ -183,13 +194,36 @@ def columns(d):
 
 
 def ncol(d: int) -> int:
-    """Width of a row of P in d dimensions (19 in 3D, 11 in 2D)."""
+    """Width of a row of P in d dimensions (19 in 3D, 11 in 2D).
+
+    Parameters
+    ----------
+    d : int
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    int
+        Number of columns of P.
+    """
     return columns(d)[7]
 
 
 @njit(cache=True, inline="always")
 def orientation_at(P, i, t, out):
-    """Orientation of particle i at window time t (Algorithm 1, module docstring) into ``out``."""
+    """Orientation of particle i at window time t (Algorithm 1, module docstring) into ``out``.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (module docstring).
+    i : int
+        The particle.
+    t : float
+        Window time.
+    out : numpy.ndarray of float64, shape (>= 4,) in 3D, (>= 1,) in 2D
+        Receives the unit quaternion (s, p_1, p_2, p_3) in 3D, the angle in 2D.
+    """
     d = 2 if P.shape[1] == 11 else 3
     _, ct, _, _, cor, cw, _, _ = columns(d)
     dt = t - P[i, ct]
@@ -215,7 +249,19 @@ def orientation_at(P, i, t, out):
 
 @njit(cache=True)
 def advance(P, i, t, scratch):
-    """Move particle i to window time t (position and orientation) and set t_i = t."""
+    """Move particle i to window time t (position and orientation) and set t_i = t.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows, row i modified in place.
+    i : int
+        The particle.
+    t : float
+        Window time.
+    scratch : numpy.ndarray of float64, shape (>= 4,)
+        Scratch for the orientation.
+    """
     d = 2 if P.shape[1] == 11 else 3
     cv, ct, _, _, cor, _, _, _ = columns(d)
     dt = t - P[i, ct]
@@ -233,7 +279,20 @@ def advance(P, i, t, scratch):
 @njit(cache=True)
 def work_arrays(d):
     """Scratch arrays (ws, wm) of :func:`pair_zeta` and the kernels that call it: ws (11, 4) with
-    row 8 zeros, wm (4, d, d)."""
+    row 8 zeros, wm (4, d, d).
+
+    Parameters
+    ----------
+    d : int
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    ws : numpy.ndarray of float64, shape (11, 4)
+        Zeroed vector scratch (row 8 must stay zero: the null shift).
+    wm : numpy.ndarray of float64, shape (4, d, d)
+        Matrix scratch.
+    """
     return np.zeros((11, 4)), np.empty((4, d, d))
 
 
@@ -297,7 +356,34 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     of the surfaces (0 unless zeta > 0), ws[10, 2] the rate n . (v_j - v_i) / |n| at which the
     centres separate along n and ws[10, 3] the bound c_i |w_i x n^| + c_j |w_j x n^| on the rate of
     the support functions along n^ from the spins (:func:`support_rate_bound`; for
-    :func:`_safe_time`)."""
+    :func:`_safe_time`).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (read only).
+    i, j : int
+        The particles.
+    shift : numpy.ndarray of float64, shape (d,)
+        Periodic shift added to j's position.
+    t : float
+        Window time.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    lam0 : float
+        Starting guess of the Perram-Wertheim parameter lambda in (0, 1).
+    ws, wm : numpy.ndarray
+        Scratch of :func:`work_arrays`, outputs as above.
+
+    Returns
+    -------
+    zeta : float
+        Perram-Wertheim overlap potential mu^2 - 1 (> 0 disjoint; Donev 2006, sec. 2.2.2.1).
+    zeta_dot : float
+        Its time derivative (Donev 2006, Eq. 2.21).
+    lam : float
+        The maximising lambda.
+    """
     d = shift.shape[0]
     cv, _, _, _, _, cw, _, _ = columns(d)
     xa, xb, rc = ws[0, :d], ws[1, :d], ws[4, :d]
@@ -551,7 +637,22 @@ def support_rate_bound(P, i, d):
     (all weight on the extreme semiaxes), and (a_max^2 - m)(m - a_min^2) / m is largest at
     m = a_max a_min, where it equals (a_max - a_min)^2: so |p_perp| <= a_max - a_min, attained
     in the plane of the longest and shortest semiaxes (the support function of an ellipse turns
-    fastest there). A spin about u does not change h(u)."""
+    fastest there). A spin about u does not change h(u).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows.
+    i : int
+        The particle.
+    d : int
+        Dimension.
+
+    Returns
+    -------
+    float
+        a_max - a_min of its window-start semiaxes.
+    """
     _, _, _, cax, _, _, _, _ = columns(d)
     amin = P[i, cax]
     amax = P[i, cax]
@@ -574,7 +675,34 @@ def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
     touching pair. A pair that starts in contact or overlapping (round-off after its collision,
     or a missed collision) collides now if it approaches (rate below -rate_tol); otherwise it is
     "touching" at the contact level zc = zeta(t_in): it collides only when it approaches at or
-    below that level (Donev 2006, Algorithm 11 step d)."""
+    below that level (Donev 2006, Algorithm 11 step d).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (read only).
+    i, j : int
+        The particles.
+    shift : numpy.ndarray of float64, shape (d,)
+        Periodic shift added to j's position.
+    t : float
+        Window time of the prediction.
+    tin : float
+        Start of the bounding spheres' overlap, relative to t.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    ws, wm : numpy.ndarray
+        Scratch of :func:`work_arrays`.
+    st : numpy.ndarray of float64, shape (PAIR_STATE,)
+        Receives the trace state.
+
+    Returns
+    -------
+    lower : float
+        Lower bound on the collision time relative to t (inf when nothing moves).
+    now : bool
+        Whether the pair collides at t + tin.
+    """
     d = shift.shape[0]
     cv, _, cr, cax, _, cw, _, _ = columns(d)
     lam = P[i, cr] / (P[i, cr] + P[j, cr])
@@ -626,7 +754,36 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
     (time, kind) with kind 0 collision, 1 CHECK, and time inf when nothing happens before the end.
     A returned collision always approaches: its rate zeta_dot is below -GRAZE_RATE times the
     pair's rate scale (the relative surface speed bound over the smallest semiaxis), so the
-    collision law never skips it for round-off."""
+    collision law never skips it for round-off.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (read only).
+    i, j : int
+        The particles.
+    shift : numpy.ndarray of float64, shape (d,)
+        Periodic shift added to j's position.
+    t : float
+        Window time of the prediction.
+    tmax : float
+        Window time at which the search stops.
+    tin, tout : float
+        Overlap interval of the bounding spheres, relative to t.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    eps_f : float
+        Tolerance on the Hermite interpolation error of zeta (module docstring).
+    ws, wm : numpy.ndarray
+        Scratch of :func:`work_arrays`.
+
+    Returns
+    -------
+    time : float
+        Window time of the event, inf for none.
+    kind : int
+        0 a collision, 1 a CHECK.
+    """
     st = np.empty(PAIR_STATE)
     lower, now = pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st)
     if now:
@@ -642,7 +799,24 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
     min(t + tout, tmax): (time, kind) as :func:`predict_pair`, or, after at least one step, a
     suspension (lower bound on the collision time, 2) as soon as that lower bound (the time
     reached plus its safe time) is at or after window time ``tyield``; ``st`` then holds the state
-    to continue from."""
+    to continue from.
+
+    Parameters
+    ----------
+    P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm
+        As in :func:`predict_pair`.
+    st : numpy.ndarray of float64, shape (PAIR_STATE,)
+        Trace state of :func:`pair_start` or of a suspended trace, updated on a suspension.
+    tyield : float
+        Window time from which the trace suspends (inf: never).
+
+    Returns
+    -------
+    time : float
+        Window time of the event or suspension bound, inf for none.
+    kind : int
+        0 a collision, 1 a CHECK, 2 a suspension.
+    """
     end = min(tout, tmax - t)
     t0, z0, d0, lam, gap0, sep0, zc = st[0], st[1], st[2], st[3], st[4], st[5], st[6]
     touching = st[7] != 0.0
@@ -769,7 +943,20 @@ def _rotation_into(o, q):
 
 @njit(cache=True)
 def wall_arrays(d):
-    """Scratch arrays (ww (8, 4), wq (d, d)) of the wall functions."""
+    """Scratch arrays (ww (8, 4), wq (d, d)) of the wall functions.
+
+    Parameters
+    ----------
+    d : int
+        Dimension, 2 or 3.
+
+    Returns
+    -------
+    ww : numpy.ndarray of float64, shape (8, 4)
+        Zeroed vector scratch.
+    wq : numpy.ndarray of float64, shape (d, d)
+        Matrix scratch.
+    """
     return np.zeros((8, 4)), np.empty((d, d))
 
 
@@ -780,7 +967,30 @@ def wall_gap(P, i, t, kappa, wspec, ww, wq):
     (:func:`hardpack.geometry.ellipsoid_container.farthest_point_body`), and its rate by the
     envelope theorem, dh/dt = -n . (v + w x r_c + g r_c) (n the outward unit normal at the
     farthest point, r_c that point less the particle centre, g the relative growth rate). On
-    return ww[5, :d] holds r_c, ww[6, :d] n."""
+    return ww[5, :d] holds r_c, ww[6, :d] n.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (read only).
+    i : int
+        The particle.
+    t : float
+        Window time.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    wspec : numpy.ndarray of float64, shape (d + 1,)
+        Container centre and radius.
+    ww, wq : numpy.ndarray
+        Scratch of :func:`wall_arrays`, outputs as above.
+
+    Returns
+    -------
+    h : float
+        Gap to the wall (negative: the particle pokes through it).
+    hdot : float
+        dh/dt.
+    """
     d = wq.shape[0]
     cv, ct, _, cax, _, cw, _, _ = columns(d)
     dt = t - P[i, ct]
@@ -858,7 +1068,32 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
     halved until it passes; a sample at or below the contact level (0, or h(t) if the particle
     starts touching: after a wall collision, or a graze) brackets a crossing located by
     :func:`_wall_refine`. A crossing whose rate is not below -GRAZE_RATE times the particle's
-    speed scale is a graze; the trace goes on from just past it."""
+    speed scale is a graze; the trace goes on from just past it.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (read only).
+    i : int
+        The particle.
+    t, tmax : float
+        Window-time interval searched.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    wspec : numpy.ndarray of float64, shape (d + 1,)
+        Container centre and radius.
+    eps_f : float
+        Tolerance on the Hermite interpolation error, relative to the smallest semiaxis.
+    ww, wq : numpy.ndarray
+        Scratch of :func:`wall_arrays`.
+
+    Returns
+    -------
+    time : float
+        Window time of the event, inf for none.
+    kind : int
+        0 a collision, 1 a CHECK.
+    """
     d = wq.shape[0]
     cv, _, cr, cax, _, cw, _, _ = columns(d)
     if not tmax > t:
@@ -963,7 +1198,30 @@ def wall_collide(P, i, t, kappa, wspec, ww, wq):
     for an approaching particle, impulse -J n on the particle with
     J = 2 v_n / (1/m + |(r_C - x) x n|^2 / I), which reverses v_n: v -= J n,
     w -= J (r_C - x) x n / I. Returns (J, the momentum given to the wall, >= 0; change of the
-    translational kinetic energy), J = 0 for a skipped (separating) particle."""
+    translational kinetic energy), J = 0 for a skipped (separating) particle.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows, row i modified in place.
+    i : int
+        The particle.
+    t : float
+        Window time of the collision.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    wspec : numpy.ndarray of float64, shape (d + 1,)
+        Container centre and radius.
+    ww, wq : numpy.ndarray
+        Scratch of :func:`wall_arrays`.
+
+    Returns
+    -------
+    impulse : float
+        J >= 0, the momentum given to the wall (0: skipped).
+    dke : float
+        Change of the translational kinetic energy.
+    """
     d = wq.shape[0]
     cv, _, _, _, _, cw, cii, _ = columns(d)
     advance(P, i, t, ww[1])
@@ -1170,7 +1428,32 @@ def _cross_n(x, n, out):
 def collide(P, i, j, t, L, kappa, ws, wm):
     """Collision of i and j at window time t (module docstring, Algorithm 12); both particles are
     first advanced to t. Returns (impulse J >= 0 on j along n, r_ij . n J, change of the
-    translational kinetic energy), J = 0 for a skipped (separating) pair."""
+    translational kinetic energy), J = 0 for a skipped (separating) pair.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows, rows i and j modified in place.
+    i, j : int
+        The colliding particles.
+    t : float
+        Window time of the collision.
+    L : numpy.ndarray of float64, shape (d,)
+        Box side lengths (j is taken at its nearest image).
+    kappa : float
+        Relative growth rate of the semiaxes.
+    ws, wm : numpy.ndarray
+        Scratch of :func:`work_arrays`.
+
+    Returns
+    -------
+    impulse : float
+        J >= 0 (0: skipped).
+    virial : float
+        r_ij . n J, the pair's virial term.
+    dke : float
+        Change of the translational kinetic energy.
+    """
     d = L.shape[0]
     cv, ct, cr, _, _, cw, cii, _ = columns(d)
     nw = 3 if d == 3 else 1
@@ -1232,7 +1515,42 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     the number of contact-function evaluations, A_WALL the momentum given to the container wall).
     ``wmode`` PERIODIC_MODE or SPHERE_MODE (a spherical container of centre wspec[:d] and radius
     wspec[d] inside the box L, which then has no periodic images: wall collisions, counted in
-    iacc[I_WALL], count towards ``coll_target``); the periodic specialisation has no wall code."""
+    iacc[I_WALL], count towards ``coll_target``); the periodic specialisation has no wall code.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (module docstring), modified in place.
+    L : numpy.ndarray of float64, shape (d,), read-only
+        Box side lengths.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    eps_f : float
+        Trace tolerance (module docstring, :data:`EPS_F`).
+    skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of, bs, nb, nn, mark
+        Bounding spheres, grid and neighbour lists, as in :func:`hardpack.md.kernel.run_events`.
+    cnt, ep, ec, hkey, heap, hpos
+        Event heap, as in :func:`hardpack.md.kernel.run_events` (ep also CHECK and WALL).
+    acc : numpy.ndarray of float64, shape (N_ACC,)
+        Float accumulators (above).
+    iacc : numpy.ndarray of int64, shape (N_COUNTERS,)
+        Counters (above).
+    coll_target : int
+        Stop after this many collisions.
+    t_cap : float
+        Stop before the first event later than this window time.
+    rebuild_lists : bool
+        Start with a complete rebuild of grid and neighbour lists.
+    wmode : tuple, optional
+        PERIODIC_MODE or SPHERE_MODE.
+    wspec : numpy.ndarray of float64, shape (d + 1,), optional
+        Container centre and radius (SPHERE_MODE).
+
+    Returns
+    -------
+    int
+        A :class:`hardpack.md.kernel.WindowStatus`.
+    """
     d = L.shape[0]
     ws, wm = work_arrays(d)
     ww, wq = wall_arrays(d)
@@ -1371,7 +1689,17 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
 def synchronise(P, t, kappa):
     """Advance every particle to window time t, grow semiaxes, bounding radii and moments of
     inertia to their size at t, renormalise quaternions (Algorithm 1) and wrap 2D angles into
-    [0, 2 pi), and reset the time origin (Algorithm 3)."""
+    [0, 2 pi), and reset the time origin (Algorithm 3).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows, modified in place.
+    t : float
+        Window time of the synchronisation.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    """
     d = 2 if P.shape[1] == 11 else 3
     _, ct, cr, cax, cor, _, cii, _ = columns(d)
     grow = 1.0 + kappa * t
@@ -1398,7 +1726,22 @@ def synchronise(P, t, kappa):
 @njit(cache=True)
 def totals(P):
     """(translational KE, rotational KE, sum of volume-equivalent radii (prod a)^(1/d),
-    sum of prod a) in a fixed summation order (bit-identical after a resume)."""
+    sum of prod a) in a fixed summation order (bit-identical after a resume).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows at a synchronisation point.
+
+    Returns
+    -------
+    ket, ker : float
+        Translational and rotational kinetic energy.
+    s1 : float
+        Sum of the volume-equivalent radii.
+    sd : float
+        Sum of the semiaxis products.
+    """
     d = 2 if P.shape[1] == 11 else 3
     cv, _, _, cax, _, cw, cii, _ = columns(d)
     nw = 3 if d == 3 else 1
@@ -1425,7 +1768,26 @@ def totals(P):
 def max_overlap(P, imgvec, nb, nn):
     """Largest relative overlap 1 - mu (mu = sqrt(1 + zeta), the Perram-Wertheim scaling factor to
     tangency; 1 - r / (a_i + a_j) for spheres) over the listed pairs at a synchronisation point, and
-    the number of pairs with a positive one. Every touching pair is listed."""
+    the number of pairs with a positive one. Every touching pair is listed.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows at a synchronisation point.
+    imgvec : numpy.ndarray of float64, shape (4**d, d)
+        Periodic shift of each image code.
+    nb : numpy.ndarray of int, shape (N, cap)
+        Neighbour lists, entries j << 2d | image code.
+    nn : numpy.ndarray of int32, shape (N,)
+        List lengths.
+
+    Returns
+    -------
+    worst : float
+        Largest 1 - mu (-inf without listed pairs).
+    count : int
+        Number of listed pairs with a positive overlap.
+    """
     d = imgvec.shape[1]
     cbits = 2 * d
     ws, wm = work_arrays(d)

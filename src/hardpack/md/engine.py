@@ -48,7 +48,32 @@ SKIN_SLACK = 1.05
 
 @dataclass
 class WindowResult:
-    """What happened in one window (all times relative to the window start)."""
+    """What happened in one window (all times relative to the window start).
+
+    Attributes
+    ----------
+    duration : float
+        Window length in MD time.
+    virial : float
+        Sum over the collisions of r_ij . J_ij.
+    ke_integral : float
+        Time integral of the total kinetic energy over the window.
+    ke_end : float
+        Total kinetic energy at the end, before any rescaling.
+    collisions, events, stale, exits, grazing : int
+        Pair collisions, events processed, stale (invalidated) events, bounding-sphere exits and
+        predicted collisions skipped as grazing (v_n >= 0) in the window.
+    max_overlap : float
+        Largest relative overlap 1 - r / (a_i + a_j) at the end.
+    n_overlapping : int
+        Pairs with a positive overlap at the end.
+    mean_neighbours : float
+        Mean neighbour-list length.
+    wall_collisions : int
+        Reflections at hard walls.
+    wall_momentum : numpy.ndarray of float, shape (d,), or None
+        Momentum given to the walls (above).
+    """
 
     duration: float  # window length in MD time
     virial: float  # sum over collisions of r_ij . J_ij
@@ -83,13 +108,37 @@ def _cell_capacity(occupancy: float) -> int:
 
 def image_shifts(codes, d: int) -> np.ndarray:
     """Lattice shifts n in {-1, 0, 1}^d of neighbour-entry image codes sum_k (n_k + 1) 4^k (a
-    code with a digit 3 maps to n_k = 2; such codes never occur in the lists)."""
+    code with a digit 3 maps to n_k = 2; such codes never occur in the lists).
+
+    Parameters
+    ----------
+    codes : array_like of int
+        Image codes, any shape S.
+    d : int
+        Dimension.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape S + (d,)
+        The shifts n.
+    """
     codes = np.asarray(codes, dtype=np.int64)
     return (codes[..., None] >> (2 * np.arange(d))) % 4 - 1
 
 
 def image_vectors(box: np.ndarray) -> np.ndarray:
-    """Table of periodic shifts L * n indexed by the image code (:func:`image_shifts`)."""
+    """Table of periodic shifts L * n indexed by the image code (:func:`image_shifts`).
+
+    Parameters
+    ----------
+    box : numpy.ndarray of float, shape (d,)
+        Box side lengths L.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (4**d, d)
+        Row ``code`` is L n of the code's shift n.
+    """
     d = len(box)
     return image_shifts(np.arange(4**d), d) * box[None, :]
 
@@ -98,7 +147,24 @@ def wall_arrays(boundary, d: int) -> tuple[tuple, np.ndarray, np.ndarray]:
     """Kernel form of a boundary (:mod:`hardpack.geometry.boundaries`): the mode tuple
     (:data:`hardpack.md.kernel.PERIODIC_MODE`, ``FLAT_WALLS_MODE`` or ``SPHERE_MODE``), the
     walled-axis flags (d,) int8 and the container (centre, radius) (d + 1,) (zeros unless a
-    spherical container)."""
+    spherical container).
+
+    Parameters
+    ----------
+    boundary : boundary object or None
+        PeriodicBoundary, HardWalls or SphericalContainer; None = periodic.
+    d : int
+        Dimension.
+
+    Returns
+    -------
+    mode : tuple
+        The kernel's boundary mode.
+    walled : numpy.ndarray of int8, shape (d,)
+        1 for the axes without periodic images.
+    spec : numpy.ndarray of float, shape (d + 1,)
+        Container centre and radius.
+    """
     kind = "periodic" if boundary is None else boundary.kind
     walled = np.zeros(d, dtype=np.int8)
     spec = np.zeros(d + 1)
@@ -115,7 +181,23 @@ def wall_arrays(boundary, d: int) -> tuple[tuple, np.ndarray, np.ndarray]:
 
 class Engine:
     """Numba state of N spheres in an orthorhombic box with side lengths ``box``: periodic, or with
-    hard walls (``boundary``, a :mod:`hardpack.geometry.boundaries` object; None = periodic)."""
+    hard walls (``boundary``, a :mod:`hardpack.geometry.boundaries` object; None = periodic).
+
+    Parameters
+    ----------
+    positions : numpy.ndarray of float, shape (N, d)
+        Centres, inside the box.
+    velocities : numpy.ndarray of float, shape (N, d)
+        Velocities (unit masses).
+    radii : numpy.ndarray of float, shape (N,)
+        Radii at window time 0.
+    box : numpy.ndarray of float, shape (d,)
+        Box side lengths.
+    capacity : int, optional
+        Initial neighbour-list capacity (doubled on overflow).
+    boundary : boundary object or None, optional
+        Walls of the box (:func:`wall_arrays`); None = periodic.
+    """
 
     def __init__(self, positions: np.ndarray, velocities: np.ndarray, radii: np.ndarray,
                  box: np.ndarray, capacity: int = 32, boundary=None):

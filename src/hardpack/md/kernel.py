@@ -116,7 +116,17 @@ N_COUNTERS = 6
 @njit(cache=True, inline="always")
 def kinetic_step(acc, t, dke):
     """Integrate the kinetic energy, constant since acc[A_TKE], up to window time t into
-    acc[A_KEINT], then change it by ``dke`` (a collision's or reflection's energy change)."""
+    acc[A_KEINT], then change it by ``dke`` (a collision's or reflection's energy change).
+
+    Parameters
+    ----------
+    acc : numpy.ndarray of float64, shape (A_WALL + d,)
+        The window's float accumulators (module constants A_KEINT, A_KE, A_TKE), modified in place.
+    t : float
+        Window time of the event.
+    dke : float
+        Change of the total kinetic energy at time t.
+    """
     acc[A_KEINT] += acc[A_KE] * (t - acc[A_TKE])
     acc[A_TKE] = t
     acc[A_KE] += dke
@@ -124,7 +134,15 @@ def kinetic_step(acc, t, dke):
 
 @njit(cache=True, inline="always")
 def end_window(acc, t):
-    """Close the window's accumulators at window time t (its end time, the kinetic integral)."""
+    """Close the window's accumulators at window time t (its end time, the kinetic integral).
+
+    Parameters
+    ----------
+    acc : numpy.ndarray of float64, shape (A_WALL + d,)
+        The window's float accumulators, modified in place (A_T, A_KEINT, A_TKE).
+    t : float
+        Window time at which the window ends.
+    """
     acc[A_T] = t
     kinetic_step(acc, t, 0.0)
 
@@ -187,7 +205,27 @@ def prefetch_row(typingctx, arr, idx):
 def prefetch_next_events(P, bs, nb, nn, ep, heap, hsize, cbits):
     """Look ahead for an event loop (the sphere and ellipsoid kernels; it is memory-latency bound
     from N ~ 1e4): start loading the rows the next events will need, the particles of the next
-    few events, the next particle's neighbours and its partner's neighbours. A hint only."""
+    few events, the next particle's neighbours and its partner's neighbours. A hint only.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol)
+        Particle state rows (:func:`run_events`; the ellipsoid kernel's wider rows also work).
+    bs : numpy.ndarray of float64, shape (N, d + 1)
+        Bounding spheres, centre then radius.
+    nb : numpy.ndarray of int32 or int64, shape (N, cap)
+        Neighbour lists, entries j << cbits | image code.
+    nn : numpy.ndarray of int32, shape (N,)
+        Length of each neighbour list.
+    ep : numpy.ndarray of int32, shape (N,)
+        Partner of each particle's predicted event (negative: not a particle).
+    heap : numpy.ndarray of int32, shape (N,)
+        Particle in each heap slot (4-ary min-heap, slot 0 the next event).
+    hsize : int
+        Number of particles in the heap.
+    cbits : int
+        Bits of the image code in a list entry, 2 d.
+    """
     for c2 in range(1, min(5, hsize)):
         q = heap[c2]
         prefetch_row(P, q)
@@ -216,6 +254,39 @@ def update_neighbour_list(i, a, P, L, invL, skin, sfac, lvl, rcap, ncl, coff, cc
 
     Returns 0, or the :class:`WindowStatus` that ends the window (BOUND_TOO_SMALL,
     CELL_OVERFLOW, OVERFLOW); the caller records the time.
+
+    Parameters
+    ----------
+    i : int
+        The particle whose list is updated.
+    a : float
+        Its current radius (the ellipsoid kernel: its bounding radius), at the update time.
+    P : numpy.ndarray of float64, shape (N, ncol)
+        Particle state rows; P[i, :d] is wrapped into the box in place.
+    L, invL : numpy.ndarray of float64, shape (d,)
+        Box side lengths and their inverses.
+    skin : float
+        Bounding-sphere skin; the bounding radius is a + skin sfac[i], at most rcap[lvl[i]].
+    sfac : numpy.ndarray of float64, shape (N,)
+        Relative skin of every particle.
+    lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of
+        Hierarchical grid, as in :func:`run_events` (ccount, cid, cbs, slot_of modified in place).
+    bs, nb, nn, mark
+        Bounding spheres, neighbour lists and their scratch marks, as in :func:`run_events`
+        (modified in place).
+    oldnb : numpy.ndarray of int, shape (cap,)
+        Scratch for i's former neighbours.
+    clo, cspan, codo : numpy.ndarray of int64, shape (d,)
+        Scratch for the cell ranges scanned along each axis.
+    wmode : tuple
+        Boundary mode (:data:`PERIODIC_MODE`, :data:`FLAT_WALLS_MODE`, :data:`SPHERE_MODE`).
+    walled : numpy.ndarray of int8, shape (d,)
+        1 for the axes without periodic images.
+
+    Returns
+    -------
+    int
+        0 on success, else the :class:`WindowStatus` that ends the window.
     """
     d = L.shape[0]
     cbits = 2 * d
@@ -736,7 +807,25 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
 @njit(cache=True)
 def synchronise(P, dims, t, kappa):
     """Advance every particle to time t, move the radii to a_i (1 + kappa t) and reset the time
-    origin (Alg. 3). Returns the total kinetic energy sum_i v_i^2 / 2."""
+    origin (Alg. 3). Returns the total kinetic energy sum_i v_i^2 / 2.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, 2 d + 2)
+        Particle state rows (:func:`run_events`), modified in place: positions at t, own times 0,
+        radii a_i (1 + kappa t).
+    dims : tuple of int
+        ``tuple(range(d))``; only its length is used.
+    t : float
+        Window time of the synchronisation.
+    kappa : float
+        Relative growth rate of the radii.
+
+    Returns
+    -------
+    float
+        Total kinetic energy sum_i v_i^2 / 2 (unit masses).
+    """
     d = len(dims)
     ke = 0.0
     grow = 1.0 + kappa * t
@@ -755,7 +844,28 @@ def synchronise(P, dims, t, kappa):
 def max_overlap(P, dims, imgvec, nb, nn):
     """Largest relative overlap 1 - |r_ij| / (a_i + a_j) over all listed pairs at a sync point (all
     particles at t = 0), and the number of pairs with overlap > 0. Every touching pair is listed,
-    because touching spheres have overlapping bounding spheres."""
+    because touching spheres have overlapping bounding spheres.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, 2 d + 2)
+        Particle state rows at a synchronisation point.
+    dims : tuple of int
+        ``tuple(range(d))``; only its length is used.
+    imgvec : numpy.ndarray of float64, shape (4**d, d)
+        Periodic shift of each image code.
+    nb : numpy.ndarray of int32 or int64, shape (N, cap)
+        Neighbour lists, entries j << 2d | image code.
+    nn : numpy.ndarray of int32, shape (N,)
+        Length of each neighbour list.
+
+    Returns
+    -------
+    worst : float
+        Largest 1 - |r_ij| / (a_i + a_j) (-inf without listed pairs; <= 0 when nothing overlaps).
+    count : int
+        Number of listed pairs that overlap.
+    """
     d = len(dims)
     worst = -np.inf
     count = 0
@@ -780,7 +890,24 @@ def max_overlap(P, dims, imgvec, nb, nn):
 @njit(cache=True)
 def totals(P, dims):
     """(kinetic energy sum v^2/2, sum of radii, sum of radii^d) in a fixed summation order, so
-    that a resumed run computes bit-identical values."""
+    that a resumed run computes bit-identical values.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, 2 d + 2)
+        Particle state rows at a synchronisation point.
+    dims : tuple of int
+        ``tuple(range(d))``; only its length is used.
+
+    Returns
+    -------
+    ke : float
+        Kinetic energy sum_i v_i^2 / 2.
+    s1 : float
+        Sum of the radii, sum_i a_i.
+    sd : float
+        Sum of the d-th powers of the radii, sum_i a_i^d.
+    """
     d = len(dims)
     ke = 0.0
     s1 = 0.0

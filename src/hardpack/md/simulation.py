@@ -90,7 +90,18 @@ def maxwell_boltzmann(n: int, d: int, seed) -> np.ndarray:
 
 def check_packing(packing: Packing) -> None:
     """Refuse packings the engine cannot run: other shapes, sheared cells, fewer than 2 particles
-    in a periodic cell (1 is enough with walls), overlaps or wall crossings."""
+    in a periodic cell (1 is enough with walls), overlaps or wall crossings.
+
+    Parameters
+    ----------
+    packing : Packing
+        The start packing.
+
+    Raises
+    ------
+    InvalidInputError
+        If the engine cannot run it.
+    """
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
     if packing.shape.kind != "sphere":
@@ -106,7 +117,18 @@ def check_packing(packing: Packing) -> None:
 
 def check_start_configuration(packing: Packing) -> None:
     """The start checks every MD engine shares: at least 2 particles in a periodic cell (1 is
-    enough with walls), every particle inside its walls, no overlaps."""
+    enough with walls), every particle inside its walls, no overlaps.
+
+    Parameters
+    ----------
+    packing : Packing
+        The start packing.
+
+    Raises
+    ------
+    InvalidInputError
+        If it has too few particles, a wall crossing or an overlap.
+    """
     if packing.n_particles < (2 if packing.boundary.kind == "periodic" else 1):
         raise InvalidInputError("MD in a periodic cell needs at least 2 particles")
     walls = packing.containment_report(DEFAULT_OVERLAP_TOL)
@@ -121,7 +143,22 @@ def check_start_configuration(packing: Packing) -> None:
 
 
 class Simulation:
-    """State of one run; :meth:`run_window` advances it by one synchronisation window."""
+    """State of one run; :meth:`run_window` advances it by one synchronisation window.
+
+    Parameters
+    ----------
+    packing : Packing
+        The start packing of spheres (:func:`check_packing`).
+    velocities : numpy.ndarray of float, shape (N, d)
+        Start velocities in the packing's order (m = 1).
+    growth_rate : float
+        Growth rate Gamma = (d<D>/dt) / sqrt(kT/m) of the diameters (0: fixed size, < 0 shrinks).
+    overlap_tol : float, optional
+        Relative overlap above which a window's end state is refused.
+    contact_windows : int, optional
+        If > 0, log every collision and keep the per-pair impulse sums of the last
+        ``contact_windows`` windows in :attr:`contacts` (:mod:`hardpack.md.contacts`).
+    """
 
     def __init__(self, packing: Packing, velocities: np.ndarray, growth_rate: float,
                  overlap_tol: float = DEFAULT_OVERLAP_TOL, contact_windows: int = 0):

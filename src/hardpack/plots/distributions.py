@@ -13,6 +13,16 @@ def plot_size_distributions(samples: dict[str, tuple[np.ndarray, Distribution]])
 
     Discrete mixtures show sampled vs nominal number fractions as bars and markers.
     Returns the figure.
+
+    Parameters
+    ----------
+    samples : dict of str to (numpy.ndarray, Distribution)
+        Ensemble name -> (sampled radii, the distribution they were drawn from).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
     """
     n = len(samples)
     ncols = min(n, 3)

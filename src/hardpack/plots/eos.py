@@ -40,7 +40,18 @@ def _plot_fit(ax, family, widths):
 
 def plot_phij_vs_width(summaries):
     """Top row: phi_J (mean +- standard error over seeds) vs omega (sigma) per family, with the published
-    fit; bottom row: phi_J(equivalent)/phi_J(poly) - 1 in percent with the +-1 % band."""
+    fit; bottom row: phi_J(equivalent)/phi_J(poly) - 1 in percent with the +-1 % band.
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        The eos_jam_summary of each family.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     summaries = sorted(summaries, key=lambda s: list(FAMILY_LABEL).index(s.attrs["family"]))
     fig, axes = figure(2, len(summaries), figsize=(3.3 * len(summaries), 5.2), sharex="col", squeeze=False,
                        gridspec_kw={"height_ratios": [2, 1]})
@@ -78,7 +89,20 @@ def plot_phij_vs_width(summaries):
 def plot_crystallisation(summary, threshold: float):
     """Slow runs (Ogarko 2014, sec. 3.1.3): left, phi_J vs omega of poly / bi / tri with the published fit;
     right, the q6 crystallinity of the large particles (mean over seeds, each seed a small marker)
-    with the ``threshold`` the validation counts as partial crystallisation."""
+    with the ``threshold`` the validation counts as partial crystallisation.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        The eos_jam_summary of the slow runs.
+    threshold : float
+        Crystallinity counted as partial crystallisation.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     stats = seed_statistics(summary)
     family = summary.attrs["family"]
     widths = stats["width"].values
@@ -107,7 +131,18 @@ def plot_crystallisation(summary, threshold: float):
 
 def plot_eos_vs_bmcsl(fluid):
     """Left: Z vs phi (simulation markers, BMCSL lines) per distribution; right: Z/Z_BMCSL - 1 in percent
-    with the +-1 % band and Ogarko's Z_OL (Eq. 3.13) relative to BMCSL as dashed lines."""
+    with the +-1 % band and Ogarko's Z_OL (Eq. 3.13) relative to BMCSL as dashed lines.
+
+    Parameters
+    ----------
+    fluid : xarray.Dataset
+        The eos_fluid_summary.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, (left, right) = figure(1, 2, figsize=(9.0, 3.8))
     grid = np.linspace(0.0, 0.5, 200)
     for k, case in enumerate(fluid["case"].values):

@@ -21,7 +21,18 @@ from hardpack.validation.targets import load_targets
 
 def plot_fcc_finite_size(summaries: dict):
     """BCMD free energies of FCC vs ln N / N (the leading finite-size term), with the fit
-    a + b ln N / N and the published values."""
+    a + b ln N / N and the published values.
+
+    Parameters
+    ----------
+    summaries : dict of str to xarray.Dataset
+        State name -> combined BCMD summary (as :func:`hardpack.validation.freeenergy.bcmd_rows`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, axes = figure(1, len(summaries), figsize=(4.2 * len(summaries), 3.4), squeeze=False)
     for ax, (state, ds) in zip(axes.flat, summaries.items()):
         tid, var = TARGETS[state]
@@ -52,7 +63,20 @@ def plot_fcc_density(bcmd, eos):
     f_c(Delta mu_d) - f vs the distance to jamming delta (log scale; f = -3 ln delta - f_J
     + ..., so Delta f tends to the jamming constant as delta -> 0), with the EOS integration of
     the engine's pressure from the published melting value and the cell limit with the published
-    jamming constant (hardpack.freeenergy.crystal)."""
+    jamming constant (hardpack.freeenergy.crystal).
+
+    Parameters
+    ----------
+    bcmd : xarray.Dataset
+        BCMD summary over (phi, seed).
+    eos : xarray.Dataset
+        MD equation-of-state summary of the crystal over phi.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, (ax1, ax2) = figure(1, 2, figsize=(9.0, 3.6))
     phi_b, ex_b = bcmd["phi"].values, bcmd["excess"].values
     phi_e, z = eos["phi"].values, eos["Z"].values

@@ -14,7 +14,18 @@ from hardpack.plots.style import RC, figure
 def plot_glass_eos(binary, mono):
     """phi~_J(phi) = phi / (1 - 2/Z) of every compression branch (and the crystal decompression),
     with the published Eq. 13.3 cubic, our fit of it, and the glassy branches of Eq. 13.4 (after
-    Donev 2006, Figs. 13.1 and 13.6)."""
+    Donev 2006, Figs. 13.1 and 13.6).
+
+    Parameters
+    ----------
+    binary, mono : xarray.Dataset
+        The glass_eos summaries of the binary and monodisperse systems.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, axes = figure(1, 2, figsize=(9.0, 3.6))
     for ax, ds, title in ((axes[0], mono, "monodisperse disks"), (axes[1], binary, "binary disks, kappa = 1.4")):
         for b in ds["branch"].values:
@@ -41,7 +52,19 @@ def plot_glass_eos(binary, mono):
 def plot_glass_entropy(binary, mono):
     """Left: excess free energies of the liquid (EOS integral) and the SOC glasses (BCMD) vs phi
     (after Fig. 13.11); right: s_c - s_mix vs phi for the binary and monodisperse systems (after
-    Fig. 13.12)."""
+    Fig. 13.12).
+
+    Parameters
+    ----------
+    binary, mono : xarray.Dataset
+        The entropy datasets of the binary and monodisperse systems
+        (:func:`hardpack.glass.study.entropy_dataset`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, axes = figure(1, 2, figsize=(9.0, 3.6))
     for ds, name, mark in ((binary, "binary", "o"), (mono, "mono", "s")):
         phi = ds["phi"].values
@@ -77,7 +100,18 @@ def _fit_label(fit) -> str:
 def plot_microsegregated(summary):
     """s_c against phi_J of each label ensemble, with phi_J's standard error, the uncorrelated
     ("random") labels marked, s_mix dashed and the exponential fit of the summary with its
-    parameters and standard errors in the legend (after Donev 2006, Fig. 13.16)."""
+    parameters and standard errors in the legend (after Donev 2006, Fig. 13.16).
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        The micro-segregated summary over ensembles.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     from hardpack.glass.microsegregated import ExponentialFit
 
     fig, ax = figure(1, 1, figsize=(5.2, 4.6), layout="constrained")
@@ -141,7 +175,18 @@ def _map_panel(fig, ax, maps, key, label, fmt):
 def plot_microsegregated_maps(maps):
     """Colour maps of phi_J(R, nu) (left) and s_c(R, nu) (right) over the grid of Matérn
     parameters, the values written in the cells and cells without an ensemble hatched as missing
-    (after Donev 2006, Fig. 13.17: nu on the x axis, R on the y axis)."""
+    (after Donev 2006, Fig. 13.17: nu on the x axis, R on the y axis).
+
+    Parameters
+    ----------
+    maps : xarray.Dataset
+        phi_J and s_c over the (R, nu) grid (:func:`hardpack.glass.microsegregated.grid_maps`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, axes = figure(1, 2, figsize=(9.5, 3.8), layout="constrained")
     with rc_context(RC):
         _map_panel(fig, axes[0], maps, "phi_J", r"$\phi_J$ (mean over packings)", "{:.4f}")

@@ -15,7 +15,20 @@ from hardpack.validation.targets import load_targets
 
 def plot_jamming_vs_d(jammed: list, verdicts: list):
     """Left: LS phi_J (mean +- s.e. over seeds) of the monodisperse ensembles vs d, with the published
-    values. Right: mean contact number after rattler removal vs d, with the isostatic 2d."""
+    values. Right: mean contact number after rattler removal vs d, with the isostatic 2d.
+
+    Parameters
+    ----------
+    jammed : list of xarray.Dataset
+        Summaries of the monodisperse LS ensembles.
+    verdicts : list of xarray.Dataset
+        Their jamming-verdict summaries.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, (left, right) = figure(1, 2, figsize=(7.0, 3.0))
     for s in jammed:
         d = int(s["d"].values.ravel()[0])

@@ -19,7 +19,18 @@ def _by_rate(series):
 
 def plot_rate_phij(series):
     """phi_J estimate phi / (1 - d/Z) (Eq. 1.2) vs phi, one colour per Gamma, with the estimate the
-    Carnahan-Starling fluid would give (the gamma -> 0 limit below freezing)."""
+    Carnahan-Starling fluid would give (the gamma -> 0 limit below freezing).
+
+    Parameters
+    ----------
+    series : iterable of xarray.Dataset
+        MD time series of the compressions.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = figure()
     for k, (rate, members) in enumerate(_by_rate(series).items()):
         for j, ts in enumerate(members):
@@ -38,7 +49,18 @@ def plot_rate_phij(series):
 
 def plot_rate_eos(series):
     """Reduced pressure Z = pV/(NkT) vs phi for each Gamma (log scale) against Carnahan-Starling and
-    the free-volume law Z = d / (1 - phi/phi_J) with the final phi_J of each run (Eq. 1.1)."""
+    the free-volume law Z = d / (1 - phi/phi_J) with the final phi_J of each run (Eq. 1.1).
+
+    Parameters
+    ----------
+    series : iterable of xarray.Dataset
+        MD time series of the compressions.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = figure()
     for k, (rate, members) in enumerate(_by_rate(series).items()):
         for j, ts in enumerate(members):

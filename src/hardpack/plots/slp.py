@@ -12,7 +12,18 @@ from hardpack.validation.targets import load_targets
 
 
 def plot_densest(summary):
-    """phi / phi_densest-known per dimension: every seed, the best, and the paper's SLP and LS values."""
+    """phi / phi_densest-known per dimension: every seed, the best, and the paper's SLP and LS values.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        SLP summary over seeds (variables d and phi).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = figure()
     d = summary["d"].values.astype(int)
     phi = summary["phi"].values
@@ -43,6 +54,16 @@ def plot_slp_vs_ls(pairs: dict):
 
     ``pairs`` maps an ensemble name to (SLP summary, LS jammed summary or None for an SLP-only
     system) Datasets. Each name is labelled with its d and N.
+
+    Parameters
+    ----------
+    pairs : dict of str to (xarray.Dataset, xarray.Dataset or None)
+        As above.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
     """
     fig, ax = figure()
     names = list(pairs)
@@ -91,6 +112,18 @@ def plot_order_map(summary, diluted=None):
     packings of the paper's Sec. VI on the left as red squares (its Fig. 6 symbol), each seed's
     rounds joined from its MRJ start, with the paper's low end phi = 0.60 (0.595 without
     rattlers) marked. Either summary may be None, not both.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset or None
+        The order-map summary.
+    diluted : xarray.Dataset, optional
+        The diluted-MRJ summary.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
     """
     if summary is None and diluted is None:
         raise ValueError("plot_order_map needs an order-map or a diluted-MRJ summary")

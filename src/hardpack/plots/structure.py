@@ -13,7 +13,18 @@ from hardpack.structure.pair import NEAR_CONTACT_FIT, fit_coordination_power_law
 
 
 def plot_g2_near_contact(ensembles: dict):
-    """Seed-averaged g2 against r / (r_i + r_j), contacts excluded; sqrt(3) and 2 marked (split second peak)."""
+    """Seed-averaged g2 against r / (r_i + r_j), contacts excluded; sqrt(3) and 2 marked (split second peak).
+
+    Parameters
+    ----------
+    ensembles : dict of str to list of xarray.Dataset
+        Ensemble name -> structure datasets of its seeds.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = figure()
     for k, (name, members) in enumerate(ensembles.items()):
         x = members[0]["x"].values
@@ -30,7 +41,20 @@ def plot_g2_near_contact(ensembles: dict):
 
 
 def plot_coordination(ensembles: dict, gap_lo: float = NEAR_CONTACT_FIT[0], gap_hi: float = NEAR_CONTACT_FIT[1]):
-    """log-log Z(l) - Z(0) of the rattler-free backbone with the fitted power law (Donev ch. 9: Z - 6 ~ 11 l^0.6)."""
+    """log-log Z(l) - Z(0) of the rattler-free backbone with the fitted power law (Donev ch. 9: Z - 6 ~ 11 l^0.6).
+
+    Parameters
+    ----------
+    ensembles : dict of str to list of xarray.Dataset
+        Ensemble name -> structure datasets of its seeds.
+    gap_lo, gap_hi : float, optional
+        Gap range of the power-law fit.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = figure()
     for k, (name, members) in enumerate(ensembles.items()):
         for j, m in enumerate(members):
@@ -57,7 +81,20 @@ def plot_coordination(ensembles: dict, gap_lo: float = NEAR_CONTACT_FIT[0], gap_
 
 
 def plot_structure_factor(ensembles: dict, k_max_d: float = 12.0):
-    """S(k) at small k (k in units of 1 / mean diameter) with the extrapolated S(0) of each seed."""
+    """S(k) at small k (k in units of 1 / mean diameter) with the extrapolated S(0) of each seed.
+
+    Parameters
+    ----------
+    ensembles : dict of str to list of xarray.Dataset
+        Ensemble name -> structure datasets of its seeds.
+    k_max_d : float, optional
+        Largest k D shown.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = figure()
     for k, (name, members) in enumerate(ensembles.items()):
         for j, m in enumerate(members):
@@ -77,7 +114,20 @@ def plot_structure_factor(ensembles: dict, k_max_d: float = 12.0):
 
 def plot_channels(ensembles: dict, ratio_max: float = 1.5):
     """Seed-averaged histogram of channel radii over central radius R / r (Ogarko ch. 4, bin 0.01);
-    the exact channels of touching equal spheres (triangle 2/sqrt(3) - 1, square sqrt(2) - 1) marked."""
+    the exact channels of touching equal spheres (triangle 2/sqrt(3) - 1, square sqrt(2) - 1) marked.
+
+    Parameters
+    ----------
+    ensembles : dict of str to list of xarray.Dataset
+        Ensemble name -> structure datasets of its seeds.
+    ratio_max : float, optional
+        Largest R / r shown.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = figure()
     for k, (name, members) in enumerate(ensembles.items()):
         hists = [m["channel_density"] for m in members if "channel_density" in m]

@@ -27,13 +27,36 @@ RC = {
 
 
 def figure(nrows: int = 1, ncols: int = 1, **kwargs):
-    """A figure in the house style (``plt.subplots`` arguments)."""
+    """A figure in the house style (``plt.subplots`` arguments).
+
+    Parameters
+    ----------
+    nrows, ncols : int, optional
+        Grid of axes.
+    **kwargs
+        Further arguments of :func:`matplotlib.pyplot.subplots`.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        The figure.
+    axes : matplotlib.axes.Axes or numpy.ndarray of them
+        Its axes.
+    """
     with plt.rc_context(RC):
         return plt.subplots(nrows, ncols, **kwargs)
 
 
 def save(fig, *paths) -> None:
-    """Write the figure to each path (format from the suffix) atomically, then close it."""
+    """Write the figure to each path (format from the suffix) atomically, then close it.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure, closed afterwards.
+    *paths : str or os.PathLike
+        Output files.
+    """
     with plt.rc_context(RC):
         for path in paths:
             with atomic_path(path, fsync=False) as tmp:

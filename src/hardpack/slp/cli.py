@@ -47,7 +47,18 @@ def _solver(args) -> str:
 
 
 def cmd_slp(args) -> int:
-    """Sequential-LP (adaptive shrinking cell) packing from a start configuration."""
+    """Sequential-LP (adaptive shrinking cell) packing from a start configuration.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack slp``.
+
+    Returns
+    -------
+    int
+        Exit status: 0, or 3 when the SLP did not converge (errors raise).
+    """
     start = load_packing(args.init)
     result = run_slp(start, args.alpha, _bounds(args), deforming=not args.isotropic, tol=args.tol,
                      max_steps=args.max_steps, method=args.lp_method, checkpoint=args.checkpoint,
@@ -67,7 +78,18 @@ def cmd_slp(args) -> int:
 
 
 def cmd_slp_dilute(args) -> int:
-    """Diluted-MRJ protocol (Torquato & Jiao 2010, Sec. VI): remove spheres at random, re-jam by SLP, repeat."""
+    """Diluted-MRJ protocol (Torquato & Jiao 2010, Sec. VI): remove spheres at random, re-jam by SLP, repeat.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack slp-dilute``.
+
+    Returns
+    -------
+    int
+        Exit status: 0, or 3 when a round did not converge (errors raise).
+    """
     start = load_packing(args.init)
     rounds = run_diluted(start, args.fraction, args.rounds, args.seed, args.alpha, _bounds(args),
                          deforming=not args.isotropic, tol=args.tol, max_steps=args.max_steps,
@@ -121,14 +143,14 @@ def register(subparsers) -> None:
     subparsers : argparse._SubParsersAction
         The subcommand parsers of :func:`hardpack.cli.build_parser`.
     """
-    p = subparsers.add_parser("slp", help=cmd_slp.__doc__)
+    p = subparsers.add_parser("slp", help=cmd_slp.__doc__.split("\n\n")[0])
     p.add_argument("--init", required=True, help="start packing (netCDF), e.g. from `hardpack init`")
     p.add_argument("--out", required=True, help="output packing (netCDF)")
     p.add_argument("--history", help="optional per-LP history (netCDF)")
     _slp_options(p)
     p.set_defaults(func=cmd_slp)
 
-    p = subparsers.add_parser("slp-dilute", help=cmd_slp_dilute.__doc__)
+    p = subparsers.add_parser("slp-dilute", help=cmd_slp_dilute.__doc__.split("\n\n")[0])
     p.add_argument("--init", required=True, help="start packing (netCDF), a jammed SLP MRJ packing")
     p.add_argument("--out-dir", required=True, help="folder of the packings round1.nc ... round<R>.nc")
     p.add_argument("--fraction", type=float, required=True,

@@ -110,7 +110,27 @@ class DilutedRound:
 
 def removal_count(n_start: int, fraction: float, rounds: int) -> int:
     """Spheres removed per round, ``round(fraction * n_start)``; refuses settings that remove
-    none or leave fewer than two spheres after ``rounds`` rounds."""
+    none or leave fewer than two spheres after ``rounds`` rounds.
+
+    Parameters
+    ----------
+    n_start : int
+        Spheres in the start packing.
+    fraction : float
+        Fraction removed per round, in (0, 1).
+    rounds : int
+        Number of rounds, >= 1.
+
+    Returns
+    -------
+    int
+        Spheres removed per round.
+
+    Raises
+    ------
+    InvalidInputError
+        For settings that remove none or too many.
+    """
     if not (0 < fraction < 1):
         raise InvalidInputError(f"fraction must be in (0, 1), got {fraction}")
     if int(rounds) != rounds or rounds < 1:
@@ -128,7 +148,24 @@ def removal_count(n_start: int, fraction: float, rounds: int) -> int:
 
 
 def remove_random(packing: Packing, n_remove: int, rng: np.random.Generator) -> tuple[Packing, np.ndarray]:
-    """``packing`` without ``n_remove`` spheres chosen uniformly at random, and the kept indices."""
+    """``packing`` without ``n_remove`` spheres chosen uniformly at random, and the kept indices.
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing.
+    n_remove : int
+        Spheres removed, in [1, N - 1].
+    rng : numpy.random.Generator
+        Random source.
+
+    Returns
+    -------
+    packing : Packing
+        The thinned packing.
+    keep : numpy.ndarray of int, shape (N - n_remove,)
+        Indices of the kept spheres, ascending.
+    """
     if int(n_remove) != n_remove or not 0 < n_remove < packing.n_particles:
         raise InvalidInputError(
             f"cannot remove {n_remove} of {packing.n_particles} spheres; remove between 1 and N - 1")

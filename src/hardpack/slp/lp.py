@@ -89,7 +89,25 @@ class Bounds:
 
 @dataclass(frozen=True)
 class StepSolution:
-    """Optimal step: strain (d x d), displacements (N x d), predicted tr(eps), pair count, LP time."""
+    """Optimal step: strain (d x d), displacements (N x d), predicted tr(eps), pair count, LP time.
+
+    Attributes
+    ----------
+    strain : numpy.ndarray of float, shape (d, d)
+        Symmetric strain eps of the cell.
+    displacement : numpy.ndarray of float, shape (N, d)
+        Displacements of the spheres.
+    trace : float
+        tr(eps), the predicted relative volume change.
+    n_constraints : int
+        Pair rows of the LP.
+    lp_seconds : float
+        Time of the LP solve.
+    duals : numpy.ndarray of float, shape (n_constraints,)
+        Duals of the pair rows (>= 0).
+    pairs : PairList
+        The pairs behind the rows.
+    """
 
     strain: np.ndarray
     displacement: np.ndarray
@@ -101,7 +119,20 @@ class StepSolution:
 
 
 def strain_index(d: int, deforming: bool):
-    """(rows, cols) of the independent strain entries: upper triangle, or the single isotropic one."""
+    """(rows, cols) of the independent strain entries: upper triangle, or the single isotropic one.
+
+    Parameters
+    ----------
+    d : int
+        Dimension.
+    deforming : bool
+        Whether the cell deforms (else it shrinks isotropically).
+
+    Returns
+    -------
+    rows, cols : numpy.ndarray of int
+        Index arrays of the strain variables.
+    """
     if not deforming:
         return np.array([0]), np.array([0])
     return np.triu_indices(d)
@@ -112,6 +143,24 @@ def redundancy_radius(bounds: Bounds, d: int, mean_diameter: float, contact: np.
     """r_safe(D_mn) beyond which a pair's row cannot bind inside the trust region (module docstring).
 
     Returns inf when the strain bound is too large (e_max >= 1/2) for the estimate to hold.
+
+    Parameters
+    ----------
+    bounds : Bounds
+        Trust-region widths.
+    d : int
+        Dimension.
+    mean_diameter : float
+        Mean diameter <D>.
+    contact : float or numpy.ndarray of float
+        Contact distances D_mn.
+    deforming : bool, optional
+        Whether the cell deforms.
+
+    Returns
+    -------
+    float or numpy.ndarray of float
+        r_safe for every contact distance.
     """
     if deforming:
         e_max = min(bounds.strain + (d - 1) * bounds.shear,
@@ -125,7 +174,29 @@ def redundancy_radius(bounds: Bounds, d: int, mean_diameter: float, contact: np.
 
 
 def influence_pairs(packing, alpha: float, bounds: Bounds, deforming: bool = True):
-    """Pairs (all images) with centre distance < alpha D_mn whose row can bind (``redundancy_radius``)."""
+    """Pairs (all images) with centre distance < alpha D_mn whose row can bind (``redundancy_radius``).
+
+    Parameters
+    ----------
+    packing : Packing
+        A periodic sphere packing.
+    alpha : float
+        Influence radius over the contact distance.
+    bounds : Bounds
+        Trust-region widths.
+    deforming : bool, optional
+        Whether the cell deforms.
+
+    Returns
+    -------
+    PairList
+        The pairs.
+
+    Raises
+    ------
+    InvalidInputError
+        Unless the packing holds spheres in a periodic cell.
+    """
     packing.require_periodic_spheres("SLP")
     d = packing.dim
     mean_diameter = 2.0 * packing.radii.mean()

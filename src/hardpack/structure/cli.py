@@ -12,7 +12,18 @@ log = logging.getLogger("hardpack.structure")
 
 
 def cmd_structure(args) -> int:
-    """g2, Z(l), S(k) with S(0), and order metrics of a packing, written as netCDF."""
+    """g2, Z(l), S(k) with S(0), and order metrics of a packing, written as netCDF.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack structure``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
     from hardpack.io import dataset_to_packing, load_dataset, write_dataset
     from hardpack.structure.analysis import analyse
 
@@ -56,7 +67,7 @@ def register(subparsers) -> None:
     """
     from hardpack.cli import _key_value
 
-    p = subparsers.add_parser("structure", help=cmd_structure.__doc__)
+    p = subparsers.add_parser("structure", help=cmd_structure.__doc__.split("\n\n")[0])
     p.add_argument("packing", help="packing netCDF file")
     p.add_argument("--out", required=True, help="output netCDF file")
     p.add_argument("--rmax", type=float, default=None, help="g2 range (default 5 mean diameters)")

@@ -154,6 +154,15 @@ class BulkExtrapolation:
     ``phi0`` is the extrapolation to delta -> 0 with standard error ``phi0_err`` (ordinary least
     squares; the residual variance estimates the scatter, so at least 3 points are needed);
     ``slope`` = -3 m_0 with its error, ``n`` points.
+
+    Attributes
+    ----------
+    phi0, phi0_err : float
+        Extrapolated bulk density and its standard error.
+    slope, slope_err : float
+        Slope s and its standard error.
+    n : int
+        Points fitted.
     """
 
     phi0: float
@@ -274,7 +283,18 @@ def window_fluctuations(packing, window_radii, n_windows: int = 1000, seed: int 
 def length_unit(packing) -> float:
     """Donev's particle length scale a of a container study (Donev 2006, Sec. 7.3.1.2): the mean
     radius of spheres (a = D/2), the geometric mean semiaxis (O_1 O_2 ... O_d)^(1/d) of ellipsoids
-    averaged over the particles."""
+    averaged over the particles.
+
+    Parameters
+    ----------
+    packing : Packing
+        A packing of spheres or ellipsoids.
+
+    Returns
+    -------
+    float
+        a.
+    """
     if packing.shape.kind == "ellipsoid":
         return float(np.mean(np.prod(packing.shape.semiaxes, axis=1) ** (1.0 / packing.dim)))
     return float(packing.radii.mean())
@@ -469,7 +489,19 @@ def window_study(packings, n_radii: int = 12, min_diameter: float = 1.0, n_windo
 class PowerLaw:
     """sigma_phi = prefactor (2R/D)^exponent fitted in log-log (ordinary least squares, standard
     errors from the scatter about the line), and the prefactor with the exponent fixed at -2 of
-    Donev 2006, Fig. 7.3 (mean of sigma_phi (2R/D)^2 with its standard error); ``n`` points."""
+    Donev 2006, Fig. 7.3 (mean of sigma_phi (2R/D)^2 with its standard error); ``n`` points.
+
+    Attributes
+    ----------
+    exponent, exponent_err : float
+        Fitted exponent and its standard error.
+    prefactor, prefactor_err : float
+        Fitted prefactor and its standard error.
+    prefactor_fixed, prefactor_fixed_err : float
+        Prefactor with the exponent fixed at -2, and its standard error.
+    n : int
+        Points fitted.
+    """
 
     exponent: float
     exponent_err: float
@@ -518,7 +550,23 @@ def fit_window_power_law(x, sigma, x_min: float = 0.0) -> PowerLaw:
 
 def wall_layer_density(profile: xr.Dataset) -> float:
     """Volume fraction of the shell R - a < r <= R next to the wall, from a radial profile
-    (:func:`radial_density_profile`; shells cut by the layer's edge count by their overlap)."""
+    (:func:`radial_density_profile`; shells cut by the layer's edge count by their overlap).
+
+    Parameters
+    ----------
+    profile : xarray.Dataset
+        Radial profile with attributes radius and a.
+
+    Returns
+    -------
+    float
+        The volume fraction.
+
+    Raises
+    ------
+    InvalidInputError
+        If an attribute is missing.
+    """
     for k in ("radius", "a"):
         if k not in profile.attrs:
             raise InvalidInputError(f"radial profile {profile.attrs.get('source', '?')} lacks the attribute {k!r}")

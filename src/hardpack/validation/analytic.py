@@ -28,7 +28,20 @@ def _parameter(label: str, name: str) -> float:
 
 def moment_values(family: str, width: float) -> dict[str, float]:
     """Our closed forms of every column of Tables 3.1 (US, UV), 3.3 (UV) and 3.4 (LN) at one width,
-    keyed like the table columns (lower case)."""
+    keyed like the table columns (lower case).
+
+    Parameters
+    ----------
+    family : str
+        "us" (uniform size), "uv" (uniform volume) or "ln" (log-normal).
+    width : float
+        The family's width parameter (omega, or sigma for "ln").
+
+    Returns
+    -------
+    dict of str to float
+        o1, o2, r_bi, n1_bi, delta, n1, n2, delta1, delta2.
+    """
     if family == "us":
         dist = uniform_size(width)
     elif family == "uv":
@@ -43,7 +56,13 @@ def moment_values(family: str, width: float) -> dict[str, float]:
 
 
 def moment_table_rows() -> list[Row]:
-    """One row per printed cell of Tables 3.1 (US, UV), 3.3 (UV tridisperse) and 3.4 (log-normal)."""
+    """One row per printed cell of Tables 3.1 (US, UV), 3.3 (UV tridisperse) and 3.4 (log-normal).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     out = []
     for prefix, family, name in (("ogarko-t3.1-us", "us", "omega"), ("ogarko-t3.1-uv", "uv", "omega"),
                                  ("ogarko-t3.3-uv", "uv", "omega"), ("ogarko-t3.4-ln", "ln", "sigma")):
@@ -56,7 +75,13 @@ def moment_table_rows() -> list[Row]:
 
 def hgrid_rows() -> list[Row]:
     """Fig. 2.15: minima of the analytic HGrid cost and their level counts (alpha = -3,
-    omega = 100, nu = 0.7, d = 3, K = 0.2), one row per printed number."""
+    omega = 100, nu = 0.7, d = 3, K = 0.2), one row per printed number.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     from hardpack.hgrid.cost_model import PowerLawSystem, best_levels
 
     system = PowerLawSystem(alpha=-3.0, omega=100.0, nu=0.7, d=3)

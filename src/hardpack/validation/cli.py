@@ -138,7 +138,18 @@ def _report_gate(rows, min_applicable: int) -> int:
 
 
 def cmd_validate(args) -> int:
-    """Validation table, report and gate from the pipeline's summaries (NAME=PATH inputs)."""
+    """Validation table, report and gate from the pipeline's summaries (NAME=PATH inputs).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack validate``.
+
+    Returns
+    -------
+    int
+        Exit status: 0, or that of the gate (non-zero when it fails).
+    """
     if args.check:
         if args.inputs or args.out_nc or args.out_md:
             raise InvalidInputError("--check TABLE.nc takes no inputs and no --out-nc / --out-md")
@@ -162,7 +173,7 @@ def register(subparsers) -> None:
     subparsers : argparse._SubParsersAction
         The subcommand parsers of :func:`hardpack.cli.build_parser`.
     """
-    p = subparsers.add_parser("validate", help=cmd_validate.__doc__)
+    p = subparsers.add_parser("validate", help=cmd_validate.__doc__.split("\n\n")[0])
     p.add_argument("inputs", nargs="*", metavar="NAME=PATH",
                    help=f"summary datasets by row builder ({', '.join(ROW_BUILDERS)}); repeatable")
     p.add_argument("--out-nc", help="validation table (netCDF)")

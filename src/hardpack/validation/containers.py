@@ -112,7 +112,19 @@ def _window_rows(targets, windows) -> list[Row]:
 
 
 def container_rows(datasets) -> list[Row]:
-    """Rows of the container and window summaries (module docstring), in input order."""
+    """Rows of the container and window summaries (module docstring), in input order.
+
+    Parameters
+    ----------
+    datasets : iterable of xarray.Dataset
+        Summaries; those of kind container_summary, ellipsoid_container_summary and window_study
+        are used.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for ds in datasets:

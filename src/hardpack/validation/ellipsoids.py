@@ -50,7 +50,18 @@ def _summaries_3d(summaries):
 
 
 def ellipsoid_rows(summaries) -> list[Row]:
-    """Rows of the 3D ellipsoid summaries (module docstring); ellipse summaries have no targets."""
+    """Rows of the 3D ellipsoid summaries (module docstring); ellipse summaries have no targets.
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        Ellipsoid packing summaries.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for s, n in _summaries_3d(summaries):
@@ -100,7 +111,18 @@ def crystal_rows(families) -> list[Row]:
     """Rows of the laminate family (:func:`hardpack.geometry.ellipsoid_crystals.laminate_family`):
     the densest laminate at alpha = sqrt(3) (density, contacts), the stretch that gives alpha = 3
     and the density of the stretched laminate at the largest alpha of the family (Donev 2006, Sec.
-    8.2, Eq. 8.3, Figs. 8.2-8.3). An alpha the family lacks leaves its row n/a."""
+    8.2, Eq. 8.3, Figs. 8.2-8.3). An alpha the family lacks leaves its row n/a.
+
+    Parameters
+    ----------
+    families : iterable of xarray.Dataset
+        Laminate families (variables over alpha).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for ds in families:
@@ -157,7 +179,18 @@ def ellipsoid_jamming_rows(summaries) -> list[Row]:
     where they are very hypostatic; their self-stress is unique and strictly positive; the smallest
     eigenvalue of A^T A lies 3-6 orders of magnitude below the next. The three claims about every
     packing are fractions that one failing packing fails; the eigenvalue gap is a mean over
-    packings; a summary without the packings a row needs leaves it n/a."""
+    packings; a summary without the packings a row needs leaves it n/a.
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        Verdict summaries.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for s, n in _summaries_3d(summaries):

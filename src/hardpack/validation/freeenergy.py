@@ -35,6 +35,22 @@ def finite_size_extrapolation(n, values) -> tuple[float, float, str]:
 
     With fewer than three sizes there is nothing to fit: the largest-N mean is returned with a
     NaN error (the caller reports the row n/a).
+
+    Parameters
+    ----------
+    n : array_like of int, shape (k,)
+        System size N of every value.
+    values : array_like of float, shape (k,)
+        The values.
+
+    Returns
+    -------
+    estimate : float
+        a, or the largest-N mean.
+    error : float
+        Standard error of a (NaN without a fit).
+    how : str
+        What was done, for a row's detail.
     """
     n = np.asarray(n, float)
     values = np.asarray(values, float)
@@ -53,7 +69,18 @@ def finite_size_extrapolation(n, values) -> tuple[float, float, str]:
 
 
 def bcmd_rows(summaries: dict) -> list[Row]:
-    """One row per state in ``summaries`` (state name -> combined BCMD Dataset)."""
+    """One row per state in ``summaries`` (state name -> combined BCMD Dataset).
+
+    Parameters
+    ----------
+    summaries : dict of str to xarray.Dataset
+        State name (a key of :data:`TARGETS`) -> combined BCMD summary.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for state, ds in summaries.items():
@@ -67,7 +94,22 @@ def bcmd_rows(summaries: dict) -> list[Row]:
 
 def eos_integral_error(phi, z, z_err) -> float:
     """Standard error of the EOS integral from phi.min() to phi.max(): the spline integral is
-    linear in the measured Z, so each point's error enters through its exact sensitivity."""
+    linear in the measured Z, so each point's error enters through its exact sensitivity.
+
+    Parameters
+    ----------
+    phi : array_like of float, shape (k,)
+        Volume fractions.
+    z : array_like of float, shape (k,)
+        Reduced pressures Z = pV/(NkT).
+    z_err : array_like of float, shape (k,)
+        Their standard errors (non-finite or zero: no contribution).
+
+    Returns
+    -------
+    float
+        The standard error of the integral.
+    """
     phi, z, z_err = (np.asarray(a, float) for a in (phi, z, z_err))
     top = np.argmax(phi)
     base = eos_excess(phi, z, excess0=0.0)[top]
@@ -86,7 +128,20 @@ def density_rows(density, eos) -> list[Row]:
     integral of the engine's crystal EOS over the same range (both at the same N; the finite-N
     offsets of the two BCMD points cancel to O(ln N / N) of their difference).
 
-    density: the BCMD summary over (phi, seed); eos: the MD summary over phi (Z, Z_err)."""
+    density: the BCMD summary over (phi, seed); eos: the MD summary over phi (Z, Z_err).
+
+    Parameters
+    ----------
+    density : xarray.Dataset
+        BCMD summary over (phi, seed).
+    eos : xarray.Dataset
+        MD equation-of-state summary over phi.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     phi_b, excess = density["phi"].values, density["excess"].values
     lo, hi = np.isclose(phi_b, MELTING_PHI, atol=1e-6), np.isclose(phi_b, phi_b.max())
     low, low_err, n_low, _ = seed_statistics(excess[lo])
@@ -111,7 +166,18 @@ def simplex_rows(ds) -> list[Row]:
     """BCMD of rattler-free LS packings against their exact jamming simplex (Donev 2006, Table
     6.1), per frozen mode: the exact value against the published one of Table 6.1's packing, and
     the largest relative difference of BCMD from the exact value. Only isostatic backbones have a
-    simplex; a mode without one fails with the isostaticity gaps in its detail."""
+    simplex; a mode without one fails with the isostaticity gaps in its detail.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Simplex summary over sample.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for frozen, suffix in (("particle", "particle"), ("cm", "cm")):
@@ -139,7 +205,18 @@ def simplex_rows(ds) -> list[Row]:
 
 def ladder_rows(ds) -> list[Row]:
     """The cheap checks (:func:`hardpack.freeenergy.ladder.ladder_dataset`): each check's
-    deviation from its exact value against 0 with our standard error."""
+    deviation from its exact value against 0 with our standard error.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The ladder dataset.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for check in ds["check"].values:
@@ -153,7 +230,18 @@ def ellipse_rows(ds) -> list[Row]:
     """Isostatic alpha = 2 ellipse packings (Donev 2006, sec. 6.4.3): the cell constant f_c^J, the
     exact f_J - f_c^J against the published packing's, and BCMD - exact, from a summary of
     ``hardpack bcmd-ellipse`` runs (variables over ``sample``: ``f_j_minus_fcj``, ``bcmd``,
-    ``exact``, ``n_particles``, ``n_fixed_translation``; ``bcmd`` NaN for exact-only runs)."""
+    ``exact``, ``n_particles``, ``n_fixed_translation``; ``bcmd`` NaN for exact-only runs).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The ellipse BCMD summary.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     from hardpack.freeenergy.ellipses import cell_log_volume
 
     targets = load_targets()
@@ -186,7 +274,18 @@ def ellipse_rows(ds) -> list[Row]:
 
 def ellipse_ladder_rows(ds) -> list[Row]:
     """Independent ellipses in shrinking cells (:func:`hardpack.freeenergy.ellipse_bcmd.disjoint_cells_check`):
-    the relative deviation of (3/2) ln(K/K0) from 3 ln(dmu_0/dmu_1) over seeds."""
+    the relative deviation of (3/2) ln(K/K0) from 3 ln(dmu_0/dmu_1) over seeds.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The disjoint-cells check over seeds (variable rel_dev).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     rel = ds["rel_dev"].values
     mean, err, seeds, _ = seed_statistics(rel)
     cost = float(ds["seconds"].sum())

@@ -15,7 +15,13 @@ from hardpack.validation.targets import load_targets
 
 
 def smix_rows() -> list[Row]:
-    """s_mix at x = 1/3 against the printed 0.6365 (analytic)."""
+    """s_mix at x = 1/3 against the printed 0.6365 (analytic).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     return [evaluate(load_targets()["donev-13.4-smix"], mixing_entropy(1 / 3), detail="closed form")]
 
 
@@ -26,7 +32,18 @@ def _seeds(ds, branch) -> int:
 
 def eos_rows(ds) -> list[Row]:
     """Eq. 13.3 coefficients (fit to the slowest compression) with their standard errors, phi~_J at
-    0.75 of that compression, and alpha and phi_J of its glassy branch (Eq. 13.4)."""
+    0.75 of that compression, and alpha and phi_J of its glassy branch (Eq. 13.4).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The glass EOS summary.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     n = int(ds.attrs.get("N", 0))
     slow = ds.attrs.get("cubic_branch")
@@ -58,7 +75,18 @@ def eos_rows(ds) -> list[Row]:
 
 
 def freezing_rows(ds) -> list[Row]:
-    """phi_F and the precipitate density (Eq. 13.2); no error estimate (NaN)."""
+    """phi_F and the precipitate density (Eq. 13.2); no error estimate (NaN).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The freezing summary.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     n = int(ds.attrs.get("n_particles", 0))
     detail = f"N = {n}; {ds.attrs.get('status')}; mu~_B: {ds.attrs.get('mu_tilde')}"
@@ -68,7 +96,18 @@ def freezing_rows(ds) -> list[Row]:
 
 def entropy_rows(ds) -> list[Row]:
     """s_c - s_mix of the snapshot at phi0 = 0.80 (binary) or 0.75 (monodisperse) of the slowest
-    compression, mean and standard error over seeds."""
+    compression, mean and standard error over seeds.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The configurational-entropy summary over seeds.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     mono = float(ds.attrs.get("x_large", 0.0)) == 0.0
     tid, phi0 = ("donev-13.4-sc-mono", 0.75) if mono else ("donev-13.4-sc-binary", 0.80)
     rate = float(np.min(ds["growth_rate"].values))
@@ -88,7 +127,18 @@ def microsegregated_rows(ds) -> list[Row]:
     """Micro-segregated packings (Donev 2006, sec. 13.5): phi_J of the uncorrelated labels
     (Fig. 13.13), phi~_J at the start of the growth (Fig. 13.14), the most clustered ensemble
     denser than the uncorrelated one, and s_c anticorrelated with phi_J over the ensembles
-    (Figs. 13.16-13.17)."""
+    (Figs. 13.16-13.17).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The micro-segregated summary over ensembles.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     from scipy.stats import spearmanr
 
     targets = load_targets()

@@ -30,7 +30,22 @@ def _system(key) -> str | None:
 def fraction_statistics(values, n_particles: int) -> tuple[float, float]:
     """Mean of per-seed particle fractions and its uncertainty: the larger of the standard error
     over seeds and the binomial error of the pooled count (one packing of N particles still has
-    sqrt(f (1 - f) / N)). NaN values make the mean NaN (the row then fails)."""
+    sqrt(f (1 - f) / N)). NaN values make the mean NaN (the row then fails).
+
+    Parameters
+    ----------
+    values : array_like of float, shape (n_seeds,)
+        Per-seed fractions.
+    n_particles : int
+        Particles per packing.
+
+    Returns
+    -------
+    mean : float
+        Mean fraction.
+    uncertainty : float
+        Its uncertainty.
+    """
     values = np.asarray(values, float)
     mean = float(values.mean())
     if not math.isfinite(mean):
@@ -41,14 +56,36 @@ def fraction_statistics(values, n_particles: int) -> tuple[float, float]:
 
 
 def verdict_fraction(values) -> float:
-    """Fraction of seeds with a positive verdict (NaN when any verdict is missing)."""
+    """Fraction of seeds with a positive verdict (NaN when any verdict is missing).
+
+    Parameters
+    ----------
+    values : array_like of float, shape (n_seeds,)
+        Verdict codes (1: jammed).
+
+    Returns
+    -------
+    float
+        The fraction.
+    """
     values = np.asarray(values, float)
     return float(np.mean(values == 1)) if np.all(np.isfinite(values)) else math.nan
 
 
 def verdict_notes(summary) -> str:
     """Undetermined verdicts (code -2) and numerical fallbacks of an ensemble's jamming tests, for
-    a row's detail (empty when there were none)."""
+    a row's detail (empty when there were none).
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        Verdict summary over seeds.
+
+    Returns
+    -------
+    str
+        The notes, "; "-separated.
+    """
     notes = []
     for test in ("collective", "strict"):
         if test in summary:
@@ -65,13 +102,35 @@ def verdict_notes(summary) -> str:
 
 def largest_magnitude(values) -> float:
     """The value of largest magnitude (NaN if any is missing): a per-packing claim must hold for
-    every seed."""
+    every seed.
+
+    Parameters
+    ----------
+    values : array_like of float
+        Per-seed values.
+
+    Returns
+    -------
+    float
+        The value.
+    """
     values = np.asarray(values, float)
     return float(values[np.argmax(np.abs(values))]) if np.all(np.isfinite(values)) else math.nan
 
 
 def jamming_rows(summaries) -> list[Row]:
-    """Isostaticity, rattler fraction and collective-jamming rate of recognised LS ensembles."""
+    """Isostaticity, rattler fraction and collective-jamming rate of recognised LS ensembles.
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        Verdict summaries of LS ensembles.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for s in summaries:
@@ -116,7 +175,18 @@ def _slope_row(target, summary, n: int, seeds: int, label: str, size: str) -> Ro
 def strict_ls_rows(summaries) -> list[Row]:
     """The fraction of strictly jammed packings of each deforming-cell LS system (verdict
     summaries with the attribute ``d``) against Donev 2006, Sec. 4.7.2.3 ("typically" strictly
-    jammed for small N)."""
+    jammed for small N).
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        Verdict summaries of deforming-cell LS systems.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for s in summaries:

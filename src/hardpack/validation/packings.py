@@ -25,7 +25,18 @@ LS_TARGETS = {
 
 
 def system_key(summary) -> tuple | None:
-    """('monodisperse' | 'binary_1.4_equimolar' | 'us_omega2', d) for recognised systems, else None."""
+    """('monodisperse' | 'binary_1.4_equimolar' | 'us_omega2', d) for recognised systems, else None.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        Ensemble summary (attribute distribution, variable d).
+
+    Returns
+    -------
+    tuple of (str, int) or None
+        The system and dimension.
+    """
     spec = json.loads(summary.attrs.get("distribution", "{}"))
     d = int(np.asarray(summary["d"].values).ravel()[0]) if "d" in summary else None
     kind = spec.get("kind")
@@ -40,14 +51,38 @@ def system_key(summary) -> tuple | None:
 
 
 def n_particles(summary) -> int:
-    """The number of particles of an ensemble summary (all its samples have the same N)."""
+    """The number of particles of an ensemble summary (all its samples have the same N).
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        Ensemble summary (variable N).
+
+    Returns
+    -------
+    int
+        N.
+    """
     values = np.unique(np.asarray(summary["N"].values).ravel())
     return int(values.max())
 
 
 def at_n(prefix: str, n: int) -> Target:
     """The row of a printed table keyed by N (targets ``<prefix>-n<N>``) at ``n``, or its nearest
-    row: that one then reports n/a, since each printed row holds at its own N only."""
+    row: that one then reports n/a, since each printed row holds at its own N only.
+
+    Parameters
+    ----------
+    prefix : str
+        Target id prefix of the table.
+    n : int
+        System size.
+
+    Returns
+    -------
+    Target
+        The target.
+    """
     rows = {int(tid.rsplit("-n", 1)[1]): t for tid, t in load_targets().items() if tid.startswith(prefix + "-n")}
     return rows[min(rows, key=lambda m: (abs(m - n), m))]
 
@@ -66,7 +101,18 @@ def _detail(s) -> str:
 
 
 def ls_rows(summaries) -> list[Row]:
-    """Mean final phi of each recognised LS ensemble against Donev's Tables 11.1, 4.2 and 4.3."""
+    """Mean final phi of each recognised LS ensemble against Donev's Tables 11.1, 4.2 and 4.3.
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        LS ensemble summaries.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     out = []
     for s in summaries:
         key = system_key(s)
@@ -79,7 +125,18 @@ def ls_rows(summaries) -> list[Row]:
 
 def slp_mrj_rows(summaries) -> list[Row]:
     """Mean SLP density of each recognised ensemble against Torquato & Jiao's Table I (or the 2D
-    polydisperse value of their Sec. V.A)."""
+    polydisperse value of their Sec. V.A).
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        SLP ensemble summaries.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     out = []
     for s in summaries:
         key = system_key(s)

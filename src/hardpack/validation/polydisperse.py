@@ -35,7 +35,18 @@ def _published_fit(target, width: float) -> float:
 
 
 def fluid_rows(summary) -> list[Row]:
-    """One row per (distribution, system): the largest |Z/Z_BMCSL - 1| over phi < 0.5."""
+    """One row per (distribution, system): the largest |Z/Z_BMCSL - 1| over phi < 0.5.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        The eos_fluid_summary.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     t = load_targets()["ogarko-fluid-bmcsl"]
     out = []
     for case in summary["case"].values:
@@ -55,7 +66,20 @@ def fluid_rows(summary) -> list[Row]:
 
 def jam_rows(summary, fits: bool = True) -> list[Row]:
     """Equivalence rows of the systems and widths the claims cover, and, if ``fits``, the
-    published fits of phi_J(omega) / phi_J(sigma) at this summary's protocol."""
+    published fits of phi_J(omega) / phi_J(sigma) at this summary's protocol.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        An eos_jam_summary.
+    fits : bool, optional
+        Add the rows of the published fits.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     stats = seed_statistics(summary)
     family, n = summary.attrs["family"], int(stats.attrs["N"])
@@ -103,7 +127,18 @@ def crystallisation_rows(summary) -> list[Row]:
     omega = 4, 5, 6, 10, so 4 < omega <= 5 is the crossover: no target covers it.
 
     Crystallised = large-particle q6 crystallinity (:func:`hardpack.eos.study.large_species_crystallinity`)
-    of at least :data:`CRYSTALLISED`, averaged over seeds."""
+    of at least :data:`CRYSTALLISED`, averaged over seeds.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        The eos_jam_summary of the slow runs.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     stats = seed_statistics(summary)
     family, n = summary.attrs["family"], int(stats.attrs["N"])
@@ -131,7 +166,23 @@ def crystallisation_rows(summary) -> list[Row]:
 def polydisperse_rows(datasets) -> list[Row]:
     """Rows from the study's summaries: ``eos_jam_summary`` (per family and study: equivalence or
     crystallisation runs) and ``eos_fluid_summary``. A family with slow (crystallisation) runs is
-    compared with its published fit there only: the fits were measured at such rates."""
+    compared with its published fit there only: the fits were measured at such rates.
+
+    Parameters
+    ----------
+    datasets : iterable of xarray.Dataset
+        The summaries.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+
+    Raises
+    ------
+    InvalidInputError
+        For a dataset of another kind.
+    """
     datasets = list(datasets)
     slow = {ds.attrs["family"] for ds in datasets if ds.attrs.get("study") == "crystallisation"}
     out = []

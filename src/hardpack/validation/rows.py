@@ -85,9 +85,23 @@ def seed_statistics(values, single_sample: bool = False) -> tuple[float, float, 
     prediction spread s sqrt(1 + 1/n) of one more sample; NaN with one seed. Missing (NaN) values
     are counted, not dropped: the caller fails the row if any.
 
+    Parameters
+    ----------
+    values : iterable of float
+        Per-seed values (NaN: missing).
+    single_sample : bool, optional
+        Return the prediction spread instead of the standard error.
+
     Returns
     -------
-    mean, uncertainty, n_seeds, n_missing
+    mean : float
+        Mean of the finite values (NaN if none).
+    uncertainty : float
+        As above.
+    n_seeds : int
+        Number of values.
+    n_missing : int
+        Number of NaN values.
     """
     values = np.asarray(list(values), float).ravel()
     finite = values[np.isfinite(values)]
@@ -161,7 +175,18 @@ def evaluate(target: Target, reproduced: float = math.nan, uncertainty: float = 
 
 
 def counts(rows: list[Row]) -> dict[str, Counter]:
-    """Status counts per kind of row."""
+    """Status counts per kind of row.
+
+    Parameters
+    ----------
+    rows : list of Row
+        The rows.
+
+    Returns
+    -------
+    dict of str to collections.Counter
+        Kind -> status -> count.
+    """
     out = {kind: Counter() for kind in KINDS}
     for r in rows:
         out[r.kind][r.status] += 1
@@ -225,7 +250,18 @@ def to_dataset(rows: list[Row]) -> xr.Dataset:
 
 
 def from_dataset(ds: xr.Dataset) -> list[Row]:
-    """The rows of a validation Dataset written by :func:`to_dataset`."""
+    """The rows of a validation Dataset written by :func:`to_dataset`.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The validation dataset (dimension ``row``).
+
+    Returns
+    -------
+    list of Row
+        The rows.
+    """
     out = []
     for i in range(ds.sizes["row"]):
         kw = {}
@@ -246,7 +282,18 @@ _MARK = {PASS: "pass", FAIL: "**FAIL**", NA: "n/a", KNOWN: "known deviation", DE
 
 
 def headline(rows: list[Row]) -> list[str]:
-    """One line per kind: pass / fail / known deviation / deviation passes / n/a counts."""
+    """One line per kind: pass / fail / known deviation / deviation passes / n/a counts.
+
+    Parameters
+    ----------
+    rows : list of Row
+        The rows.
+
+    Returns
+    -------
+    list of str
+        Markdown list items.
+    """
     lines = []
     for kind, c in counts(rows).items():
         applicable = sum(c[s] for s in APPLICABLE)

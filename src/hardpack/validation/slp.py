@@ -13,7 +13,18 @@ from hardpack.validation.targets import load_targets
 
 def densest_rows(summary) -> list[Row]:
     """Table II: the best density over seeds from N = 3^d random starts against the densest known
-    lattice that the paper's SLP reaches (n/a where our N is not the paper's 3^d)."""
+    lattice that the paper's SLP reaches (n/a where our N is not the paper's 3^d).
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        SLP summary over seeds (variables d, phi, N).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     d_all = summary["d"].values.astype(int)
@@ -37,7 +48,18 @@ def mrj_jamming_rows(summaries) -> list[Row]:
 
     The rattler fraction's uncertainty is the larger of the standard error over seeds and the
     binomial error of the pooled count. Strict jamming is a published claim in d = 2 and 3 only
-    (the paper's LP tests): other dimensions get no row."""
+    (the paper's LP tests): other dimensions get no row.
+
+    Parameters
+    ----------
+    summaries : iterable of xarray.Dataset
+        The slp_jamming summaries.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     out = []
     for s in summaries:
@@ -65,7 +87,18 @@ def mrj_jamming_rows(summaries) -> list[Row]:
 def order_map_rows(summary) -> list[Row]:
     """Fig. 6: the densest packing of the SLP order map (a Barlow packing), the least dense from
     random dilute starts (the paper's 0.64; its lower densities come from the Sec. VI protocol,
-    :func:`diluted_rows`), and the strict-jamming rate."""
+    :func:`diluted_rows`), and the strict-jamming rate.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        The order-map summary.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     phi, t = summary["phi"].values, summary["T"].values
     n = summary["N"].values.astype(int)
@@ -87,7 +120,18 @@ def diluted_rows(summary) -> list[Row]:
     summary over (seed, round)). The least dense strictly jammed one (the least dense of all when
     none is) against the paper's lower end 0.6, its
     density without rattlers against 0.595, its backbone contact number against Z = 6.3 at
-    phi = 0.6, and the fraction of them that are strictly jammed."""
+    phi = 0.6, and the fraction of them that are strictly jammed.
+
+    Parameters
+    ----------
+    summary : xarray.Dataset
+        The slp_diluted summary over (seed, round).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     targets = load_targets()
     diluted = summary.sel(round=[r for r in summary["round"].values if r >= 1])
     phi = diluted["phi"].values.ravel()

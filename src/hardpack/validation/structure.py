@@ -31,7 +31,20 @@ from hardpack.validation.targets import load_targets
 
 
 def fluid_s0(phi: float) -> float:
-    """Carnahan-Starling S(0) = kT (d rho / d p) = (1 - phi)^4 / (1 + 4 phi + 4 phi^2 - 4 phi^3 + phi^4)."""
+    """Carnahan-Starling S(0) = kT (d rho / d p) = (1 - phi)^4 / (1 + 4 phi + 4 phi^2 - 4 phi^3 + phi^4).
+
+    Carnahan & Starling (1969) equation of state.
+
+    Parameters
+    ----------
+    phi : float
+        Volume fraction.
+
+    Returns
+    -------
+    float
+        S(0).
+    """
     return (1 - phi) ** 4 / (1 + 4 * phi + 4 * phi**2 - 4 * phi**3 + phi**4)
 
 
@@ -46,7 +59,20 @@ def _ensemble(ds) -> str:
 
 def pooled_s0(members: list) -> tuple[float, float]:
     """S(0) and its error from one linear fit of the small-k shells of all ``members``; NaN when
-    they have fewer than 3 shells in the fit range (small cells)."""
+    they have fewer than 3 shells in the fit range (small cells).
+
+    Parameters
+    ----------
+    members : list of xarray.Dataset
+        Structure-factor datasets (variables S and n_vectors over k).
+
+    Returns
+    -------
+    s0 : float
+        S(0).
+    error : float
+        Its standard error.
+    """
     pooled = xr.concat([m[["S", "n_vectors"]] for m in members], dim="k")
     diameter = float(np.mean([m.attrs["mean_diameter"] for m in members]))
     try:
@@ -91,7 +117,18 @@ def _rows(name: str, members: list) -> list[Row]:
 
 
 def structure_rows(datasets) -> list[Row]:
-    """Rows for every 3D monodisperse ensemble among the structure Datasets."""
+    """Rows for every 3D monodisperse ensemble among the structure Datasets.
+
+    Parameters
+    ----------
+    datasets : iterable of xarray.Dataset
+        Structure datasets.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
     groups = defaultdict(list)
     for ds in datasets:
         if int(ds.attrs["dim"]) == 3 and float(ds.attrs.get("radius_ratio", math.inf)) < 1 + 1e-9:

@@ -28,7 +28,18 @@ PARAMETER_COLUMNS = ("N", "error")
 
 
 def ulp(printed: str) -> float:
-    """One unit in the last printed digit of ``printed`` ("0.080" -> 0.001, "6.1e-4" -> 1e-5)."""
+    """One unit in the last printed digit of ``printed`` ("0.080" -> 0.001, "6.1e-4" -> 1e-5).
+
+    Parameters
+    ----------
+    printed : str
+        A number as printed.
+
+    Returns
+    -------
+    float
+        The unit.
+    """
     return float(Decimal(1).scaleb(Decimal(printed).as_tuple().exponent))
 
 
@@ -190,6 +201,16 @@ def _scalar_target(entry: dict) -> Target:
 def parse_targets(document: dict) -> dict[str, Target]:
     """Targets by id from a parsed ``targets.yaml`` document (validated against the schema).
 
+    Parameters
+    ----------
+    document : dict
+        The parsed YAML document.
+
+    Returns
+    -------
+    dict of str to Target
+        Target id -> target.
+
     Raises
     ------
     InvalidInputError
@@ -245,7 +266,25 @@ def load_targets(path=None) -> dict[str, Target]:
 
 
 def target(target_id: str, targets: dict[str, Target] | None = None) -> Target:
-    """One target by id (from ``targets``, default the packaged table)."""
+    """One target by id (from ``targets``, default the packaged table).
+
+    Parameters
+    ----------
+    target_id : str
+        The id.
+    targets : dict of str to Target, optional
+        The table.
+
+    Returns
+    -------
+    Target
+        The target.
+
+    Raises
+    ------
+    InvalidInputError
+        For an unknown id.
+    """
     table = _packaged() if targets is None else targets
     try:
         return table[target_id]

@@ -54,6 +54,22 @@ def cell_counts(heights, cell_size, count, max_cells_per_particle: float) -> np.
     Level h gets n_{h,k} = floor(h_k / cell_size[h]) cells along lattice vector k (cells at least
     ``cell_size[h]`` wide); a level whose grid would have more than ``max_cells_per_particle`` cells per
     particle on it (``count[h]`` of them) is coarsened by the same factor in every direction.
+
+    Parameters
+    ----------
+    heights : array_like of float, shape (d,)
+        Perpendicular widths h_k of the cell (:func:`perpendicular_widths`).
+    cell_size : array_like of float, shape (L,)
+        Smallest cell width of every level.
+    count : array_like of int, shape (L,)
+        Particles on every level.
+    max_cells_per_particle : float
+        Cap on the cells per particle of a level.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (L, d)
+        n_{h,k}.
     """
     heights = np.asarray(heights, dtype=float)
     size = np.asarray(cell_size, dtype=float).reshape(-1)
@@ -68,7 +84,18 @@ def cell_counts(heights, cell_size, count, max_cells_per_particle: float) -> np.
 
 
 def c_strides(n_cells: np.ndarray) -> np.ndarray:
-    """Flat-index strides (C order: the last lattice direction fastest) of every level, (L, d)."""
+    """Flat-index strides (C order: the last lattice direction fastest) of every level, (L, d).
+
+    Parameters
+    ----------
+    n_cells : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction of every level.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (L, d)
+        The strides.
+    """
     strides = np.ones_like(n_cells)
     for a in range(n_cells.shape[1] - 2, -1, -1):
         strides[:, a] = strides[:, a + 1] * n_cells[:, a + 1]
@@ -84,6 +111,33 @@ class Grid:
     ``level_reach[h]`` is the largest interaction radius on level h; ``n_cells[h, k]`` the cells of
     level h along lattice vector k; ``strides`` their flat-index strides and ``cell_offset[h]`` the
     first flat index of level h.
+
+    Attributes
+    ----------
+    lattice : numpy.ndarray of float, shape (d, d)
+        Cell, lattice vectors as columns.
+    heights : numpy.ndarray of float, shape (d,)
+        Perpendicular widths h_k.
+    periodic : numpy.ndarray of bool, shape (d,)
+        The lattice vectors that are periods.
+    frac : numpy.ndarray of float, shape (N, d)
+        Fractional coordinates.
+    x : numpy.ndarray of float, shape (N, d)
+        Wrapped Cartesian centres.
+    reach : numpy.ndarray of float, shape (N,)
+        Interaction radii.
+    levels : LevelAssignment
+        The level of every point.
+    level_reach : numpy.ndarray of float, shape (L,)
+        Largest interaction radius on every level.
+    n_cells, strides : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction and flat-index strides of every level.
+    cell_offset : numpy.ndarray of int64, shape (L + 1,)
+        First flat index of every level (the last entry: the total number of cells).
+    cell_start : numpy.ndarray of int64, shape (n_total + 1,)
+        Start of every cell's points in ``order``.
+    order : numpy.ndarray of int64, shape (N,)
+        Point indices sorted by flat cell.
     """
 
     lattice: np.ndarray  # (d, d), columns are the lattice vectors
@@ -119,7 +173,18 @@ def _flat_cells(frac, level, n_cells, strides, cell_offset) -> np.ndarray:
 
 
 def perpendicular_widths(lattice) -> np.ndarray:
-    """h_k = 1 / |row k of lattice^-1|: the distance between the faces of the cell spanned by the others."""
+    """h_k = 1 / |row k of lattice^-1|: the distance between the faces of the cell spanned by the others.
+
+    Parameters
+    ----------
+    lattice : array_like of float, shape (d, d)
+        Cell, lattice vectors as columns.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (d,)
+        h_k.
+    """
     return 1.0 / np.linalg.norm(np.linalg.inv(lattice), axis=1)
 
 
@@ -133,6 +198,35 @@ def build_grid(frac, lattice, reach, *, periodic=None, levels=None, K: float = 0
     number of levels (Eq. 2.7 with this K), an integer L (1: the single-level linked-cell grid) or a
     :class:`LevelAssignment` of these radii. per_cell: cells per nominal cell size (2 halves the cells:
     fewer distance tests for long ranges).
+
+    Parameters
+    ----------
+    frac : array_like of float, shape (N, d)
+        Fractional coordinates, in [0, 1) along the periodic axes.
+    lattice : array_like of float, shape (d, d)
+        Cell, lattice vectors as columns.
+    reach : array_like of float, shape (N,)
+        Positive interaction radii.
+    periodic : array_like of bool, shape (d,), optional
+        Lattice vectors that are periods (default: all).
+    levels : None, int or LevelAssignment, optional
+        Levels (above).
+    K : float, optional
+        Cost ratio of Ogarko's Eq. 2.7 for the optimal number of levels.
+    per_cell : int, optional
+        Cells per nominal cell size.
+    max_cells_per_particle : float, optional
+        Cap on the cells per particle of a level (:func:`cell_counts`).
+
+    Returns
+    -------
+    Grid
+        The sorted grid.
+
+    Raises
+    ------
+    InvalidInputError
+        For non-positive radii, or coordinates outside [0, 1) along a periodic axis.
     """
     frac = np.ascontiguousarray(frac, dtype=float)
     lattice = np.ascontiguousarray(lattice, dtype=float)
@@ -165,7 +259,22 @@ def build_grid(frac, lattice, reach, *, periodic=None, levels=None, K: float = 0
 
 def stencil(grid: Grid, cutoff: float, level: int = 0) -> np.ndarray:
     """Offsets m (n_offsets, d) with |m_k| <= ceil(cutoff n_k / h_k): the cells of ``level`` that can
-    hold a point within ``cutoff`` of some point of a given cell."""
+    hold a point within ``cutoff`` of some point of a given cell.
+
+    Parameters
+    ----------
+    grid : Grid
+        The grid.
+    cutoff : float
+        Largest distance searched.
+    level : int, optional
+        The level.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (n_offsets, d)
+        The cell offsets.
+    """
     reach = np.ceil(cutoff * grid.n_cells[level] / grid.heights).astype(np.int64)
     offsets = np.array(list(itertools.product(*[range(-k, k + 1) for k in reach])), dtype=np.int64)
     return offsets.reshape(-1, grid.heights.size)
@@ -176,7 +285,23 @@ def stencil(grid: Grid, cutoff: float, level: int = 0) -> np.ndarray:
 
 @numba.njit(cache=True)
 def search_range(s, beta, inv_heights, n_cells, h, lo, hi):
-    """Unbounded cells [lo, hi] of level h holding every point within beta of fractional point s."""
+    """Unbounded cells [lo, hi] of level h holding every point within beta of fractional point s.
+
+    Parameters
+    ----------
+    s : numpy.ndarray of float, shape (d,)
+        Fractional point.
+    beta : float
+        Search radius.
+    inv_heights : numpy.ndarray of float, shape (d,)
+        1 / h_k.
+    n_cells : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction of every level.
+    h : int
+        The level.
+    lo, hi : numpy.ndarray of int64, shape (d,)
+        Receive the range.
+    """
     for k in range(s.shape[0]):
         w = beta * inv_heights[k]
         lo[k] = int(np.floor((s[k] - w) * n_cells[h, k]))
@@ -186,7 +311,19 @@ def search_range(s, beta, inv_heights, n_cells, h, lo, hi):
 @numba.njit(cache=True)
 def clamp_range(periodic, n_cells, h, lo, hi):
     """Clamp the cell range [lo, hi] of level h to the stored cells [0, n - 1] along the axes without
-    images (``periodic[k]`` False), where cell indices are clamped the same way."""
+    images (``periodic[k]`` False), where cell indices are clamped the same way.
+
+    Parameters
+    ----------
+    periodic : numpy.ndarray of bool, shape (d,)
+        The lattice vectors that are periods.
+    n_cells : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction of every level.
+    h : int
+        The level.
+    lo, hi : numpy.ndarray of int64, shape (d,)
+        The range, clamped in place.
+    """
     for k in range(lo.shape[0]):
         if not periodic[k]:
             top = n_cells[h, k] - 1
@@ -197,7 +334,26 @@ def clamp_range(periodic, n_cells, h, lo, hi):
 @numba.njit(cache=True)
 def image_cell(c, n_cells, strides, cell_offset, h, image):
     """Flat index of the stored cell behind unbounded cell c of level h; ``image`` receives the lattice
-    image floor(c / n) it is seen through."""
+    image floor(c / n) it is seen through.
+
+    Parameters
+    ----------
+    c : numpy.ndarray of int64, shape (d,)
+        Unbounded cell indices.
+    n_cells, strides : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction and flat-index strides of every level.
+    cell_offset : numpy.ndarray of int64, shape (L + 1,)
+        First flat index of every level.
+    h : int
+        The level.
+    image : numpy.ndarray of int64, shape (d,)
+        Receives the lattice image.
+
+    Returns
+    -------
+    int
+        The flat cell index.
+    """
     flat = cell_offset[h]
     for k in range(c.shape[0]):
         t = c[k]
@@ -209,7 +365,20 @@ def image_cell(c, n_cells, strides, cell_offset, h, image):
 
 @numba.njit(cache=True)
 def next_cell(c, lo, hi):
-    """Odometer step over the cell range [lo, hi]; False when the range is done."""
+    """Odometer step over the cell range [lo, hi]; False when the range is done.
+
+    Parameters
+    ----------
+    c : numpy.ndarray of int64, shape (d,)
+        Current cell, advanced in place (axis 0 fastest).
+    lo, hi : numpy.ndarray of int64, shape (d,)
+        The range.
+
+    Returns
+    -------
+    bool
+        False when the range is exhausted.
+    """
     for k in range(c.shape[0]):
         c[k] += 1
         if c[k] <= hi[k]:
@@ -242,6 +411,40 @@ def pair_kernel(frac, x, lattice, inv_heights, periodic, reach, level, level_rea
     whose cells are consecutive in the flat index) at a time: a row is at most a few contiguous runs of
     points, one per lattice image along that direction. Returns (rows (p, q, n_0..n_{d-1}) in sorted
     indices, distance tests, cell visits), rows in arbitrary order.
+
+    Parameters
+    ----------
+    frac, x : numpy.ndarray of float, shape (N, d)
+        Fractional and Cartesian coordinates, sorted by flat cell.
+    lattice : numpy.ndarray of float, shape (d, d)
+        Cell, lattice vectors as columns.
+    inv_heights : numpy.ndarray of float, shape (d,)
+        1 / h_k.
+    periodic : numpy.ndarray of bool, shape (d,)
+        The lattice vectors that are periods.
+    reach : numpy.ndarray of float, shape (N,)
+        Interaction radii a_p, sorted.
+    level : numpy.ndarray of int64, shape (N,)
+        Level of every point, sorted.
+    level_reach : numpy.ndarray of float, shape (L,)
+        Largest radius on every level.
+    n_cells, strides : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction and flat-index strides of every level.
+    cell_offset : numpy.ndarray of int64, shape (L + 1,)
+        First flat index of every level.
+    cell_start : numpy.ndarray of int64, shape (n_total + 1,)
+        Start of every cell's points.
+    pad : float
+        Relative pad of the cutoff, >= 1.
+
+    Returns
+    -------
+    rows : numpy.ndarray of int64, shape (M, d + 2)
+        (p, q, n) of every pair.
+    tests : int
+        Distance tests.
+    visits : int
+        Cell visits.
     """
     n_points, d = x.shape
     last = d - 1
@@ -353,6 +556,46 @@ def pair_histograms(x, radii, lattice, n_cells, strides, cell_start, order, offs
     contacts: counted separately and left out of both histograms. Self-image pairs are included only if
     ``self_images``. Returns (hist_r, hist_x, n_contacts) as floats (self-image pairs carry weight 1/2
     per ordered visit, as (i, i, n) and (i, i, -n) are both visited).
+
+    Parameters
+    ----------
+    x : numpy.ndarray of float, shape (N, d)
+        Cartesian centres.
+    radii : numpy.ndarray of float, shape (N,)
+        Particle radii.
+    lattice : numpy.ndarray of float, shape (d, d)
+        Cell, lattice vectors as columns.
+    n_cells, strides : numpy.ndarray of int64, shape (d,)
+        Cells per lattice direction and flat-index strides of level 0 (rows 0 of the grid's).
+    cell_start : numpy.ndarray of int64, shape (n_total + 1,)
+        Start of every cell's points in ``order``.
+    order : numpy.ndarray of int64, shape (N,)
+        Particle indices sorted by flat cell.
+    offsets : numpy.ndarray of int64, shape (n_offsets, d)
+        The stencil.
+    cutoff : float
+        Largest distance counted.
+    dr : float
+        Bin width of r.
+    n_r : int
+        Bins of r.
+    dx : float
+        Bin width of r / (r_i + r_j).
+    n_x : int
+        Bins of r / (r_i + r_j).
+    contact_tol : float
+        Relative tolerance of a contact.
+    self_images : bool
+        Count a particle's pairs with its own images.
+
+    Returns
+    -------
+    hist_r : numpy.ndarray of float, shape (n_r,)
+        Pairs per r bin.
+    hist_x : numpy.ndarray of float, shape (n_x,)
+        Pairs per r / (r_i + r_j) bin.
+    n_contacts : float
+        Contacts.
     """
     d = x.shape[1]
     n_total = cell_start.size - 1
@@ -412,6 +655,32 @@ def window_counts(centres_frac, x, lattice, inv_heights, n_cells, strides, cell_
 
     ``window_radii`` must be sorted ascending; returns counts (M, n_radii) with counts[m, k] =
     #{images with |x - centre_m| < window_radii[k]}.
+
+    Parameters
+    ----------
+    centres_frac : numpy.ndarray of float, shape (M, d)
+        Window centres, fractional coordinates.
+    x : numpy.ndarray of float, shape (N, d)
+        Cartesian points.
+    lattice : numpy.ndarray of float, shape (d, d)
+        Cell, lattice vectors as columns.
+    inv_heights : numpy.ndarray of float, shape (d,)
+        1 / h_k.
+    n_cells, strides : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction and flat-index strides of every level (level 0 is used).
+    cell_offset : numpy.ndarray of int64, shape (L + 1,)
+        First flat index of every level.
+    cell_start : numpy.ndarray of int64, shape (n_total + 1,)
+        Start of every cell's points in ``order``.
+    order : numpy.ndarray of int64, shape (N,)
+        Point indices sorted by flat cell.
+    window_radii : numpy.ndarray of float, shape (n_radii,)
+        Sorted window radii.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (M, n_radii)
+        The counts.
     """
     d = x.shape[1]
     m_total = centres_frac.shape[0]

@@ -60,7 +60,19 @@ def _assign(group_dpow, group_count, volume, m, ends):
 @dataclass(frozen=True)
 class LevelAssignment:
     """level[i] (0-based) of every particle (input order), cell_sizes[h] (= largest diameter on level h),
-    the threshold m used, and the realised particles per cell m_h = N_h (s_h^d / V) per level."""
+    the threshold m used, and the realised particles per cell m_h = N_h (s_h^d / V) per level.
+
+    Attributes
+    ----------
+    level : numpy.ndarray of int, shape (N,)
+        Level of every particle.
+    cell_sizes : numpy.ndarray of float, shape (L,)
+        Cell size of every level, ascending.
+    m : float
+        The threshold of particles per cell.
+    m_per_level : numpy.ndarray of float, shape (L,)
+        Realised particles per cell of every level.
+    """
 
     level: np.ndarray
     cell_sizes: np.ndarray
@@ -74,7 +86,20 @@ class LevelAssignment:
 
 def insertion_levels(radii, cell_sizes) -> np.ndarray:
     """Level of insertion h(p) = min{h : s_h >= 2 r_p} (Eq. 2.3) for ascending cell sizes; a diameter
-    above the largest cell size gets len(cell_sizes)."""
+    above the largest cell size gets len(cell_sizes).
+
+    Parameters
+    ----------
+    radii : array_like of float, shape (N,)
+        Particle radii.
+    cell_sizes : array_like of float, shape (L,)
+        Ascending cell sizes.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (N,)
+        The levels.
+    """
     return np.searchsorted(np.asarray(cell_sizes, dtype=float), 2.0 * np.asarray(radii, dtype=float),
                            side="left")
 
@@ -136,7 +161,24 @@ class _Groups:
 
 
 def assign_with_threshold(radii, volume: float, d: int, m: float) -> LevelAssignment:
-    """Greedy assignment for a given threshold m of particles per cell (Eq. 2.8): the map m -> L(m)."""
+    """Greedy assignment for a given threshold m of particles per cell (Eq. 2.8): the map m -> L(m).
+
+    Parameters
+    ----------
+    radii : array_like of float, shape (N,)
+        Particle radii.
+    volume : float
+        Volume of the cell.
+    d : int
+        Dimension.
+    m : float
+        Threshold of particles per cell, >= 0.
+
+    Returns
+    -------
+    LevelAssignment
+        The assignment.
+    """
     if not (np.isfinite(m) and m >= 0):
         raise InvalidInputError(f"threshold m must be >= 0 and finite, got {m!r}")
     return _Groups(radii, volume, d).assignment(float(m))
@@ -151,13 +193,49 @@ def _check_n_levels(n_levels) -> int:
 def assign_levels(radii, volume: float, d: int, n_levels: int) -> LevelAssignment:
     """Equal-particles-per-cell assignment with (at most) ``n_levels`` levels, using the smallest m that
     gives that many (appendix of ch. 2.1). If no m gives exactly n_levels (the count jumps over it)
-    the result has the next smaller number of levels; it never exceeds the number of distinct radii."""
+    the result has the next smaller number of levels; it never exceeds the number of distinct radii.
+
+    Parameters
+    ----------
+    radii : array_like of float, shape (N,)
+        Particle radii.
+    volume : float
+        Volume of the cell.
+    d : int
+        Dimension.
+    n_levels : int
+        Number of levels wanted, >= 1.
+
+    Returns
+    -------
+    LevelAssignment
+        The assignment.
+    """
     return _Groups(radii, volume, d).with_levels(_check_n_levels(n_levels))
 
 
 def optimal_levels(radii, volume: float, d: int, K: float = 0.3, max_levels: int = 30) -> LevelAssignment:
     """Assignment with the optimal number of levels (ONL), minimising L (m(L) + K) (Eq. 2.7; K = 0.3 as
-    fitted in Sec. 2.1.3)."""
+    fitted in Sec. 2.1.3).
+
+    Parameters
+    ----------
+    radii : array_like of float, shape (N,)
+        Particle radii.
+    volume : float
+        Volume of the cell.
+    d : int
+        Dimension.
+    K : float, optional
+        Cost ratio of a cell visit to a distance test.
+    max_levels : int, optional
+        Most levels tried.
+
+    Returns
+    -------
+    LevelAssignment
+        The assignment.
+    """
     if not (np.isfinite(K) and K >= 0):
         raise InvalidInputError(f"K must be a finite number >= 0, got {K!r}")
     groups = _Groups(radii, volume, d)
@@ -178,7 +256,24 @@ def optimal_levels(radii, volume: float, d: int, K: float = 0.3, max_levels: int
 def geometric_levels(radii, volume: float, d: int, ratio: float) -> LevelAssignment:
     """Levels of cell sizes in geometric progression s_{h+1} = ratio s_h (Eq. 2.43), anchored at the
     smallest diameter: level h holds the radii in [r_min ratio^h, r_min ratio^(h+1)) (module docstring).
-    ``m`` of the result is the largest realised occupancy m_h."""
+    ``m`` of the result is the largest realised occupancy m_h.
+
+    Parameters
+    ----------
+    radii : array_like of float, shape (N,)
+        Particle radii.
+    volume : float
+        Volume of the cell.
+    d : int
+        Dimension.
+    ratio : float
+        Ratio of successive cell sizes, > 1.
+
+    Returns
+    -------
+    LevelAssignment
+        The assignment.
+    """
     r = _check_radii(radii, volume, d)
     if not (np.isfinite(ratio) and ratio > 1):
         raise InvalidInputError(f"the ratio of successive cell sizes must be > 1, got {ratio!r}")
@@ -193,7 +288,26 @@ def geometric_levels(radii, volume: float, d: int, ratio: float) -> LevelAssignm
 def choose_levels(radii, volume: float, d: int, levels=None, K: float = 0.3) -> LevelAssignment:
     """The level assignment a grid uses: ``levels`` None for the optimal number of levels
     (:func:`optimal_levels`), an integer L for :func:`assign_levels` (1: the single-level linked-cell grid),
-    or a :class:`LevelAssignment` computed before for the same radii (returned as it is)."""
+    or a :class:`LevelAssignment` computed before for the same radii (returned as it is).
+
+    Parameters
+    ----------
+    radii : array_like of float, shape (N,)
+        Particle radii.
+    volume : float
+        Volume of the cell.
+    d : int
+        Dimension.
+    levels : None, int or LevelAssignment, optional
+        As above.
+    K : float, optional
+        Cost ratio of :func:`optimal_levels`.
+
+    Returns
+    -------
+    LevelAssignment
+        The assignment.
+    """
     if isinstance(levels, LevelAssignment):
         if levels.level.shape != np.shape(radii):
             raise InvalidInputError(

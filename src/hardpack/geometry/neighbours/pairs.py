@@ -66,7 +66,19 @@ class PairList:
 @dataclass(frozen=True)
 class GridPairs:
     """Raw result of a grid search: candidate pairs i <= j with lattice images, and the work done
-    (distance tests: Ogarko's T_cd; cell visits: T_ca, Eqs. 2.31-2.32)."""
+    (distance tests: Ogarko's T_cd; cell visits: T_ca, Eqs. 2.31-2.32).
+
+    Attributes
+    ----------
+    i, j : numpy.ndarray of int, shape (M,)
+        The pairs, i <= j.
+    shift : numpy.ndarray of int, shape (M, d)
+        Lattice image n of j.
+    distance_tests : int
+        Distance tests.
+    cell_visits : int
+        Cell visits.
+    """
 
     i: np.ndarray
     j: np.ndarray
@@ -110,7 +122,18 @@ def _pair_order(i, j, n, n_points: int) -> np.ndarray:
 def grid_pairs(grid: Grid) -> GridPairs:
     """Every pair with |x_j + L n - x_i| <= a_i + a_j (up to a relative 1e-9 of round-off margin) for the
     interaction radii a of ``grid``, once: i < j, or i == j with n lexicographically positive; sorted by
-    (i, j, n)."""
+    (i, j, n).
+
+    Parameters
+    ----------
+    grid : Grid
+        The grid (:func:`hardpack.geometry.neighbours.grid.build_grid`).
+
+    Returns
+    -------
+    GridPairs
+        The pairs and the work done.
+    """
     order = grid.order
     rows, tests, visits = pair_kernel(
         grid.frac[order], grid.x[order], grid.lattice, 1.0 / grid.heights, grid.periodic, grid.reach[order],
@@ -126,7 +149,18 @@ def grid_pairs(grid: Grid) -> GridPairs:
 
 def wrapped_positions(packing) -> np.ndarray:
     """The centres frac @ lattice.T that pair separations refer to: inside the unit cell along the periodic
-    axes (``Packing.fractional``)."""
+    axes (``Packing.fractional``).
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N, d)
+        The wrapped centres.
+    """
     return packing.fractional() @ packing.lattice.T
 
 

@@ -130,6 +130,31 @@ def random_sequential_addition(radii, box, seed, max_trials: int = 100_000, wall
     periodic image can reach a sphere inside the walls) and rejected outside the walls.
     Raises InvalidInputError when a sphere cannot be placed in ``max_trials`` trials (the density is
     above RSA saturation for these radii).
+
+    Parameters
+    ----------
+    radii : array_like of float, shape (N,)
+        Positive radii.
+    box : array_like of float, shape (d,)
+        Box side lengths.
+    seed : int or numpy.random.Generator
+        Random source.
+    max_trials : int, optional
+        Trials per sphere before giving up.
+    walled : array_like of bool, shape (d,), optional
+        Axes with hard walls.
+    container : tuple of (array_like of float, shape (d,), float), optional
+        Centre and radius of a spherical container.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N, d)
+        The positions, in the input order of ``radii``.
+
+    Raises
+    ------
+    InvalidInputError
+        For bad input or when a sphere cannot be placed.
     """
     r = np.asarray(radii, dtype=float)
     box = np.asarray(box, dtype=float)
