@@ -8,10 +8,11 @@ make Snakemake run each rule once under SLURM, plus the jobs downstream of the d
 (combines, summaries, figures, the validation report and gate). The SLURM validation dataset is
 then rebuilt from SLURM outputs and local ones, and must equal the local dataset.
 
-The job of each rule is the one whose rerun costs least: its own wall time in the local run plus
-that of every job downstream of it, from Snakemake's records of the local run
-(.snakemake/metadata: each output's job, inputs, start and end). Without records, the first job
-of the rule in `snakemake --summary` is taken.
+The deleted files are chosen so that the rerun costs little: deleting one output reruns its job
+and every job downstream of it, which covers their rules too, so a greedy set cover over
+Snakemake's records of the local run (.snakemake/metadata: each output's job, inputs, start and
+end) picks them. Without records, the first output of each rule in `snakemake --summary` is
+taken.
 
     python .ci/slurm_subset.py SUMMARY_TSV SLURM_DIR [METADATA_DIR] > targets.txt
 """
@@ -46,11 +47,11 @@ def local_jobs(metadata_dir: Path) -> tuple[dict[str, tuple], dict[tuple, float]
     return job_of, seconds, readers
 
 
-def rerun_cost(output: str, job_of, seconds, readers) -> float:
-    """Wall time of the local jobs that run again when ``output`` is deleted: its job and every
-    job downstream of it (infinite when the job is not recorded)."""
+def rerun_jobs(output: str, job_of, readers) -> set:
+    """The local jobs that run again when ``output`` is deleted: its job and every job downstream
+    of it (none when the job is not recorded)."""
     if output not in job_of:
-        return float("inf")
+        return set()
     outputs_of: dict[tuple, list] = defaultdict(list)
     for path, job in job_of.items():
         outputs_of[job].append(path)
@@ -62,23 +63,49 @@ def rerun_cost(output: str, job_of, seconds, readers) -> float:
         seen.add(job)
         for path in outputs_of[job]:
             todo.extend(readers.get(path, ()))
-    return sum(seconds[job] for job in seen)
+    return seen
+
+
+def rerun_cost(output: str, job_of, seconds, readers) -> float:
+    """Wall time in the local run of :func:`rerun_jobs` (infinite when the job is not recorded)."""
+    jobs = rerun_jobs(output, job_of, readers)
+    return sum(seconds[job] for job in jobs) if jobs else float("inf")
 
 
 def one_output_per_rule(summary_tsv: str, metadata_dir: Path = Path(".snakemake/metadata")) -> dict[str, str]:
-    """For every rule in a `snakemake --summary` table (tab-separated), an output file of the job
-    that is cheapest to run again (:func:`rerun_cost`); its first job when none is recorded."""
+    """Output files to delete so that every rule of a `snakemake --summary` table (tab-separated)
+    runs again at least once, at little cost: a greedy set cover over the recorded jobs (each
+    deletion covers the rules of the jobs it reruns, :func:`rerun_jobs`; the next one is the
+    deletion with the least new job time per newly covered rule). Rules without records get their
+    first output. Returns {rule: file deleted for it}; a deletion listed under one rule may cover
+    others."""
     with open(summary_tsv, newline="") as fh:
         rows = list(csv.DictReader(fh, delimiter="\t"))
     if not rows or "rule" not in rows[0] or "output_file" not in rows[0]:
         raise SystemExit(f"{summary_tsv}: not a `snakemake --summary` table")
-    records = local_jobs(metadata_dir)
-    best: dict[str, tuple[float, str]] = {}
+    job_of, seconds, readers = local_jobs(metadata_dir)
+    candidates = {row["output_file"]: rerun_jobs(row["output_file"], job_of, readers) for row in rows}
+    picks: dict[str, str] = {}
     for row in rows:
-        cost = rerun_cost(row["output_file"], *records)
-        if row["rule"] not in best or cost < best[row["rule"]][0]:
-            best[row["rule"]] = (cost, row["output_file"])
-    return {rule: output for rule, (_, output) in best.items()}
+        if not candidates[row["output_file"]]:
+            picks.setdefault(row["rule"], row["output_file"])
+    uncovered = {row["rule"] for row in rows} - set(picks)
+    running: set = set()
+    while uncovered:
+        best = None
+        for output, jobs in candidates.items():
+            newly = {job[0] for job in jobs} & uncovered
+            if newly:
+                price = sum(seconds[job] for job in jobs - running) / len(newly)
+                if best is None or price < best[0]:
+                    best = (price, output, newly, jobs)
+        if best is None:  # rules whose jobs are all unrecorded were picked above
+            break
+        _, output, newly, jobs = best
+        picks[sorted(newly)[0]] = output
+        uncovered -= newly
+        running |= jobs
+    return picks
 
 
 def main(summary_tsv: str, slurm_dir: str, metadata_dir: str = ".snakemake/metadata") -> None:
