@@ -17,7 +17,7 @@ import pytest
 
 from hardpack.errors import InvalidInputError
 from hardpack.io import dataset_to_packing, load_dataset
-from hardpack.jamming.ellipsoids import ellipsoid_contacts
+from hardpack.jamming.ellipsoids import contacts_of_pairs, ellipsoid_contacts
 from hardpack.jamming.refine import refine_jamming_point, verify_at_jamming_point
 from hardpack.jamming.result import Verdict
 from hardpack.jamming.second_order import verify_ellipsoids
@@ -134,3 +134,41 @@ def test_cli_refine(tmp_path, capsys):
     save_packing(lattice_packing("fcc", (2, 2, 2)), spheres)
     assert main(["verify", str(spheres), "--out", str(tmp_path / "v.nc"), "--refine"]) != 0
     assert "--refine is for ellipse and ellipsoid packings" in capsys.readouterr().err
+
+
+def test_newton_step_is_solved_to_round_off():
+    """The Newton step cancels the gaps to their round-off. A gap is computed from a separation
+    x_j + L n - x_i of centres in a cell of side L, so it carries an error of a few eps L (measured
+    by the same pairs taken in the other order, j -> i, whose Perram-Wertheim gap is the same
+    exactly). The sparse LU's backward error is relative to the whole KKT system, dominated by the
+    forces: without iterative refinement it left 6.6e-14 a in the gaps of this packing (2.9e-12 a
+    at N = 1000, above the tolerance), with it 3.8e-15 a."""
+    packing = _packing("mm_n80_seed2_slow_p1e12")
+    res = verify_ellipsoids(packing, delta="gaps")
+    ref = refine_jamming_point(packing, res)
+    a = float(np.min(packing.shape.semiaxes))
+    floor = 8 * np.finfo(float).eps * float(np.max(np.abs(packing.lattice))) / a  # 2e-14
+    pairs = ellipsoid_contacts(ref.packing, 1e-9)
+    forward = contacts_of_pairs(ref.packing, pairs.i, pairs.j, pairs.shift, positions=pairs.positions)
+    backward = contacts_of_pairs(ref.packing, pairs.j, pairs.i, -pairs.shift, positions=pairs.positions)
+    roundoff = np.abs(forward.zeta / forward.scale - backward.zeta / backward.scale).max() / a
+    assert 0 < roundoff < floor  # the bound holds the measured round-off
+    assert ref.converged and ref.gap[-1] < floor and ref.balance[-1] < 1e-12
+
+
+def test_stationary_point_with_negative_forces_is_not_a_jamming_point():
+    """Oblate spheroids (N = 40, LS to p = 1e12): with the contact tolerance widened to 2.06e-3,
+    two pairs 1e-3 apart count as contacts. Holding them closed, Newton reaches a stationary point
+    of the KKT equations (gaps and balance at round-off) whose self-stress pulls on exactly those
+    two pairs (measured: 2 negative forces, down to -0.38 of the mean): it is not a jamming point
+    (they would open as the particles grow), so the refinement has not converged and the verdict
+    is the packing's own."""
+    packing = _packing("oblate_n40_slow_p1e12")
+    res = verify_ellipsoids(packing, delta=2.06e-3)
+    ref = refine_jamming_point(packing, res)
+    assert ref.gap[-1] < 1e-12 and ref.balance[-1] < 1e-12  # the KKT equations are solved
+    assert not ref.converged and ref.negative == 2
+    opened = res.network.gap[res.contacts_used] > 1e-6  # the pairs open in the LS packing
+    assert opened.sum() == 2 and np.array_equal(ref.forces < 0, opened)
+    out = verify_at_jamming_point(packing, delta=2.06e-3)
+    assert out.params["refined"] == 0 and "2 of its forces are negative" in out.params["refine_note"]

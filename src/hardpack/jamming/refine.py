@@ -29,6 +29,14 @@ overlaps there: a network whose jamming point overlaps other pairs is not the ne
 packing's jamming point (Donev 2006, Sec. 5.6: a missed contact makes spurious floppy modes).
 Such pairs join the network and Newton runs again (an active-set iteration, ``rounds``); the
 result counts the pairs still overlapping (``overlaps``) and those added (``added``).
+
+Newton's method finds a stationary point of the KKT equations, whose multipliers may have either
+sign. It is a jamming point only if every force is positive (a contact with a negative force
+would open as the particles grow), so convergence asks for that besides gaps and balance at the
+tolerance. The tolerance, 1e-12, lies above the round-off of the gaps, a few eps L / a for
+centres in a cell of side L (measured: 3e-15 at N = 1000, L = 28 a, by the same pairs taken in
+the other order), provided the Newton step is solved to round-off in the gap rows, which needs
+iterative refinement of the sparse LU (:func:`_solve`).
 """
 
 from __future__ import annotations
@@ -62,6 +70,8 @@ OVERLAP_SEARCH = 1e-2
 CONTACT_GAP = 1e-9
 #: Newton steps of :func:`verify_at_jamming_point` (it converges in 3-5 when it converges)
 REFINE_STEPS = 12
+#: convergence tolerance of :func:`refine_jamming_point` (gaps in smallest semiaxes, relative balance)
+REFINE_TOL = 1e-12
 
 
 @dataclass
@@ -92,6 +102,10 @@ class Refinement:
     added : int
         Contacts added to the network over the rounds (pairs that overlapped at the jamming point
         of the smaller network).
+    negative : int
+        Contacts with a negative force at the last iterate. A solution of the KKT equations with a
+        negative multiplier is not a jamming point (those contacts would open as the particles
+        grow), so ``converged`` is False then even when the gaps and the balance met the tolerance.
     """
 
     packing: Packing
@@ -104,6 +118,7 @@ class Refinement:
     forces: np.ndarray
     overlaps: int
     added: int = 0
+    negative: int = 0
 
 
 def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float) -> Packing:
@@ -121,7 +136,7 @@ def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, facto
                    overlap_tol=packing.overlap_tol, allow_overlap=True)
 
 
-def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: float = 1e-12,
+def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: float = REFINE_TOL,
                          rounds: int = 3) -> Refinement:
     """Newton's method to the jamming point of a packing's contact network (module docstring).
 
@@ -135,8 +150,8 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         contacts and self-stress (exact or near) start the iteration; rattlers stay where they are.
     max_iter : int, default 20
         Newton steps at most.
-    tol : float, default 1e-12
-        Convergence: max |h_c| / a and |A F| / (|A| |F|) both below it.
+    tol : float, default REFINE_TOL (1e-12)
+        Convergence: max |h_c| / a and |A F| / (|A| |F|) both below it, and every force positive.
     rounds : int, default 3
         Newton runs at most: after each converged one, the pairs that overlap at the jamming point
         of the network join it (with the mean force to start) and Newton runs again.
@@ -194,7 +209,8 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     overlaps = current.overlap_report(packing.overlap_tol).n_overlapping
     return Refinement(packing=current, converged=converged, iterations=len(steps), gap=np.array(gaps),
                       balance=np.array(balances), steps=np.array(steps), size_change=factor - 1.0,
-                      forces=forces, overlaps=int(overlaps), added=added)
+                      forces=forces, overlaps=int(overlaps), added=added,
+                      negative=int((forces < 0).sum()))
 
 
 def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, steps):
@@ -213,7 +229,8 @@ def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, st
         gaps.append(float(np.abs(h).max() / a))
         balances.append(float(np.linalg.norm(at.T @ forces) / (spla.norm(at) * np.linalg.norm(forces))))
         if gaps[-1] <= tol and balances[-1] <= tol:
-            return current, True, forces, factor
+            # a KKT point of growing the particles only if every multiplier (force) is positive
+            return current, bool(forces.min() > 0), forces, factor
         if it == max_iter:
             break
         k = (t.T @ stiffness_matrix_full(net, forces, contact_hessians(net)) @ t).tocsr()
@@ -228,7 +245,7 @@ def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, st
             sp.hstack([z(triv.T), z((nt, m)), z((nt, 1)), z((nt, nt))]),
         ]).tocsc()
         rhs = np.concatenate([np.zeros(n), -h, [float(m)], np.zeros(nt)])
-        sol = spla.spsolve(kkt, rhs)
+        sol = _solve(kkt, rhs)
         if not np.all(np.isfinite(sol)):
             break
         dq, forces, ds = sol[:n], sol[n:n + m], float(sol[n + m])
@@ -238,6 +255,36 @@ def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, st
         factor *= 1.0 + ds
         current = _turned(current, x, move[:, d:], 1.0 + ds)
     return current, False, forces, factor
+
+
+#: iterative-refinement steps of :func:`_solve` at most
+SOLVE_REFINEMENTS = 3
+
+
+def _solve(kkt: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
+    """The Newton step: sparse LU of the KKT matrix, then iterative refinement (Golub & Van Loan
+    2013, Sec. 3.5.3) while the residual decreases.
+
+    The LU's backward error is relative to the whole system, whose solution is dominated by the
+    forces (O(1) each, the rows of -K and A of O(1 / a)): a residual of eps |KKT| |x| times the
+    pivot growth lands in the gap rows too, where the gaps to be cancelled are ~1e-12 a near
+    convergence. Measured at N = 1000 (M&M, 9964 unknowns): 2-3e-12 a in the gap rows after
+    every step, so the gaps stalled at 2.9e-12 a while the steps converged quadratically; one
+    refinement brings the residual to round-off."""
+    lu = spla.splu(kkt)
+    sol = lu.solve(rhs)
+    res = rhs - kkt @ sol
+    size = np.abs(res).max()
+    for _ in range(SOLVE_REFINEMENTS):
+        if not (np.isfinite(size) and size > 0):
+            break
+        new = sol + lu.solve(res)
+        new_res = rhs - kkt @ new
+        new_size = np.abs(new_res).max()
+        if not new_size < size:
+            break
+        sol, res, size = new, new_res, new_size
+    return sol
 
 
 def verify_at_jamming_point(packing: Packing, **options):
@@ -251,7 +298,8 @@ def verify_at_jamming_point(packing: Packing, **options):
     round-off. The result's ``params`` say what happened: ``refined`` (1: the verdict is that of
     the jamming point; 0: of the packing as given), ``refine_note``, ``refine_iterations``,
     ``refine_step`` (the largest Newton step, in smallest semiaxes or radians),
-    ``refine_size_change`` and ``refine_added`` (contacts added by the active-set rounds).
+    ``refine_size_change``, ``refine_added`` (contacts added by the active-set rounds) and
+    ``refine_negative`` (negative forces at the last iterate).
 
     Parameters
     ----------
@@ -276,7 +324,8 @@ def verify_at_jamming_point(packing: Packing, **options):
     if note is None:
         ref = refine_jamming_point(packing, result, max_iter=REFINE_STEPS)
         info = dict(refine_iterations=ref.iterations, refine_step=float(ref.steps.max(initial=0.0)),
-                    refine_size_change=ref.size_change, refine_added=ref.added)
+                    refine_size_change=ref.size_change, refine_added=ref.added,
+                    refine_negative=ref.negative)
         if ref.converged and not ref.overlaps:
             refined = verify_ellipsoids(ref.packing, **options)
             same = (refined.collective.n_constraints == dec.n_constraints
@@ -291,7 +340,14 @@ def verify_at_jamming_point(packing: Packing, **options):
                    f"{int(result.rattler.sum())})")), **info)
             refined.collective.reason = f"at the jamming point of the contacts: {refined.collective.reason}"
             return refined
-        note = (f"not refined: Newton did not converge in {ref.iterations} steps (balance {ref.balance[-1]:.2g}, "
+        solved = ref.gap[-1] <= REFINE_TOL and ref.balance[-1] <= REFINE_TOL
+        note = (f"not refined: Newton reached the stationary point of the contacts in {ref.iterations} steps "
+                f"(gaps {ref.gap[-1]:.2g}, balance {ref.balance[-1]:.2g}, largest step {info['refine_step']:.3g}) "
+                f"but {ref.negative} of its forces are negative (smallest {ref.forces.min() / ref.forces.mean():.2g} "
+                "of the mean): those contacts would open, so it is not a jamming point"
+                + (f"; {ref.overlaps} other pair(s) overlap there" if ref.overlaps else "")
+                if not ref.converged and solved and ref.negative else
+                f"not refined: Newton did not converge in {ref.iterations} steps (balance {ref.balance[-1]:.2g}, "
                 f"largest step {info['refine_step']:.3g}): the jamming point is ill-defined at second order"
                 if not ref.converged else
                 f"not refined: at the jamming point of the contacts {ref.overlaps} pair(s) overlap, so the "

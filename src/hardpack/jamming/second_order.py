@@ -383,6 +383,10 @@ def self_stress_lp(a: sp.spmatrix) -> tuple[float, np.ndarray]:
     return float(res.x[-1]), np.asarray(res.x[:m])
 
 
+#: simplex iterations of :func:`first_order_lp` per row and column before the next solver is tried
+LP_ITERATIONS = 20
+
+
 def first_order_lp(at: sp.spmatrix, trivial: np.ndarray, rng: np.random.Generator,
                    tol: float = 1e-9, stress: np.ndarray | None = None) -> tuple[bool, float, float]:
     """Randomised LP test for a first-order flex (Donev 2006, Eqs. 5.6 and 5.10, in the displacement
@@ -429,7 +433,10 @@ def first_order_lp(at: sp.spmatrix, trivial: np.ndarray, rng: np.random.Generato
         if norm == 0:
             optima.append(0.0)
             continue
-        res = solve_lp(-load, A_ub=-at, b_ub=np.zeros(m), bounds=(-1.0, 1.0), **eq)
+        # an iteration limit: the dual simplex can stall on this degenerate LP (measured: > 7 min on the
+        # refined near-sphere packing, N = 100); solve_lp then tries the interior-point method
+        res = solve_lp(-load, A_ub=-at, b_ub=np.zeros(m), bounds=(-1.0, 1.0),
+                       options=dict(maxiter=LP_ITERATIONS * (m + n)), **eq)
         optima.append(float(-res.fun) / norm)
     return bool(max(optima) > tol), optima[0], optima[1]
 
