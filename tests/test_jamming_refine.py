@@ -145,9 +145,9 @@ def test_newton_step_is_solved_to_round_off():
     at N = 1000, above the tolerance), with it 3.8e-15 a."""
     packing = _packing("mm_n80_seed2_slow_p1e12")
     res = verify_ellipsoids(packing, delta="gaps")
-    ref = refine_jamming_point(packing, res)
     a = float(np.min(packing.shape.semiaxes))
     floor = 8 * np.finfo(float).eps * float(np.max(np.abs(packing.lattice))) / a  # 2e-14
+    ref = refine_jamming_point(packing, res, tol=floor)  # (without refinement: 20 steps at 5-10e-14)
     pairs = ellipsoid_contacts(ref.packing, 1e-9)
     forward = contacts_of_pairs(ref.packing, pairs.i, pairs.j, pairs.shift, positions=pairs.positions)
     backward = contacts_of_pairs(ref.packing, pairs.j, pairs.i, -pairs.shift, positions=pairs.positions)
