@@ -161,14 +161,19 @@ def test_stationary_point_with_negative_forces_is_not_a_jamming_point():
     two pairs 1e-3 apart count as contacts. Holding them closed, Newton reaches a stationary point
     of the KKT equations (gaps and balance at round-off) whose self-stress pulls on exactly those
     two pairs (measured: 2 negative forces, down to -0.38 of the mean): it is not a jamming point
-    (they would open as the particles grow), so the refinement has not converged and the verdict
-    is the packing's own."""
+    (they would open as the particles grow). The active set drops them and Newton reaches the
+    jamming point of the other contacts, every force positive."""
     packing = _packing("oblate_n40_slow_p1e12")
     res = verify_ellipsoids(packing, delta=2.06e-3)
-    ref = refine_jamming_point(packing, res)
-    assert ref.gap[-1] < 1e-12 and ref.balance[-1] < 1e-12  # the KKT equations are solved
-    assert not ref.converged and ref.negative == 2
+    first = refine_jamming_point(packing, res, rounds=1)
+    assert first.gap[-1] < 1e-12 and first.balance[-1] < 1e-12  # the KKT equations are solved
+    assert not first.converged and first.negative == 2 and first.dropped == 0
     opened = res.network.gap[res.contacts_used] > 1e-6  # the pairs open in the LS packing
-    assert opened.sum() == 2 and np.array_equal(ref.forces < 0, opened)
+    assert opened.sum() == 2 and np.array_equal(first.forces < 0, opened)
+    ref = refine_jamming_point(packing, res)
+    assert ref.converged and ref.dropped == 2 and ref.negative == 0 and ref.overlaps == 0
+    assert len(ref.forces) == len(first.forces) - 2 and ref.forces.min() > 0
+    assert ref.gap[-1] < 1e-12 and ref.balance[-1] < 1e-12
     out = verify_at_jamming_point(packing, delta=2.06e-3)
-    assert out.params["refined"] == 0 and "2 of its forces are negative" in out.params["refine_note"]
+    assert out.params["refined"] == 1 and out.params["refine_dropped"] == 2
+    assert "2 contact(s) with negative forces at a stationary point left them" in out.params["refine_note"]

@@ -33,10 +33,11 @@ result counts the pairs still overlapping (``overlaps``) and those added (``adde
 Newton's method finds a stationary point of the KKT equations, whose multipliers may have either
 sign. It is a jamming point only if every force is positive (a contact with a negative force
 would open as the particles grow), so convergence asks for that besides gaps and balance at the
-tolerance. The tolerance, 1e-12, lies above the round-off of the gaps, a few eps L / a for
-centres in a cell of side L (measured: 3e-15 at N = 1000, L = 28 a, by the same pairs taken in
-the other order), provided the Newton step is solved to round-off in the gap rows, which needs
-iterative refinement of the sparse LU (:func:`_solve`).
+tolerance; such contacts leave the network and Newton runs again (the other half of the
+active-set iteration, counted in ``dropped``). The tolerance, 1e-12, lies above the round-off of
+the gaps, a few eps L / a for centres in a cell of side L (measured: 3e-15 at N = 1000,
+L = 28 a, by the same pairs taken in the other order), provided the Newton step is solved to
+round-off in the gap rows, which needs iterative refinement of the sparse LU (:func:`_solve`).
 """
 
 from __future__ import annotations
@@ -102,6 +103,9 @@ class Refinement:
     added : int
         Contacts added to the network over the rounds (pairs that overlapped at the jamming point
         of the smaller network).
+    dropped : int
+        Contacts dropped from the network over the rounds (those with a negative force at a
+        stationary point of the larger network).
     negative : int
         Contacts with a negative force at the last iterate. A solution of the KKT equations with a
         negative multiplier is not a jamming point (those contacts would open as the particles
@@ -119,6 +123,7 @@ class Refinement:
     overlaps: int
     added: int = 0
     negative: int = 0
+    dropped: int = 0
 
 
 def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float) -> Packing:
@@ -137,7 +142,7 @@ def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, facto
 
 
 def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: float = REFINE_TOL,
-                         rounds: int = 3) -> Refinement:
+                         rounds: int = 6) -> Refinement:
     """Newton's method to the jamming point of a packing's contact network (module docstring).
 
     Parameters
@@ -152,9 +157,12 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         Newton steps at most.
     tol : float, default REFINE_TOL (1e-12)
         Convergence: max |h_c| / a and |A F| / (|A| |F|) both below it, and every force positive.
-    rounds : int, default 3
-        Newton runs at most: after each converged one, the pairs that overlap at the jamming point
-        of the network join it (with the mean force to start) and Newton runs again.
+    rounds : int, default 6
+        Newton runs at most, an active-set iteration on the contact network: when Newton reaches
+        a stationary point whose self-stress has negative forces, those contacts leave the
+        network (they open as the particles grow); when it reaches a jamming point of the
+        network at which other pairs overlap, those pairs join it (with the mean force to
+        start); then Newton runs again.
 
     Returns
     -------
@@ -187,14 +195,25 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     net = result.network
     pairs = net.i[used], net.j[used], net.shift[used]
     a = float(np.min(packing.shape.semiaxes))
-    current, factor, added = packing, 1.0, 0
+    current, factor, added, dropped = packing, 1.0, 0, 0
     gaps, balances, steps = [], [], []
     for round_ in range(rounds):
-        current, converged, forces, growth = _newton(current, pairs, forces, active, max_iter, tol, a,
-                                                     gaps, balances, steps)
+        current, stationary, forces, growth = _newton(current, pairs, forces, active, max_iter, tol, a,
+                                                      gaps, balances, steps)
         factor *= growth
-        if not converged or round_ == rounds - 1:
+        # a KKT point of growing the particles only if every multiplier (force) is positive
+        converged = stationary and bool(forces.min() > 0)
+        if not stationary or round_ == rounds - 1:
             break
+        if not converged:
+            # contacts pulled on (negative multipliers) open as the particles grow: they leave
+            keep = forces > 0
+            if keep.sum() < 2:
+                break
+            pairs = tuple(p[keep] for p in pairs)
+            forces = forces[keep] * (keep.sum() / forces[keep].sum())
+            dropped += int((~keep).sum())
+            continue
         # pairs outside the network that overlap at its jamming point join it (active set)
         near = ellipsoid_contacts(current, OVERLAP_SEARCH)
         keep = (near.gap <= CONTACT_GAP) & present[near.i] & present[near.j] & (active[near.i] | active[near.j])
@@ -210,13 +229,13 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     return Refinement(packing=current, converged=converged, iterations=len(steps), gap=np.array(gaps),
                       balance=np.array(balances), steps=np.array(steps), size_change=factor - 1.0,
                       forces=forces, overlaps=int(overlaps), added=added,
-                      negative=int((forces < 0).sum()))
+                      negative=int((forces < 0).sum()), dropped=dropped)
 
 
 def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, steps):
     """Newton steps on the KKT equations of the contacts ``pairs`` (module docstring), appending
-    the history to ``gaps``, ``balances``, ``steps``. Returns (packing, converged, forces, growth
-    factor of the semiaxes)."""
+    the history to ``gaps``, ``balances``, ``steps``. Returns (packing, stationary: whether the
+    gaps and the balance met ``tol``, forces, growth factor of the semiaxes)."""
     d, f = current.dim, dof_per_particle(current.dim)
     m = len(pairs[0])
     x = wrapped_positions(current)
@@ -229,8 +248,7 @@ def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, st
         gaps.append(float(np.abs(h).max() / a))
         balances.append(float(np.linalg.norm(at.T @ forces) / (spla.norm(at) * np.linalg.norm(forces))))
         if gaps[-1] <= tol and balances[-1] <= tol:
-            # a KKT point of growing the particles only if every multiplier (force) is positive
-            return current, bool(forces.min() > 0), forces, factor
+            return current, True, forces, factor
         if it == max_iter:
             break
         k = (t.T @ stiffness_matrix_full(net, forces, contact_hessians(net)) @ t).tocsr()
@@ -298,8 +316,8 @@ def verify_at_jamming_point(packing: Packing, **options):
     round-off. The result's ``params`` say what happened: ``refined`` (1: the verdict is that of
     the jamming point; 0: of the packing as given), ``refine_note``, ``refine_iterations``,
     ``refine_step`` (the largest Newton step, in smallest semiaxes or radians),
-    ``refine_size_change``, ``refine_added`` (contacts added by the active-set rounds) and
-    ``refine_negative`` (negative forces at the last iterate).
+    ``refine_size_change``, ``refine_added`` and ``refine_dropped`` (contacts added and dropped by
+    the active-set rounds) and ``refine_negative`` (negative forces at the last iterate).
 
     Parameters
     ----------
@@ -325,7 +343,7 @@ def verify_at_jamming_point(packing: Packing, **options):
         ref = refine_jamming_point(packing, result, max_iter=REFINE_STEPS)
         info = dict(refine_iterations=ref.iterations, refine_step=float(ref.steps.max(initial=0.0)),
                     refine_size_change=ref.size_change, refine_added=ref.added,
-                    refine_negative=ref.negative)
+                    refine_dropped=ref.dropped, refine_negative=ref.negative)
         if ref.converged and not ref.overlaps:
             refined = verify_ellipsoids(ref.packing, **options)
             same = (refined.collective.n_constraints == dec.n_constraints
@@ -335,6 +353,8 @@ def verify_at_jamming_point(packing: Packing, **options):
                 f"(largest {info['refine_step']:.3g}), gaps {ref.gap[-1]:.2g}, balance {ref.balance[-1]:.2g}"
                 + (f"; {ref.added} pair(s) that overlapped at the jamming point of the packing's contacts "
                    "joined them" if ref.added else "")
+                + (f"; {ref.dropped} contact(s) with negative forces at a stationary point left them"
+                   if ref.dropped else "")
                 + ("" if same else f"; the test there found {refined.collective.n_constraints} backbone contacts "
                    f"and {int(refined.rattler.sum())} rattlers (before: {dec.n_constraints}, "
                    f"{int(result.rattler.sum())})")), **info)
