@@ -17,7 +17,7 @@ import numpy as np
 from hardpack import __version__
 from hardpack.errors import InvalidInputError
 
-#: the subcommands of this module
+#: the subcommands registered by this module itself (no other module is imported for them)
 CORE_SUBCOMMANDS = ("init", "lattice", "laminate", "info", "combine")
 #: the module that registers each subcommand beyond the core ones (its ``register(subparsers)``);
 #: a command line imports only its own command's module, which keeps a job's start-up short
