@@ -177,3 +177,19 @@ def test_stationary_point_with_negative_forces_is_not_a_jamming_point():
     out = verify_at_jamming_point(packing, delta=2.06e-3)
     assert out.params["refined"] == 1 and out.params["refine_dropped"] == 2
     assert "2 contact(s) with negative forces at a stationary point left them" in out.params["refine_note"]
+
+
+def test_collective_test_starts_the_refinement_when_the_local_test_loses_every_particle():
+    """Self-dual alpha = 1.05, N = 100, LS to p = 1e12 (the full study's seed 1): the local test
+    finds no particle with its own near self-stress (torques of order alpha - 1), so every
+    particle looks like a rattler; the collective test of every particle has a strictly positive
+    near self-stress, Newton converges from it (one pair added), and at the jamming point the full
+    test (local test included) finds no rattler and second-order jamming of a hypostatic backbone
+    (Donev 2006, Sec. 5.6)."""
+    packing = _packing("self_dual_a1.05_n100_seed1_slow_p1e12")
+    as_given = verify_ellipsoids(packing, delta="gaps")
+    assert as_given.rattler.all() and as_given.verdict != Verdict.JAMMED
+    out = verify_at_jamming_point(packing, delta="gaps")
+    assert out.params["refined"] == 1 and "collective test of every particle" in out.params["refine_note"]
+    assert (out.verdict, out.order) == (Verdict.JAMMED, "second") and not out.rattler.any()
+    assert out.z_mean < 12 and out.params["refine_added"] >= 1

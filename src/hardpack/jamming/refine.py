@@ -305,6 +305,18 @@ def _solve(kkt: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
     return sol
 
 
+def _obstacle(packing: Packing, result) -> str | None:
+    """Why ``result`` cannot start :func:`refine_jamming_point` (None when it can)."""
+    dec = result.collective
+    if packing.boundary.kind != "periodic":
+        return "not refined: walls are not handled"
+    if dec.approx_stress is None:
+        return "not refined: no near self-stress (exact self-stresses, or none)"
+    if not (dec.forces.size and dec.forces.min() > 0):
+        return "not refined: the near self-stress is not strictly positive"
+    return None
+
+
 def verify_at_jamming_point(packing: Packing, **options):
     """The jamming test of an ellipsoid packing at the jamming point of its contacts, when the
     packing is near one.
@@ -313,7 +325,11 @@ def verify_at_jamming_point(packing: Packing, **options):
     positive near self-stress (a packing near, not at, its jamming point; periodic cells), refines
     the configuration with :func:`refine_jamming_point` and, when that converges with no pair
     overlapping, tests the refined configuration instead, whose balance A F = 0 is exact to
-    round-off. The result's ``params`` say what happened: ``refined`` (1: the verdict is that of
+    round-off. When the local test of the packing as given finds no backbone with a near
+    self-stress (near the sphere point the torques are of order alpha - 1, and a particle's own
+    near self-stress can be lost in them, so that every particle looks like a rattler), the
+    collective test of every particle (``local=False``) starts the refinement, and the refined
+    configuration gets the full test. The result's ``params`` say what happened: ``refined`` (1: the verdict is that of
     the jamming point; 0: of the packing as given), ``refine_note``, ``refine_iterations``,
     ``refine_step`` (the largest Newton step, in smallest semiaxes or radians),
     ``refine_size_change``, ``refine_added`` and ``refine_dropped`` (contacts added and dropped by
@@ -332,15 +348,18 @@ def verify_at_jamming_point(packing: Packing, **options):
     """
     result = verify_ellipsoids(packing, **options)
     dec = result.collective
-    note = None
-    if packing.boundary.kind != "periodic":
-        note = "not refined: walls are not handled"
-    elif dec.approx_stress is None:
-        note = "not refined: no near self-stress (exact self-stresses, or none)"
-    elif not (dec.forces.size and dec.forces.min() > 0):
-        note = "not refined: the near self-stress is not strictly positive"
+    note, start, whole = _obstacle(packing, result), result, ""
+    if note is not None and packing.boundary.kind == "periodic" and options.get("local", True):
+        # the local test needs each particle's own near self-stress, which an LS packing near the
+        # sphere point (torques of order alpha - 1) can miss: every particle then looks like a
+        # rattler; the collective test of all particles can still start the refinement
+        collective = verify_ellipsoids(packing, **{**options, "local": False})
+        if _obstacle(packing, collective) is None:
+            note, start = None, collective
+            whole = ("; Newton started from the collective test of every particle (the local test of the "
+                     f"packing as given found {int(result.rattler.sum())} rattler(s))")
     if note is None:
-        ref = refine_jamming_point(packing, result, max_iter=REFINE_STEPS)
+        ref = refine_jamming_point(packing, start, max_iter=REFINE_STEPS)
         info = dict(refine_iterations=ref.iterations, refine_step=float(ref.steps.max(initial=0.0)),
                     refine_size_change=ref.size_change, refine_added=ref.added,
                     refine_dropped=ref.dropped, refine_negative=ref.negative)
@@ -354,7 +373,7 @@ def verify_at_jamming_point(packing: Packing, **options):
                 + (f"; {ref.added} pair(s) that overlapped at the jamming point of the packing's contacts "
                    "joined them" if ref.added else "")
                 + (f"; {ref.dropped} contact(s) with negative forces at a stationary point left them"
-                   if ref.dropped else "")
+                   if ref.dropped else "") + whole
                 + ("" if same else f"; the test there found {refined.collective.n_constraints} backbone contacts "
                    f"and {int(refined.rattler.sum())} rattlers (before: {dec.n_constraints}, "
                    f"{int(result.rattler.sum())})")), **info)
@@ -373,6 +392,6 @@ def verify_at_jamming_point(packing: Packing, **options):
                 f"not refined: at the jamming point of the contacts {ref.overlaps} pair(s) overlap, so the "
                 "packing is not near the jamming point of its own contacts")
         result.params.update(info)
-    result.params.update(refined=0, refine_note=note)
+    result.params.update(refined=0, refine_note=note + whole)
     result.collective.reason = f"{result.collective.reason} ({note})"
     return result
