@@ -18,7 +18,7 @@ import pytest
 from hardpack.errors import InvalidInputError
 from hardpack.io import dataset_to_packing, load_dataset
 from hardpack.jamming.ellipsoids import contacts_of_pairs, ellipsoid_contacts
-from hardpack.jamming.refine import refine_jamming_point, verify_at_jamming_point
+from hardpack.jamming.refine import MAX_STEP, refine_jamming_point, verify_at_jamming_point
 from hardpack.jamming.result import Verdict
 from hardpack.jamming.second_order import verify_ellipsoids
 
@@ -193,3 +193,14 @@ def test_collective_test_starts_the_refinement_when_the_local_test_loses_every_p
     assert out.params["refined"] == 1 and "collective test of every particle" in out.params["refine_note"]
     assert (out.verdict, out.order) == (Verdict.JAMMED, "second") and not out.rattler.any()
     assert out.z_mean < 12 and out.params["refine_added"] >= 1
+
+
+def test_a_diverging_newton_iteration_stops_instead_of_crashing():
+    """Pairs up to 2e-2 apart held as contacts (oblate N = 40): the first Newton step is larger than
+    a semiaxis (the network has no jamming point near). Unbounded, the next steps shrank the
+    particles through zero (a crash on negative semiaxes) or exhausted memory; the iteration stops
+    unconverged instead."""
+    packing = _packing("oblate_n40_slow_p1e12")
+    res = verify_ellipsoids(packing, delta=2e-2)
+    ref = refine_jamming_point(packing, res)
+    assert not ref.converged and ref.steps[-1] > MAX_STEP and ref.iterations == 1

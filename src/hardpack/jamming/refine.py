@@ -269,12 +269,18 @@ def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, st
         dq, forces, ds = sol[:n], sol[n:n + m], float(sol[n + m])
         move = (t @ dq).reshape(current.n_particles, f)
         steps.append(float(max(np.abs(move[:, :d]).max() / a, np.abs(move[:, d:]).max())))
+        if not (steps[-1] <= MAX_STEP and abs(ds) <= MAX_STEP):
+            break  # beyond the reach of the linearised contacts: no jamming point of this network near
         x = x + move[:, :d]
         factor *= 1.0 + ds
         current = _turned(current, x, move[:, d:], 1.0 + ds)
     return current, False, forces, factor
 
 
+#: the largest Newton step taken (in smallest semiaxes, radians, or relative size change): a
+#: larger one leaves the configuration the contact network describes (it diverged, e.g. after the
+#: active set dropped contacts), and the iteration stops unconverged
+MAX_STEP = 0.5
 #: iterative-refinement steps of :func:`_solve` at most
 SOLVE_REFINEMENTS = 3
 
