@@ -204,3 +204,13 @@ def test_a_diverging_newton_iteration_stops_instead_of_crashing():
     res = verify_ellipsoids(packing, delta=2e-2)
     ref = refine_jamming_point(packing, res)
     assert not ref.converged and ref.steps[-1] > MAX_STEP and ref.iterations == 1
+
+
+def test_a_singular_newton_system_is_reported_not_raised():
+    """Prolate alpha = 1.02, N = 100, LS to p = 1e12 (the full study's seed 2): the local test loses
+    every particle; the collective test of all of them starts Newton, whose first KKT matrix is
+    exactly singular (SuperLU raised RuntimeError, a crash of the verifier). The verifier reports
+    it and keeps the packing's own verdict."""
+    packing = _packing("prolate_a1.02_n100_seed2_slow_p1e12")
+    out = verify_at_jamming_point(packing, delta="gaps")
+    assert out.params["refined"] == 0 and "singular" in out.params["refine_note"]

@@ -294,8 +294,12 @@ def _solve(kkt: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
     pivot growth lands in the gap rows too, where the gaps to be cancelled are ~1e-12 a near
     convergence. Measured at N = 1000 (M&M, 9964 unknowns): 2-3e-12 a in the gap rows after
     every step, so the gaps stalled at 2.9e-12 a while the steps converged quadratically; one
-    refinement brings the residual to round-off."""
-    lu = spla.splu(kkt)
+    refinement brings the residual to round-off. An exactly singular matrix gives NaNs (the
+    caller stops unconverged)."""
+    try:
+        lu = spla.splu(kkt)
+    except RuntimeError:  # exactly singular (e.g. a particle without contacts): no Newton step
+        return np.full(rhs.shape, np.nan)
     sol = lu.solve(rhs)
     res = rhs - kkt @ sol
     size = np.abs(res).max()
@@ -392,6 +396,9 @@ def verify_at_jamming_point(packing: Packing, **options):
                 "of the mean): those contacts would open, so it is not a jamming point"
                 + (f"; {ref.overlaps} other pair(s) overlap there" if ref.overlaps else "")
                 if not ref.converged and solved and ref.negative else
+                "not refined: the Newton system of the contacts is singular (a particle without contacts, "
+                "or a floppy mode the stress does not hold)"
+                if not (ref.converged or ref.iterations) else
                 f"not refined: Newton did not converge in {ref.iterations} steps (balance {ref.balance[-1]:.2g}, "
                 f"largest step {info['refine_step']:.3g}): the jamming point is ill-defined at second order"
                 if not ref.converged else
