@@ -210,7 +210,13 @@ def test_a_singular_newton_system_is_reported_not_raised():
     """Prolate alpha = 1.02, N = 100, LS to p = 1e12 (the full study's seed 2): the local test loses
     every particle; the collective test of all of them starts Newton, whose first KKT matrix is
     exactly singular (SuperLU raised RuntimeError, a crash of the verifier). The verifier reports
-    it and keeps the packing's own verdict."""
+    it; the verdict is undetermined, not "not jammed, every particle a rattler" (the local test's
+    loss of every particle says nothing about the packing)."""
     packing = _packing("prolate_a1.02_n100_seed2_slow_p1e12")
+    as_given = verify_ellipsoids(packing, delta="gaps")
+    assert as_given.rattler.all() and as_given.verdict == Verdict.NOT_JAMMED
     out = verify_at_jamming_point(packing, delta="gaps")
     assert out.params["refined"] == 0 and "singular" in out.params["refine_note"]
+    assert (out.verdict, out.order) == (Verdict.UNDETERMINED, "undetermined")
+    ds = out.to_dataset()
+    assert ds.attrs["verdict"] == int(Verdict.UNDETERMINED) and ds.attrs["order"] == "undetermined"

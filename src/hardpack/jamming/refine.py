@@ -61,6 +61,7 @@ from hardpack.jamming.ellipsoids import (
     rigidity_transpose_full,
     stiffness_matrix_full,
 )
+from hardpack.jamming.result import Verdict
 from hardpack.jamming.second_order import dof_basis, trivial_motions, verify_ellipsoids
 
 __all__ = ["Refinement", "refine_jamming_point", "verify_at_jamming_point", "REFINE_STEPS"]
@@ -339,7 +340,9 @@ def verify_at_jamming_point(packing: Packing, **options):
     self-stress (near the sphere point the torques are of order alpha - 1, and a particle's own
     near self-stress can be lost in them, so that every particle looks like a rattler), the
     collective test of every particle (``local=False``) starts the refinement, and the refined
-    configuration gets the full test. The result's ``params`` say what happened: ``refined`` (1: the verdict is that of
+    configuration gets the full test; when that refinement fails too, the verdict is
+    *undetermined* (a local test that loses every particle says nothing about the packing).
+    The result's ``params`` say what happened: ``refined`` (1: the verdict is that of
     the jamming point; 0: of the packing as given), ``refine_note``, ``refine_iterations``,
     ``refine_step`` (the largest Newton step, in smallest semiaxes or radians),
     ``refine_size_change``, ``refine_added`` and ``refine_dropped`` (contacts added and dropped by
@@ -406,5 +409,11 @@ def verify_at_jamming_point(packing: Packing, **options):
                 "packing is not near the jamming point of its own contacts")
         result.params.update(info)
     result.params.update(refined=0, refine_note=note + whole)
+    if whole and not result.backbone.any():
+        # every particle a "rattler" only because its own near self-stress was lost: no verdict
+        dec.verdict, dec.order = Verdict.UNDETERMINED, "undetermined"
+        dec.reason = ("the local test lost every particle (no particle's own near self-stress stands out; "
+                      "torques near the sphere point are small) and the jamming point of all the contacts "
+                      "was not reached")
     result.collective.reason = f"{result.collective.reason} ({note})"
     return result
