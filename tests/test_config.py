@@ -10,6 +10,9 @@ import jsonschema
 import pytest
 import yaml
 
+from hardpack.config import check_config
+from hardpack.errors import InvalidInputError
+
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = yaml.safe_load((ROOT / "workflow/schemas/config.schema.yaml").read_text())
 
@@ -83,11 +86,11 @@ def test_snakemake_dry_run_lists_the_dag(configfile):
 
 
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
-@pytest.mark.parametrize("configfile", ["config/config.yaml", "config/smoke.yaml"])
-def test_snakemake_lint_finds_nothing(configfile):
+def test_snakemake_lint_finds_nothing():
     """`snakemake --lint` exits non-zero on any finding (rules mixed with functions, a rule without
-    log or software environment, hard-coded path prefixes in params, ...)."""
-    out = subprocess.run(["snakemake", "--lint", "--configfile", configfile], cwd=ROOT,
+    log or software environment, hard-coded path prefixes in params, ...). The lints read the rules,
+    which both configs share (no rule file is included conditionally), so one config suffices."""
+    out = subprocess.run(["snakemake", "--lint", "--configfile", "config/smoke.yaml"], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0 and "Lints for" not in out.stdout + out.stderr, out.stdout + out.stderr
 
@@ -135,24 +138,45 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
     assert "grwoth_rate" in out.stdout + out.stderr
 
 
-@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
 @pytest.mark.parametrize("mutate, expected", [
     (lambda c: c["slp"]["diluted"].update(ensemble="uv3d_w4"), "must be one of slp.mrj.ensembles"),
     (lambda c: c["slp"]["diluted"].update(seeds=[1, 7]), r"slp.diluted.seeds \[7\] are not seeds"),
+    (lambda c: c["slp"]["mrj"].update(ensembles=["nope"]), "slp.mrj.ensembles names 'nope'"),
     (lambda c: c["freeenergy"]["simplex"].update(ensemble="mono9d"), r"freeenergy.simplex.ensemble 'mono9d' is not one"),
     (lambda c: c["freeenergy"]["simplex"].update(seeds=[1, 7]), r"freeenergy.simplex.seeds \[7\] are not seeds"),
+    (lambda c: c["rates"].update(ensemble="mono9d"), "rates.ensemble 'mono9d' is not one of the ensembles"),
+    (lambda c: c["glass"].update(N=c["glass"]["N"] + 1), "glass.N = .* must be even"),
+    (lambda c: c["glass"].update(phi_end=0.5), "glass.phi_end must be above every glass.snapshots"),
+    (lambda c: c["ellipsoids"].update(near_sphere={"families": ["cube"]}), r"near_sphere.families \['cube'\]"),
+    (lambda c: c["ellipsoids"]["mm"].update(family="cube"), "ellipsoids.mm.family 'cube' is not one of"),
     (lambda c: c["containers"]["windows"].update(ensemble="binary2d"), "must be a monodisperse 3D ensemble"),
     (lambda c: c["containers"].update(core_margin=6), "core_margin = 6 a leaves no core"),
     (lambda c: c["ellipsoid_containers"].update(core_margin=4), "ellipsoid_containers.core_margin = 4 a leaves no core"),
     (lambda c: c["containers"].update(fit_min_n=200), "fewer than 2 container sizes"),
     (lambda c: c["containers"]["windows"].update(fit_min_diameter=0.1), "fit_min_diameter must be >= min_diameter"),
 ])
-def test_snakemake_refuses_a_study_without_its_input_packings(tmp_path, mutate, expected):
-    cfg = load("smoke.yaml")
+def test_contradicting_sections_are_refused_naming_the_key(mutate, expected):
+    cfg = copy.deepcopy(load("smoke.yaml"))
+    assert errors(cfg) == []
+    check_config(copy.deepcopy(cfg))
     mutate(cfg)
+    with pytest.raises(InvalidInputError, match=expected):
+        check_config(cfg)
+
+
+@pytest.mark.parametrize("name", ["config.yaml", "smoke.yaml"])
+def test_shipped_configs_pass_the_cross_checks(name):
+    check_config(load(name))
+
+
+@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
+def test_snakemake_refuses_a_study_without_its_input_packings(tmp_path):
+    """The workflow runs the cross-reference checks (one case end to end; the others above)."""
+    cfg = load("smoke.yaml")
+    cfg["slp"]["diluted"].update(seeds=[1, 7])
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(cfg))
     out = subprocess.run(["snakemake", "-n", "--configfile", str(bad)], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
     assert out.returncode != 0
-    assert __import__("re").search(expected, out.stdout + out.stderr), out.stdout + out.stderr
+    assert re.search(r"slp.diluted.seeds \[7\] are not seeds", out.stdout + out.stderr), out.stdout + out.stderr

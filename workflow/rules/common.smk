@@ -20,7 +20,7 @@ import shlex
 
 from snakemake.utils import validate
 
-from hardpack.distributions import from_spec
+from hardpack.config import check_config
 
 
 validate(config, "../schemas/config.schema.yaml")
@@ -55,111 +55,8 @@ VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
 
 
-# ---------------------------------------------------------------------------------------------
 # Config checks the JSON schema cannot express (cross references); each names the key to fix.
-
-def _check_distribution(where, spec):
-    try:
-        from_spec(spec)
-    except ValueError as exc:
-        raise ValueError(f"config: {where}.distribution: {exc}") from None
-
-
-def check_config():
-    """Refuse a config whose sections contradict each other."""
-    for name, ens in ENSEMBLES.items():
-        _check_distribution(f"ensembles.{name}", ens["distribution"])
-    if RATES and RATES["ensemble"] not in ENSEMBLES:
-        raise ValueError(f"config: rates.ensemble {RATES['ensemble']!r} is not one of the ensembles "
-                         f"{sorted(ENSEMBLES)}")
-    if SLP_DENSEST and len({run["d"] for run in SLP_DENSEST["runs"]}) != len(SLP_DENSEST["runs"]):
-        raise ValueError("config: slp.densest.runs lists a dimension twice")
-    if SLP_MRJ:
-        for name in SLP_MRJ["ensembles"]:
-            if name not in ENSEMBLES:
-                raise ValueError(f"config: slp.mrj.ensembles names {name!r}, which is not an ensemble")
-        for name, spec in SLP_MRJ.get("systems", {}).items():
-            if name in ENSEMBLES:
-                raise ValueError(f"config: slp.mrj.systems.{name} has the name of an ensemble; rename it")
-            if "distribution" in spec:
-                _check_distribution(f"slp.mrj.systems.{name}", spec["distribution"])
-    if SLP_DILUTED:
-        if not SLP_MRJ or SLP_DILUTED["ensemble"] not in SLP_MRJ["ensembles"]:
-            raise ValueError(f"config: slp.diluted.ensemble {SLP_DILUTED['ensemble']!r} must be one of "
-                             "slp.mrj.ensembles (its SLP MRJ packings are the starts)")
-        missing = set(SLP_DILUTED["seeds"]) - set(ENSEMBLES[SLP_DILUTED["ensemble"]]["seeds"])
-        if missing:
-            raise ValueError(f"config: slp.diluted.seeds {sorted(missing)} are not seeds of ensemble "
-                             f"{SLP_DILUTED['ensemble']!r}")
-    if FREEENERGY:
-        simplex = FREEENERGY["simplex"]
-        if simplex["ensemble"] not in ENSEMBLES:
-            raise ValueError(f"config: freeenergy.simplex.ensemble {simplex['ensemble']!r} is not one of "
-                             f"the ensembles {sorted(ENSEMBLES)}")
-        missing = set(simplex["seeds"]) - set(ENSEMBLES[simplex["ensemble"]]["seeds"])
-        if missing:
-            raise ValueError(f"config: freeenergy.simplex.seeds {sorted(missing)} are not seeds of ensemble "
-                             f"{simplex['ensemble']!r} (its LS packings are the inputs)")
-    if GLASS:
-        if GLASS["N"] % 2:
-            raise ValueError(f"config: glass.N = {GLASS['N']} must be even (the triangular crystal has 2 disks per cell)")
-        if not max(GLASS["snapshots"]) < GLASS["phi_end"]:
-            raise ValueError("config: glass.phi_end must be above every glass.snapshots density")
-        dx = GLASS["composition"]["dx"]
-        if not (0 < GLASS["x_large"] - dx and GLASS["x_large"] + dx < 1):
-            raise ValueError("config: glass.x_large -+ glass.composition.dx must stay in (0, 1)")
-    if MICROSEG:
-        rows, cols = MICROSEG["shape"]
-        if rows % 2:
-            raise ValueError(f"config: microsegregated.shape rows = {rows} must be even (the triangular crystal)")
-        if MICROSEG["window"][0] > rows or MICROSEG["window"][1] > cols:
-            raise ValueError("config: microsegregated.window must fit microsegregated.shape")
-        if MICROSEG["packings"] > MICROSEG["label_realisations"]:
-            raise ValueError("config: microsegregated.packings must not exceed label_realisations (one "
-                             "packing per label realisation)")
-
-
-def check_ellipsoids():
-    """The M&M system and the near-sphere systems name ellipsoid families."""
-    if not ELLIPSOIDS:
-        return
-    if "mm" in ELLIPSOIDS and ELLIPSOIDS["mm"]["family"] not in ELLIPSOIDS["families"]:
-        raise ValueError(f"config: ellipsoids.mm.family {ELLIPSOIDS['mm']['family']!r} is not one of "
-                         f"ellipsoids.families {sorted(ELLIPSOIDS['families'])}")
-    unknown = set(ELLIPSOIDS.get("near_sphere", {}).get("families", [])) - set(ELLIPSOIDS["families"])
-    if unknown:
-        raise ValueError(f"config: ellipsoids.near_sphere.families {sorted(unknown)} are not ellipsoids.families "
-                         f"{sorted(ELLIPSOIDS['families'])}")
-
-
-def check_containers():
-    """The window study reads a 3D LS ensemble; the largest container (of spheres and of
-    ellipsoids) has a core; the fit has points."""
-    if not CONTAINERS:
-        return
-    windows = CONTAINERS["windows"]
-    ens = ENSEMBLES.get(windows["ensemble"])
-    if ens is None or ens["d"] != 3 or ens["distribution"]["kind"] != "monodisperse":
-        raise ValueError(f"config: containers.windows.ensemble {windows['ensemble']!r} must be a monodisperse "
-                         "3D ensemble (its LS packings are the periodic packings of Fig. 7.3)")
-    if not CONTAINERS["core_margin"] < max(CONTAINERS["N"]) ** (1 / 3):
-        raise ValueError(f"config: containers.core_margin = {CONTAINERS['core_margin']} a leaves no core in the "
-                         f"largest container (N = {max(CONTAINERS['N'])}, R > N^(1/3) a): lower it")
-    fitted = [n for n in CONTAINERS["N"] if n >= CONTAINERS["fit_min_n"]]
-    if len(fitted) < 2 or len(fitted) * len(CONTAINERS["seeds"]) < 3:
-        raise ValueError("config: containers.fit_min_n leaves fewer than 2 container sizes or 3 packings for "
-                         "the Eq. 7.2 fit")
-    if not windows["fit_min_diameter"] >= windows["min_diameter"]:
-        raise ValueError("config: containers.windows.fit_min_diameter must be >= min_diameter")
-    ell = ELLIPSOID_CONTAINERS
-    if ell and not ell["core_margin"] < max(ell["N"]) ** (1 / 3):
-        raise ValueError(f"config: ellipsoid_containers.core_margin = {ell['core_margin']} a leaves no core in the "
-                         f"largest container (N = {max(ell['N'])}, R > N^(1/3) a): lower it")
-
-
-check_config()
-check_ellipsoids()
-check_containers()
+check_config(config)
 
 
 # ---------------------------------------------------------------------------------------------
