@@ -6,6 +6,8 @@ largest possible contact distance, filtered by the exact criterion |x_i - x_j| <
 The grid must return exactly the same set of pairs, each once.
 """
 
+import itertools
+
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
@@ -14,7 +16,7 @@ from hardpack.distributions import LogNormal, uniform_size, uniform_volume
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import ball_volume
 from hardpack.geometry.neighbours import build_grid, grid_pairs, insertion_levels, random_sequential_addition
-from hardpack.geometry.neighbours.grid import search_range
+from hardpack.geometry.neighbours.grid import points_within, search_range
 
 
 def wrap(x, box):
@@ -144,3 +146,27 @@ def test_rsa_refuses_above_saturation():
     box = np.full(3, (ball_volume(r, 3).sum() / 0.45) ** (1 / 3))  # monodisperse RSA saturates at 0.384
     with pytest.raises(InvalidInputError, match="saturation"):
         random_sequential_addition(r, box, seed=1, max_trials=2000)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_points_within_windows_match_an_exhaustive_search_over_images(d):
+    """Window members of a sheared periodic cell, radius beyond half the cell (several images of a
+    point in one window): the grid finds exactly the (point, image) pairs an exhaustive search over
+    lattice images finds, with their distances."""
+    rng = np.random.default_rng(3)
+    lattice = np.eye(d) * 4.0
+    lattice[0, 1] = 1.5
+    frac = rng.random((60, d))
+    x = frac @ lattice.T
+    centres = rng.random((25, d))
+    radius = 2.6
+    grid = build_grid(frac, lattice, np.full(len(frac), radius / 2), per_cell=2)
+    start, point, dist = points_within(centres, grid.x, grid.lattice, 1.0 / grid.heights, grid.n_cells,
+                                       grid.strides, grid.cell_offset, grid.cell_start, grid.order, radius)
+    images = np.array(list(itertools.product(range(-3, 4), repeat=d))) @ lattice.T
+    for m, c in enumerate(centres @ lattice.T):
+        r = np.linalg.norm(x[:, None, :] + images[None] - c, axis=2)
+        want = sorted((j, round(v, 12)) for j, v in zip(*np.nonzero(r < radius)[:1], r[r < radius]))
+        got = sorted((j, round(v, 12)) for j, v in zip(point[start[m]:start[m + 1]], dist[start[m]:start[m + 1]]))
+        assert got == want
+    assert start[-1] > len(centres) * len(frac) * 0.3  # a real test: windows hold many points

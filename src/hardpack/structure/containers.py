@@ -38,6 +38,8 @@ import xarray as xr
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import ball_volume
 from hardpack.geometry.ellipsoid_ball import TOLERANCE, covered_volumes
+from hardpack.geometry.neighbours import build_grid
+from hardpack.geometry.neighbours.grid import points_within
 
 
 def ball_intersection_volume(big, small, dist, d: int = 3) -> np.ndarray:
@@ -243,8 +245,6 @@ def window_fluctuations(packing, window_radii, n_windows: int = 1000, seed: int 
     _sphere_check(packing, "the window fluctuations")
     if packing.boundary.kind != "periodic" or not packing.is_orthorhombic:
         raise InvalidInputError("window fluctuations need a periodic orthorhombic cell")
-    from scipy.spatial import cKDTree
-
     d = packing.dim
     box = np.diag(packing.lattice).copy()
     radii_w = np.atleast_1d(np.asarray(window_radii, float))
@@ -254,19 +254,18 @@ def window_fluctuations(packing, window_radii, n_windows: int = 1000, seed: int 
                                 f"{box.min() / 2 - a.max():.4g} (one periodic image per sphere)")
     if int(n_windows) != n_windows or n_windows < 2:
         raise InvalidInputError(f"n_windows must be an integer >= 2, got {n_windows!r}")
-    x = packing.wrapped().positions % box
-    tree = cKDTree(x, boxsize=box)
+    reach = 0.5 * (radii_w.max() + a.max())
+    grid = build_grid(packing.fractional(), packing.lattice, np.full(packing.n_particles, reach), per_cell=2)
     rng = np.random.default_rng(seed)
     mean, sd = [], []
     for R in radii_w:
-        centres = rng.random((int(n_windows), d)) * box
-        vals = np.empty(int(n_windows))
-        for w, c in enumerate(centres):
-            idx = np.asarray(tree.query_ball_point(c, R + a.max()), dtype=np.int64)
-            dx = x[idx] - c
-            dx -= box * np.rint(dx / box)
-            dist = np.sqrt(np.einsum("ij,ij->i", dx, dx))
-            vals[w] = ball_intersection_volume(R, a[idx], dist, d).sum() / ball_volume(R, d)
+        centres = rng.random((int(n_windows), d))
+        start, member, dist = points_within(centres, grid.x, grid.lattice, 1.0 / grid.heights, grid.n_cells,
+                                            grid.strides, grid.cell_offset, grid.cell_start, grid.order,
+                                            R + a.max())
+        window = np.repeat(np.arange(int(n_windows)), np.diff(start))
+        covered = ball_intersection_volume(R, a[member], dist, d)
+        vals = np.bincount(window, weights=covered, minlength=int(n_windows)) / ball_volume(R, d)
         mean.append(vals.mean())
         sd.append(vals.std(ddof=1))
     sd = np.array(sd)

@@ -724,3 +724,90 @@ def window_counts(centres_frac, x, lattice, inv_heights, n_cells, strides, cell_
             acc += hist[k]
             out[m, k] = acc
     return out
+
+
+@numba.njit(cache=True)
+def points_within(centres_frac, x, lattice, inv_heights, n_cells, strides, cell_offset, cell_start, order,
+                  radius):
+    """Every point image (all periodic images) closer than ``radius`` to each centre, on a single-level
+    grid: the members of spherical windows.
+
+    Parameters
+    ----------
+    centres_frac : numpy.ndarray of float, shape (M, d)
+        Window centres, fractional coordinates.
+    x : numpy.ndarray of float, shape (N, d)
+        Cartesian points.
+    lattice : numpy.ndarray of float, shape (d, d)
+        Cell, lattice vectors as columns.
+    inv_heights : numpy.ndarray of float, shape (d,)
+        1 / h_k.
+    n_cells, strides : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction and flat-index strides of every level (level 0 is used).
+    cell_offset : numpy.ndarray of int64, shape (L + 1,)
+        First flat index of every level.
+    cell_start : numpy.ndarray of int64, shape (n_total + 1,)
+        Start of every cell's points in ``order``.
+    order : numpy.ndarray of int64, shape (N,)
+        Point indices sorted by flat cell.
+    radius : float
+        Window radius.
+
+    Returns
+    -------
+    start : numpy.ndarray of int64, shape (M + 1,)
+        The members of window m are ``point[start[m]:start[m + 1]]``.
+    point : numpy.ndarray of int64, shape (K,)
+        Point indices (an index appears once per image within the window).
+    distance : numpy.ndarray of float, shape (K,)
+        Distance of that image from the window's centre.
+    """
+    d = x.shape[1]
+    m_total = centres_frac.shape[0]
+    r2max = radius * radius
+    lo = np.empty(d, dtype=np.int64)
+    hi = np.empty(d, dtype=np.int64)
+    c = np.empty(d, dtype=np.int64)
+    image = np.empty(d, dtype=np.int64)
+    shift = np.empty(d)
+    centre = np.empty(d)
+    start = np.zeros(m_total + 1, dtype=np.int64)
+    point = np.empty(0, dtype=np.int64)
+    distance = np.empty(0)
+    for fill in range(2):  # count, then fill
+        k = 0
+        for m in range(m_total):
+            for a in range(d):
+                s = 0.0
+                for b in range(d):
+                    s += lattice[a, b] * centres_frac[m, b]
+                centre[a] = s
+            search_range(centres_frac[m], radius * (1.0 + RANGE_PAD), inv_heights, n_cells, 0, lo, hi)
+            for a in range(d):
+                c[a] = lo[a]
+            while True:
+                flat = image_cell(c, n_cells, strides, cell_offset, 0, image)
+                for a in range(d):
+                    s = 0.0
+                    for b in range(d):
+                        s += lattice[a, b] * image[b]
+                    shift[a] = s
+                for q in range(cell_start[flat], cell_start[flat + 1]):
+                    j = order[q]
+                    r2 = 0.0
+                    for a in range(d):
+                        t = x[j, a] + shift[a] - centre[a]
+                        r2 += t * t
+                    if r2 < r2max:
+                        if fill:
+                            point[k] = j
+                            distance[k] = np.sqrt(r2)
+                        k += 1
+                if not next_cell(c, lo, hi):
+                    break
+            if not fill:
+                start[m + 1] = k
+        if not fill:
+            point = np.empty(k, dtype=np.int64)
+            distance = np.empty(k)
+    return start, point, distance
