@@ -682,47 +682,27 @@ def window_counts(centres_frac, x, lattice, inv_heights, n_cells, strides, cell_
     numpy.ndarray of int64, shape (M, n_radii)
         The counts.
     """
-    d = x.shape[1]
     m_total = centres_frac.shape[0]
     n_rad = window_radii.size
     out = np.zeros((m_total, n_rad), dtype=np.int64)
     rmax = window_radii[-1]
-    rmax2 = rmax * rmax
     for m in numba.prange(m_total):
-        lo = np.empty(d, dtype=np.int64)
-        hi = np.empty(d, dtype=np.int64)
-        c = np.empty(d, dtype=np.int64)
-        image = np.empty(d, dtype=np.int64)
-        shift = np.empty(d)
-        centre = np.zeros(d)
-        for a in range(d):
-            for b in range(d):
-                centre[a] += lattice[a, b] * centres_frac[m, b]
+        point = np.empty(64, dtype=np.int64)
+        dist = np.empty(64)
+        k = _window_members(centres_frac[m], rmax, x, lattice, inv_heights, n_cells, strides, cell_offset,
+                            cell_start, order, point, dist)
+        if k > point.size:
+            point = np.empty(k, dtype=np.int64)
+            dist = np.empty(k)
+            _window_members(centres_frac[m], rmax, x, lattice, inv_heights, n_cells, strides, cell_offset,
+                            cell_start, order, point, dist)
         hist = np.zeros(n_rad + 1, dtype=np.int64)
-        search_range(centres_frac[m], rmax * (1.0 + RANGE_PAD), inv_heights, n_cells, 0, lo, hi)
-        for a in range(d):
-            c[a] = lo[a]
-        while True:
-            flat = image_cell(c, n_cells, strides, cell_offset, 0, image)
-            for a in range(d):
-                s = 0.0
-                for b in range(d):
-                    s += lattice[a, b] * image[b]
-                shift[a] = s
-            for q in range(cell_start[flat], cell_start[flat + 1]):
-                j = order[q]
-                r2 = 0.0
-                for a in range(d):
-                    t = x[j, a] + shift[a] - centre[a]
-                    r2 += t * t
-                if r2 < rmax2:
-                    hist[np.searchsorted(window_radii, np.sqrt(r2), side="right")] += 1
-            if not next_cell(c, lo, hi):
-                break
+        for q in range(k):
+            hist[np.searchsorted(window_radii, dist[q], side="right")] += 1
         acc = 0
-        for k in range(n_rad):
-            acc += hist[k]
-            out[m, k] = acc
+        for b in range(n_rad):
+            acc += hist[b]
+            out[m, b] = acc
     return out
 
 
@@ -762,52 +742,60 @@ def points_within(centres_frac, x, lattice, inv_heights, n_cells, strides, cell_
     distance : numpy.ndarray of float, shape (K,)
         Distance of that image from the window's centre.
     """
-    d = x.shape[1]
     m_total = centres_frac.shape[0]
+    start = np.zeros(m_total + 1, dtype=np.int64)
+    none_i = np.empty(0, dtype=np.int64)
+    none_f = np.empty(0)
+    for m in range(m_total):  # count
+        start[m + 1] = start[m] + _window_members(centres_frac[m], radius, x, lattice, inv_heights, n_cells,
+                                                  strides, cell_offset, cell_start, order, none_i, none_f)
+    point = np.empty(start[-1], dtype=np.int64)
+    distance = np.empty(start[-1])
+    for m in range(m_total):  # fill
+        _window_members(centres_frac[m], radius, x, lattice, inv_heights, n_cells, strides, cell_offset,
+                        cell_start, order, point[start[m]:start[m + 1]], distance[start[m]:start[m + 1]])
+    return start, point, distance
+
+
+@numba.njit(cache=True)
+def _window_members(centre_frac, radius, x, lattice, inv_heights, n_cells, strides, cell_offset, cell_start,
+                    order, point, distance):
+    """The point images closer than ``radius`` to one centre (fractional ``centre_frac``) on level 0 of
+    the grid: writes the first ``point.size`` of them (index, distance) into ``point`` and ``distance``
+    and returns how many there are (call again with larger buffers if that is more)."""
+    d = x.shape[1]
     r2max = radius * radius
     lo = np.empty(d, dtype=np.int64)
     hi = np.empty(d, dtype=np.int64)
     c = np.empty(d, dtype=np.int64)
     image = np.empty(d, dtype=np.int64)
     shift = np.empty(d)
-    centre = np.empty(d)
-    start = np.zeros(m_total + 1, dtype=np.int64)
-    point = np.empty(0, dtype=np.int64)
-    distance = np.empty(0)
-    for fill in range(2):  # count, then fill
-        k = 0
-        for m in range(m_total):
+    centre = np.zeros(d)
+    for a in range(d):
+        for b in range(d):
+            centre[a] += lattice[a, b] * centre_frac[b]
+    search_range(centre_frac, radius * (1.0 + RANGE_PAD), inv_heights, n_cells, 0, lo, hi)
+    for a in range(d):
+        c[a] = lo[a]
+    k = 0
+    while True:
+        flat = image_cell(c, n_cells, strides, cell_offset, 0, image)
+        for a in range(d):
+            s = 0.0
+            for b in range(d):
+                s += lattice[a, b] * image[b]
+            shift[a] = s
+        for q in range(cell_start[flat], cell_start[flat + 1]):
+            j = order[q]
+            r2 = 0.0
             for a in range(d):
-                s = 0.0
-                for b in range(d):
-                    s += lattice[a, b] * centres_frac[m, b]
-                centre[a] = s
-            search_range(centres_frac[m], radius * (1.0 + RANGE_PAD), inv_heights, n_cells, 0, lo, hi)
-            for a in range(d):
-                c[a] = lo[a]
-            while True:
-                flat = image_cell(c, n_cells, strides, cell_offset, 0, image)
-                for a in range(d):
-                    s = 0.0
-                    for b in range(d):
-                        s += lattice[a, b] * image[b]
-                    shift[a] = s
-                for q in range(cell_start[flat], cell_start[flat + 1]):
-                    j = order[q]
-                    r2 = 0.0
-                    for a in range(d):
-                        t = x[j, a] + shift[a] - centre[a]
-                        r2 += t * t
-                    if r2 < r2max:
-                        if fill:
-                            point[k] = j
-                            distance[k] = np.sqrt(r2)
-                        k += 1
-                if not next_cell(c, lo, hi):
-                    break
-            if not fill:
-                start[m + 1] = k
-        if not fill:
-            point = np.empty(k, dtype=np.int64)
-            distance = np.empty(k)
-    return start, point, distance
+                t = x[j, a] + shift[a] - centre[a]
+                r2 += t * t
+            if r2 < r2max:
+                if k < point.size:
+                    point[k] = j
+                    distance[k] = np.sqrt(r2)
+                k += 1
+        if not next_cell(c, lo, hi):
+            break
+    return k
