@@ -365,7 +365,9 @@ def _ellipsoid_verdicts(n=100, jammed=(1, 1, 1, 1, 1, 1), order=(2, 2, 2, 2, 2, 
     """Six 3D packings: three at alpha = 1.05 and three at 1.5 (beta = 0.5), hypostatic."""
     k = len(jammed)
     alpha = [1.05] * (k // 2) + [1.5] * (k - k // 2)
-    data = {"jammed": ("sample", np.asarray(jammed, float)), "order_code": ("sample", np.asarray(order)),
+    verdict = [1 if j else (-2 if o == 0 else 0) for j, o in zip(jammed, order)]
+    data = {"verdict": ("sample", np.asarray(verdict)), "jammed": ("sample", np.asarray(jammed, float)),
+            "order_code": ("sample", np.asarray(order)),
             "hypostatic": ("sample", np.ones(k)), "n_stresses": ("sample", np.ones(k)),
             "approximate_stress": ("sample", np.ones(k)), "stress_gap": ("sample", np.full(k, gap)),
             "d": ("sample", np.full(k, 3)), "N": ("sample", np.full(k, n))}
@@ -387,6 +389,11 @@ def test_ellipsoid_jamming_rows_judge_the_second_order_claims():
                                                                              order=(1, 1, 1, 2, 2, 2), gap=1e-4)])}
     assert bad["donev-5.6-near-sphere-hypostatic-second-order"].status == FAIL
     assert bad["donev-5.6-stress-eigenvalue-gap"].status == FAIL
+    # an undetermined verdict (order 0) is not "jammed at second order": it fails, and the row says so
+    unknown = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts(jammed=(1, 0, 1, 1, 1, 1),
+                                                                                 order=(2, 0, 2, 2, 2, 2))])}
+    row = unknown["donev-5.6-near-sphere-hypostatic-second-order"]
+    assert row.status == FAIL and "2 of 3 packings" in row.detail and "(1 undetermined)" in row.detail
     small = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts(n=40)])}
     assert {r.status for r in small.values()} == {NA}
     # a claim about every packing: one packing of six not jammed fails it (a standard error over

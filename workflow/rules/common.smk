@@ -542,7 +542,7 @@ ELLIPSOID_VARIABLES = ("z_mean", "z_all", "rattler_fraction", "nematic_S", "pres
 
 
 #: per-packing numbers of the ellipsoid jamming verdicts (hardpack verify --delta gaps --refine)
-ELLIPSOID_VERDICT_VARIABLES = ("jammed", "order_code", "hypostatic", "z_mean", "rattler_fraction",
+ELLIPSOID_VERDICT_VARIABLES = ("verdict", "jammed", "order_code", "hypostatic", "z_mean", "rattler_fraction",
                                "isostaticity_gap", "n_floppy", "n_stresses", "approximate_stress",
                                "stress_residual", "stress_gap", "delta", "delta_ambiguous", "lambda_min",
                                "stiffness_scale", "n_backbone", "jamming_distance", "refined")

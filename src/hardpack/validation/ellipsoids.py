@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from hardpack.jamming.result import Verdict
 from hardpack.validation.rows import Row, evaluate, seed_statistics
 from hardpack.validation.targets import load_targets
 
@@ -204,11 +205,12 @@ def ellipsoid_jamming_rows(summaries) -> list[Row]:
             targets["donev-5.6-ls-ellipsoids-jammed"], jammed[aspherical], n, "alpha > 1",
             f"{int(jammed[aspherical].sum())} of {int(aspherical.sum())} packings with alpha > 1 jammed"))
         near_ok = jammed & second & hypostatic
+        undetermined = np.asarray(s["verdict"].values) == int(Verdict.UNDETERMINED)
         out.append(_every_packing_row(
             targets["donev-5.6-near-sphere-hypostatic-second-order"], near_ok[near], n,
             f"1 < alpha <= {NEAR_SPHERE_ALPHA:g}",
             f"{int(near_ok[near].sum())} of {int(near.sum())} packings near the sphere point "
-            "hypostatic and jammed at second order"))
+            f"hypostatic and jammed at second order ({int(undetermined[near].sum())} undetermined)"))
         is_jammed = aspherical & jammed
         unique = np.asarray(s["n_stresses"].values) == 1
         out.append(_every_packing_row(
