@@ -18,7 +18,7 @@ import pytest
 from numba import njit
 
 import hardpack
-from hardpack.md import kernel
+from hardpack.md import _kernel as kernel
 
 
 def python_function(obj):
@@ -39,7 +39,7 @@ def public_api() -> dict[str, object]:
             if python_function(obj) is None and not inspect.isclass(obj):
                 continue
             found[f"{obj.__module__}.{name}"] = obj
-    found["hardpack.md.kernel.run_events"] = kernel.run_events
+    found["hardpack.md._kernel.run_events"] = kernel.run_events
     return found
 
 
@@ -87,7 +87,7 @@ def missing_sections(obj) -> list[str]:
 
 def test_the_public_api_is_found():
     assert len(API) >= 90
-    for name in ("hardpack.jamming.verify.verify", "hardpack.md.kernel.run_events",
+    for name in ("hardpack.jamming.verify.verify", "hardpack.md._kernel.run_events",
                  "hardpack.events.roots.pair_time", "hardpack.geometry.packing.Packing",
                  "hardpack.jamming.contacts.contact_network"):
         assert name in API
@@ -201,7 +201,7 @@ def test_every_subpackage_is_audited():
                    if info.ispkg and not info.name.startswith("_")}
     audited = {name.split(".")[1] for name in DOCUMENTED_MODULES if name.count(".") >= 1}
     assert subpackages <= audited
-    assert {"hardpack", "hardpack.cli", "hardpack.md.kernel", "hardpack.geometry.neighbours.grid"} <= set(
+    assert {"hardpack", "hardpack.cli", "hardpack.md.engine", "hardpack.geometry.neighbours.grid"} <= set(
         DOCUMENTED_MODULES)
 
 

@@ -1,5 +1,5 @@
 """Ellipsoids and ellipses in a hard spherical container: the wall events of the ellipsoid MD
-(:func:`hardpack.md.ellipsoid_kernel.wall_predict`, :func:`~hardpack.md.ellipsoid_kernel.wall_collide`;
+(:func:`hardpack.md._ellipsoid_kernel.wall_predict`, :func:`~hardpack.md._ellipsoid_kernel.wall_collide`;
 Donev 2006, Ch. 7 and sec. 3.5).
 
 - A single rotating ellipsoid (and ellipse) bouncing ~10^3 times: kinetic energy (translational

@@ -22,7 +22,7 @@ from hardpack.geometry import Packing
 from hardpack.geometry.shapes import Ellipsoids
 from hardpack.initial import random_ellipsoid_packing
 from hardpack.md import StopCriteria, equilibrate, maxwell_boltzmann
-from hardpack.md import ellipsoid_kernel as ek
+from hardpack.md import _ellipsoid_kernel as ek
 from hardpack.md.ellipsoid import EllipsoidSimulation, compress_ellipsoids, random_angular_velocities
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, moments_of_inertia
 
@@ -218,7 +218,7 @@ def test_support_rate_bound_holds_and_is_tight(d):
 @pytest.mark.parametrize("d", [2, 3])
 @pytest.mark.parametrize("seed", range(40))
 def test_safe_time_is_a_lower_bound_on_the_contact_time(d, seed):
-    """The safe time of a pair (:func:`hardpack.md.ellipsoid_kernel.pair_start`: the slab width
+    """The safe time of a pair (:func:`hardpack.md._ellipsoid_kernel.pair_start`: the slab width
     over the bound on its closing rate from the centres' motion, the spins through
     support_rate_bound, and the growth) is positive for disjoint particles and no contact happens
     before it: zeta stays positive on a fine grid of times up to it, for random aspherical pairs
@@ -513,8 +513,8 @@ def test_spheres_and_bad_input_are_refused():
 def test_a_stalled_window_raises_the_ellipsoid_error_and_restores_the_start(monkeypatch):
     """The window loop (Engine.run_window) hands a STALLED kernel status to the ellipsoid engine's
     own error, with the particles back at the window start, never a silent window."""
+    from hardpack.md._kernel import WindowStatus
     from hardpack.md.ellipsoid_engine import EngineStalledError
-    from hardpack.md.kernel import WindowStatus
 
     eng = _pair_engine(3, 2)
     start = eng.P.copy()

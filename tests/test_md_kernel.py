@@ -1,6 +1,6 @@
 """Two-body analytics of the event-driven MD kernel: collision times with growth, neighbourhood
 exit times, and post-collision velocities (the growth-corrected elastic law derived in
-hardpack.md.kernel).
+hardpack.md._kernel).
 
 Every expected number below is derived by hand from straight-line motion and linearly growing
 radii, independently of the kernel's quadratic formulas.

@@ -6,7 +6,7 @@ grows only the large disks of a binary packing).
   velocity is reflected in the frame of the growing surfaces (approach speed u + Gamma / 2 before
   and after), total momentum conserved, the fixed disk keeps its radius exactly;
 - uniform growth through the per-particle path is bit-identical to the scalar-rate arithmetic
-  (:func:`hardpack.md.deforming_kernel.pair_sigma` with equal rates);
+  (:func:`hardpack.md._deforming_kernel.pair_sigma` with equal rates);
 - a run in which a third of the disks grow conserves the total momentum and leaves the others'
   radii untouched;
 - bad masks are refused.
@@ -21,7 +21,7 @@ from hardpack.distributions import monodisperse
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
-from hardpack.md import deforming_kernel as dk
+from hardpack.md import _deforming_kernel as dk
 from hardpack.md.deforming import DeformingSimulation
 
 

@@ -3,7 +3,7 @@
 ``heap[k]`` is the item in slot k and ``hkey[k]`` its key (the predicted event time), so a sift
 compares keys that sit next to each other in memory; ``hpos[i]`` is the slot of item i (-1 when
 absent). One item per particle, whose key changes in place (Donev's "one event per particle"
-schedule, Donev 2006, dissertation sec. 3.4.1). Used by :mod:`hardpack.md.kernel`
+schedule, Donev 2006, dissertation sec. 3.4.1). Used by :mod:`hardpack.md._kernel`
 and :mod:`hardpack.freeenergy._kernel`; inlined into their event loops.
 """
 

@@ -1,12 +1,12 @@
 """Event times of hard-particle dynamics: the roots shared by every event-driven engine.
 
 - :func:`contact_root` / :func:`pair_time`: first contact of two spheres whose contact distance
-  grows linearly, sigma(t) = sigma_0 + g t (derived in :mod:`hardpack.md.kernel`); the MD engine
+  grows linearly, sigma(t) = sigma_0 + g t (derived in :mod:`hardpack.md._kernel`); the MD engine
   uses it with growth, the bounding-cell MD (:mod:`hardpack.freeenergy`) with g = 0.
 - :func:`exit_time`: a growing sphere touches the inside of its fixed bounding sphere (the
   near-neighbour lists of Donev 2006, sec. 3.3.2).
 - :func:`container_time`: a growing sphere hits the wall of a fixed spherical container (Donev 2006,
-  Ch. 7); flat walls need only a linear root (in :mod:`hardpack.md.kernel`).
+  Ch. 7); flat walls need only a linear root (in :mod:`hardpack.md._kernel`).
 
 The ``*_root`` functions take the dot products and are inlined into the numba kernels' loops;
 the ``*_time`` functions take vectors.
@@ -46,7 +46,7 @@ def dot_products(a, b):
 def pair_time(r, u, sig0, g):
     """First contact time >= 0 of a pair whose contact distance grows linearly; inf if none.
 
-    Solves |r + u t| = sig0 + g t (derivation in :mod:`hardpack.md.kernel`) through
+    Solves |r + u t| = sig0 + g t (derivation in :mod:`hardpack.md._kernel`) through
     :func:`contact_root` with no upper time limit.
 
     Parameters
@@ -75,7 +75,7 @@ def contact_root(rr, ru, uu, sig0, g, tmax):
     """First contact time >= 0 of a pair from its dot products; inf if none, or early.
 
     The root of A t^2 + 2 B t + C = 0 with A = uu - g^2, B = ru - sig0 g, C = rr - sig0^2
-    (derivation in :mod:`hardpack.md.kernel`). When A >= 0 the root is at least C / (-2B), which
+    (derivation in :mod:`hardpack.md._kernel`). When A >= 0 the root is at least C / (-2B), which
     rejects most pairs before the square root.
 
     Parameters

@@ -9,7 +9,7 @@ the cell centres (periodic image included); entries nb_start[i]:nb_end[i] are th
 cells can still overlap (the caller prunes them as the cells shrink). Particles with inverse
 mass 0 are frozen: never moved, never scheduled.
 
-State, one row per particle as in :mod:`hardpack.md.kernel`: ``P[i] = (dr_0..dr_{d-1},
+State, one row per particle as in :mod:`hardpack.md._kernel`: ``P[i] = (dr_0..dr_{d-1},
 v_0..v_{d-1}, s_i)``, displacement and velocity at the particle's own last update time s_i.
 
 Events follow the md engine's scheme (one predicted event per particle in a 4-ary min-heap with

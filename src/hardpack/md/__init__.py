@@ -11,7 +11,7 @@
 Engine: one predicted event per particle in a 4-ary heap, lazy invalidation with collision
 counters, neighbour lists with immobile bounding spheres (Donev's NNL) rebuilt particle by
 particle on a (hierarchical, for wide size distributions) cell grid, all masses 1 and kT = 1
-(:mod:`hardpack.md.kernel`, :mod:`hardpack.md.engine`).
+(:mod:`hardpack.md._kernel`, :mod:`hardpack.md.engine`).
 """
 
 from hardpack.md.compress import CompressResult, StopCriteria, compress, default_window

@@ -9,7 +9,7 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
 
 **Scheme used here** (simplest correct form; the departures from Donev's scheme are marked):
 
-1. A window of MD runs in a FIXED cell (:mod:`hardpack.md.deforming_kernel`); it measures the
+1. A window of MD runs in a FIXED cell (:mod:`hardpack.md._deforming_kernel`); it measures the
    time-averaged stress sigma = (int sum_i v_i v_i^T dt + sum_coll r_ij J_ij^T) / (V dt)
    (m = 1; the kinetic term is the ideal-gas part Donev's collisional stress leaves out), in
    units of the window's mean kT.
@@ -74,7 +74,7 @@ Growth is uniform (every radius at the same relative rate, d<D>/dt = Gamma, as i
 :func:`hardpack.md.compress`) or, with a ``growing`` mask, confined to some particles, each at
 dD/dt = Gamma while the others keep their size (Donev 2006, sec. 13.5 grows the large disks of a
 labelled crystal at constant pressure); the pair's summed growth rate enters the contact
-prediction and the collision law (:func:`hardpack.md.deforming_kernel.pair_sigma`).
+prediction and the collision law (:func:`hardpack.md._deforming_kernel.pair_sigma`).
 
 This is an overdamped, deterministic barostat: it drives the mean stress to P0 I but does not
 sample the isobaric ensemble's volume fluctuations. Tests: an ideal-gas check that the mean
@@ -95,7 +95,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
-from hardpack.md import deforming_kernel as dk
+from hardpack.md import _deforming_kernel as dk
 from hardpack.md.compress import CompressResult, StopCriteria, _check_run_options, _stop_reason, default_window
 from hardpack.md.simulation import OverlapError, maxwell_boltzmann
 
@@ -322,7 +322,7 @@ class DeformingSimulation:
         dk.wrap_into_cell(self.X, self.H, np.linalg.inv(self.H))
 
     def relative_rates(self) -> np.ndarray:
-        """kappa_i = (da_i/dt) / a_i of the next window (:mod:`hardpack.md.deforming_kernel`): all
+        """kappa_i = (da_i/dt) / a_i of the next window (:mod:`hardpack.md._deforming_kernel`): all
         Gamma / (2 <a>) (uniform growth), or Gamma / (2 a_i) for the growing particles and 0 for
         the others."""
         if self.growing is None:

@@ -1,7 +1,7 @@
 """Lubachevsky-Stillinger compression of hard ellipsoids (3D) and ellipses (2D).
 
 Event-driven MD with rotation and growing semiaxes (Donev 2006, dissertation sec. 3.5; kernels and
-physics in :mod:`hardpack.md.ellipsoid_kernel`), run window by window exactly as the sphere
+physics in :mod:`hardpack.md._ellipsoid_kernel`), run window by window exactly as the sphere
 compression (:mod:`hardpack.md.compress`): velocities (translational and angular) rescaled to
 kT = 1 at every synchronisation of a growing run, the reduced pressure of each window from the
 collision virial, stop criteria (:class:`hardpack.md.StopCriteria`), checkpoint/resume bit for bit
@@ -28,9 +28,9 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.shapes import Ellipsoids
 from hardpack.io import checkpoint as ckpt
+from hardpack.md._ellipsoid_kernel import EPS_F
 from hardpack.md.compress import StopCriteria, _check_run_options, default_window, run_windows, timeseries_dataset
 from hardpack.md.ellipsoid_engine import EllipsoidEngine, rotational_dof
-from hardpack.md.ellipsoid_kernel import EPS_F
 from hardpack.md.simulation import OverlapError, Simulation, check_start_configuration, maxwell_boltzmann
 
 log = logging.getLogger("hardpack.md")
@@ -247,7 +247,7 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
     packing : Packing
         Ellipsoids (3D) or ellipses (2D) without overlaps: N >= 2 in a periodic orthorhombic cell, or
         N >= 1 inside a spherical container (Donev 2006, Ch. 7; the wall events of
-        :mod:`hardpack.md.ellipsoid_kernel`; the window records then hold ``Z_wall``, the pressure
+        :mod:`hardpack.md._ellipsoid_kernel`; the window records then hold ``Z_wall``, the pressure
         on the wall, and ``wall_collisions``).
     growth_rate : float
         Gamma (module docstring), finite.

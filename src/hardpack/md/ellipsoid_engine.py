@@ -4,16 +4,16 @@ The window logic (neighbour-list persistence, spatial sorts, capacity doubling a
 window after an overflow, bounding-radius caps, grid levels) is the sphere engine's
 (:class:`hardpack.md.engine.Engine`), which this class extends: the bounding radius of a particle
 (its largest semiaxis) plays the sphere radius there, so ``radii`` are bounding radii. The kernels
-are :mod:`hardpack.md.ellipsoid_kernel`.
+are :mod:`hardpack.md._ellipsoid_kernel`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from hardpack.md import ellipsoid_kernel as ek
+from hardpack.md import _ellipsoid_kernel as ek
+from hardpack.md._kernel import WindowStatus
 from hardpack.md.engine import Engine, WindowResult, _aligned_rows
-from hardpack.md.kernel import WindowStatus
 
 
 class EngineStalledError(RuntimeError):
@@ -23,7 +23,7 @@ class EngineStalledError(RuntimeError):
 def moments_of_inertia(semiaxes: np.ndarray) -> np.ndarray:
     """Spherically symmetric moment of inertia of unit-mass ellipsoids (N, 3) or ellipses (N, 2):
     (2/15)(a^2 + b^2 + c^2), the mean principal moment (exact for spheres), or (a^2 + b^2)/4
-    (module docstring of :mod:`hardpack.md.ellipsoid_kernel`).
+    (module docstring of :mod:`hardpack.md._ellipsoid_kernel`).
 
     Parameters
     ----------
@@ -75,7 +75,7 @@ class EllipsoidEngine(Engine):
     capacity : int, optional
         Initial neighbour-list capacity (doubled on overflow).
     eps_f : float, optional
-        Trace tolerance (:data:`hardpack.md.ellipsoid_kernel.EPS_F`).
+        Trace tolerance (:data:`hardpack.md._ellipsoid_kernel.EPS_F`).
     boundary : SphericalContainer or None, optional
         A spherical container inside the box; None = periodic.
     """

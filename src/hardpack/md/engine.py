@@ -2,7 +2,7 @@
 
 A *window* starts at a synchronisation point with time t = 0 (Donev Alg. 3): all particles are at
 the same time and the schedule is reset (Alg. 4). Events are then processed
-(:func:`hardpack.md.kernel.run_events`) until the window's collision budget is spent or a time
+(:func:`hardpack.md._kernel.run_events`) until the window's collision budget is spent or a time
 cap is reached, and every particle is synchronised again. The bounding-sphere neighbour lists
 persist across windows (positions are advanced, never re-wrapped, by a synchronisation); they are
 rebuilt completely (Alg. 9) after a spatial sort, when the particles have grown close to the
@@ -23,8 +23,8 @@ import numpy as np
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.neighbours import cell_counts, geometric_levels
-from hardpack.md import kernel
-from hardpack.md.kernel import WindowStatus
+from hardpack.md import _kernel as kernel
+from hardpack.md._kernel import WindowStatus
 
 #: cells per particle of a level above which its grid is coarsened (dilute systems)
 MAX_CELLS_PER_PARTICLE = 2.0
@@ -145,7 +145,7 @@ def image_vectors(box: np.ndarray) -> np.ndarray:
 
 def wall_arrays(boundary, d: int) -> tuple[tuple, np.ndarray, np.ndarray]:
     """Kernel form of a boundary (:mod:`hardpack.geometry.boundaries`): the mode tuple
-    (:data:`hardpack.md.kernel.PERIODIC_MODE`, ``FLAT_WALLS_MODE`` or ``SPHERE_MODE``), the
+    (:data:`hardpack.md._kernel.PERIODIC_MODE`, ``FLAT_WALLS_MODE`` or ``SPHERE_MODE``), the
     walled-axis flags (d,) int8 and the container (centre, radius) (d + 1,) (zeros unless a
     spherical container).
 
@@ -369,7 +369,7 @@ class Engine:
         bounding-radius cap (or the requested skin exceeds what the cap allows). Every
         decision depends only on the state, so a restarted run repeats it exactly.
         ``log``: optional (pairs (M, 2) int32, values (M, d + 1)) arrays, M >= coll_target, that
-        receive the window's collisions (:func:`hardpack.md.kernel.run_events`).
+        receive the window's collisions (:func:`hardpack.md._kernel.run_events`).
 
         The event kernel itself is called by :meth:`_run_events` and the result read by
         :meth:`_window_result`, the two places where the sphere and ellipsoid engines differ.

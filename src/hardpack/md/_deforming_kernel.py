@@ -4,10 +4,10 @@ The cell is a general (sheared) lattice H whose columns are the lattice vectors 
 Donev 2006, sec. 3.2.4 and Eq. 3.1); it stays FIXED during a window and is deformed only between
 windows by the driver, so inside a window every particle moves on a straight line and the pair
 contact time is the quadratic root of the fixed-cell engine (:func:`hardpack.events.roots.contact_root`,
-derived in :mod:`hardpack.md.kernel`), not Donev's quartic of a cell deforming during the flight
+derived in :mod:`hardpack.md._kernel`), not Donev's quartic of a cell deforming during the flight
 (Donev 2006, sec. 3.2.2.2).
 
-Same event scheme as :mod:`hardpack.md.kernel` in its simplest form: one predicted event per
+Same event scheme as :mod:`hardpack.md._kernel` in its simplest form: one predicted event per
 particle in a 4-ary heap (:func:`hardpack.events.heap.heap_set`), lazy invalidation by collision
 counters, and neighbour lists with immobile bounding spheres (Donev 2006, sec. 3.3.2). There is no
 cell grid: a list is (re)built by scanning all N particles, so a partial update costs O(N d^2)

@@ -1,6 +1,6 @@
 """Numba kernels of event-driven MD of hard ellipsoids (d = 3) and ellipses (d = 2).
 
-The event loop is the one of the sphere engine (:mod:`hardpack.md.kernel`: one predicted event
+The event loop is the one of the sphere engine (:mod:`hardpack.md._kernel`: one predicted event
 per particle in a 4-ary heap with lazy invalidation by collision counters, neighbour lists with
 immobile bounding spheres rebuilt particle by particle on a cell grid, time measured from the last
 synchronisation); what differs is the particle state, the pair prediction and the collision law
@@ -107,7 +107,7 @@ from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
 from hardpack.geometry.contact import pw_contact_into
 from hardpack.geometry.ellipsoid_container import farthest_point_body
-from hardpack.md.kernel import (
+from hardpack.md._kernel import (
     A_T,
     A_VIRIAL,
     I_COLL,
@@ -128,7 +128,7 @@ CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
 WALL = -4  # event: the particle hits the wall of the spherical container
 
 #: boundary modes of :func:`run_events`, tuples whose LENGTH is a compile-time constant (as in
-#: :mod:`hardpack.md.kernel`): the periodic specialisation has no wall code at all
+#: :mod:`hardpack.md._kernel`): the periodic specialisation has no wall code at all
 PERIODIC_MODE = ()
 SPHERE_MODE = (0, 0)
 
@@ -1248,7 +1248,7 @@ def wall_collide(P, i, t, kappa, wspec, ww, wq):
 def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of,
              bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode, walled):
     """Partial NNL update of particle i at window time t (Donev 2006, Algorithm 10): advance i to
-    t and :func:`hardpack.md.kernel.update_neighbour_list` with the bounding radius R_i (largest
+    t and :func:`hardpack.md._kernel.update_neighbour_list` with the bounding radius R_i (largest
     semiaxis) in place of the sphere radius; in a container (``wmode``, ``walled`` all 1) without
     periodic images and wraps. Returns 0 or a :class:`WindowStatus` to stop with."""
     _, _, cr, _, _, _, _, _ = columns(L.shape[0])
@@ -1507,7 +1507,7 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
                coll_target, t_cap, rebuild_lists, wmode=PERIODIC_MODE, wspec=None):
     """One window of ellipsoid MD; arguments, accumulators and return codes as in
-    :func:`hardpack.md.kernel.run_events` (no ``dims``: d is the length of ``L``; ``eps_f`` the
+    :func:`hardpack.md._kernel.run_events` (no ``dims``: d is the length of ``L``; ``eps_f`` the
     trace tolerance; ``iacc`` has N_COUNTERS entries: after the sphere engine's, I_CHECK counts
     CHECK events and I_STALL_PARTICLE, I_STALL_PARTNER name the last event of a STALLED window (its
     time in acc[A_T]); acc[A_KE]
@@ -1528,9 +1528,9 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     eps_f : float
         Trace tolerance (module docstring, :data:`EPS_F`).
     skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs, slot_of, bs, nb, nn, mark
-        Bounding spheres, grid and neighbour lists, as in :func:`hardpack.md.kernel.run_events`.
+        Bounding spheres, grid and neighbour lists, as in :func:`hardpack.md._kernel.run_events`.
     cnt, ep, ec, hkey, heap, hpos
-        Event heap, as in :func:`hardpack.md.kernel.run_events` (ep also CHECK and WALL).
+        Event heap, as in :func:`hardpack.md._kernel.run_events` (ep also CHECK and WALL).
     acc : numpy.ndarray of float64, shape (N_ACC,)
         Float accumulators (above).
     iacc : numpy.ndarray of int64, shape (N_COUNTERS,)
@@ -1549,7 +1549,7 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     Returns
     -------
     int
-        A :class:`hardpack.md.kernel.WindowStatus`.
+        A :class:`hardpack.md._kernel.WindowStatus`.
     """
     d = L.shape[0]
     ws, wm = work_arrays(d)
