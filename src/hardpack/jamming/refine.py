@@ -457,7 +457,8 @@ def verify_at_jamming_point(packing: Packing, **options):
                 f"not refined: Newton did not converge: it diverged at step {ref.iterations} (a step of "
                 f"{ref.steps[-1]:.3g} smallest semiaxes or radians, beyond {MAX_STEP:g}; balance {ref.balance[-1]:.2g}"
                 + (f", after {ref.dropped} contact(s) left and {ref.added} joined the network"
-                   if ref.dropped or ref.added else "") + "): no jamming point of these contacts near the packing"
+                   if ref.dropped or ref.added else "")
+                + "): the jamming point of these contacts, if any, is beyond the reach of Newton from the packing"
                 if not ref.converged and ref.steps.size and ref.steps[-1] > MAX_STEP else
                 f"not refined: Newton did not converge in {ref.iterations} steps (balance {ref.balance[-1]:.2g}, "
                 f"largest step {info['refine_step']:.3g}): the jamming point is ill-defined at second order"
@@ -466,8 +467,7 @@ def verify_at_jamming_point(packing: Packing, **options):
                 "packing is not near the jamming point of its own contacts")
         result.params.update(info)
         if ref.pinned:
-            whole = (f"; {ref.pinned} particle(s) with fewer than {packing.dim + 1} contacts held fixed as rattlers"
-                     + whole)
+            note += f"; {ref.pinned} particle(s) with fewer than {packing.dim + 1} contacts held fixed as rattlers"
     result.params.update(refined=0, refine_note=note + whole)
     if whole and not result.backbone.any():
         # every particle a "rattler" only because its own near self-stress was lost: no verdict
