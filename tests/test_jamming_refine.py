@@ -14,11 +14,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from hardpack.errors import InvalidInputError
 from hardpack.io import dataset_to_packing, load_dataset
 from hardpack.jamming.ellipsoids import contacts_of_pairs, ellipsoid_contacts
-from hardpack.jamming.refine import MAX_STEP, refine_jamming_point, verify_at_jamming_point
+from hardpack.jamming.refine import (
+    MAX_STEP,
+    _next_network,
+    _solve,
+    refine_jamming_point,
+    verify_at_jamming_point,
+)
 from hardpack.jamming.result import Verdict
 from hardpack.jamming.second_order import verify_ellipsoids
 
@@ -206,17 +213,72 @@ def test_a_diverging_newton_iteration_stops_instead_of_crashing():
     assert not ref.converged and ref.steps[-1] > MAX_STEP and ref.iterations == 1
 
 
-def test_a_singular_newton_system_is_reported_not_raised():
+def test_contacts_without_a_particle_to_hold_are_pinned_out_of_the_newton_system():
     """Prolate alpha = 1.02, N = 100, LS to p = 1e12 (the full study's seed 2): the local test loses
-    every particle; the collective test of all of them starts Newton, whose first KKT matrix is
-    exactly singular (SuperLU raised RuntimeError, a crash of the verifier). The verifier reports
-    it; the verdict is undetermined, not "not jammed, every particle a rattler" (the local test's
-    loss of every particle says nothing about the packing)."""
+    every particle, so the collective test of all of them starts Newton. Three particles have no
+    contact: their 3 x 5 dof are free in -K and A^T, and the first KKT matrix had exactly that null
+    space (measured by SVD: rank deficiency 15, every null vector on those three particles;
+    SuperLU: singular). Held fixed as rattlers (fewer than d + 1 contacts, Donev 2006,
+    Sec. 4.4.3.1), they leave a regular system (smallest singular value 1.2e-5 of the largest) on
+    which Newton converges quadratically to a stationary point (gaps and balance at round-off).
+    That point is not a jamming point: one force is negative and 12 other pairs overlap there.
+    With them the network diverges (a step of 2.8 semiaxes): the verdict is undetermined, and
+    the note says why (not "singular")."""
     packing = _packing("prolate_a1.02_n100_seed2_slow_p1e12")
-    as_given = verify_ellipsoids(packing, delta="gaps")
-    assert as_given.rattler.all() and as_given.verdict == Verdict.NOT_JAMMED
+    res = verify_ellipsoids(packing, delta="gaps", local=False)
+    used = res.contacts_used
+    count = np.bincount(np.concatenate([res.network.i[used], res.network.j[used]]), minlength=100)
+    assert (count == 0).sum() == 3 and count[count > 0].min() >= 4  # three particles without contacts
+    first = refine_jamming_point(packing, res, rounds=1)
+    assert first.pinned == 3 and first.iterations >= 3  # (without pinning: 0 steps, a singular system)
+    assert first.gap[-1] < 1e-12 and first.balance[-1] < 1e-12  # the KKT equations are solved
+    assert all(b <= 100 * a**2 + 1e-13 for a, b in zip(first.steps, first.steps[1:]))  # quadratically
+    assert not first.converged and first.negative == 1 and first.overlaps == 12
     out = verify_at_jamming_point(packing, delta="gaps")
-    assert out.params["refined"] == 0 and "singular" in out.params["refine_note"]
+    assert out.params["refined"] == 0 and out.params["refine_pinned"] == 3
+    assert "diverged" in out.params["refine_note"] and "singular" not in out.params["refine_note"]
     assert (out.verdict, out.order) == (Verdict.UNDETERMINED, "undetermined")
     ds = out.to_dataset()
     assert ds.attrs["verdict"] == int(Verdict.UNDETERMINED) and ds.attrs["order"] == "undetermined"
+
+
+def test_a_singular_newton_system_gives_no_step():
+    """An exactly singular KKT matrix (SuperLU raises RuntimeError) gives NaNs, on which Newton
+    stops unconverged, instead of an exception from the verifier."""
+    kkt = sp.csc_matrix(np.array([[1.0, 0.0], [0.0, 0.0]]))
+    assert np.isnan(_solve(kkt, np.ones(2))).all()
+    assert np.allclose(_solve(sp.csc_matrix(np.diag([1.0, 2.0])), np.ones(2)), [1.0, 0.5])
+
+
+def test_the_next_network_drops_contacts_and_adds_only_overlapping_pairs():
+    """Oblate N = 40 with two pairs 1e-3 apart held as contacts: at the stationary point of the
+    first Newton run both are closed (touching to 1e-12) with negative forces. The next network
+    is the current one without them; a rebuild from every touching pair (mu - 1 <= 1e-9) at that
+    point would put them back and Newton would return to the same stationary point. Self-dual
+    alpha = 1.05: at the jamming point of the LS contacts two pairs overlap; exactly those join."""
+    packing = _packing("oblate_n40_slow_p1e12")
+    res = verify_ellipsoids(packing, delta=2.06e-3)
+    net, used = res.network, res.contacts_used
+    pairs = net.i[used], net.j[used], net.shift[used]
+    present = res.backbone | res.frozen
+    first = refine_jamming_point(packing, res, rounds=1)
+    assert first.negative == 2
+    at = contacts_of_pairs(first.packing, *pairs)
+    assert np.abs(at.gap[first.forces < 0]).max() < 1e-9  # the dropped pairs touch there
+    after, forces, out, new = _next_network(first.packing, pairs, first.forces, present, res.backbone,
+                                            packing.overlap_tol)
+    assert (out, new) == (2, 0) and len(after[0]) == len(pairs[0]) - 2
+    kept = {(int(i), int(j)) for i, j in zip(*after[:2])}
+    assert not kept & {(int(pairs[0][c]), int(pairs[1][c])) for c in np.flatnonzero(first.forces < 0)}
+    assert forces.min() > 0 and forces.sum() == pytest.approx(len(forces))
+    # a stationary point with overlaps: the overlapping pairs join, the network stays
+    packing = _packing("self_dual_a1.05_n100_slow_p1e12")
+    res = verify_ellipsoids(packing, delta="gaps")
+    net, used = res.network, res.contacts_used
+    pairs = net.i[used], net.j[used], net.shift[used]
+    one = refine_jamming_point(packing, res, rounds=1)
+    assert one.converged and one.overlaps == 2
+    after, forces, out, new = _next_network(one.packing, pairs, one.forces, res.backbone | res.frozen,
+                                            res.backbone, packing.overlap_tol)
+    assert (out, new) == (0, 2) and np.array_equal(after[0][:-2], pairs[0])
+    assert (contacts_of_pairs(one.packing, *(p[-2:] for p in after)).gap < -packing.overlap_tol).all()

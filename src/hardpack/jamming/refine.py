@@ -28,13 +28,19 @@ The refined configuration is the jamming point only if no pair outside the conta
 overlaps there: a network whose jamming point overlaps other pairs is not the network of the
 packing's jamming point (Donev 2006, Sec. 5.6: a missed contact makes spurious floppy modes).
 Such pairs join the network and Newton runs again (an active-set iteration, ``rounds``); the
-result counts the pairs still overlapping (``overlaps``) and those added (``added``).
+result counts the pairs still overlapping (``overlaps``) and those added (``added``). Only pairs
+that overlap join, to the current network: a rebuild from every touching pair would put back the
+contacts just dropped for their negative forces (below), which touch at the stationary point.
 
 Newton's method finds a stationary point of the KKT equations, whose multipliers may have either
 sign. It is a jamming point only if every force is positive (a contact with a negative force
 would open as the particles grow), so convergence asks for that besides gaps and balance at the
 tolerance; such contacts leave the network and Newton runs again (the other half of the
-active-set iteration, counted in ``dropped``). The tolerance, 1e-12, lies above the round-off of
+active-set iteration, counted in ``dropped``). A particle with fewer than d + 1 contacts in the
+network cannot be held (Donev 2006, Sec. 4.4.3.1): its free motions are a null space of the KKT
+matrix (e.g. a particle without contacts, as the collective test of every particle near the
+sphere point keeps them), so such particles leave the network with their contacts, repeatedly,
+and stay where they are (``pinned``). The tolerance, 1e-12, lies above the round-off of
 the gaps, a few eps L / a for centres in a cell of side L (measured: 3e-15 at N = 1000,
 L = 28 a, by the same pairs taken in the other order), provided the Newton step is solved to
 round-off in the gap rows, which needs iterative refinement of the sparse LU (:func:`_solve`).
@@ -68,8 +74,6 @@ __all__ = ["Refinement", "refine_jamming_point", "verify_at_jamming_point", "REF
 
 #: pairs within this mu - 1 are searched for overlaps at a network's jamming point
 OVERLAP_SEARCH = 1e-2
-#: pairs within this mu - 1 of touching at a converged jamming point are its contacts
-CONTACT_GAP = 1e-9
 #: Newton steps of :func:`verify_at_jamming_point` (it converges in 3-5 when it converges)
 REFINE_STEPS = 12
 #: convergence tolerance of :func:`refine_jamming_point` (gaps in smallest semiaxes, relative balance)
@@ -107,6 +111,9 @@ class Refinement:
     dropped : int
         Contacts dropped from the network over the rounds (those with a negative force at a
         stationary point of the larger network).
+    pinned : int
+        Particles of the starting backbone held fixed as rattlers, with fewer than d + 1 contacts
+        in the network (after removing such particles and their contacts, repeatedly).
     negative : int
         Contacts with a negative force at the last iterate. A solution of the KKT equations with a
         negative multiplier is not a jamming point (those contacts would open as the particles
@@ -125,6 +132,7 @@ class Refinement:
     added: int = 0
     negative: int = 0
     dropped: int = 0
+    pinned: int = 0
 
 
 def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float) -> Packing:
@@ -190,15 +198,23 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     if not forces.size or forces.min() <= 0:
         raise InvalidInputError("the result has no strictly positive self-stress (not jammed at first order): "
                                 "there is no jamming point of its contacts to refine to")
-    active = result.backbone
-    present = active | result.frozen
+    active = result.backbone.copy()
+    frozen = result.frozen
     used = np.flatnonzero(result.contacts_used)
     net = result.network
     pairs = net.i[used], net.j[used], net.shift[used]
     a = float(np.min(packing.shape.semiaxes))
     current, factor, added, dropped = packing, 1.0, 0, 0
     gaps, balances, steps = [], [], []
+    backbone = int(active.sum())
     for round_ in range(rounds):
+        # particles with fewer than d + 1 contacts cannot be held: their free motions would make the
+        # KKT matrix singular, so they leave the network with their contacts and stay where they are
+        pairs, forces, active = _pinned(pairs, forces, active, frozen, packing.dim)
+        present = active | frozen
+        if len(forces) < 2:
+            converged = False
+            break
         current, stationary, forces, growth = _newton(current, pairs, forces, active, max_iter, tol, a,
                                                       gaps, balances, steps)
         factor *= growth
@@ -206,31 +222,64 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         converged = stationary and bool(forces.min() > 0)
         if not stationary or round_ == rounds - 1:
             break
-        if not converged:
-            # contacts pulled on (negative multipliers) open as the particles grow: they leave
-            keep = forces > 0
-            if keep.sum() < 2:
-                break
-            pairs = tuple(p[keep] for p in pairs)
-            forces = forces[keep] * (keep.sum() / forces[keep].sum())
-            dropped += int((~keep).sum())
-            continue
-        # pairs outside the network that overlap at its jamming point join it (active set)
-        near = ellipsoid_contacts(current, OVERLAP_SEARCH)
-        keep = (near.gap <= CONTACT_GAP) & present[near.i] & present[near.j] & (active[near.i] | active[near.j])
-        new = int(keep.sum()) - len(pairs[0])
-        if not (near.gap[keep] < -packing.overlap_tol).any() or new <= 0:
+        following, start_forces, out, new = _next_network(current, pairs, forces, present, active,
+                                                          packing.overlap_tol)
+        if not (out or new) or len(start_forces) < 2:
             break
-        old = {(int(i), int(j)): float(v) for i, j, v in zip(pairs[0], pairs[1], forces)}
-        pairs = near.i[keep], near.j[keep], near.shift[keep]
-        forces = np.array([old.get((int(i), int(j)), float(np.mean(forces))) for i, j in zip(*pairs[:2])])
-        forces *= len(forces) / forces.sum()
+        pairs, forces = following, start_forces
+        dropped += out
         added += new
     overlaps = current.overlap_report(packing.overlap_tol).n_overlapping
     return Refinement(packing=current, converged=converged, iterations=len(steps), gap=np.array(gaps),
                       balance=np.array(balances), steps=np.array(steps), size_change=factor - 1.0,
                       forces=forces, overlaps=int(overlaps), added=added,
-                      negative=int((forces < 0).sum()), dropped=dropped)
+                      negative=int((forces < 0).sum()), dropped=dropped, pinned=backbone - int(active.sum()))
+
+
+def _pinned(pairs, forces, active: np.ndarray, frozen: np.ndarray, d: int):
+    """The network without its rattlers: active particles with fewer than d + 1 contacts (whose
+    contacts cannot balance a force, Donev 2006, Sec. 4.4.3.1) leave it with their contacts,
+    repeatedly. Returns (pairs, forces rescaled to sum M, active)."""
+    active = active.copy()
+    n = len(active)
+    while True:
+        present = active | frozen
+        inside = present[pairs[0]] & present[pairs[1]]
+        count = np.bincount(np.concatenate([pairs[0][inside], pairs[1][inside]]), minlength=n)
+        loose = active & (count < d + 1)
+        if not loose.any():
+            break
+        active &= ~loose
+    if inside.all():
+        return pairs, forces, active
+    pairs = tuple(p[inside] for p in pairs)
+    forces = forces[inside]
+    if forces.size:
+        forces = forces * (len(forces) / forces.sum())
+    return pairs, forces, active
+
+
+def _next_network(current: Packing, pairs, forces: np.ndarray, present: np.ndarray, active: np.ndarray,
+                  overlap_tol: float):
+    """The contact network of the next active-set round, from a stationary point ``current`` of
+    the network ``pairs`` with multipliers ``forces``: contacts with a force <= 0 leave (they open
+    as the particles grow), pairs outside the network that overlap by more than ``overlap_tol``
+    (between particles in ``present``, one of them ``active``) join with the mean force. Only
+    overlapping pairs join, so a contact that leaves (touching, not overlapping) stays out.
+    Returns (pairs, forces rescaled to sum M, contacts dropped, pairs added)."""
+    keep = forces > 0
+    near = ellipsoid_contacts(current, OVERLAP_SEARCH)
+    inside = {(int(i), int(j), *map(int, k)) for i, j, k in zip(*pairs)}
+    inside |= {(int(j), int(i), *map(int, -np.asarray(k))) for i, j, k in zip(*pairs)}
+    outside = np.array([(int(i), int(j), *map(int, k)) not in inside
+                        for i, j, k in zip(near.i, near.j, near.shift)], dtype=bool)
+    join = (outside & (near.gap < -overlap_tol) & present[near.i] & present[near.j]
+            & (active[near.i] | active[near.j]))
+    if not keep.any():
+        return tuple(p[keep] for p in pairs), forces[keep], int(keep.size), 0
+    pairs = tuple(np.concatenate([p[keep], q[join]]) for p, q in zip(pairs, (near.i, near.j, near.shift)))
+    forces = np.concatenate([forces[keep], np.full(int(join.sum()), forces[keep].mean())])
+    return pairs, forces * (len(forces) / forces.sum()), int((~keep).sum()), int(join.sum())
 
 
 def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, steps):
@@ -346,7 +395,8 @@ def verify_at_jamming_point(packing: Packing, **options):
     the jamming point; 0: of the packing as given), ``refine_note``, ``refine_iterations``,
     ``refine_step`` (the largest Newton step, in smallest semiaxes or radians),
     ``refine_size_change``, ``refine_added`` and ``refine_dropped`` (contacts added and dropped by
-    the active-set rounds) and ``refine_negative`` (negative forces at the last iterate).
+    the active-set rounds), ``refine_negative`` (negative forces at the last iterate) and
+    ``refine_pinned`` (particles with fewer than d + 1 contacts held fixed as rattlers).
 
     Parameters
     ----------
@@ -375,7 +425,7 @@ def verify_at_jamming_point(packing: Packing, **options):
         ref = refine_jamming_point(packing, start, max_iter=REFINE_STEPS)
         info = dict(refine_iterations=ref.iterations, refine_step=float(ref.steps.max(initial=0.0)),
                     refine_size_change=ref.size_change, refine_added=ref.added,
-                    refine_dropped=ref.dropped, refine_negative=ref.negative)
+                    refine_dropped=ref.dropped, refine_negative=ref.negative, refine_pinned=ref.pinned)
         if ref.converged and not ref.overlaps:
             refined = verify_ellipsoids(ref.packing, **options)
             same = (refined.collective.n_constraints == dec.n_constraints
@@ -386,7 +436,9 @@ def verify_at_jamming_point(packing: Packing, **options):
                 + (f"; {ref.added} pair(s) that overlapped at the jamming point of the packing's contacts "
                    "joined them" if ref.added else "")
                 + (f"; {ref.dropped} contact(s) with negative forces at a stationary point left them"
-                   if ref.dropped else "") + whole
+                   if ref.dropped else "")
+                + (f"; {ref.pinned} particle(s) with fewer than {packing.dim + 1} contacts held fixed as rattlers"
+                   if ref.pinned else "") + whole
                 + ("" if same else f"; the test there found {refined.collective.n_constraints} backbone contacts "
                    f"and {int(refined.rattler.sum())} rattlers (before: {dec.n_constraints}, "
                    f"{int(result.rattler.sum())})")), **info)
@@ -402,12 +454,20 @@ def verify_at_jamming_point(packing: Packing, **options):
                 "not refined: the Newton system of the contacts is singular (a particle without contacts, "
                 "or a floppy mode the stress does not hold)"
                 if not (ref.converged or ref.iterations) else
+                f"not refined: Newton did not converge: it diverged at step {ref.iterations} (a step of "
+                f"{ref.steps[-1]:.3g} smallest semiaxes or radians, beyond {MAX_STEP:g}; balance {ref.balance[-1]:.2g}"
+                + (f", after {ref.dropped} contact(s) left and {ref.added} joined the network"
+                   if ref.dropped or ref.added else "")
+                + "): the jamming point of these contacts, if any, is beyond the reach of Newton from the packing"
+                if not ref.converged and ref.steps.size and ref.steps[-1] > MAX_STEP else
                 f"not refined: Newton did not converge in {ref.iterations} steps (balance {ref.balance[-1]:.2g}, "
                 f"largest step {info['refine_step']:.3g}): the jamming point is ill-defined at second order"
                 if not ref.converged else
                 f"not refined: at the jamming point of the contacts {ref.overlaps} pair(s) overlap, so the "
                 "packing is not near the jamming point of its own contacts")
         result.params.update(info)
+        if ref.pinned:
+            note += f"; {ref.pinned} particle(s) with fewer than {packing.dim + 1} contacts held fixed as rattlers"
     result.params.update(refined=0, refine_note=note + whole)
     if whole and not result.backbone.any():
         # every particle a "rattler" only because its own near self-stress was lost: no verdict
