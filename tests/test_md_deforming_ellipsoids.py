@@ -126,3 +126,20 @@ def test_bad_input_is_refused():
     start = random_ellipsoid_packing(8, PROLATE, 0.2, seed=0)
     with pytest.raises(InvalidInputError, match="applied_pressure"):
         compress_deforming(start, 0.02, 0, applied_pressure=-1.0)
+
+
+def test_cli_compresses_ellipsoids_in_a_deforming_cell(tmp_path):
+    from hardpack.cli import main
+    from hardpack.io import load_packing, packing_to_dataset, write_dataset
+
+    start = random_ellipsoid_packing(8, PROLATE, 0.2, seed=4)
+    write_dataset(packing_to_dataset(start), tmp_path / "init.nc")
+    out = tmp_path / "out.nc"
+    assert main(["compress", "--init", str(tmp_path / "init.nc"), "--out", str(out), "--growth-rate",
+                 "0.1", "--seed", "0", "--max-pressure", "1e3", "--deforming-cell"]) == 0
+    final = load_packing(out)
+    assert final.shape.kind == "ellipsoid"
+    assert not final.is_orthorhombic
+    assert abs(np.linalg.det(final.lattice)) == pytest.approx(start.volume, rel=1e-12)
+    assert final.phi > 0.5
+    assert final.overlap_report().n_overlapping == 0
