@@ -10,7 +10,8 @@ Physics checked:
 - the densest laminate (Donev 2006, ch. 8), expanded and sheared, relaxes its cell at zero
   growth in the shape-only mode until the stress is isotropic (|<sigma / p - I>| from above 0.2
   to below 0.1), and no pair overlaps (checked independently with the Perram-Wertheim
-  potential); 2D ellipses run too;
+  potential); LS from the expanded laminate returns to phi = 0.770732 with 14 contacts per
+  particle; 2D ellipses run too;
 - bad input is refused.
 """
 
@@ -22,6 +23,7 @@ from test_ellipsoid_md import _b2_3d_spheroid
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.ellipsoid_crystals import laminate
+from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts
 from hardpack.geometry.packing import Packing
 from hardpack.geometry.shapes import Ellipsoids
 from hardpack.initial import random_ellipsoid_packing
@@ -104,6 +106,21 @@ def test_strained_laminate_crystal_relaxes_to_an_isotropic_stress():
     assert np.linalg.norm(m0) - np.linalg.norm(m1) > 3 * np.hypot(np.linalg.norm(e0), np.linalg.norm(e1))
     assert res.packing.overlap_report().n_overlapping == 0
     assert abs(np.linalg.det(res.packing.lattice)) == pytest.approx(start.volume, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_ls_from_the_expanded_laminate_returns_to_the_densest_packing():
+    """LS in the deforming cell from the densest laminate expanded by 2 % (phi = 0.726, 32
+    spheroids 1 : 1 : sqrt 3) ends at Donev's phi = 0.770732 (Donev 2006, sec. 8.2) with the
+    laminate's 14 contacts on every particle (Perram-Wertheim gaps below 1e-3)."""
+    crystal = laminate(np.sqrt(3.0)).tiled((2, 2, 2))
+    f = np.eye(3) * 1.02
+    start = Packing(crystal.positions @ f.T, lattice=f @ crystal.lattice, shape=crystal.shape)
+    res = compress_deforming(start, 0.03, 0, StopCriteria(max_pressure=1e5))
+    assert res.stats["phi"] == pytest.approx(0.770732, abs=2e-4)
+    contacts = ellipsoid_contacts(res.packing, tol=1e-3, min_contacts=1)
+    assert np.all(contacts.degree == 14)
+    assert res.packing.overlap_report().n_overlapping == 0
 
 
 def test_ellipse_glass_in_a_deforming_cell():
