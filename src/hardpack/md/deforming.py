@@ -1,4 +1,5 @@
-"""Lubachevsky-Stillinger compression in a deforming periodic cell (spheres, any d).
+"""Lubachevsky-Stillinger compression in a deforming periodic cell (spheres in any d, ellipsoids
+in 3D and ellipses in 2D: :class:`EllipsoidDeformingSimulation`).
 
 Donev 2006, sec. 3.2.4.2 ("iso-stress", a pseudo Parrinello-Rahman scheme for event-driven MD)
 makes the lattice vectors (the columns of the cell matrix Lambda) dynamic: at synchronisation
@@ -75,6 +76,12 @@ Growth is uniform (every radius at the same relative rate, d<D>/dt = Gamma, as i
 dD/dt = Gamma while the others keep their size (Donev 2006, sec. 13.5 grows the large disks of a
 labelled crystal at constant pressure); the pair's summed growth rate enters the contact
 prediction and the collision law (:func:`hardpack.md.deforming_kernel.pair_sigma`).
+
+Ellipsoids (:class:`EllipsoidDeformingSimulation`) use the same windows, strain rule and cell
+map, with the ellipsoid engine's prediction and collision law in the general cell
+(:mod:`hardpack.md.ellipsoid_deforming_kernel`, which also explains the stress of non-central
+contact forces), the map applied to the centres only, a Perram-Wertheim version of step 3 and a
+thermostat that sets the translational and rotational temperatures separately.
 
 This is an overdamped, deterministic barostat: it drives the mean stress to P0 I but does not
 sample the isobaric ensemble's volume fluctuations. Tests: an ideal-gas check that the mean
