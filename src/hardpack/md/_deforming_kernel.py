@@ -203,11 +203,12 @@ def pair_sigma(ai, aj, ki, kj, t):
 
 
 @njit(cache=True)
-def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
-    """List every bounding sphere j < jstop (j != i) that overlaps i's, in both lists; returns
+def list_particle(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, lmin):
+    """List every bounding sphere j < jstop (j != i) that overlaps i's, in both lists (entries
+    j * mul + code, the image -n of code c has code m - 1 - c for a table of m images); returns
     OVERFLOW when a list is full, SELF_IMAGE when i's bounding sphere reaches its own image
     (``lmin`` is the shortest lattice vector), else 0. ``cfac`` = 1 / h_k."""
-    d = X.shape[1]
+    d = H.shape[0]
     cap = nb.shape[1]
     ds = np.empty(d)
     lo = np.empty(d, dtype=np.int64)
@@ -239,9 +240,9 @@ def _list_particle(i, jstop, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin):
             if d2 < reach * reach:
                 if nn[i] >= cap or nn[j] >= cap:
                     return DeformingStatus.OVERFLOW
-                nb[i, nn[i]] = j * m + code
+                nb[i, nn[i]] = j * mul + code
                 nn[i] += 1
-                nb[j, nn[j]] = i * m + (m - 1 - code)
+                nb[j, nn[j]] = i * mul + (m - 1 - code)
                 nn[j] += 1
     return 0
 
@@ -333,7 +334,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
             bs[i, k] = X[i, k]
         bs[i, d] = A[i] + skin[i]
     for i in range(n):
-        st = _list_particle(i, i, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin)
+        st = list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin)
         if st != 0:
             return st
     hsize = 0
@@ -385,7 +386,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 for k in range(d):
                     bs[i, k] = X[i, k]
                 bs[i, d] = A[i] * (1.0 + kappa[i] * t) + skin[i]
-                st = _list_particle(i, n, X, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin)
+                st = list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin)
                 if st != 0:
                     acc[0] = t
                     return st

@@ -1271,10 +1271,14 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     the second smallest key), until the smallest key is after the earliest event found (``done``:
     0 new, 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs). In a
     container (``wmode``) the wall collision (:func:`wall_predict`) before the exit comes first
-    and bounds the pair search (partner WALL, or CHECK when its trace reached the step cap)."""
+    and bounds the pair search (partner WALL, or CHECK when its trace reached the step cap).
+    ``imgvec`` has 2^c rows for image codes of c bits (4^d for the orthorhombic box; the general
+    cells of :mod:`hardpack.md._ellipsoid_deforming_kernel` use longer tables)."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
-    cbits = 2 * d
+    cbits = 0  # list entries are j << cbits | image code, 2^cbits the length of imgvec
+    while (1 << cbits) < imgvec.shape[0]:
+        cbits += 1
     cmask = (1 << cbits) - 1
     dt = t - P[i, ct]
     ri = P[i, cr]
@@ -1455,14 +1459,44 @@ def collide(P, i, j, t, L, kappa, ws, wm):
         Change of the translational kinetic energy.
     """
     d = L.shape[0]
-    cv, ct, cr, _, _, cw, cii, _ = columns(d)
-    nw = 3 if d == 3 else 1
     advance(P, i, t, ws[2])
     advance(P, j, t, ws[2])
     sh = ws[9, :d]
     for k in range(d):
         dx = P[j, k] - P[i, k]
         sh[k] = -L[k] * np.floor(dx / L[k] + 0.5)
+    return collide_at(P, i, j, t, sh, kappa, ws, wm)
+
+
+@njit(cache=True)
+def collide_at(P, i, j, t, sh, kappa, ws, wm):
+    """Collision of i and j, j shifted by the periodic image ``sh``, at window time t, both
+    already advanced to t (:func:`collide`, which finds the image in an orthorhombic box).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows, rows i and j modified in place.
+    i, j : int
+        The colliding particles.
+    t : float
+        Window time of the collision.
+    sh : numpy.ndarray of float64, shape (d,)
+        Periodic shift added to j's position.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    ws, wm : numpy.ndarray
+        Scratch of :func:`work_arrays`; on return ws[0, :d], ws[1, :d] hold the centres and
+        ws[5, :d] the unit normal.
+
+    Returns
+    -------
+    impulse, virial, dke : float
+        As :func:`collide`.
+    """
+    d = sh.shape[0]
+    cv, ct, cr, _, _, cw, cii, _ = columns(d)
+    nw = 3 if d == 3 else 1
     lam0 = P[i, cr] / (P[i, cr] + P[j, cr])
     zeta, zdot, lam = pair_zeta(P, i, j, sh, t, kappa, lam0, ws, wm)
     xa, xb, rc, n = ws[0, :d], ws[1, :d], ws[4, :d], ws[5, :d]

@@ -100,15 +100,16 @@ def _deforming_options(args, ellipsoids: bool) -> dict | None:
     clash = [flag for flag, on in (("--checkpoint", args.checkpoint is not None),
                                    ("--contact-forces", args.contact_forces),
                                    ("--target-phi", args.target_phi is not None)) if on]
-    if ellipsoids:
-        raise InvalidInputError("--deforming-cell is implemented for spheres only")
     if clash:
         raise InvalidInputError(f"--deforming-cell cannot be combined with {', '.join(clash)} (not "
                                 "implemented for the deforming cell); drop it")
     from hardpack.md.deforming import CELL_STEP
 
-    return {"applied_pressure": args.applied_pressure,
-            "cell_step": CELL_STEP if args.cell_step is None else args.cell_step}
+    options = {"applied_pressure": args.applied_pressure,
+               "cell_step": CELL_STEP if args.cell_step is None else args.cell_step}
+    if ellipsoids:
+        options["eps_f"] = args.eps_f
+    return options
 
 
 def cmd_eos(args) -> int:

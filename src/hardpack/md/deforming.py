@@ -1,4 +1,5 @@
-"""Lubachevsky-Stillinger compression in a deforming periodic cell (spheres, any d).
+"""Lubachevsky-Stillinger compression in a deforming periodic cell (spheres in any d, ellipsoids
+in 3D and ellipses in 2D: :class:`EllipsoidDeformingSimulation`).
 
 Donev 2006, sec. 3.2.4.2 ("iso-stress", a pseudo Parrinello-Rahman scheme for event-driven MD)
 makes the lattice vectors (the columns of the cell matrix Lambda) dynamic: at synchronisation
@@ -76,6 +77,12 @@ dD/dt = Gamma while the others keep their size (Donev 2006, sec. 13.5 grows the 
 labelled crystal at constant pressure); the pair's summed growth rate enters the contact
 prediction and the collision law (:func:`hardpack.md._deforming_kernel.pair_sigma`).
 
+Ellipsoids (:class:`EllipsoidDeformingSimulation`) use the same windows, strain rule and cell
+map, with the ellipsoid engine's prediction and collision law in the general cell
+(:mod:`hardpack.md._ellipsoid_deforming_kernel`, which also explains the stress of non-central
+contact forces), the map applied to the centres only, a Perram-Wertheim version of step 3 and a
+thermostat that sets the translational and rotational temperatures separately.
+
 This is an overdamped, deterministic barostat: it drives the mean stress to P0 I but does not
 sample the isobaric ensemble's volume fluctuations. Tests: an ideal-gas check that the mean
 volume is N kT Z(phi) / P0, crystals keep their cell, and LS packings of small systems pass the
@@ -95,8 +102,13 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
+from hardpack.geometry.shapes import Ellipsoids
 from hardpack.md import _deforming_kernel as dk
+from hardpack.md import _ellipsoid_deforming_kernel as edk
+from hardpack.md import _ellipsoid_kernel as ek
+from hardpack.md import _kernel as mdk
 from hardpack.md.compress import CompressResult, StopCriteria, _check_run_options, _stop_reason, default_window
+from hardpack.md.ellipsoid_engine import moments_of_inertia, rotational_dof
 from hardpack.md.simulation import OverlapError, maxwell_boltzmann
 
 #: default alpha: relative volume relaxation per window (module docstring, step 2)
@@ -205,8 +217,11 @@ def _check_adaptive_cell(adaptive_cell) -> None:
 def _check_packing(packing: Packing) -> None:
     if not isinstance(packing, Packing):
         raise InvalidInputError(f"expected a hardpack Packing, got {type(packing).__name__}")
-    if packing.shape.kind != "sphere":
-        raise InvalidInputError(f"the deforming-cell MD handles spheres only, not {packing.shape.name}")
+    if packing.shape.kind not in ("sphere", "ellipsoid"):
+        raise InvalidInputError(f"the deforming-cell MD handles spheres, ellipsoids and ellipses, not "
+                                f"{packing.shape.name}")
+    if packing.shape.kind == "ellipsoid" and packing.dim not in (2, 3):
+        raise InvalidInputError(f"ellipsoid MD runs in 2D (ellipses) or 3D, not d = {packing.dim}")
     if packing.boundary.kind != "periodic":
         raise InvalidInputError("a deforming cell needs a periodic boundary on every axis; this packing "
                                 f"has {packing.boundary}: drop --deforming-cell or use a periodic packing")
@@ -216,7 +231,7 @@ def _check_packing(packing: Packing) -> None:
     if report.n_overlapping:
         raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
                                 "hard-sphere MD needs a non-overlapping start")
-    dmax = 2.0 * float(packing.radii.max())
+    dmax = 2.0 * float(packing.shape.bounding_radii.max())
     if shortest_vector(packing.lattice) <= SELF_CONTACT * dmax:
         raise InvalidInputError(
             f"the cell is too small: its shortest lattice vector {shortest_vector(packing.lattice):.4g} "
@@ -336,15 +351,7 @@ class DeformingSimulation:
         start = time.perf_counter()
         n, d = self.n, self.d
         self._reduce_cell()
-        Hinv = np.linalg.inv(self.H)
-        lmin = shortest_vector(self.H)
-        amax = float(self.A.max())
-        mean_a = float(self.A.mean())
         kappa = self.relative_rates()
-        skin = np.full(n, min(self.shell * mean_a, 0.45 * (lmin - 2.0 * amax)))
-        M = dk.image_ranges(self.H, lmin)
-        img = dk.image_table(self.H, M)
-        cfac = np.linalg.norm(Hinv, axis=1)
         if self.last_duration > 0.0:
             t_cap = self.last_duration * coll_target / max(self.last_collisions, 1)
             t_cap = min(t_cap, 2.0 * self.last_duration)
@@ -354,39 +361,13 @@ class DeformingSimulation:
         if kappa.min() < 0.0:
             t_cap = min(t_cap, 0.5 / -kappa.min())
         t_cap = min(t_cap, float(max_time))
-        saved = (self.X.copy(), self.V.copy())
-        while True:
-            nb = np.zeros((n, self.capacity), dtype=np.int64)
-            acc = np.zeros(2)
-            iacc = np.zeros(dk.N_COUNTERS, dtype=np.int64)
-            status = dk.run_events(self.X, self.V, self.T, self.A, self.H, Hinv, M, img, cfac, lmin,
-                                   kappa, skin, self.bs, nb, self.nn, self.mark, self.cnt, self.ep, self.ei,
-                                   self.ec, self.tv, self.hkey, self.heap, self.hpos, self.kin,
-                                   self.vir, acc, iacc, int(budget), float(t_cap))
-            if status == dk.DeformingStatus.OVERFLOW:
-                self.X[:], self.V[:] = saved
-                self.T[:] = 0.0
-                self.capacity *= 2
-                continue
-            if status == dk.DeformingStatus.SELF_IMAGE:
-                raise InvalidInputError(
-                    f"a particle grew to touch its own periodic image (shortest lattice vector "
-                    f"{lmin:.4g}, largest diameter {2 * amax:.4g}): the cell is too small for these "
-                    "particles; use more particles")
-            if status == dk.DeformingStatus.STUCK:
-                raise RuntimeError("no event can ever happen: no particle moves and none grows")
-            break
-        duration = float(acc[0])
-        dk.synchronise(self.X, self.V, self.T, self.A, duration, kappa)
-        colls = int(iacc[dk.I_COLL])
+        duration, colls, exits, ke_int = self._events(kappa, int(budget), float(t_cap))
         self.last_duration, self.last_collisions = duration, colls
-        exits = int(iacc[dk.I_EXIT])
         if exits > colls:
             self.shell = min(self.shell * SHELL_STEP, SHELL_MAX)
         elif 10 * exits < colls:
             self.shell = max(self.shell / SHELL_STEP, SHELL_MIN)
         volume = self.volume
-        ke_int = float(acc[1])
         if duration > 0.0 and ke_int > 0.0:
             kt_mean = 2.0 * ke_int / (d * n * duration)
             sigma = (self.kin + self.vir) / (volume * duration * kt_mean)  # units kT_mean / length^d
@@ -394,14 +375,12 @@ class DeformingSimulation:
         else:
             kt_mean, sigma, z = np.nan, np.full((d, d), np.nan), np.inf
         self.stress = sigma
-        reach = 2.0 * SELF_CONTACT * 2.0 * amax
-        _, gmin = dk.strain_limit(self.X, self.A, self.H, Hinv, np.zeros((d, d)), reach, 0.0)
+        gmin = self._smallest_gap()
         if gmin < -self.overlap_tol:
             raise OverlapError(f"pairs overlap at the end of window {self.windows}: smallest relative gap "
                                f"{gmin:.3e} < -{self.overlap_tol:g}")
         if self.growth_rate != 0.0:
-            ke = 0.5 * float(np.sum(self.V * self.V))
-            self.V *= math.sqrt(d * n / (2.0 * ke))
+            self._rescale()
         if np.isfinite(z):
             self.update_mobility(sigma, z)
             step, frac = self._deform(sigma, z)
@@ -417,12 +396,64 @@ class DeformingSimulation:
             "kT_mean": kt_mean, "volume": self.volume, "pressure": p,
             "shear": float(np.linalg.norm(sigma - p * np.eye(d)) / p) if p > 0 else np.nan,
             "strain_step": step, "step_fraction": frac, "mobility": self.mobility,
-            "exits": int(iacc[dk.I_EXIT]), "wall_time": self.wall_time, "growth_rate": self.growth_rate,
+            "exits": exits, "wall_time": self.wall_time, "growth_rate": self.growth_rate,
         }
         for k in RECORD_FIELDS:
             self.records[k].append(record[k])
         self.deviatoric.append(sigma / p - np.eye(d) if p > 0 else np.full((d, d), np.nan))
         return record
+
+    def _events(self, kappa: np.ndarray, budget: int, t_cap: float) -> tuple[float, int, int, float]:
+        """The window's events in the fixed cell (:func:`hardpack.md._deforming_kernel.run_events`),
+        all particles synchronised at its end; fills ``kin`` and ``vir``; returns (duration,
+        collisions, bounding-sphere exits, time integral of the kinetic energy)."""
+        n = self.n
+        Hinv = np.linalg.inv(self.H)
+        lmin = shortest_vector(self.H)
+        amax = float(self.A.max())
+        skin = np.full(n, min(self.shell * float(self.A.mean()), 0.45 * (lmin - 2.0 * amax)))
+        M = dk.image_ranges(self.H, lmin)
+        img = dk.image_table(self.H, M)
+        cfac = np.linalg.norm(Hinv, axis=1)
+        saved = (self.X.copy(), self.V.copy())
+        while True:
+            nb = np.zeros((n, self.capacity), dtype=np.int64)
+            acc = np.zeros(2)
+            iacc = np.zeros(dk.N_COUNTERS, dtype=np.int64)
+            status = dk.run_events(self.X, self.V, self.T, self.A, self.H, Hinv, M, img, cfac, lmin,
+                                   kappa, skin, self.bs, nb, self.nn, self.mark, self.cnt, self.ep, self.ei,
+                                   self.ec, self.tv, self.hkey, self.heap, self.hpos, self.kin,
+                                   self.vir, acc, iacc, budget, t_cap)
+            if status == dk.DeformingStatus.OVERFLOW:
+                self.X[:], self.V[:] = saved
+                self.T[:] = 0.0
+                self.capacity *= 2
+                continue
+            if status == dk.DeformingStatus.SELF_IMAGE:
+                raise InvalidInputError(
+                    f"a particle grew to touch its own periodic image (shortest lattice vector "
+                    f"{lmin:.4g}, largest diameter {2 * amax:.4g}): the cell is too small for these "
+                    "particles; use more particles")
+            if status == dk.DeformingStatus.STUCK:
+                raise RuntimeError("no event can ever happen: no particle moves and none grows")
+            break
+        duration = float(acc[0])
+        dk.synchronise(self.X, self.V, self.T, self.A, duration, kappa)
+        return duration, int(iacc[dk.I_COLL]), int(iacc[dk.I_EXIT]), float(acc[1])
+
+    def _smallest_gap(self) -> float:
+        """Smallest relative gap (|r| - sigma) / sigma of the pairs at the window end (a
+        particle's own images with sigma its diameter)."""
+        amax = float(self.A.max())
+        reach = 2.0 * SELF_CONTACT * 2.0 * amax
+        _, gmin = dk.strain_limit(self.X, self.A, self.H, np.linalg.inv(self.H), np.zeros((self.d, self.d)),
+                                  reach, 2.0 * amax)
+        return gmin
+
+    def _rescale(self) -> None:
+        """Velocities to kT = 1 (growing runs, at every window end)."""
+        ke = 0.5 * float(np.sum(self.V * self.V))
+        self.V *= math.sqrt(self.d * self.n / (2.0 * ke))
 
     def imbalance(self, sigma: np.ndarray) -> np.ndarray:
         """(sigma - P0 I) / max(p, P0), symmetric; traceless in the shape-only mode."""
@@ -459,7 +490,16 @@ class DeformingSimulation:
         norm = float(np.linalg.norm(e))
         return e * (MAX_STRAIN / norm) if norm > MAX_STRAIN else e
 
-    def _deform(self, sigma: np.ndarray, z: float) -> float:
+    def _cell_map(self, s: float, e: np.ndarray, H0: np.ndarray) -> np.ndarray:
+        """F = exp(s E) (det F = exp(s tr E) exactly), scaled to keep the start volume in the
+        shape-only mode (no drift over many windows)."""
+        lam, q = np.linalg.eigh(s * e)
+        f = (q * np.exp(lam)) @ q.T
+        if self.applied_pressure is None:
+            f *= (self.volume0 / abs(np.linalg.det(f @ H0))) ** (1.0 / self.d)
+        return f
+
+    def _deform(self, sigma: np.ndarray, z: float) -> tuple[float, float]:
         """Map cell and centres by F = exp(s E) (module docstring, steps 2-4); returns (|s E|, s)."""
         d = self.d
         e = self.strain(sigma, z)
@@ -473,10 +513,7 @@ class DeformingSimulation:
         for _ in range(MAX_HALVINGS + 1):
             if s <= 0.0:
                 break
-            lam, q = np.linalg.eigh(s * e)
-            f = (q * np.exp(lam)) @ q.T  # exp(s E): det F = exp(s tr E) exactly
-            if self.applied_pressure is None:  # the start volume exactly (no drift over many windows)
-                f *= (self.volume0 / abs(np.linalg.det(f @ H0))) ** (1.0 / d)
+            f = self._cell_map(s, e, H0)
             self.H = f @ H0
             self.X = np.array(X0 @ f.T)
             dk.wrap_into_cell(self.X, self.H, np.linalg.inv(self.H))
@@ -486,6 +523,237 @@ class DeformingSimulation:
                 return float(s * np.linalg.norm(e)), float(s)
             s *= 0.5
         self.H, self.X = H0, X0
+        return 0.0, 0.0
+
+
+class EllipsoidDeformingSimulation(DeformingSimulation):
+    """Deforming-cell run of ellipsoids (3D) or ellipses (2D): the windows of
+    :mod:`hardpack.md._ellipsoid_deforming_kernel` (the ellipsoid engine's prediction and collision
+    law in a general cell, with the stress tensor), the strain rule of :class:`DeformingSimulation`
+    (module docstring, steps 2, 4 to 7), and the cell map applied to the centres only (the
+    orientations are not changed by an affine map of the cell: the particles are rigid).
+
+    Step 3 for ellipsoids: the step s starts at 1 and is halved (at most MAX_HALVINGS times, then
+    the deformation is skipped) until every pair whose bounding spheres can meet keeps at least
+    half its Perram-Wertheim gap, mu - 1 with mu = sqrt(1 + zeta) the scaling factor to tangency
+    (Donev 2006, sec. 2.2.2.1; the sphere rule's half gap, since mu = r / (a_i + a_j) for
+    spheres), and the shortest lattice vector stays above SELF_CONTACT largest bounding
+    diameters (a particle never meets its own image).
+
+    Parameters
+    ----------
+    packing : Packing
+        Periodic ellipsoid or ellipse packing without overlaps.
+    velocities : numpy.ndarray, shape (N, d)
+        Start velocities.
+    angular_velocities : numpy.ndarray, shape (N, 3) in 3D, (N,) in 2D
+        Start angular velocities in the lab frame.
+    growth_rate : float
+        Gamma: every semiaxis grows at the relative rate Gamma / (2 <(prod a)^(1/d)>)
+        (:mod:`hardpack.md.ellipsoid`).
+    applied_pressure, cell_step, overlap_tol, adaptive_cell
+        As for :class:`DeformingSimulation`.
+    eps_f : float, optional
+        Trace tolerance of the engine.
+    """
+
+    def __init__(self, packing: Packing, velocities: np.ndarray, angular_velocities: np.ndarray,
+                 growth_rate: float, applied_pressure: float | None = None, cell_step: float = CELL_STEP,
+                 overlap_tol: float = DEFAULT_OVERLAP_TOL, adaptive_cell: bool = True, eps_f: float = ek.EPS_F):
+        _check_packing(packing)
+        if packing.shape.kind != "ellipsoid":
+            raise InvalidInputError(f"EllipsoidDeformingSimulation runs ellipsoids, not {packing.shape.name}")
+        check_cell_options(applied_pressure, cell_step)
+        _check_adaptive_cell(adaptive_cell)
+        n, d = packing.n_particles, packing.dim
+        shape = packing.shape
+        self.growing = None
+        self.n, self.d = n, d
+        self.H = np.array(packing.lattice, dtype=float)
+        cv, ct, cr, cax, cor, cw, cii, width = ek.columns(d)
+        self.P = np.zeros((n, width))
+        self.P[:, :d] = packing.wrapped().positions
+        self.P[:, cv:cv + d] = velocities
+        self.P[:, cr] = shape.semiaxes.max(axis=1)
+        self.P[:, cax:cax + d] = shape.semiaxes
+        self.P[:, cor:cw] = np.asarray(shape.orientations, dtype=float).reshape(n, -1)
+        self.P[:, cw:cii] = np.asarray(angular_velocities, dtype=float).reshape(n, -1)
+        self.P[:, cii] = 1.0 / moments_of_inertia(shape.semiaxes)
+        self.species = packing.species
+        self.growth_rate = float(growth_rate)
+        self.applied_pressure = applied_pressure
+        self.cell_step = float(cell_step)
+        self.overlap_tol = float(overlap_tol)
+        self.eps_f = float(eps_f)
+        self.volume0 = abs(float(np.linalg.det(self.H)))
+        self.capacity = 16
+        self.bs = np.zeros((n, d + 1))
+        self.nn = np.zeros(n, dtype=np.int64)
+        self.mark = np.zeros(n, dtype=np.int8)
+        self.cnt = np.zeros(n, dtype=np.int64)
+        self.ep = np.zeros(n, dtype=np.int64)
+        self.ec = np.zeros(n, dtype=np.int64)
+        self.hkey = np.zeros(n)
+        self.heap = np.zeros(n, dtype=np.int64)
+        self.hpos = np.zeros(n, dtype=np.int64)
+        self.kin = np.zeros((d, d))
+        self.vir = np.zeros((d, d))
+        self.time = 0.0
+        self.collisions = 0
+        self.windows = 0
+        self.wall_time = 0.0
+        self.last_duration = 0.0
+        self.last_collisions = 0
+        self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
+        self.stress = np.zeros((d, d))
+        self.deviatoric: list[np.ndarray] = []
+        self.shell = SHELL_START
+        self.adaptive_cell = adaptive_cell
+        self.mobility = 1.0
+        self.block_sum, self.block_count, self.last_block = 0.0, 0, None
+
+    def _column(self, k: int) -> int:
+        return ek.columns(self.d)[k]
+
+    @property
+    def semiaxes(self) -> np.ndarray:
+        cax = self._column(3)
+        return self.P[:, cax:cax + self.d]
+
+    @property
+    def V(self) -> np.ndarray:
+        """Translational velocities (a view of the state rows)."""
+        cv = self._column(0)
+        return self.P[:, cv:cv + self.d]
+
+    def angular_velocities(self) -> np.ndarray:
+        cw, cii = self._column(5), self._column(6)
+        w = self.P[:, cw:cii].copy()
+        return w[:, 0] if self.d == 2 else w
+
+    def phi(self) -> float:
+        return unit_ball_volume(self.d) * float(np.sum(np.prod(self.semiaxes, axis=1))) / self.volume
+
+    def packing(self) -> Packing:
+        """The current configuration, centres wrapped into the current cell (not checked for
+        overlaps: callers check it with :meth:`Packing.overlap_report`)."""
+        P = self.P.copy()
+        edk.wrap_rows(P, self.H, np.linalg.inv(self.H))
+        cor, cw = self._column(4), self._column(5)
+        o = P[:, cor:cw]
+        shape = Ellipsoids(self.semiaxes.copy(), o[:, 0].copy() if self.d == 2 else o.copy())
+        return Packing(P[:, :self.d], lattice=self.H.copy(), species=self.species, shape=shape,
+                       overlap_tol=self.overlap_tol, allow_overlap=True)
+
+    def _reduce_cell(self) -> None:
+        reduced, u = lll_reduce(self.H)
+        if not np.array_equal(u, np.eye(self.d, dtype=u.dtype)):
+            self.H = reduced
+        edk.wrap_rows(self.P, self.H, np.linalg.inv(self.H))
+
+    def relative_rates(self) -> np.ndarray:
+        """kappa = Gamma / (2 <(prod a)^(1/d)>) for every particle (:mod:`hardpack.md.ellipsoid`)."""
+        mean = float(np.mean(np.prod(self.semiaxes, axis=1) ** (1.0 / self.d)))
+        return np.full(self.n, self.growth_rate / (2.0 * mean))
+
+    def _events(self, kappa: np.ndarray, budget: int, t_cap: float) -> tuple[float, int, int, float]:
+        """The window's events (:func:`hardpack.md._ellipsoid_deforming_kernel.run_events`); the
+        kinetic tensor integral K_end t - sum t_c Delta K and the symmetric part of the virial
+        tensor into ``kin`` and ``vir``."""
+        n, d = self.n, self.d
+        Hinv = np.linalg.inv(self.H)
+        lmin = shortest_vector(self.H)
+        rb = self.P[:, self._column(2)]
+        rmax = float(rb.max())
+        skin = np.full(n, min(self.shell * float(rb.mean()), 0.45 * (lmin - 2.0 * rmax)))
+        M = dk.image_ranges(self.H, lmin)
+        img, cbits = edk.padded_image_table(self.H, M)
+        cfac = np.linalg.norm(Hinv, axis=1)
+        saved = self.P.copy()
+        vir, kw = np.zeros((d, d)), np.zeros((d, d))
+        while True:
+            cap = self.capacity
+            nb = np.zeros((n, cap), dtype=np.int64)
+            acc = np.zeros(edk.N_ACC)
+            acc[mdk.A_KE] = 0.5 * float(np.sum(self.V * self.V))
+            iacc = np.zeros(edk.N_COUNTERS, dtype=np.int64)
+            status = edk.run_events(
+                self.P, self.H, Hinv, M, img, cbits, cfac, lmin, float(kappa[0]), self.eps_f, skin, self.bs,
+                nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey, self.heap, self.hpos,
+                np.empty(cap), np.empty(cap), np.empty(cap, dtype=np.int8), np.empty((cap, ek.PAIR_STATE)),
+                vir, kw, acc, iacc, budget, t_cap)
+            if status == dk.DeformingStatus.OVERFLOW:
+                self.P[:] = saved
+                self.capacity *= 2
+                continue
+            if status == dk.DeformingStatus.SELF_IMAGE:
+                raise InvalidInputError(
+                    f"a particle grew to touch its own periodic image (shortest lattice vector "
+                    f"{lmin:.4g}, largest bounding diameter {2 * rmax:.4g}): the cell is too small for "
+                    "these particles; use more particles")
+            if status == dk.DeformingStatus.STUCK:
+                raise RuntimeError("no event can ever happen: no particle moves and none grows")
+            break
+        duration = float(acc[mdk.A_T])
+        ek.synchronise(self.P, duration, float(kappa[0]))
+        v = self.V
+        self.kin = v.T @ v * duration - kw
+        self.vir = 0.5 * (vir + vir.T)
+        return duration, int(iacc[dk.I_COLL]), int(iacc[dk.I_EXIT]), float(acc[mdk.A_KEINT])
+
+    def _pairs(self, scale: float):
+        return edk.near_pairs(self.P, self.H, np.linalg.inv(self.H), scale)
+
+    def _smallest_gap(self) -> float:
+        """Smallest mu - 1 (Perram-Wertheim, relative) of the pairs at the window end."""
+        mu, _ = edk.pair_scales(self.P, self.H, *self._pairs(1.0), np.zeros((self.d, self.d)))
+        return float(mu.min() - 1.0) if len(mu) else np.inf
+
+    def _rescale(self) -> None:
+        """Translational and angular velocities each to kT = 1 (equipartition imposed by the
+        thermostat). One factor for both (as :meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.
+        rescale_velocities`, which relies on the collisions to keep equipartition) fails for
+        near-spheres: their collisions hardly exchange energy with the rotations, so the growth
+        heats the translations only and every rescaling moves rotational energy into them; at
+        alpha = 1 the translational kT tends to 2 (measured: 2.0000 after 100 windows, 16
+        spheres-as-ellipsoids; at alpha = 1.2 it stays near 1.25 during a Gamma = 0.1 growth),
+        which slows the growth in units of the thermal speed by sqrt(2)."""
+        ket, ker, _, _ = ek.totals(self.P)
+        cv, cw, cii = self._column(0), self._column(5), self._column(6)
+        self.P[:, cv:cv + self.d] *= math.sqrt(0.5 * self.d * self.n / ket)
+        if ker > 0.0:
+            self.P[:, cw:cii] *= math.sqrt(0.5 * rotational_dof(self.d) * self.n / ker)
+
+    def _deform(self, sigma: np.ndarray, z: float) -> tuple[float, float]:
+        """Map cell and centres by F = exp(s E) (class docstring); returns (|s E|, s)."""
+        d = self.d
+        e = self.strain(sigma, z)
+        if not np.any(e):
+            return 0.0, 1.0
+        H0, P0 = self.H.copy(), self.P.copy()
+        floor = SELF_CONTACT * 2.0 * float(self.P[:, self._column(2)].max())
+        # every pair that F (or its volume correction) can bring within bounding reach
+        pairs = self._pairs(math.exp(2.0 * float(np.linalg.norm(e))) * 1.01)
+        mu0, rate = edk.pair_scales(P0, H0, *pairs, e)
+        # first-order step that keeps half of every approaching pair's zeta (as the sphere rule)
+        zeta0 = mu0 * mu0 - 1.0
+        closing = rate < 0.0
+        s = float(min(1.0, np.min(0.5 * np.maximum(zeta0[closing], 0.0) / -rate[closing], initial=1.0)))
+        for _ in range(MAX_HALVINGS + 1):
+            if s <= 0.0:
+                break
+            f = self._cell_map(s, e, H0)
+            H1 = f @ H0
+            if shortest_vector(H1) > floor:
+                self.P[:, :d] = P0[:, :d] @ f.T
+                mu1, _ = edk.pair_scales(self.P, H1, *pairs, e)
+                if np.all(np.where(mu0 > 1.0, mu1 - 1.0 >= 0.5 * (mu0 - 1.0), mu1 >= mu0)):
+                    self.H = H1
+                    edk.wrap_rows(self.P, self.H, np.linalg.inv(self.H))
+                    return float(s * np.linalg.norm(e)), float(s)
+                self.P[:] = P0
+            s *= 0.5
+        self.H, self.P = H0, P0
         return 0.0, 0.0
 
 
@@ -516,15 +784,18 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
                        *, applied_pressure: float | None = None, cell_step: float = CELL_STEP,
                        window: float | None = None, final_growth_rate: float | None = None,
                        switch_pressure: float = 1e3, overlap_tol: float = DEFAULT_OVERLAP_TOL,
-                       adaptive_cell: bool = True, progress=None) -> CompressResult:
+                       adaptive_cell: bool = True, eps_f: float = ek.EPS_F, progress=None) -> CompressResult:
     """LS compression (or, at growth rate 0, an isobaric or shape-relaxing run) in a deforming
     periodic cell (module docstring).
 
     Parameters
     ----------
     packing : Packing
-        Periodic sphere packing without overlaps (any lattice, sheared or not); its shortest
-        lattice vector must exceed SELF_CONTACT largest diameters.
+        Periodic packing of spheres (any d), ellipsoids (3D) or ellipses (2D) without overlaps
+        (any lattice, sheared or not; ellipsoids run :class:`EllipsoidDeformingSimulation`, with
+        uniform growth of the semiaxes, Gamma as in :func:`hardpack.md.ellipsoid.compress_ellipsoids`,
+        and velocities and angular velocities at kT = 1); its shortest lattice vector must exceed
+        SELF_CONTACT largest (bounding) diameters.
     growth_rate : float
         Gamma = (d<D>/dt) / sqrt(kT/m) as in :func:`hardpack.md.compress`; >= 0 (0 needs a
         collision or time limit).
@@ -549,6 +820,9 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         The adaptive cell mobility while growing in the shape-only mode and the default window
         :func:`cell_window` (module docstring, steps 2 and 6); False: Donev's rule with the fixed
         1 / Z mobility and the window :func:`hardpack.md.default_window`.
+    eps_f : float
+        Trace tolerance of the ellipsoid engine (:data:`hardpack.md._ellipsoid_kernel.EPS_F`;
+        ellipsoids only).
     progress : callable, optional
         Receives each window's record.
 
@@ -586,8 +860,19 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
             return float(window)
         return cell_window(rate, packing.dim, cell_step) if adaptive_cell else default_window(rate, packing.dim)
 
-    sim = DeformingSimulation(packing, maxwell_boltzmann(packing.n_particles, packing.dim, seed),
-                              growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell=adaptive_cell)
+    if packing.shape.kind == "ellipsoid":
+        from hardpack.md.ellipsoid import random_angular_velocities
+
+        seeds = np.random.SeedSequence(seed).spawn(2)
+        n, d = packing.n_particles, packing.dim
+        sim = EllipsoidDeformingSimulation(
+            packing, maxwell_boltzmann(n, d, seeds[0]),
+            random_angular_velocities(n, d, moments_of_inertia(packing.shape.semiaxes), seeds[1]),
+            growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell=adaptive_cell, eps_f=eps_f)
+        sim._rescale()
+    else:
+        sim = DeformingSimulation(packing, maxwell_boltzmann(packing.n_particles, packing.dim, seed),
+                                  growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell=adaptive_cell)
     started = time.perf_counter()
     while (reason := _stop_reason(stop, sim, started)) is None:
         budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
@@ -621,7 +906,11 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         "mobility_grow": MOBILITY_GROW, "mobility_shrink": MOBILITY_SHRINK,
         "cell_lag": CELL_LAG, "final_mobility": float(sim.mobility),
         "volume_ratio": sim.volume / sim.volume0, "mass": 1.0, "kT": 1.0,
+        "shape_kind": packing.shape.kind,
     }
+    if packing.shape.kind == "ellipsoid":
+        stats.update(eps_f=float(sim.eps_f), max_overlap=float(report.overlap),
+                     moment_of_inertia="spherically symmetric: (2/15)(a^2+b^2+c^2) in 3D, (a^2+b^2)/4 in 2D")
     if final_growth_rate is not None:
         stats.update({"final_growth_rate": float(final_growth_rate), "switch_pressure": float(switch_pressure)})
     units = {k: k for k in RECORD_FIELDS}

@@ -1,0 +1,463 @@
+"""Numba kernels of ellipsoid (3D) and ellipse (2D) MD in a fixed general (sheared) periodic cell,
+the windows of the deforming-cell driver (:mod:`hardpack.md.deforming`).
+
+The event loop is the one of the sphere deforming-cell kernel (:mod:`hardpack.md._deforming_kernel`:
+lists of (partner, lattice image) entries built by scanning all N bounding spheres over every
+image within reach, so a small or sheared cell holds several images of one partner, and a
+bounding-sphere exit re-wraps the particle into the cell); the particle state, the pair
+prediction (trace event location of the Perram-Wertheim potential, best first over the
+neighbours: :func:`hardpack.md._ellipsoid_kernel._predict`) and the collision law
+(:func:`hardpack.md._ellipsoid_kernel.collide_at`) are the ellipsoid engine's (Donev 2006, sec.
+3.5). A list entry is j << cbits | code with the image vectors H n in a table padded to 2^cbits
+rows (the ellipsoid kernel's entry format); the predicted partner does not say which image it
+collides with, so the collision takes the listed image of the partner with the smallest
+zeta (the one in contact: the others do not overlap).
+
+**Stress.** Besides the scalar virial the window accumulates the collisional virial tensor
+sum_coll r_ij (x) J_ij, r_ij = x_j - x_i the CENTRE separation and J_ij = J n the impulse on j
+(along the contact normal n, not along r_ij), and W = sum_coll t_c Delta(sum_i v_i v_i^T), from
+which the driver gets the time integral of the translational kinetic tensor, K_end t - W. The
+centre separation is right for non-central contact forces: the momentum flux through a plane of
+a system of rigid bodies is carried by their centres of mass (the molecular virial; Allen and
+Tildesley 1987, sec. 2.4: the pressure of rigid molecules from the centre-of-mass virial with the
+total force on each molecule), the point where a contact force acts on a body only moves
+angular momentum within it. The tensor sum r_ij J n^T is not symmetric for one collision (r_ij is
+not along n), its antisymmetric part is the torque sum, zero on average in a steady state; the
+driver uses the symmetric part.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from hardpack.events.heap import heap_set
+from hardpack.md import _deforming_kernel as dk
+from hardpack.md import _ellipsoid_kernel as ek
+from hardpack.md._kernel import A_T, A_VIRIAL, end_window, kinetic_step
+
+#: integer counters (after :mod:`hardpack.md._deforming_kernel`'s): CHECK events
+I_CHECK = dk.N_COUNTERS
+N_COUNTERS = dk.N_COUNTERS + 1
+#: float accumulators of :mod:`hardpack.md._kernel` (A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE) and the
+#: contact-function evaluations
+A_EVAL = 5
+N_ACC = 6
+
+
+def code_bits(m: int) -> int:
+    """Bits of an image code for a table of m images: the smallest c with 2^c >= m.
+
+    Parameters
+    ----------
+    m : int
+        Number of images.
+
+    Returns
+    -------
+    int
+        c.
+    """
+    return max(1, int(m - 1).bit_length())
+
+
+def padded_image_table(lattice: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, int]:
+    """Image vectors H n (:func:`hardpack.md._deforming_kernel.image_table`) in a table padded with
+    zero rows to 2^cbits rows, and cbits.
+
+    Parameters
+    ----------
+    lattice : numpy.ndarray of float, shape (d, d)
+        The cell H, lattice vectors as columns.
+    M : numpy.ndarray of int64, shape (d,)
+        Image ranges (:func:`hardpack.md._deforming_kernel.image_ranges`).
+
+    Returns
+    -------
+    img : numpy.ndarray of float64, shape (2^cbits, d)
+        Rows 0 .. m - 1 the images in code order, the rest zeros (never listed).
+    cbits : int
+        Bits of an image code.
+    """
+    table = dk.image_table(np.ascontiguousarray(lattice, dtype=float), M)
+    cbits = code_bits(table.shape[0])
+    img = np.zeros((1 << cbits, table.shape[1]))
+    img[: table.shape[0]] = table
+    return img, cbits
+
+
+@njit(cache=True)
+def _wrap_row(P, i, H, Hinv):
+    """Move the centre of particle i (columns 0 .. d-1 of P) into the cell by lattice vectors."""
+    d = H.shape[0]
+    s = np.empty(d)
+    for k in range(d):
+        acc = 0.0
+        for q in range(d):
+            acc += Hinv[k, q] * P[i, q]
+        s[k] = np.floor(acc)
+    for q in range(d):
+        acc = 0.0
+        for k in range(d):
+            acc += H[q, k] * s[k]
+        P[i, q] -= acc
+
+
+@njit(cache=True)
+def wrap_rows(P, H, Hinv):
+    """Move every centre into the cell (fractional coordinates in [0, 1)).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (:mod:`hardpack.md._ellipsoid_kernel`), centres modified in place.
+    H, Hinv : numpy.ndarray of float64, shape (d, d)
+        The cell (lattice vectors as columns) and its inverse.
+    """
+    for i in range(P.shape[0]):
+        _wrap_row(P, i, H, Hinv)
+
+
+@njit(cache=True)
+def _stress_step(P, i, j, t, jimp, ws, vir, kw):
+    """Add one collision's terms to the virial tensor (r_ij (x) J n, module docstring) and to
+    kw = sum t_c Delta(v v^T), from the centres ws[0], ws[1], the unit normal ws[5] and the
+    velocities after the collision in P."""
+    d = vir.shape[0]
+    cv = d
+    xa, xb, n = ws[0, :d], ws[1, :d], ws[5, :d]
+    for a in range(d):
+        ra = xb[a] - xa[a]
+        for b in range(d):
+            vir[a, b] += ra * jimp * n[b]
+    # v_i = v_i' + J n, v_j = v_j' - J n:  Delta(v v^T) = -+ J (v' n^T + n v'^T) - J^2 n n^T
+    for a in range(d):
+        for b in range(d):
+            dki = -jimp * (P[i, cv + a] * n[b] + n[a] * P[i, cv + b]) - jimp * jimp * n[a] * n[b]
+            dkj = jimp * (P[j, cv + a] * n[b] + n[a] * P[j, cv + b]) - jimp * jimp * n[a] * n[b]
+            kw[a, b] += t * (dki + dkj)
+
+
+@njit(cache=True)
+def _partner_image(P, i, j, t, nb, nn, img, cbits, ws, wm):
+    """Code of the listed image of j (both advanced to t) with the smallest zeta (the one in
+    contact), -1 if j is not listed."""
+    d = img.shape[1]
+    _, _, cr, _, _, _, _, _ = ek.columns(d)
+    cmask = (1 << cbits) - 1
+    sh = ws[9, :d]
+    best = np.inf
+    code = -1
+    for e in range(nn[i]):
+        if nb[i, e] >> cbits != j:
+            continue
+        c = nb[i, e] & cmask
+        d2 = 0.0
+        for k in range(d):
+            sh[k] = img[c, k]
+            dx = P[j, k] + sh[k] - P[i, k]
+            d2 += dx * dx
+        if code >= 0 and d2 >= (P[i, cr] + P[j, cr]) ** 2 * 4.0:
+            continue
+        z, _, _ = ek.pair_zeta(P, i, j, sh, t, 0.0, 0.5, ws, wm)
+        if z < best:
+            best = z
+            code = c
+    return code
+
+
+@njit(cache=True)
+def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb, nn, mark, cnt, ep, ec,
+               hkey, heap, hpos, tins, touts, done, pst, vir, kw, acc, iacc, coll_target, t_cap):
+    """One window of ellipsoid MD in the fixed cell H from a synchronisation point (all particle
+    times 0, centres wrapped into the cell): build all lists, predict, process events until
+    ``coll_target`` collisions or ``t_cap``.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows (:mod:`hardpack.md._ellipsoid_kernel`), modified in place.
+    H, Hinv : numpy.ndarray of float64, shape (d, d)
+        The cell (lattice vectors as columns) and its inverse.
+    M : numpy.ndarray of int64, shape (d,)
+        Image ranges (:func:`hardpack.md._deforming_kernel.image_ranges`).
+    img : numpy.ndarray of float64, shape (2^cbits, d)
+        Image vectors (:func:`padded_image_table`).
+    cbits : int
+        Bits of an image code.
+    cfac : numpy.ndarray of float64, shape (d,)
+        Row norms of H^-1.
+    lmin : float
+        Shortest lattice vector.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    eps_f : float
+        Trace tolerance (:data:`hardpack.md._ellipsoid_kernel.EPS_F`).
+    skin : numpy.ndarray of float64, shape (N,)
+        Bounding-sphere skins.
+    bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos
+        Bounding spheres, lists and event heap as in :func:`hardpack.md._deforming_kernel.run_events`
+        (no image array: the image is found at the collision).
+    tins, touts, done, pst
+        Scratch of :func:`hardpack.md._ellipsoid_kernel._predict`, one row per list slot.
+    vir, kw : numpy.ndarray of float64, shape (d, d)
+        Outputs (zeroed here): sum r_ij (x) J_ij and sum t_c Delta(sum v v^T) (module docstring).
+    acc : numpy.ndarray of float64, shape (N_ACC,)
+        acc[A_KE] enters the translational kinetic energy; outputs A_T (end time), A_VIRIAL,
+        A_KEINT (time integral of the translational kinetic energy), A_EVAL.
+    iacc : numpy.ndarray of int64, shape (N_COUNTERS,)
+        Counters of :mod:`hardpack.md._deforming_kernel` and I_CHECK (added to).
+    coll_target : int
+        Stop after this many collisions.
+    t_cap : float
+        Stop before the first event later than this window time.
+
+    Returns
+    -------
+    int
+        A :class:`hardpack.md._deforming_kernel.DeformingStatus`.
+    """
+    n = P.shape[0]
+    d = H.shape[0]
+    _, ct, cr, _, _, _, _, _ = ek.columns(d)
+    m0 = 1
+    for k in range(d):
+        m0 *= 2 * M[k] + 1
+    mul = 1 << cbits
+    strides = np.ones(d, dtype=np.int64)
+    for k in range(1, d):
+        strides[k] = strides[k - 1] * (2 * M[k - 1] + 1)
+    ws, wm = ek.work_arrays(d)
+    ww, wq = ek.wall_arrays(d)
+    wspec = np.zeros(d + 1)
+    scratch = np.empty(4)
+    vir[:, :] = 0.0
+    kw[:, :] = 0.0
+    nn[:] = 0
+    mark[:] = 0
+    hpos[:] = -1
+    cnt[:] = 0
+    upd = np.empty(2, dtype=np.int64)
+    for i in range(n):
+        for k in range(d):
+            bs[i, k] = P[i, k]
+        bs[i, d] = P[i, cr] + skin[i]
+    for i in range(n):
+        st = dk.list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, lmin)
+        if st != 0:
+            return st
+    hsize = 0
+    for i in range(n):
+        key, partner = ek._predict(i, 0.0, P, kappa, eps_f, img, bs, nb, nn, tins, touts, done, pst, ws, wm,
+                                   ek.PERIODIC_MODE, wspec, ww, wq)
+        ep[i] = partner
+        if partner >= 0:
+            ec[i] = cnt[partner]
+        hsize = heap_set(hkey, heap, hpos, hsize, i, key)
+    t = 0.0
+    while True:
+        i = heap[0]
+        tn = hkey[0]
+        if tn > t_cap:
+            t = t_cap
+            break
+        if tn == np.inf:
+            acc[A_T] = t
+            return dk.DeformingStatus.STUCK
+        t = tn
+        iacc[dk.I_EVENTS] += 1
+        p = ep[i]
+        npred = 1
+        upd[0] = i
+        if p == ek.EXIT:
+            iacc[dk.I_EXIT] += 1
+            ek.advance(P, i, t, scratch)
+            _wrap_row(P, i, H, Hinv)
+            for e in range(nn[i]):  # drop i from its old neighbours' lists (each list once)
+                j = nb[i, e] >> cbits
+                if mark[j]:
+                    continue
+                mark[j] = 1
+                q2 = 0
+                while q2 < nn[j]:
+                    if nb[j, q2] >> cbits == i:
+                        nn[j] -= 1
+                        nb[j, q2] = nb[j, nn[j]]
+                    else:
+                        q2 += 1
+            for e in range(nn[i]):
+                mark[nb[i, e] >> cbits] = 0
+            nn[i] = 0
+            for k in range(d):
+                bs[i, k] = P[i, k]
+            bs[i, d] = P[i, cr] * (1.0 + kappa * t) + skin[i]
+            st = dk.list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, lmin)
+            if st != 0:
+                acc[A_T] = t
+                return st
+            cnt[i] += 1  # others' predictions against i used the old image codes
+        elif p == ek.CHECK:
+            iacc[I_CHECK] += 1
+        elif p < 0 or ec[i] != cnt[p]:
+            iacc[dk.I_STALE] += 1
+        else:
+            j = p
+            ek.advance(P, i, t, scratch)
+            ek.advance(P, j, t, scratch)
+            code = _partner_image(P, i, j, t, nb, nn, img, cbits, ws, wm)
+            sh = ws[9, :d]
+            for k in range(d):
+                sh[k] = img[code, k]
+            jimp, vr, dke = ek.collide_at(P, i, j, t, sh, kappa, ws, wm)
+            if jimp > 0.0:
+                acc[A_VIRIAL] += vr
+                kinetic_step(acc, t, dke)
+                _stress_step(P, i, j, t, jimp, ws, vir, kw)
+                cnt[i] += 1
+                cnt[j] += 1
+                iacc[dk.I_COLL] += 1
+            else:
+                iacc[dk.I_GRAZE] += 1
+            upd[1] = j
+            npred = 2
+        for q in range(npred):
+            k = upd[q]
+            key, partner = ek._predict(k, t, P, kappa, eps_f, img, bs, nb, nn, tins, touts, done, pst, ws, wm,
+                                       ek.PERIODIC_MODE, wspec, ww, wq)
+            ep[k] = partner
+            if partner >= 0:
+                ec[k] = cnt[partner]
+            hsize = heap_set(hkey, heap, hpos, hsize, k, key)
+        if npred == 2 and iacc[dk.I_COLL] >= coll_target:
+            break
+    end_window(acc, t)
+    acc[A_EVAL] = ws[10, 0]
+    if t == t_cap:
+        return dk.DeformingStatus.DONE_TIME
+    return dk.DeformingStatus.DONE_COLLISIONS
+
+
+@njit(cache=True)
+def near_pairs(P, H, Hinv, scale):
+    """The pairs i < j and lattice images n whose centres are closer than ``scale`` times the sum
+    of their bounding radii (a particle's own images are not listed: the driver keeps them
+    apart by the shortest lattice vector). Centres need not be wrapped.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows at a synchronisation point.
+    H, Hinv : numpy.ndarray of float64, shape (d, d)
+        The cell and its inverse.
+    scale : float
+        Reach in units of R_i + R_j.
+
+    Returns
+    -------
+    pi, pj : numpy.ndarray of int64, shape (K,)
+        The pairs.
+    pn : numpy.ndarray of int64, shape (K, d)
+        The image n of j (r_ij = x_j + H n - x_i).
+    """
+    n = P.shape[0]
+    d = H.shape[0]
+    _, _, cr, _, _, _, _, _ = ek.columns(d)
+    cfac = np.empty(d)
+    for k in range(d):
+        s2 = 0.0
+        for q in range(d):
+            s2 += Hinv[k, q] * Hinv[k, q]
+        cfac[k] = np.sqrt(s2)
+    ds = np.empty(d)
+    lo = np.empty(d, dtype=np.int64)
+    hi = np.empty(d, dtype=np.int64)
+    od = np.empty(d, dtype=np.int64)
+    cap = 16 * n
+    pi = np.empty(cap, dtype=np.int64)
+    pj = np.empty(cap, dtype=np.int64)
+    pn = np.empty((cap, d), dtype=np.int64)
+    count = 0
+    for i in range(n):
+        for j in range(i + 1, n):
+            reach = scale * (P[i, cr] + P[j, cr])
+            total = dk._image_box(P[i, :d], P[j, :d], Hinv, reach, cfac, ds, lo, hi, od)
+            for _ in range(total):
+                rr = 0.0
+                for q in range(d):
+                    a = 0.0
+                    for k in range(d):
+                        a += H[q, k] * (ds[k] + od[k])
+                    rr += a * a
+                if rr < reach * reach:
+                    if count == cap:
+                        cap *= 2
+                        pi2 = np.empty(cap, dtype=np.int64)
+                        pj2 = np.empty(cap, dtype=np.int64)
+                        pn2 = np.empty((cap, d), dtype=np.int64)
+                        pi2[:count] = pi[:count]
+                        pj2[:count] = pj[:count]
+                        pn2[:count] = pn[:count]
+                        pi, pj, pn = pi2, pj2, pn2
+                    pi[count] = i
+                    pj[count] = j
+                    for k in range(d):
+                        pn[count, k] = od[k]
+                    count += 1
+                for k in range(d):
+                    od[k] += 1
+                    if od[k] <= hi[k]:
+                        break
+                    od[k] = lo[k]
+    return pi[:count], pj[:count], pn[:count]
+
+
+@njit(cache=True)
+def pair_scales(P, H, pi, pj, pn, strain):
+    """Perram-Wertheim scaling factor mu = sqrt(1 + zeta) to tangency (> 1 disjoint, < 1
+    overlapping; Donev 2006, sec. 2.2.2.1) of each listed pair and image at a synchronisation
+    point (:func:`near_pairs`), and the rate d zeta / ds along the affine map of the centres
+    r -> r + s ``strain`` r with the orientations fixed: 2 lambda (1 - lambda) n . (strain r)
+    (Donev 2006, Eq. 2.21 with the relative centre velocity strain r and no spin or growth).
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows at a synchronisation point (all particle times 0).
+    H : numpy.ndarray of float64, shape (d, d)
+        The cell.
+    pi, pj, pn
+        Pairs and images (:func:`near_pairs`).
+    strain : numpy.ndarray of float64, shape (d, d)
+        The strain E of the rate.
+
+    Returns
+    -------
+    mu : numpy.ndarray of float64, shape (K,)
+        mu of every pair.
+    rate : numpy.ndarray of float64, shape (K,)
+        d zeta / ds of every pair.
+    """
+    d = H.shape[0]
+    _, _, cr, _, _, _, _, _ = ek.columns(d)
+    ws, wm = ek.work_arrays(d)
+    sh = np.empty(d)
+    out = np.empty(pi.shape[0])
+    rate = np.empty(pi.shape[0])
+    for q in range(pi.shape[0]):
+        i, j = pi[q], pj[q]
+        for k in range(d):
+            a = 0.0
+            for m in range(d):
+                a += H[k, m] * pn[q, m]
+            sh[k] = a
+        z, _, lam = ek.pair_zeta(P, i, j, sh, 0.0, 0.0, P[i, cr] / (P[i, cr] + P[j, cr]), ws, wm)
+        out[q] = np.sqrt(max(1.0 + z, 0.0))
+        r, n = ws[7, :d], ws[5, :d]
+        nu = 0.0
+        for k in range(d):
+            u = 0.0
+            for m in range(d):
+                u += strain[k, m] * r[m]
+            nu += n[k] * u
+        rate[q] = 2.0 * lam * (1.0 - lam) * nu
+    return out, rate
