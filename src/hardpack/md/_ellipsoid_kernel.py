@@ -43,7 +43,8 @@ ahead with a bound on the rate): every evaluation also gives the width of the sl
 particles' support planes normal to the contact normal n, r . n^ (1 - 1 / sqrt(1 + zeta)), a lower
 bound on the distance of the surfaces; along that fixed n^ the width changes at the rate n^ . (v_j
 - v_i) of the centres less the rates of the two support functions (at most c |w x n^| each for a spin w,
-:func:`support_rate_bound`) and the growth, so no contact happens before the safe time
+:func:`support_rate_bound`, or c |w^perp| for a spheroid, :func:`_spin_rate`) and the growth, so no
+contact happens before the safe time
 :func:`_safe_time`, and the trace jumps there with one evaluation (no midpoint). When the safe time
 is shorter than the step below, an ordinary step: [t0, t0 + h] with zeta and zeta_dot at both ends
 define a cubic Hermite interpolant, whose error is estimated at the midpoint, e = |H(1/2) - zeta(t0
@@ -354,8 +355,8 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     wm[1] the inverse shape matrices, ws[10, 1] the width of the slab between the particles'
     support planes normal to n, r . n / |n| (1 - 1 / sqrt(1 + zeta)), a lower bound on the distance
     of the surfaces (0 unless zeta > 0), ws[10, 2] the rate n . (v_j - v_i) / |n| at which the
-    centres separate along n and ws[10, 3] the bound c_i |w_i x n^| + c_j |w_j x n^| on the rate of
-    the support functions along n^ from the spins (:func:`support_rate_bound`; for
+    centres separate along n and ws[10, 3] the bound on the rate of
+    the support functions along n^ from the spins (:func:`_spin_rate`; for
     :func:`_safe_time`).
 
     Parameters
@@ -411,8 +412,7 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     nn = np.sqrt(nn)
     ws[10, 1] = rn / nn * (1.0 - 1.0 / np.sqrt(1.0 + zeta)) if zeta > 0.0 else 0.0
     ws[10, 2] = nv / nn
-    ws[10, 3] = support_rate_bound(P, i, d) * _spin_across(P, i, n, nn) \
-        + support_rate_bound(P, j, d) * _spin_across(P, j, n, nn)
+    ws[10, 3] = _spin_rate(P, i, n, nn) + _spin_rate(P, j, n, nn)
     # zeta_dot = 2 lam (1 - lam) n . v_C (Donev 2006, Eq. 2.21; :func:`hardpack.geometry.contact.pw_rate`)
     g = kappa / (1.0 + kappa * t)
     if d == 2:
@@ -511,7 +511,8 @@ def _safe_time(gap, sep_rate, spin, grow_speed, kappa, t):
     distance of the surfaces at all times; it grows at the rate ``sep_rate`` = u . (v_j - v_i) of
     the centres less the rates of the support functions h(u) = sqrt(u^T X^-1 u), each at most
     c |w x u| (1 + kappa t') for a spin w (``spin`` = c_i |w_i x u| + c_j |w_j x u|,
-    c = a_max - a_min at the window start: derived in :func:`support_rate_bound`)
+    c = a_max - a_min at the window start: derived in :func:`support_rate_bound`; a spheroid's
+    term may be c |w^perp| instead, :func:`_spin_rate`)
     plus |kappa| R for the growth (``grow_speed``). The first root of
     gap - (grow_speed + spin (1 + kappa t) - sep_rate) s - spin kappa s^2 / 2 = 0, or inf."""
     if gap <= 0.0:
@@ -564,8 +565,7 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
     width = ur - np.sqrt(_quad(mi, u)) - np.sqrt(_quad(mj, u))
     if width <= 0.0:
         return 0.0
-    spin = support_rate_bound(P, i, d) * _spin_across(P, i, u, 1.0) \
-        + support_rate_bound(P, j, d) * _spin_across(P, j, u, 1.0)
+    spin = _spin_rate(P, i, u, 1.0) + _spin_rate(P, j, u, 1.0)
     return _safe_time(width, sep, spin, abs(kappa) * (P[i, cr] + P[j, cr]), kappa, t)
 
 
@@ -620,6 +620,50 @@ def _spin_across(P, i, n, nn):
     c1 = w2 * n[0] - w0 * n[2]
     c2 = w0 * n[1] - w1 * n[0]
     return np.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / nn
+
+
+@njit(cache=True, inline="always")
+def _spin_rate(P, i, n, nn):
+    """Bound on |dh/dt| from the spin of i for the support function h(u) of i along the fixed
+    unit vector u = n / nn: c_i |w_i x u| (:func:`support_rate_bound`), and for a spheroid
+    (two equal semiaxes) at most c_i |w_i^perp|, w_i^perp the part of the spin normal to the
+    symmetry axis e_i.
+
+    Derived here: X^-1 = a_eq^2 I + (a_s^2 - a_eq^2) e e^T for a spheroid, so its rate under the
+    spin, (a_s^2 - a_eq^2)(de/dt e^T + e de/dt^T) with de/dt = w x e = w^perp x e, is the same
+    for w and w^perp: the bound of :func:`support_rate_bound` holds with w^perp, |dh/dt| <=
+    c |w^perp x u| <= c |w^perp|. Under free rotation at a constant w, e turns about w, so
+    w . e and |w^perp| = sqrt(|w|^2 - (w . e)^2) are constant over the whole flight (computed
+    from the stored orientation). In 2D, and for triaxial ellipsoids, c_i |w_i x u|."""
+    d = n.shape[0]
+    c = support_rate_bound(P, i, d)
+    across = _spin_across(P, i, n, nn)
+    if d == 2 or c == 0.0:
+        return c * across
+    _, _, _, cax, cor, cw, _, _ = columns(d)
+    a0, a1, a2 = P[i, cax], P[i, cax + 1], P[i, cax + 2]
+    if a1 == a2:
+        k = 0
+    elif a0 == a2:
+        k = 1
+    elif a0 == a1:
+        k = 2
+    else:
+        return c * across
+    s, p1, p2, p3 = P[i, cor], P[i, cor + 1], P[i, cor + 2], P[i, cor + 3]
+    diag = s * s - 0.5
+    # row k of the rotation of :func:`_pose` (X^-1 = Q^T diag(a^2) Q): body axis k in the lab
+    if k == 0:
+        e0, e1, e2 = 2 * (p1 * p1 + diag), 2 * (p1 * p2 + s * p3), 2 * (p1 * p3 - s * p2)
+    elif k == 1:
+        e0, e1, e2 = 2 * (p2 * p1 - s * p3), 2 * (p2 * p2 + diag), 2 * (p2 * p3 + s * p1)
+    else:
+        e0, e1, e2 = 2 * (p3 * p1 + s * p2), 2 * (p3 * p2 - s * p1), 2 * (p3 * p3 + diag)
+    w0, w1, w2 = P[i, cw], P[i, cw + 1], P[i, cw + 2]
+    we = w0 * e0 + w1 * e1 + w2 * e2
+    ee = e0 * e0 + e1 * e1 + e2 * e2  # 1 up to the round-off of the stored quaternion
+    perp = np.sqrt(max(w0 * w0 + w1 * w1 + w2 * w2 - we * we / ee, 0.0))
+    return c * min(across, perp * (1.0 + 1e-12))
 
 
 @njit(cache=True, inline="always")
