@@ -218,7 +218,7 @@ def test_support_rate_bound_holds_and_is_tight(d):
 def test_spheroid_spin_rate_bound_holds_along_the_flight():
     """For a spheroid only the spin normal to its symmetry axis turns X^-1, so the rate of its
     support function along a fixed unit u is at most c |w^perp| at every time of a free flight
-    (:func:`hardpack.md.ellipsoid_kernel._spin_rate`, from the stored orientation): the exact rate
+    (:func:`hardpack.md._ellipsoid_kernel._spin_rate`, from the stored orientation): the exact rate
     -(w x u) . (X^-1 u) / h at 30 times along each of 600 flights of prolate and oblate spheroids
     (the equal pair of semiaxes at each position) never exceeds it; with the spin nearly along the
     axis the bound is far below c |w x u| (so it is used), and the rate comes within 2 % of it
