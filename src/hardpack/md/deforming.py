@@ -282,22 +282,26 @@ class DeformingSimulation:
         self.V = np.ascontiguousarray(velocities, dtype=float).copy()
         self.A = np.array(packing.radii, dtype=float)
         self.T = np.zeros(self.n)
+        self._init_run(packing, growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell)
+        self.ei = np.zeros(self.n, dtype=np.int64)
+        self.tv = np.zeros(self.n)
+
+    def _init_run(self, packing, growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell) -> None:
+        """The run's parameters, counters and event-loop work arrays (spheres and ellipsoids)."""
+        n, d = self.n, self.d
         self.species = packing.species
         self.growth_rate = float(growth_rate)
         self.applied_pressure = applied_pressure
         self.cell_step = float(cell_step)
         self.overlap_tol = float(overlap_tol)
         self.volume0 = abs(float(np.linalg.det(self.H)))
-        n, d = self.n, self.d
         self.capacity = 16
         self.bs = np.zeros((n, d + 1))
         self.nn = np.zeros(n, dtype=np.int64)
         self.mark = np.zeros(n, dtype=np.int8)
         self.cnt = np.zeros(n, dtype=np.int64)
         self.ep = np.zeros(n, dtype=np.int64)
-        self.ei = np.zeros(n, dtype=np.int64)
         self.ec = np.zeros(n, dtype=np.int64)
-        self.tv = np.zeros(n)
         self.hkey = np.zeros(n)
         self.heap = np.zeros(n, dtype=np.int64)
         self.hpos = np.zeros(n, dtype=np.int64)
@@ -579,38 +583,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         self.P[:, cor:cw] = np.asarray(shape.orientations, dtype=float).reshape(n, -1)
         self.P[:, cw:cii] = np.asarray(angular_velocities, dtype=float).reshape(n, -1)
         self.P[:, cii] = 1.0 / moments_of_inertia(shape.semiaxes)
-        self.species = packing.species
-        self.growth_rate = float(growth_rate)
-        self.applied_pressure = applied_pressure
-        self.cell_step = float(cell_step)
-        self.overlap_tol = float(overlap_tol)
         self.eps_f = float(eps_f)
-        self.volume0 = abs(float(np.linalg.det(self.H)))
-        self.capacity = 16
-        self.bs = np.zeros((n, d + 1))
-        self.nn = np.zeros(n, dtype=np.int64)
-        self.mark = np.zeros(n, dtype=np.int8)
-        self.cnt = np.zeros(n, dtype=np.int64)
-        self.ep = np.zeros(n, dtype=np.int64)
-        self.ec = np.zeros(n, dtype=np.int64)
-        self.hkey = np.zeros(n)
-        self.heap = np.zeros(n, dtype=np.int64)
-        self.hpos = np.zeros(n, dtype=np.int64)
-        self.kin = np.zeros((d, d))
-        self.vir = np.zeros((d, d))
-        self.time = 0.0
-        self.collisions = 0
-        self.windows = 0
-        self.wall_time = 0.0
-        self.last_duration = 0.0
-        self.last_collisions = 0
-        self.records: dict[str, list] = {k: [] for k in RECORD_FIELDS}
-        self.stress = np.zeros((d, d))
-        self.deviatoric: list[np.ndarray] = []
-        self.shell = SHELL_START
-        self.adaptive_cell = adaptive_cell
-        self.mobility = 1.0
-        self.block_sum, self.block_count, self.last_block = 0.0, 0, None
+        self._init_run(packing, growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell)
 
     def _column(self, k: int) -> int:
         return ek.columns(self.d)[k]
