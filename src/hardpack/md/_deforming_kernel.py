@@ -118,21 +118,22 @@ def wrap_into_cell(X, H, Hinv):
 
     Parameters
     ----------
-    X : numpy.ndarray of float64, shape (N, d)
-        Cartesian positions, modified in place (shifted by whole lattice vectors).
+    X : numpy.ndarray of float64, shape (N, d) or (N, m > d)
+        Cartesian positions in columns 0 .. d - 1 (further columns, as in the ellipsoid state rows,
+        are left alone), modified in place (shifted by whole lattice vectors).
     H, Hinv : numpy.ndarray of float64, shape (d, d)
         The cell (lattice vectors as columns) and its inverse.
     """
-    n, d = X.shape
-    s = np.empty(d)
-    for i in range(n):
-        _wrap_one(X, i, H, Hinv, s)
+    s = np.empty(H.shape[0])
+    for i in range(X.shape[0]):
+        wrap_one(X, i, H, Hinv, s)
 
 
 @njit(cache=True, inline="always")
-def _wrap_one(X, i, H, Hinv, s):
-    """Move position i into the cell by whole lattice vectors (``s``: scratch of length d)."""
-    d = X.shape[1]
+def wrap_one(X, i, H, Hinv, s):
+    """Move position i (columns 0 .. d - 1 of row i of X, which may hold more columns, such as the
+    ellipsoid state rows) into the cell by whole lattice vectors (``s``: scratch of length d)."""
+    d = H.shape[0]
     for k in range(d):
         acc = 0.0
         for q in range(d):
@@ -327,7 +328,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
     tv[:] = 0.0
     rv = np.empty(d)
     xi = np.empty(d)
-    wrap = np.empty(d)  # scratch of _wrap_one
+    wrap = np.empty(d)  # scratch of wrap_one
     upd = np.empty(2, dtype=np.int64)
     for i in range(n):  # complete rebuild at t = 0 (positions wrapped by the caller)
         for k in range(d):
@@ -367,7 +368,7 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 for k in range(d):
                     X[i, k] += V[i, k] * dt
                 T[i] = t
-                _wrap_one(X, i, H, Hinv, wrap)  # wrap i into the cell
+                wrap_one(X, i, H, Hinv, wrap)  # wrap i into the cell
                 for e in range(nn[i]):  # drop i from its old neighbours' lists (each list once)
                     j = nb[i, e] // m
                     if mark[j]:

@@ -87,38 +87,6 @@ def padded_image_table(lattice: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, 
 
 
 @njit(cache=True)
-def _wrap_row(P, i, H, Hinv):
-    """Move the centre of particle i (columns 0 .. d-1 of P) into the cell by lattice vectors."""
-    d = H.shape[0]
-    s = np.empty(d)
-    for k in range(d):
-        acc = 0.0
-        for q in range(d):
-            acc += Hinv[k, q] * P[i, q]
-        s[k] = np.floor(acc)
-    for q in range(d):
-        acc = 0.0
-        for k in range(d):
-            acc += H[q, k] * s[k]
-        P[i, q] -= acc
-
-
-@njit(cache=True)
-def wrap_rows(P, H, Hinv):
-    """Move every centre into the cell (fractional coordinates in [0, 1)).
-
-    Parameters
-    ----------
-    P : numpy.ndarray of float64, shape (N, ncol(d))
-        Particle state rows (:mod:`hardpack.md._ellipsoid_kernel`), centres modified in place.
-    H, Hinv : numpy.ndarray of float64, shape (d, d)
-        The cell (lattice vectors as columns) and its inverse.
-    """
-    for i in range(P.shape[0]):
-        _wrap_row(P, i, H, Hinv)
-
-
-@njit(cache=True)
 def _stress_step(P, i, j, t, jimp, ws, vir, kw):
     """Add one collision's terms to the virial tensor (r_ij (x) J n, module docstring) and to
     kw = sum t_c Delta(v v^T), from the centres ws[0], ws[1], the unit normal ws[5] and the
@@ -231,6 +199,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
     ww, wq = ek.wall_arrays(d)
     wspec = np.zeros(d + 1)
     scratch = np.empty(4)
+    wrap = np.empty(d)  # scratch of wrap_one
     vir[:, :] = 0.0
     kw[:, :] = 0.0
     nn[:] = 0
@@ -272,7 +241,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
         if p == ek.EXIT:
             iacc[dk.I_EXIT] += 1
             ek.advance(P, i, t, scratch)
-            _wrap_row(P, i, H, Hinv)
+            dk.wrap_one(P, i, H, Hinv, wrap)
             for e in range(nn[i]):  # drop i from its old neighbours' lists (each list once)
                 j = nb[i, e] >> cbits
                 if mark[j]:

@@ -612,7 +612,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         """The current configuration, centres wrapped into the current cell (not checked for
         overlaps: callers check it with :meth:`Packing.overlap_report`)."""
         P = self.P.copy()
-        edk.wrap_rows(P, self.H, np.linalg.inv(self.H))
+        dk.wrap_into_cell(P, self.H, np.linalg.inv(self.H))
         cor, cw = self._column(4), self._column(5)
         o = P[:, cor:cw]
         shape = Ellipsoids(self.semiaxes.copy(), o[:, 0].copy() if self.d == 2 else o.copy())
@@ -623,7 +623,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         reduced, u = lll_reduce(self.H)
         if not np.array_equal(u, np.eye(self.d, dtype=u.dtype)):
             self.H = reduced
-        edk.wrap_rows(self.P, self.H, np.linalg.inv(self.H))
+        dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
 
     def relative_rates(self) -> np.ndarray:
         """kappa = Gamma / (2 <(prod a)^(1/d)>) for every particle (:mod:`hardpack.md.ellipsoid`)."""
@@ -723,7 +723,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
                 mu1, _ = edk.pair_scales(self.P, H1, *pairs, e)
                 if np.all(np.where(mu0 > 1.0, mu1 - 1.0 >= 0.5 * (mu0 - 1.0), mu1 >= mu0)):
                     self.H = H1
-                    edk.wrap_rows(self.P, self.H, np.linalg.inv(self.H))
+                    dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
                     return float(s * np.linalg.norm(e)), float(s)
                 self.P[:] = P0
             s *= 0.5
