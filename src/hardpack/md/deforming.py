@@ -238,6 +238,17 @@ def _check_packing(packing: Packing) -> None:
             f"must exceed {SELF_CONTACT} largest diameters ({SELF_CONTACT * dmax:.4g}); use more particles")
 
 
+def _refuse_window_end(status, lmin: float, diameter: float) -> None:
+    """Raise for a window that ended because a particle met its own image or nothing can move."""
+    if status == dk.DeformingStatus.SELF_IMAGE:
+        raise InvalidInputError(
+            f"a particle grew to touch its own periodic image (shortest lattice vector {lmin:.4g}, "
+            f"largest bounding diameter {diameter:.4g}): the cell is too small for these particles; "
+            "use more particles")
+    if status == dk.DeformingStatus.STUCK:
+        raise RuntimeError("no event can ever happen: no particle moves and none grows")
+
+
 class DeformingSimulation:
     """State of one deforming-cell run; :meth:`run_window` advances it by one window and then
     deforms the cell (module docstring).
@@ -433,13 +444,7 @@ class DeformingSimulation:
                 self.T[:] = 0.0
                 self.capacity *= 2
                 continue
-            if status == dk.DeformingStatus.SELF_IMAGE:
-                raise InvalidInputError(
-                    f"a particle grew to touch its own periodic image (shortest lattice vector "
-                    f"{lmin:.4g}, largest diameter {2 * amax:.4g}): the cell is too small for these "
-                    "particles; use more particles")
-            if status == dk.DeformingStatus.STUCK:
-                raise RuntimeError("no event can ever happen: no particle moves and none grows")
+            _refuse_window_end(status, lmin, 2 * amax)
             break
         duration = float(acc[0])
         dk.synchronise(self.X, self.V, self.T, self.A, duration, kappa)
@@ -660,13 +665,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
                 self.P[:] = saved
                 self.capacity *= 2
                 continue
-            if status == dk.DeformingStatus.SELF_IMAGE:
-                raise InvalidInputError(
-                    f"a particle grew to touch its own periodic image (shortest lattice vector "
-                    f"{lmin:.4g}, largest bounding diameter {2 * rmax:.4g}): the cell is too small for "
-                    "these particles; use more particles")
-            if status == dk.DeformingStatus.STUCK:
-                raise RuntimeError("no event can ever happen: no particle moves and none grows")
+            _refuse_window_end(status, lmin, 2 * rmax)
             break
         duration = float(acc[mdk.A_T])
         ek.synchronise(self.P, duration, float(kappa[0]))
