@@ -1685,14 +1685,14 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
     same = 0
     max_same = STALL_EVENTS + 10 * n
     while True:
-        i = heap[0]
+        i = np.int64(heap[0])  # one type for particle indices: one compilation of the pair functions
         t = hkey[0]
         if t > t_cap:
             end_window(acc, t_cap)
             return WindowStatus.DONE_TIME
         if t == np.inf:
             return WindowStatus.STUCK
-        p = ep[i]
+        p = np.int64(ep[i])
         # progress guard: every event but a collision advances the time (collisions at one
         # instant change the velocities); a long run of other events at one time is a failure
         if t == t_last:
