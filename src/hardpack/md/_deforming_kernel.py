@@ -9,15 +9,20 @@ derived in :mod:`hardpack.md._kernel`), not Donev's quartic of a cell deforming 
 
 Same event scheme as :mod:`hardpack.md._kernel` in its simplest form: one predicted event per
 particle in a 4-ary heap (:func:`hardpack.events.heap.heap_set`), lazy invalidation by collision
-counters, and neighbour lists with immobile bounding spheres (Donev 2006, sec. 3.3.2). There is no
-cell grid: a list is (re)built by scanning all N particles, so a partial update costs O(N d^2)
-and a complete one O(N^2 d^2) (meant for the small systems of strict-jamming and crystal
-searches, N up to a few thousand). The periodic images of a candidate pair are the integer
-vectors n with |H (s_j - s_i + n)| < R_i + R_j; along lattice vector k only the n_k with
-|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k are visited (h_k the cell height, 1 / |row k of H^-1|),
-so a sheared cell costs nothing more than an orthogonal one. A list entry is j * m + code, code
-the index of n in the image table ``img`` (m entries, n_k in [-M_k, M_k], lexicographic with
-axis 0 fastest, so the image -n has code m - 1 - code).
+counters, and neighbour lists with immobile bounding spheres (Donev 2006, sec. 3.3.2). A list
+entry is a neighbour j and a periodic image n with |H (s_j - s_i + n)| < R_i + R_j (s = H^-1 x,
+R the bounding radii), packed as j * m + code, code the index of n in the image table ``img``
+(m entries, n_k in [-M_k, M_k], lexicographic with axis 0 fastest, so the image -n has code
+m - 1 - code). The candidates come from a single-level cell grid of the bounding-sphere centres
+over the fractional coordinates (:mod:`hardpack.geometry.neighbours.grid`, linked lists per cell
+since a centre moves at every rebuild of its list): a rebuild visits the cells within R_i + max R
+of i's centre, a bounded number in a large cell, so the first build of a window costs O(N) and a
+partial one O(1); the unbounded cell range visits every (centre, image) within reach once, so
+small and sheared cells (fewer cells than the reach spans, several images of one neighbour) need
+nothing special. :func:`list_particle` is the exhaustive scan over all N particles and their
+image boxes (|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k, h_k the cell height 1 / |row k of H^-1|),
+O(N) per list; the ellipsoid kernel (:mod:`hardpack.md._ellipsoid_deforming_kernel`) builds its
+lists with it.
 
 A bounding-sphere exit re-wraps the particle into the cell and rebuilds its list; it also raises
 the particle's collision counter, so that predictions of others against it (whose image codes
@@ -39,6 +44,15 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
+from hardpack.geometry.neighbours.grid import (
+    RANGE_PAD,
+    image_cell,
+    link_point,
+    next_cell,
+    point_cell,
+    search_range,
+    unlink_point,
+)
 
 EXIT = -1
 NONE = -2
@@ -249,8 +263,161 @@ def list_particle(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, lmin)
 
 
 @njit(cache=True)
-def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn, mark, cnt, ep, ei, ec, tv,
-               hkey, heap, hpos, kin, vir, acc, iacc, coll_target, t_cap):
+def link_cells(Y, Hinv, n_cells, strides, head, nxt, cell_of, wrap):
+    """Sort the points Y (any position, wrapped or not) into the linked lists of a single-level
+    grid of the cell (:func:`hardpack.geometry.neighbours.grid.point_cell`).
+
+    Parameters
+    ----------
+    Y : numpy.ndarray of float64, shape (N, >= d)
+        Cartesian points in columns 0 .. d - 1.
+    Hinv : numpy.ndarray of float64, shape (d, d)
+        Inverse of the cell.
+    n_cells, strides : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction and their flat-index strides.
+    head : numpy.ndarray of int64, shape (prod n_cells,)
+        Receives the first point of every cell (-1: empty).
+    nxt, cell_of : numpy.ndarray of int64, shape (N,)
+        Receive the next point of every point's cell and every point's flat cell.
+    wrap : numpy.ndarray of int64, shape (N, d)
+        Receives floor(s) of every point's fractional coordinates s (a point found through the
+        unbounded cell c is its image floor(c / n) - wrap).
+    """
+    d = Hinv.shape[0]
+    s = np.empty(d)
+    coff = np.zeros(2, dtype=np.int64)
+    head[:] = -1
+    for i in range(Y.shape[0]):
+        _fractional(Y, i, Hinv, s)
+        cell_of[i] = point_cell(s, n_cells, strides, coff, 0, wrap[i])
+        link_point(head, nxt, i, cell_of[i])
+
+
+@njit(cache=True, inline="always")
+def _fractional(Y, i, Hinv, s):
+    """s = H^-1 y_i (row i of Y, columns 0 .. d - 1)."""
+    d = Hinv.shape[0]
+    for k in range(d):
+        acc = 0.0
+        for q in range(d):
+            acc += Hinv[k, q] * Y[i, q]
+        s[k] = acc
+
+
+@njit(cache=True)
+def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin, rmax, n_cells, cstr,
+                       head, nxt, wrap, ent):
+    """The lists of :func:`list_particle` (the same entries in the same order) from the bounding
+    spheres in the cells within R_i + ``rmax`` of i's centre instead of all N: every bounding
+    sphere j < jstop (j != i) that overlaps i's, with each periodic image n for which
+    |H (s_j - s_i + n)| < R_i + R_j (s = H^-1 x, the arithmetic of the scan), in both lists.
+
+    The cells are a single-level grid of the bounding-sphere centres over the fractional
+    coordinates (:mod:`hardpack.geometry.neighbours.grid`; :func:`link_cells`); the unbounded cell
+    range of :func:`hardpack.geometry.neighbours.grid.search_range` visits every (sphere, image)
+    within reach once, also when it is wider than the cell (small or sheared cells). The entries
+    found are sorted by value j * m + code before they are appended, which is the scan's order
+    (j ascending, images in code order).
+
+    Parameters
+    ----------
+    i, jstop : int
+        The particle and the partner bound (i for the first build, N for a rebuild).
+    bs : numpy.ndarray of float64, shape (N, d + 1)
+        Bounding spheres, centre then radius.
+    H, Hinv : numpy.ndarray of float64, shape (d, d)
+        The cell and its inverse.
+    M, strides : numpy.ndarray of int64, shape (d,)
+        Image ranges and the strides of the image code.
+    nb, nn : numpy.ndarray of int64
+        Neighbour lists (N, cap) and their lengths (N,), appended to.
+    m : int
+        Entries of the image table (the multiplier of j in an entry).
+    cfac : numpy.ndarray of float64, shape (d,)
+        1 / h_k, the row norms of H^-1.
+    lmin : float
+        Shortest lattice vector.
+    rmax : float
+        Upper bound of every bounding radius in the grid.
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction and flat-index strides of the grid.
+    head, nxt, wrap
+        The grid's linked lists and the wrap of every centre (:func:`link_cells`).
+    ent : numpy.ndarray of int64, shape (cap,)
+        Scratch of the entries found.
+
+    Returns
+    -------
+    int
+        OVERFLOW when a list is full, SELF_IMAGE when i's bounding sphere reaches its own image,
+        else 0.
+    """
+    d = H.shape[0]
+    cap = nb.shape[1]
+    ri = bs[i, d]
+    if 2.0 * ri >= lmin:  # i's bounding sphere would reach its own periodic image
+        return DeformingStatus.SELF_IMAGE
+    s = np.empty(d)
+    ds = np.empty(d)
+    lo = np.empty(d, dtype=np.int64)
+    hi = np.empty(d, dtype=np.int64)
+    c = np.empty(d, dtype=np.int64)
+    image = np.empty(d, dtype=np.int64)
+    coff = np.zeros(2, dtype=np.int64)
+    _fractional(bs, i, Hinv, s)
+    search_range(s, (ri + rmax) * (1.0 + RANGE_PAD), cfac, n_cells, 0, lo, hi)
+    for k in range(d):
+        c[k] = lo[k]
+    found = 0
+    while True:
+        flat = image_cell(c, n_cells, cstr, coff, 0, image)
+        j = head[flat]
+        while j >= 0:
+            if j < jstop and j != i:
+                reach = ri + bs[j, d]
+                for k in range(d):
+                    acc = 0.0
+                    for q in range(d):
+                        acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
+                    ds[k] = acc
+                d2 = 0.0
+                for q in range(d):
+                    acc = 0.0
+                    for k in range(d):
+                        acc += H[q, k] * (ds[k] + (image[k] - wrap[j, k]))
+                    d2 += acc * acc
+                if d2 < reach * reach:
+                    if found == cap:
+                        return DeformingStatus.OVERFLOW
+                    code = 0
+                    for k in range(d):
+                        code += (image[k] - wrap[j, k] + M[k]) * strides[k]
+                    ent[found] = j * m + code
+                    found += 1
+            j = nxt[j]
+        if not next_cell(c, lo, hi):
+            break
+    for a in range(1, found):  # insertion sort: the scan's order
+        e = ent[a]
+        b = a - 1
+        while b >= 0 and ent[b] > e:
+            ent[b + 1] = ent[b]
+            b -= 1
+        ent[b + 1] = e
+    for a in range(found):
+        j = ent[a] // m
+        if nn[i] >= cap or nn[j] >= cap:
+            return DeformingStatus.OVERFLOW
+        nb[i, nn[i]] = ent[a]
+        nn[i] += 1
+        nb[j, nn[j]] = i * m + (m - 1 - (ent[a] - j * m))
+        nn[j] += 1
+    return 0
+
+
+@njit(cache=True)
+def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, n_cells, cstr, kappa, skin, bs, nb, nn, mark, cnt, ep,
+               ei, ec, tv, hkey, heap, hpos, kin, vir, acc, iacc, coll_target, t_cap):
     """One window in a fixed cell H from a synchronisation point (all T = 0): build all lists,
     predict, process events until ``coll_target`` collisions or ``t_cap``.
 
@@ -279,6 +446,10 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
         Row norms of H^-1, 1 / h_k.
     lmin : float
         Length of the shortest lattice vector (:func:`hardpack.md.deforming.shortest_vector`).
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d), read-only
+        Cells per lattice direction of the grid of bounding-sphere centres that the lists are
+        built from (:func:`list_particle_grid`; any counts >= 1 give the same lists, cells about
+        as wide as the largest bounding diameter the fewest tests) and their flat-index strides.
     kappa : numpy.ndarray of float64, shape (N,), read-only
         Relative growth rate of every radius.
     skin : numpy.ndarray of float64, shape (N,), read-only
@@ -330,12 +501,23 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
     xi = np.empty(d)
     wrap = np.empty(d)  # scratch of wrap_one
     upd = np.empty(2, dtype=np.int64)
+    sfr = np.empty(d)  # fractional coordinates of a bounding centre
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    gwrap = np.empty((n, d), dtype=np.int64)
+    ent = np.empty(nb.shape[1], dtype=np.int64)
+    coff = np.zeros(2, dtype=np.int64)
+    rmax = 0.0  # largest bounding radius in the grid
     for i in range(n):  # complete rebuild at t = 0 (positions wrapped by the caller)
         for k in range(d):
             bs[i, k] = X[i, k]
         bs[i, d] = A[i] + skin[i]
+        rmax = max(rmax, bs[i, d])
+    link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap)
     for i in range(n):
-        st = list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin)
+        st = list_particle_grid(i, i, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin, rmax, n_cells, cstr,
+                                head, nxt, gwrap, ent)
         if st != 0:
             return st
     hsize = 0
@@ -387,7 +569,13 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 for k in range(d):
                     bs[i, k] = X[i, k]
                 bs[i, d] = A[i] * (1.0 + kappa[i] * t) + skin[i]
-                st = list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin)
+                rmax = max(rmax, bs[i, d])
+                unlink_point(head, nxt, i, cell_of[i])
+                _fractional(bs, i, Hinv, sfr)
+                cell_of[i] = point_cell(sfr, n_cells, cstr, coff, 0, gwrap[i])
+                link_point(head, nxt, i, cell_of[i])
+                st = list_particle_grid(i, n, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin, rmax, n_cells,
+                                        cstr, head, nxt, gwrap, ent)
                 if st != 0:
                     acc[0] = t
                     return st
@@ -524,11 +712,14 @@ def synchronise(X, V, T, A, t, kappa):
 
 
 @njit(cache=True)
-def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
+def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
     """Largest s in [0, 1] such that mapping positions and cell by (I + s strain) leaves every
     pair within ``reach`` at least half its gap (|r| - sigma), and the smallest relative gap
     (|r| - sigma) / sigma before the map. A particle's own images count as pairs with contact
-    distance ``self_sigma``. Positions must be wrapped into the cell.
+    distance ``self_sigma``. The pairs (i <= j, image n; n != 0 for i = j) with
+    |r| = |H (s_j - s_i + n)| < reach come from a single-level grid of the centres over the
+    fractional coordinates (:func:`link_cells`; every (particle, image) in the unbounded cell range
+    within ``reach`` of i is visited once, also in cells narrower than ``reach``).
 
     Along the path r(s) = r + s strain r the first s with |r(s)| = sigma + gap / 2 is the
     contact root of a pair with relative velocity strain r (:func:`hardpack.events.roots.contact_root`).
@@ -547,6 +738,9 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
         Pairs farther apart than this are ignored.
     self_sigma : float
         Contact distance of a particle with its own images.
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction of the grid (any counts >= 1 give the same result; cells about
+        ``reach`` wide the fewest tests) and their flat-index strides.
 
     Returns
     -------
@@ -562,22 +756,48 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
         for q in range(d):
             s2 += Hinv[k, q] * Hinv[k, q]
         cfac[k] = np.sqrt(s2)
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    wrap = np.empty((n, d), dtype=np.int64)
+    link_cells(X, Hinv, n_cells, cstr, head, nxt, cell_of, wrap)
+    coff = np.zeros(2, dtype=np.int64)
+    s = np.empty(d)
     ds = np.empty(d)
     r = np.empty(d)
+    od = np.empty(d, dtype=np.int64)
     lo = np.empty(d, dtype=np.int64)
     hi = np.empty(d, dtype=np.int64)
-    od = np.empty(d, dtype=np.int64)
+    c = np.empty(d, dtype=np.int64)
+    image = np.empty(d, dtype=np.int64)
     smax = 1.0
     gmin = np.inf
     for i in range(n):
-        for j in range(i, n):
-            total = _image_box(X[i], X[j], Hinv, reach, cfac, ds, lo, hi, od)
-            sigma = self_sigma if i == j else A[i] + A[j]
-            for _ in range(total):
-                skip = i == j
+        _fractional(X, i, Hinv, s)
+        search_range(s, reach * (1.0 + RANGE_PAD), cfac, n_cells, 0, lo, hi)
+        for k in range(d):
+            c[k] = lo[k]
+        while True:
+            flat = image_cell(c, n_cells, cstr, coff, 0, image)
+            more = next_cell(c, lo, hi)
+            j = head[flat]
+            while j >= 0:
+                jj = j
+                j = nxt[j]
+                if jj < i:
+                    continue
+                skip = i == jj
                 for k in range(d):
+                    od[k] = image[k] - wrap[jj, k]
                     if od[k] != 0:
                         skip = False
+                if skip:
+                    continue
+                for k in range(d):
+                    acc = 0.0
+                    for q in range(d):
+                        acc += Hinv[k, q] * (X[jj, q] - X[i, q])
+                    ds[k] = acc
                 rr = 0.0
                 for q in range(d):
                     acc = 0.0
@@ -585,13 +805,9 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
                         acc += H[q, k] * (ds[k] + od[k])
                     r[q] = acc
                     rr += acc * acc
-                for k in range(d):
-                    od[k] += 1
-                    if od[k] <= hi[k]:
-                        break
-                    od[k] = lo[k]
-                if skip or rr >= reach * reach:
+                if rr >= reach * reach:
                     continue
+                sigma = self_sigma if i == jj else A[i] + A[jj]
                 gap = np.sqrt(rr) - sigma
                 gmin = min(gmin, gap / sigma)
                 ru = 0.0
@@ -607,4 +823,6 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
                         smax = 0.0
                 else:
                     smax = min(smax, contact_root(rr, ru, uu, sigma + 0.5 * gap, 0.0, smax))
+            if not more:
+                break
     return smax, gmin
