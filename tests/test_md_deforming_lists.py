@@ -65,16 +65,16 @@ def _grid_lists(H, bs, n_cells, jstop_all=False, cap=512):
     cstr = c_strides(n_cells)
     head = np.empty(int(np.prod(n_cells)), dtype=np.int64)
     nxt, cell_of = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
-    wrap = np.empty((n, d), dtype=np.int64)
-    dk.link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, wrap)
+    wrap, sw = np.empty((n, d), dtype=np.int64), np.empty((n, d))
+    dk.link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, wrap, sw)
     nb, nn, ent = np.zeros((n, cap), dtype=np.int64), np.zeros(n, dtype=np.int64), np.empty(cap, dtype=np.int64)
     rmax = float(bs[:, d].max())
     out = []
     for i in range(n):
         if jstop_all:
             nn[:] = 0
-        st = dk.list_particle_grid(i, n if jstop_all else i, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin, rmax,
-                                   n_cells, cstr, head, nxt, wrap, ent)
+        st = dk.list_particle_grid(i, n if jstop_all else i, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin,
+                                   rmax, n_cells, cstr, head, nxt, wrap, sw, ent)
         assert st == 0
         if jstop_all:
             out.append(nb[i, :nn[i]].copy())

@@ -263,7 +263,7 @@ def list_particle(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, lmin)
 
 
 @njit(cache=True)
-def link_cells(Y, Hinv, n_cells, strides, head, nxt, cell_of, wrap):
+def link_cells(Y, Hinv, n_cells, strides, head, nxt, cell_of, wrap, sw):
     """Sort the points Y (any position, wrapped or not) into the linked lists of a single-level
     grid of the cell (:func:`hardpack.geometry.neighbours.grid.point_cell`).
 
@@ -282,15 +282,67 @@ def link_cells(Y, Hinv, n_cells, strides, head, nxt, cell_of, wrap):
     wrap : numpy.ndarray of int64, shape (N, d)
         Receives floor(s) of every point's fractional coordinates s (a point found through the
         unbounded cell c is its image floor(c / n) - wrap).
+    sw : numpy.ndarray of float64, shape (N, d)
+        Receives s - floor(s).
     """
-    d = Hinv.shape[0]
-    s = np.empty(d)
-    coff = np.zeros(2, dtype=np.int64)
     head[:] = -1
     for i in range(Y.shape[0]):
-        _fractional(Y, i, Hinv, s)
-        cell_of[i] = point_cell(s, n_cells, strides, coff, 0, wrap[i])
-        link_point(head, nxt, i, cell_of[i])
+        link_one(Y, i, Hinv, n_cells, strides, head, nxt, cell_of, wrap, sw, True)
+
+
+@njit(cache=True, inline="always")
+def link_one(Y, i, Hinv, n_cells, strides, head, nxt, cell_of, wrap, sw, first):
+    """Put point i into its cell (:func:`link_cells`), taking it out of its old one unless ``first``
+    (``head`` must be all -1 before the first point)."""
+    d = Hinv.shape[0]
+    if not first:
+        unlink_point(head, nxt, i, cell_of[i])
+    coff = np.zeros(2, dtype=np.int64)
+    _fractional(Y, i, Hinv, sw[i])
+    cell_of[i] = point_cell(sw[i], n_cells, strides, coff, 0, wrap[i])
+    for k in range(d):
+        sw[i, k] -= wrap[i, k]
+    link_point(head, nxt, i, cell_of[i])
+
+
+@njit(cache=True, inline="always")
+def _cell_range(s, beta, cfac, n_cells, w, lo, hi, wide):
+    """The cells to visit for the points within ``beta`` of fractional point s: the unbounded range
+    of :func:`hardpack.geometry.neighbours.grid.search_range` (padded against round-off), except
+    along the axes where it spans all n_k cells (``wide``), whose stored cells are visited once
+    and each point's images along them are found by :func:`_image_range`; ``w`` receives the
+    fractional half-widths beta / h_k."""
+    search_range(s, beta * (1.0 + RANGE_PAD), cfac, n_cells, 0, lo, hi)
+    for k in range(s.shape[0]):
+        w[k] = beta * (1.0 + RANGE_PAD) * cfac[k]
+        wide[k] = hi[k] - lo[k] + 1 >= n_cells[0, k]
+        if wide[k]:
+            lo[k] = 0
+            hi[k] = n_cells[0, k] - 1
+
+
+@njit(cache=True, inline="always")
+def _image_range(s, w, swj, wide, image, blo, bhi, od):
+    """The images n of the point at wrapped fractional coordinates ``swj``, found in a cell seen
+    through ``image``, with |swj_k + n_k - s_k| <= w_k along every axis: n_k = image_k along the
+    narrow axes (if within w_k), the integers within w_k along the ``wide`` ones (:func:`_cell_range`);
+    returns their number (0 if none) with the box in [blo, bhi] and ``od`` set to its first image."""
+    total = 1
+    for k in range(s.shape[0]):
+        if wide[k]:
+            blo[k] = int(np.ceil(s[k] - w[k] - swj[k]))
+            bhi[k] = int(np.floor(s[k] + w[k] - swj[k]))
+            if bhi[k] < blo[k]:
+                return 0
+        else:
+            t = swj[k] + image[k] - s[k]
+            if t > w[k] or t < -w[k]:
+                return 0
+            blo[k] = image[k]
+            bhi[k] = image[k]
+        total *= bhi[k] - blo[k] + 1
+        od[k] = blo[k]
+    return total
 
 
 @njit(cache=True, inline="always")
@@ -305,8 +357,8 @@ def _fractional(Y, i, Hinv, s):
 
 
 @njit(cache=True)
-def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin, rmax, n_cells, cstr,
-                       head, nxt, wrap, ent):
+def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, lmin, rmax, n_cells, cstr,
+                       head, nxt, wrap, sw, ent):
     """The lists of :func:`list_particle` (the same entries in the same order) from the bounding
     spheres in the cells within R_i + ``rmax`` of i's centre instead of all N: every bounding
     sphere j < jstop (j != i) that overlaps i's, with each periodic image n for which
@@ -315,8 +367,10 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin,
     The cells are a single-level grid of the bounding-sphere centres over the fractional
     coordinates (:mod:`hardpack.geometry.neighbours.grid`; :func:`link_cells`); the unbounded cell
     range of :func:`hardpack.geometry.neighbours.grid.search_range` visits every (sphere, image)
-    within reach once, also when it is wider than the cell (small or sheared cells). The entries
-    found are sorted by value j * m + code before they are appended, which is the scan's order
+    within reach once; along an axis where it spans all cells (small or sheared cells) the stored
+    cells are visited once and a sphere's images along it are those of the scan's image box
+    (:func:`_cell_range`, :func:`_image_range`). The entries
+    found are sorted by value j * mul + code before they are appended, which is the scan's order
     (j ascending, images in code order).
 
     Parameters
@@ -331,8 +385,9 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin,
         Image ranges and the strides of the image code.
     nb, nn : numpy.ndarray of int64
         Neighbour lists (N, cap) and their lengths (N,), appended to.
-    m : int
-        Entries of the image table (the multiplier of j in an entry).
+    m, mul : int
+        Entries of the image table (the image -n of code c has code m - 1 - c) and the multiplier
+        of j in an entry (>= m).
     cfac : numpy.ndarray of float64, shape (d,)
         1 / h_k, the row norms of H^-1.
     lmin : float
@@ -341,8 +396,9 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin,
         Upper bound of every bounding radius in the grid.
     n_cells, cstr : numpy.ndarray of int64, shape (1, d)
         Cells per lattice direction and flat-index strides of the grid.
-    head, nxt, wrap
-        The grid's linked lists and the wrap of every centre (:func:`link_cells`).
+    head, nxt, wrap, sw
+        The grid's linked lists, the wrap of every centre and its wrapped fractional coordinates
+        (:func:`link_cells`).
     ent : numpy.ndarray of int64, shape (cap,)
         Scratch of the entries found.
 
@@ -358,14 +414,19 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin,
     if 2.0 * ri >= lmin:  # i's bounding sphere would reach its own periodic image
         return DeformingStatus.SELF_IMAGE
     s = np.empty(d)
+    w = np.empty(d)
     ds = np.empty(d)
     lo = np.empty(d, dtype=np.int64)
     hi = np.empty(d, dtype=np.int64)
+    wide = np.empty(d, dtype=np.bool_)
     c = np.empty(d, dtype=np.int64)
     image = np.empty(d, dtype=np.int64)
+    blo = np.empty(d, dtype=np.int64)
+    bhi = np.empty(d, dtype=np.int64)
+    od = np.empty(d, dtype=np.int64)
     coff = np.zeros(2, dtype=np.int64)
     _fractional(bs, i, Hinv, s)
-    search_range(s, (ri + rmax) * (1.0 + RANGE_PAD), cfac, n_cells, 0, lo, hi)
+    _cell_range(s, ri + rmax, cfac, n_cells, w, lo, hi, wide)
     for k in range(d):
         c[k] = lo[k]
     found = 0
@@ -373,27 +434,32 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin,
         flat = image_cell(c, n_cells, cstr, coff, 0, image)
         j = head[flat]
         while j >= 0:
+            total = 0
             if j < jstop and j != i:
+                total = _image_range(s, w, sw[j], wide, image, blo, bhi, od)
+            if total > 0:
                 reach = ri + bs[j, d]
                 for k in range(d):
                     acc = 0.0
                     for q in range(d):
                         acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
                     ds[k] = acc
+            for _ in range(total):
                 d2 = 0.0
                 for q in range(d):
                     acc = 0.0
                     for k in range(d):
-                        acc += H[q, k] * (ds[k] + (image[k] - wrap[j, k]))
+                        acc += H[q, k] * (ds[k] + (od[k] - wrap[j, k]))
                     d2 += acc * acc
                 if d2 < reach * reach:
                     if found == cap:
                         return DeformingStatus.OVERFLOW
                     code = 0
                     for k in range(d):
-                        code += (image[k] - wrap[j, k] + M[k]) * strides[k]
-                    ent[found] = j * m + code
+                        code += (od[k] - wrap[j, k] + M[k]) * strides[k]
+                    ent[found] = j * mul + code
                     found += 1
+                next_cell(od, blo, bhi)
             j = nxt[j]
         if not next_cell(c, lo, hi):
             break
@@ -405,12 +471,12 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin,
             b -= 1
         ent[b + 1] = e
     for a in range(found):
-        j = ent[a] // m
+        j = ent[a] // mul
         if nn[i] >= cap or nn[j] >= cap:
             return DeformingStatus.OVERFLOW
         nb[i, nn[i]] = ent[a]
         nn[i] += 1
-        nb[j, nn[j]] = i * m + (m - 1 - (ent[a] - j * m))
+        nb[j, nn[j]] = i * mul + (m - 1 - (ent[a] - j * mul))
         nn[j] += 1
     return 0
 
@@ -501,23 +567,22 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, n_cells, cstr, kappa, sk
     xi = np.empty(d)
     wrap = np.empty(d)  # scratch of wrap_one
     upd = np.empty(2, dtype=np.int64)
-    sfr = np.empty(d)  # fractional coordinates of a bounding centre
     head = np.empty(n_cells[0].prod(), dtype=np.int64)
     nxt = np.empty(n, dtype=np.int64)
     cell_of = np.empty(n, dtype=np.int64)
     gwrap = np.empty((n, d), dtype=np.int64)
+    gsw = np.empty((n, d))
     ent = np.empty(nb.shape[1], dtype=np.int64)
-    coff = np.zeros(2, dtype=np.int64)
     rmax = 0.0  # largest bounding radius in the grid
     for i in range(n):  # complete rebuild at t = 0 (positions wrapped by the caller)
         for k in range(d):
             bs[i, k] = X[i, k]
         bs[i, d] = A[i] + skin[i]
         rmax = max(rmax, bs[i, d])
-    link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap)
+    link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw)
     for i in range(n):
-        st = list_particle_grid(i, i, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin, rmax, n_cells, cstr,
-                                head, nxt, gwrap, ent)
+        st = list_particle_grid(i, i, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin, rmax, n_cells, cstr,
+                                head, nxt, gwrap, gsw, ent)
         if st != 0:
             return st
     hsize = 0
@@ -570,12 +635,9 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, n_cells, cstr, kappa, sk
                     bs[i, k] = X[i, k]
                 bs[i, d] = A[i] * (1.0 + kappa[i] * t) + skin[i]
                 rmax = max(rmax, bs[i, d])
-                unlink_point(head, nxt, i, cell_of[i])
-                _fractional(bs, i, Hinv, sfr)
-                cell_of[i] = point_cell(sfr, n_cells, cstr, coff, 0, gwrap[i])
-                link_point(head, nxt, i, cell_of[i])
-                st = list_particle_grid(i, n, bs, H, Hinv, M, strides, nb, nn, m, cfac, lmin, rmax, n_cells,
-                                        cstr, head, nxt, gwrap, ent)
+                link_one(bs, i, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw, False)
+                st = list_particle_grid(i, n, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin, rmax, n_cells,
+                                        cstr, head, nxt, gwrap, gsw, ent)
                 if st != 0:
                     acc[0] = t
                     return st
@@ -760,21 +822,27 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
     nxt = np.empty(n, dtype=np.int64)
     cell_of = np.empty(n, dtype=np.int64)
     wrap = np.empty((n, d), dtype=np.int64)
-    link_cells(X, Hinv, n_cells, cstr, head, nxt, cell_of, wrap)
+    sw = np.empty((n, d))
+    link_cells(X, Hinv, n_cells, cstr, head, nxt, cell_of, wrap, sw)
     coff = np.zeros(2, dtype=np.int64)
     s = np.empty(d)
+    w = np.empty(d)
     ds = np.empty(d)
     r = np.empty(d)
-    od = np.empty(d, dtype=np.int64)
     lo = np.empty(d, dtype=np.int64)
     hi = np.empty(d, dtype=np.int64)
+    wide = np.empty(d, dtype=np.bool_)
     c = np.empty(d, dtype=np.int64)
     image = np.empty(d, dtype=np.int64)
+    blo = np.empty(d, dtype=np.int64)
+    bhi = np.empty(d, dtype=np.int64)
+    od = np.empty(d, dtype=np.int64)
+    nv = np.empty(d, dtype=np.int64)
     smax = 1.0
     gmin = np.inf
     for i in range(n):
         _fractional(X, i, Hinv, s)
-        search_range(s, reach * (1.0 + RANGE_PAD), cfac, n_cells, 0, lo, hi)
+        _cell_range(s, reach, cfac, n_cells, w, lo, hi, wide)
         for k in range(d):
             c[k] = lo[k]
         while True:
@@ -786,43 +854,47 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
                 j = nxt[j]
                 if jj < i:
                     continue
-                skip = i == jj
-                for k in range(d):
-                    od[k] = image[k] - wrap[jj, k]
-                    if od[k] != 0:
-                        skip = False
-                if skip:
-                    continue
-                for k in range(d):
-                    acc = 0.0
+                total = _image_range(s, w, sw[jj], wide, image, blo, bhi, od)
+                if total > 0:
+                    for k in range(d):
+                        acc = 0.0
+                        for q in range(d):
+                            acc += Hinv[k, q] * (X[jj, q] - X[i, q])
+                        ds[k] = acc
+                for _ in range(total):
+                    skip = i == jj
+                    for k in range(d):
+                        nv[k] = od[k] - wrap[jj, k]
+                        if nv[k] != 0:
+                            skip = False
+                    next_cell(od, blo, bhi)
+                    if skip:
+                        continue
+                    rr = 0.0
                     for q in range(d):
-                        acc += Hinv[k, q] * (X[jj, q] - X[i, q])
-                    ds[k] = acc
-                rr = 0.0
-                for q in range(d):
-                    acc = 0.0
-                    for k in range(d):
-                        acc += H[q, k] * (ds[k] + od[k])
-                    r[q] = acc
-                    rr += acc * acc
-                if rr >= reach * reach:
-                    continue
-                sigma = self_sigma if i == jj else A[i] + A[jj]
-                gap = np.sqrt(rr) - sigma
-                gmin = min(gmin, gap / sigma)
-                ru = 0.0
-                uu = 0.0
-                for q in range(d):
-                    u = 0.0
-                    for k in range(d):
-                        u += strain[q, k] * r[k]
-                    ru += r[q] * u
-                    uu += u * u
-                if gap <= 0.0:  # touching (round-off): the strain must not push the pair closer
-                    if ru < 0.0:
-                        smax = 0.0
-                else:
-                    smax = min(smax, contact_root(rr, ru, uu, sigma + 0.5 * gap, 0.0, smax))
+                        acc = 0.0
+                        for k in range(d):
+                            acc += H[q, k] * (ds[k] + nv[k])
+                        r[q] = acc
+                        rr += acc * acc
+                    if rr >= reach * reach:
+                        continue
+                    sigma = self_sigma if i == jj else A[i] + A[jj]
+                    gap = np.sqrt(rr) - sigma
+                    gmin = min(gmin, gap / sigma)
+                    ru = 0.0
+                    uu = 0.0
+                    for q in range(d):
+                        u = 0.0
+                        for k in range(d):
+                            u += strain[q, k] * r[k]
+                        ru += r[q] * u
+                        uu += u * u
+                    if gap <= 0.0:  # touching (round-off): the strain must not push the pair closer
+                        if ru < 0.0:
+                            smax = 0.0
+                    else:
+                        smax = min(smax, contact_root(rr, ru, uu, sigma + 0.5 * gap, 0.0, smax))
             if not more:
                 break
     return smax, gmin
