@@ -311,14 +311,19 @@ def _cell_range(s, beta, cfac, n_cells, w, lo, hi, wide):
     of :func:`hardpack.geometry.neighbours.grid.search_range` (padded against round-off), except
     along the axes where it spans all n_k cells (``wide``), whose stored cells are visited once
     and each point's images along them are found by :func:`_image_range`; ``w`` receives the
-    fractional half-widths beta / h_k."""
+    fractional half-widths beta / h_k. Returns True when every axis is wide: every point is a
+    candidate, and the caller takes them in index order instead of from the cells."""
     search_range(s, beta * (1.0 + RANGE_PAD), cfac, n_cells, 0, lo, hi)
+    every = True
     for k in range(s.shape[0]):
         w[k] = beta * (1.0 + RANGE_PAD) * cfac[k]
         wide[k] = hi[k] - lo[k] + 1 >= n_cells[0, k]
         if wide[k]:
             lo[k] = 0
             hi[k] = n_cells[0, k] - 1
+        else:
+            every = False
+    return every
 
 
 @njit(cache=True, inline="always")
@@ -426,43 +431,52 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, 
     od = np.empty(d, dtype=np.int64)
     coff = np.zeros(2, dtype=np.int64)
     _fractional(bs, i, Hinv, s)
-    _cell_range(s, ri + rmax, cfac, n_cells, w, lo, hi, wide)
-    for k in range(d):
-        c[k] = lo[k]
+    every = _cell_range(s, ri + rmax, cfac, n_cells, w, lo, hi, wide)
+    j = 0  # every: the candidates are 0 .. jstop - 1
+    more = not every  # else those of the cells of the range, in turn
+    if more:
+        for k in range(d):
+            c[k] = lo[k]
+        j = -1
     found = 0
     while True:
-        flat = image_cell(c, n_cells, cstr, coff, 0, image)
-        j = head[flat]
-        while j >= 0:
-            total = 0
-            if j < jstop and j != i:
-                total = _image_range(s, w, sw[j], wide, image, blo, bhi, od)
-            if total > 0:
-                reach = ri + bs[j, d]
-                for k in range(d):
-                    acc = 0.0
-                    for q in range(d):
-                        acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
-                    ds[k] = acc
-            for _ in range(total):
-                d2 = 0.0
+        if every:
+            if j >= jstop:
+                break
+        else:
+            while j < 0 and more:
+                flat = image_cell(c, n_cells, cstr, coff, 0, image)
+                more = next_cell(c, lo, hi)
+                j = head[flat]
+            if j < 0:
+                break
+        total = 0
+        if j < jstop and j != i:
+            total = _image_range(s, w, sw[j], wide, image, blo, bhi, od)
+        if total > 0:
+            reach = ri + bs[j, d]
+            for k in range(d):
+                acc = 0.0
                 for q in range(d):
-                    acc = 0.0
-                    for k in range(d):
-                        acc += H[q, k] * (ds[k] + (od[k] - wrap[j, k]))
-                    d2 += acc * acc
-                if d2 < reach * reach:
-                    if found == cap:
-                        return DeformingStatus.OVERFLOW
-                    code = 0
-                    for k in range(d):
-                        code += (od[k] - wrap[j, k] + M[k]) * strides[k]
-                    ent[found] = j * mul + code
-                    found += 1
-                next_cell(od, blo, bhi)
-            j = nxt[j]
-        if not next_cell(c, lo, hi):
-            break
+                    acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
+                ds[k] = acc
+        for _ in range(total):
+            d2 = 0.0
+            for q in range(d):
+                acc = 0.0
+                for k in range(d):
+                    acc += H[q, k] * (ds[k] + (od[k] - wrap[j, k]))
+                d2 += acc * acc
+            if d2 < reach * reach:
+                if found == cap:
+                    return DeformingStatus.OVERFLOW
+                code = 0
+                for k in range(d):
+                    code += (od[k] - wrap[j, k] + M[k]) * strides[k]
+                ent[found] = j * mul + code
+                found += 1
+            next_cell(od, blo, bhi)
+        j = j + 1 if every else nxt[j]
     for a in range(1, found):  # insertion sort: the scan's order
         e = ent[a]
         b = a - 1
@@ -842,59 +856,67 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
     gmin = np.inf
     for i in range(n):
         _fractional(X, i, Hinv, s)
-        _cell_range(s, reach, cfac, n_cells, w, lo, hi, wide)
-        for k in range(d):
-            c[k] = lo[k]
+        every = _cell_range(s, reach, cfac, n_cells, w, lo, hi, wide)
+        j = i  # every: the candidates are i .. n - 1
+        more = not every  # else those of the cells of the range, in turn
+        if more:
+            for k in range(d):
+                c[k] = lo[k]
+            j = -1
         while True:
-            flat = image_cell(c, n_cells, cstr, coff, 0, image)
-            more = next_cell(c, lo, hi)
-            j = head[flat]
-            while j >= 0:
-                jj = j
-                j = nxt[j]
-                if jj < i:
+            if every:
+                if j >= n:
+                    break
+            else:
+                while j < 0 and more:
+                    flat = image_cell(c, n_cells, cstr, coff, 0, image)
+                    more = next_cell(c, lo, hi)
+                    j = head[flat]
+                if j < 0:
+                    break
+            jj = j
+            j = j + 1 if every else nxt[j]
+            if jj < i:
+                continue
+            total = _image_range(s, w, sw[jj], wide, image, blo, bhi, od)
+            if total > 0:
+                for k in range(d):
+                    acc = 0.0
+                    for q in range(d):
+                        acc += Hinv[k, q] * (X[jj, q] - X[i, q])
+                    ds[k] = acc
+            for _ in range(total):
+                skip = i == jj
+                for k in range(d):
+                    nv[k] = od[k] - wrap[jj, k]
+                    if nv[k] != 0:
+                        skip = False
+                next_cell(od, blo, bhi)
+                if skip:
                     continue
-                total = _image_range(s, w, sw[jj], wide, image, blo, bhi, od)
-                if total > 0:
+                rr = 0.0
+                for q in range(d):
+                    acc = 0.0
                     for k in range(d):
-                        acc = 0.0
-                        for q in range(d):
-                            acc += Hinv[k, q] * (X[jj, q] - X[i, q])
-                        ds[k] = acc
-                for _ in range(total):
-                    skip = i == jj
+                        acc += H[q, k] * (ds[k] + nv[k])
+                    r[q] = acc
+                    rr += acc * acc
+                if rr >= reach * reach:
+                    continue
+                sigma = self_sigma if i == jj else A[i] + A[jj]
+                gap = np.sqrt(rr) - sigma
+                gmin = min(gmin, gap / sigma)
+                ru = 0.0
+                uu = 0.0
+                for q in range(d):
+                    u = 0.0
                     for k in range(d):
-                        nv[k] = od[k] - wrap[jj, k]
-                        if nv[k] != 0:
-                            skip = False
-                    next_cell(od, blo, bhi)
-                    if skip:
-                        continue
-                    rr = 0.0
-                    for q in range(d):
-                        acc = 0.0
-                        for k in range(d):
-                            acc += H[q, k] * (ds[k] + nv[k])
-                        r[q] = acc
-                        rr += acc * acc
-                    if rr >= reach * reach:
-                        continue
-                    sigma = self_sigma if i == jj else A[i] + A[jj]
-                    gap = np.sqrt(rr) - sigma
-                    gmin = min(gmin, gap / sigma)
-                    ru = 0.0
-                    uu = 0.0
-                    for q in range(d):
-                        u = 0.0
-                        for k in range(d):
-                            u += strain[q, k] * r[k]
-                        ru += r[q] * u
-                        uu += u * u
-                    if gap <= 0.0:  # touching (round-off): the strain must not push the pair closer
-                        if ru < 0.0:
-                            smax = 0.0
-                    else:
-                        smax = min(smax, contact_root(rr, ru, uu, sigma + 0.5 * gap, 0.0, smax))
-            if not more:
-                break
+                        u += strain[q, k] * r[k]
+                    ru += r[q] * u
+                    uu += u * u
+                if gap <= 0.0:  # touching (round-off): the strain must not push the pair closer
+                    if ru < 0.0:
+                        smax = 0.0
+                else:
+                    smax = min(smax, contact_root(rr, ru, uu, sigma + 0.5 * gap, 0.0, smax))
     return smax, gmin
