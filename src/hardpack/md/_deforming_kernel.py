@@ -17,9 +17,11 @@ m - 1 - code). The candidates come from a single-level cell grid of the bounding
 over the fractional coordinates (:mod:`hardpack.geometry.neighbours.grid`, linked lists per cell
 since a centre moves at every rebuild of its list): a rebuild visits the cells within R_i + max R
 of i's centre, a bounded number in a large cell, so the first build of a window costs O(N) and a
-partial one O(1); the unbounded cell range visits every (centre, image) within reach once, so
-small and sheared cells (fewer cells than the reach spans, several images of one neighbour) need
-nothing special. :func:`list_particle` is the exhaustive scan over all N particles and their
+partial one O(1); the unbounded cell range visits every (centre, image) within reach once.
+Along an axis where the range spans every cell (small or sheared cells, several images of one
+neighbour) the stored cells are visited once and a centre's images along it are the integers of
+the per-pair image box below; when it does so along every axis all particles are candidates,
+taken in index order. :func:`list_particle` is the exhaustive scan over all N particles and their
 image boxes (|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k, h_k the cell height 1 / |row k of H^-1|),
 O(N) per list; the ellipsoid kernel (:mod:`hardpack.md._ellipsoid_deforming_kernel`) builds its
 lists with it.
@@ -374,7 +376,8 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, 
     range of :func:`hardpack.geometry.neighbours.grid.search_range` visits every (sphere, image)
     within reach once; along an axis where it spans all cells (small or sheared cells) the stored
     cells are visited once and a sphere's images along it are those of the scan's image box
-    (:func:`_cell_range`, :func:`_image_range`). The entries
+    (:func:`_cell_range`, :func:`_image_range`; all particles in index order when every axis is
+    such). The entries
     found are sorted by value j * mul + code before they are appended, which is the scan's order
     (j ascending, images in code order).
 
