@@ -22,7 +22,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
 from hardpack.md import _deforming_kernel as dk
-from hardpack.md.deforming import DeformingSimulation
+from hardpack.md.deforming import DeformingSimulation, cell_grid
 
 
 def _first_collision(packing, velocities, kappa):
@@ -40,7 +40,7 @@ def _first_collision(packing, velocities, kappa):
     acc, iacc = np.zeros(2), np.zeros(dk.N_COUNTERS, dtype=np.int64)
     T = z()
     status = dk.run_events(X, V, T, A, H, Hinv, M, img, np.linalg.norm(Hinv, axis=1), lmin,
-                           np.asarray(kappa, dtype=float), np.full(n, 0.3), np.zeros((n, d + 1)),
+                           *cell_grid(H, 2 * (float(A.max()) + 0.3), n), np.asarray(kappa, dtype=float), np.full(n, 0.3), np.zeros((n, d + 1)),
                            np.zeros((n, 16), dtype=np.int64), z(np.int64), z(np.int8), z(np.int64),
                            z(np.int64), z(np.int64), z(np.int64), z(), z(), z(np.int64), z(np.int64),
                            np.zeros((d, d)), np.zeros((d, d)), acc, iacc, 1, np.inf)

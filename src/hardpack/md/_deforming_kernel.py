@@ -9,15 +9,22 @@ derived in :mod:`hardpack.md._kernel`), not Donev's quartic of a cell deforming 
 
 Same event scheme as :mod:`hardpack.md._kernel` in its simplest form: one predicted event per
 particle in a 4-ary heap (:func:`hardpack.events.heap.heap_set`), lazy invalidation by collision
-counters, and neighbour lists with immobile bounding spheres (Donev 2006, sec. 3.3.2). There is no
-cell grid: a list is (re)built by scanning all N particles, so a partial update costs O(N d^2)
-and a complete one O(N^2 d^2) (meant for the small systems of strict-jamming and crystal
-searches, N up to a few thousand). The periodic images of a candidate pair are the integer
-vectors n with |H (s_j - s_i + n)| < R_i + R_j; along lattice vector k only the n_k with
-|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k are visited (h_k the cell height, 1 / |row k of H^-1|),
-so a sheared cell costs nothing more than an orthogonal one. A list entry is j * m + code, code
-the index of n in the image table ``img`` (m entries, n_k in [-M_k, M_k], lexicographic with
-axis 0 fastest, so the image -n has code m - 1 - code).
+counters, and neighbour lists with immobile bounding spheres (Donev 2006, sec. 3.3.2). A list
+entry is a neighbour j and a periodic image n with |H (s_j - s_i + n)| < R_i + R_j (s = H^-1 x,
+R the bounding radii), packed as j * m + code, code the index of n in the image table ``img``
+(m entries, n_k in [-M_k, M_k], lexicographic with axis 0 fastest, so the image -n has code
+m - 1 - code). The candidates come from a single-level cell grid of the bounding-sphere centres
+over the fractional coordinates (:mod:`hardpack.geometry.neighbours.grid`, linked lists per cell
+since a centre moves at every rebuild of its list): a rebuild visits the cells within R_i + max R
+of i's centre, a bounded number in a large cell, so the first build of a window costs O(N) and a
+partial one O(1); the unbounded cell range visits every (centre, image) within reach once.
+Along an axis where the range spans every cell (small or sheared cells, several images of one
+neighbour) the stored cells are visited once and a centre's images along it are the integers of
+the per-pair image box below; when it does so along every axis all particles are candidates,
+taken in index order. :func:`list_particle` is the exhaustive scan over all N particles and their
+image boxes (|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k, h_k the cell height 1 / |row k of H^-1|),
+O(N) per list; the ellipsoid kernel (:mod:`hardpack.md._ellipsoid_deforming_kernel`) builds its
+lists with it.
 
 A bounding-sphere exit re-wraps the particle into the cell and rebuilds its list; it also raises
 the particle's collision counter, so that predictions of others against it (whose image codes
@@ -39,6 +46,15 @@ from numba import njit
 
 from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
+from hardpack.geometry.neighbours.grid import (
+    RANGE_PAD,
+    image_cell,
+    link_point,
+    next_cell,
+    point_cell,
+    search_range,
+    unlink_point,
+)
 
 EXIT = -1
 NONE = -2
@@ -249,8 +265,242 @@ def list_particle(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, lmin)
 
 
 @njit(cache=True)
-def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn, mark, cnt, ep, ei, ec, tv,
-               hkey, heap, hpos, kin, vir, acc, iacc, coll_target, t_cap):
+def link_cells(Y, Hinv, n_cells, strides, head, nxt, cell_of, wrap, sw):
+    """Sort the points Y (any position, wrapped or not) into the linked lists of a single-level
+    grid of the cell (:func:`hardpack.geometry.neighbours.grid.point_cell`).
+
+    Parameters
+    ----------
+    Y : numpy.ndarray of float64, shape (N, >= d)
+        Cartesian points in columns 0 .. d - 1.
+    Hinv : numpy.ndarray of float64, shape (d, d)
+        Inverse of the cell.
+    n_cells, strides : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction and their flat-index strides.
+    head : numpy.ndarray of int64, shape (prod n_cells,)
+        Receives the first point of every cell (-1: empty).
+    nxt, cell_of : numpy.ndarray of int64, shape (N,)
+        Receive the next point of every point's cell and every point's flat cell.
+    wrap : numpy.ndarray of int64, shape (N, d)
+        Receives floor(s) of every point's fractional coordinates s (a point found through the
+        unbounded cell c is its image floor(c / n) - wrap).
+    sw : numpy.ndarray of float64, shape (N, d)
+        Receives s - floor(s).
+    """
+    head[:] = -1
+    for i in range(Y.shape[0]):
+        link_one(Y, i, Hinv, n_cells, strides, head, nxt, cell_of, wrap, sw, True)
+
+
+@njit(cache=True, inline="always")
+def link_one(Y, i, Hinv, n_cells, strides, head, nxt, cell_of, wrap, sw, first):
+    """Put point i into its cell (:func:`link_cells`), taking it out of its old one unless ``first``
+    (``head`` must be all -1 before the first point)."""
+    d = Hinv.shape[0]
+    if not first:
+        unlink_point(head, nxt, i, cell_of[i])
+    coff = np.zeros(2, dtype=np.int64)
+    _fractional(Y, i, Hinv, sw[i])
+    cell_of[i] = point_cell(sw[i], n_cells, strides, coff, 0, wrap[i])
+    for k in range(d):
+        sw[i, k] -= wrap[i, k]
+    link_point(head, nxt, i, cell_of[i])
+
+
+@njit(cache=True, inline="always")
+def _cell_range(s, beta, cfac, n_cells, w, lo, hi, wide):
+    """The cells to visit for the points within ``beta`` of fractional point s: the unbounded range
+    of :func:`hardpack.geometry.neighbours.grid.search_range` (padded against round-off), except
+    along the axes where it spans all n_k cells (``wide``), whose stored cells are visited once
+    and each point's images along them are found by :func:`_image_range`; ``w`` receives the
+    fractional half-widths beta / h_k. Returns True when every axis is wide: every point is a
+    candidate, and the caller takes them in index order instead of from the cells."""
+    search_range(s, beta * (1.0 + RANGE_PAD), cfac, n_cells, 0, lo, hi)
+    every = True
+    for k in range(s.shape[0]):
+        w[k] = beta * (1.0 + RANGE_PAD) * cfac[k]
+        wide[k] = hi[k] - lo[k] + 1 >= n_cells[0, k]
+        if wide[k]:
+            lo[k] = 0
+            hi[k] = n_cells[0, k] - 1
+        else:
+            every = False
+    return every
+
+
+@njit(cache=True, inline="always")
+def _image_range(s, w, swj, wide, image, blo, bhi, od):
+    """The images n of the point at wrapped fractional coordinates ``swj``, found in a cell seen
+    through ``image``, with |swj_k + n_k - s_k| <= w_k along every axis: n_k = image_k along the
+    narrow axes (if within w_k), the integers within w_k along the ``wide`` ones (:func:`_cell_range`);
+    returns their number (0 if none) with the box in [blo, bhi] and ``od`` set to its first image."""
+    total = 1
+    for k in range(s.shape[0]):
+        if wide[k]:
+            blo[k] = int(np.ceil(s[k] - w[k] - swj[k]))
+            bhi[k] = int(np.floor(s[k] + w[k] - swj[k]))
+            if bhi[k] < blo[k]:
+                return 0
+        else:
+            t = swj[k] + image[k] - s[k]
+            if t > w[k] or t < -w[k]:
+                return 0
+            blo[k] = image[k]
+            bhi[k] = image[k]
+        total *= bhi[k] - blo[k] + 1
+        od[k] = blo[k]
+    return total
+
+
+@njit(cache=True, inline="always")
+def _fractional(Y, i, Hinv, s):
+    """s = H^-1 y_i (row i of Y, columns 0 .. d - 1)."""
+    d = Hinv.shape[0]
+    for k in range(d):
+        acc = 0.0
+        for q in range(d):
+            acc += Hinv[k, q] * Y[i, q]
+        s[k] = acc
+
+
+@njit(cache=True)
+def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, lmin, rmax, n_cells, cstr,
+                       head, nxt, wrap, sw, ent):
+    """The lists of :func:`list_particle` (the same entries in the same order) from the bounding
+    spheres in the cells within R_i + ``rmax`` of i's centre instead of all N: every bounding
+    sphere j < jstop (j != i) that overlaps i's, with each periodic image n for which
+    |H (s_j - s_i + n)| < R_i + R_j (s = H^-1 x, the arithmetic of the scan), in both lists.
+
+    The cells are a single-level grid of the bounding-sphere centres over the fractional
+    coordinates (:mod:`hardpack.geometry.neighbours.grid`; :func:`link_cells`); the unbounded cell
+    range of :func:`hardpack.geometry.neighbours.grid.search_range` visits every (sphere, image)
+    within reach once; along an axis where it spans all cells (small or sheared cells) the stored
+    cells are visited once and a sphere's images along it are those of the scan's image box
+    (:func:`_cell_range`, :func:`_image_range`; all particles in index order when every axis is
+    such). The entries
+    found are sorted by value j * mul + code before they are appended, which is the scan's order
+    (j ascending, images in code order).
+
+    Parameters
+    ----------
+    i, jstop : int
+        The particle and the partner bound (i for the first build, N for a rebuild).
+    bs : numpy.ndarray of float64, shape (N, d + 1)
+        Bounding spheres, centre then radius.
+    H, Hinv : numpy.ndarray of float64, shape (d, d)
+        The cell and its inverse.
+    M, strides : numpy.ndarray of int64, shape (d,)
+        Image ranges and the strides of the image code.
+    nb, nn : numpy.ndarray of int64
+        Neighbour lists (N, cap) and their lengths (N,), appended to.
+    m, mul : int
+        Entries of the image table (the image -n of code c has code m - 1 - c) and the multiplier
+        of j in an entry (>= m).
+    cfac : numpy.ndarray of float64, shape (d,)
+        1 / h_k, the row norms of H^-1.
+    lmin : float
+        Shortest lattice vector.
+    rmax : float
+        Upper bound of every bounding radius in the grid.
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction and flat-index strides of the grid.
+    head, nxt, wrap, sw
+        The grid's linked lists, the wrap of every centre and its wrapped fractional coordinates
+        (:func:`link_cells`).
+    ent : numpy.ndarray of int64, shape (cap,)
+        Scratch of the entries found.
+
+    Returns
+    -------
+    int
+        OVERFLOW when a list is full, SELF_IMAGE when i's bounding sphere reaches its own image,
+        else 0.
+    """
+    d = H.shape[0]
+    cap = nb.shape[1]
+    ri = bs[i, d]
+    if 2.0 * ri >= lmin:  # i's bounding sphere would reach its own periodic image
+        return DeformingStatus.SELF_IMAGE
+    s = np.empty(d)
+    w = np.empty(d)
+    ds = np.empty(d)
+    lo = np.empty(d, dtype=np.int64)
+    hi = np.empty(d, dtype=np.int64)
+    wide = np.empty(d, dtype=np.bool_)
+    c = np.empty(d, dtype=np.int64)
+    image = np.empty(d, dtype=np.int64)
+    blo = np.empty(d, dtype=np.int64)
+    bhi = np.empty(d, dtype=np.int64)
+    od = np.empty(d, dtype=np.int64)
+    coff = np.zeros(2, dtype=np.int64)
+    _fractional(bs, i, Hinv, s)
+    every = _cell_range(s, ri + rmax, cfac, n_cells, w, lo, hi, wide)
+    j = 0  # every: the candidates are 0 .. jstop - 1
+    more = not every  # else those of the cells of the range, in turn
+    if more:
+        for k in range(d):
+            c[k] = lo[k]
+        j = -1
+    found = 0
+    while True:
+        if every:
+            if j >= jstop:
+                break
+        else:
+            while j < 0 and more:
+                flat = image_cell(c, n_cells, cstr, coff, 0, image)
+                more = next_cell(c, lo, hi)
+                j = head[flat]
+            if j < 0:
+                break
+        total = 0
+        if j < jstop and j != i:
+            total = _image_range(s, w, sw[j], wide, image, blo, bhi, od)
+        if total > 0:
+            reach = ri + bs[j, d]
+            for k in range(d):
+                acc = 0.0
+                for q in range(d):
+                    acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
+                ds[k] = acc
+        for _ in range(total):
+            d2 = 0.0
+            for q in range(d):
+                acc = 0.0
+                for k in range(d):
+                    acc += H[q, k] * (ds[k] + (od[k] - wrap[j, k]))
+                d2 += acc * acc
+            if d2 < reach * reach:
+                if found == cap:
+                    return DeformingStatus.OVERFLOW
+                code = 0
+                for k in range(d):
+                    code += (od[k] - wrap[j, k] + M[k]) * strides[k]
+                ent[found] = j * mul + code
+                found += 1
+            next_cell(od, blo, bhi)
+        j = j + 1 if every else nxt[j]
+    for a in range(1, found):  # insertion sort: the scan's order
+        e = ent[a]
+        b = a - 1
+        while b >= 0 and ent[b] > e:
+            ent[b + 1] = ent[b]
+            b -= 1
+        ent[b + 1] = e
+    for a in range(found):
+        j = ent[a] // mul
+        if nn[i] >= cap or nn[j] >= cap:
+            return DeformingStatus.OVERFLOW
+        nb[i, nn[i]] = ent[a]
+        nn[i] += 1
+        nb[j, nn[j]] = i * mul + (m - 1 - (ent[a] - j * mul))
+        nn[j] += 1
+    return 0
+
+
+@njit(cache=True)
+def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, n_cells, cstr, kappa, skin, bs, nb, nn, mark, cnt, ep,
+               ei, ec, tv, hkey, heap, hpos, kin, vir, acc, iacc, coll_target, t_cap):
     """One window in a fixed cell H from a synchronisation point (all T = 0): build all lists,
     predict, process events until ``coll_target`` collisions or ``t_cap``.
 
@@ -279,6 +529,10 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
         Row norms of H^-1, 1 / h_k.
     lmin : float
         Length of the shortest lattice vector (:func:`hardpack.md.deforming.shortest_vector`).
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d), read-only
+        Cells per lattice direction of the grid of bounding-sphere centres that the lists are
+        built from (:func:`list_particle_grid`; any counts >= 1 give the same lists, cells about
+        as wide as the largest bounding diameter the fewest tests) and their flat-index strides.
     kappa : numpy.ndarray of float64, shape (N,), read-only
         Relative growth rate of every radius.
     skin : numpy.ndarray of float64, shape (N,), read-only
@@ -330,12 +584,22 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
     xi = np.empty(d)
     wrap = np.empty(d)  # scratch of wrap_one
     upd = np.empty(2, dtype=np.int64)
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    gwrap = np.empty((n, d), dtype=np.int64)
+    gsw = np.empty((n, d))
+    ent = np.empty(nb.shape[1], dtype=np.int64)
+    rmax = 0.0  # largest bounding radius in the grid
     for i in range(n):  # complete rebuild at t = 0 (positions wrapped by the caller)
         for k in range(d):
             bs[i, k] = X[i, k]
         bs[i, d] = A[i] + skin[i]
+        rmax = max(rmax, bs[i, d])
+    link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw)
     for i in range(n):
-        st = list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin)
+        st = list_particle_grid(i, i, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin, rmax, n_cells, cstr,
+                                head, nxt, gwrap, gsw, ent)
         if st != 0:
             return st
     hsize = 0
@@ -387,7 +651,10 @@ def run_events(X, V, T, A, H, Hinv, M, img, cfac, lmin, kappa, skin, bs, nb, nn,
                 for k in range(d):
                     bs[i, k] = X[i, k]
                 bs[i, d] = A[i] * (1.0 + kappa[i] * t) + skin[i]
-                st = list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin)
+                rmax = max(rmax, bs[i, d])
+                link_one(bs, i, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw, False)
+                st = list_particle_grid(i, n, bs, H, Hinv, M, strides, nb, nn, m, m, cfac, lmin, rmax, n_cells,
+                                        cstr, head, nxt, gwrap, gsw, ent)
                 if st != 0:
                     acc[0] = t
                     return st
@@ -524,11 +791,14 @@ def synchronise(X, V, T, A, t, kappa):
 
 
 @njit(cache=True)
-def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
+def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
     """Largest s in [0, 1] such that mapping positions and cell by (I + s strain) leaves every
     pair within ``reach`` at least half its gap (|r| - sigma), and the smallest relative gap
     (|r| - sigma) / sigma before the map. A particle's own images count as pairs with contact
-    distance ``self_sigma``. Positions must be wrapped into the cell.
+    distance ``self_sigma``. The pairs (i <= j, image n; n != 0 for i = j) with
+    |r| = |H (s_j - s_i + n)| < reach come from a single-level grid of the centres over the
+    fractional coordinates (:func:`link_cells`; every (particle, image) in the unbounded cell range
+    within ``reach`` of i is visited once, also in cells narrower than ``reach``).
 
     Along the path r(s) = r + s strain r the first s with |r(s)| = sigma + gap / 2 is the
     contact root of a pair with relative velocity strain r (:func:`hardpack.events.roots.contact_root`).
@@ -547,6 +817,9 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
         Pairs farther apart than this are ignored.
     self_sigma : float
         Contact distance of a particle with its own images.
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction of the grid (any counts >= 1 give the same result; cells about
+        ``reach`` wide the fewest tests) and their flat-index strides.
 
     Returns
     -------
@@ -562,36 +835,78 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma):
         for q in range(d):
             s2 += Hinv[k, q] * Hinv[k, q]
         cfac[k] = np.sqrt(s2)
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    wrap = np.empty((n, d), dtype=np.int64)
+    sw = np.empty((n, d))
+    link_cells(X, Hinv, n_cells, cstr, head, nxt, cell_of, wrap, sw)
+    coff = np.zeros(2, dtype=np.int64)
+    s = np.empty(d)
+    w = np.empty(d)
     ds = np.empty(d)
     r = np.empty(d)
     lo = np.empty(d, dtype=np.int64)
     hi = np.empty(d, dtype=np.int64)
+    wide = np.empty(d, dtype=np.bool_)
+    c = np.empty(d, dtype=np.int64)
+    image = np.empty(d, dtype=np.int64)
+    blo = np.empty(d, dtype=np.int64)
+    bhi = np.empty(d, dtype=np.int64)
     od = np.empty(d, dtype=np.int64)
+    nv = np.empty(d, dtype=np.int64)
     smax = 1.0
     gmin = np.inf
     for i in range(n):
-        for j in range(i, n):
-            total = _image_box(X[i], X[j], Hinv, reach, cfac, ds, lo, hi, od)
-            sigma = self_sigma if i == j else A[i] + A[j]
-            for _ in range(total):
-                skip = i == j
+        _fractional(X, i, Hinv, s)
+        every = _cell_range(s, reach, cfac, n_cells, w, lo, hi, wide)
+        j = i  # every: the candidates are i .. n - 1
+        more = not every  # else those of the cells of the range, in turn
+        if more:
+            for k in range(d):
+                c[k] = lo[k]
+            j = -1
+        while True:
+            if every:
+                if j >= n:
+                    break
+            else:
+                while j < 0 and more:
+                    flat = image_cell(c, n_cells, cstr, coff, 0, image)
+                    more = next_cell(c, lo, hi)
+                    j = head[flat]
+                if j < 0:
+                    break
+            jj = j
+            j = j + 1 if every else nxt[j]
+            if jj < i:
+                continue
+            total = _image_range(s, w, sw[jj], wide, image, blo, bhi, od)
+            if total > 0:
                 for k in range(d):
-                    if od[k] != 0:
+                    acc = 0.0
+                    for q in range(d):
+                        acc += Hinv[k, q] * (X[jj, q] - X[i, q])
+                    ds[k] = acc
+            for _ in range(total):
+                skip = i == jj
+                for k in range(d):
+                    nv[k] = od[k] - wrap[jj, k]
+                    if nv[k] != 0:
                         skip = False
+                next_cell(od, blo, bhi)
+                if skip:
+                    continue
                 rr = 0.0
                 for q in range(d):
                     acc = 0.0
                     for k in range(d):
-                        acc += H[q, k] * (ds[k] + od[k])
+                        acc += H[q, k] * (ds[k] + nv[k])
                     r[q] = acc
                     rr += acc * acc
-                for k in range(d):
-                    od[k] += 1
-                    if od[k] <= hi[k]:
-                        break
-                    od[k] = lo[k]
-                if skip or rr >= reach * reach:
+                if rr >= reach * reach:
                     continue
+                sigma = self_sigma if i == jj else A[i] + A[jj]
                 gap = np.sqrt(rr) - sigma
                 gmin = min(gmin, gap / sigma)
                 ru = 0.0

@@ -100,6 +100,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
+from hardpack.geometry.neighbours.grid import MAX_CELLS_PER_PARTICLE, c_strides, cell_counts, perpendicular_widths
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
 from hardpack.geometry.shapes import Ellipsoids
@@ -184,6 +185,29 @@ def shortest_vector(lattice: np.ndarray) -> float:
     if len(ns):
         best = min(best, float(np.linalg.norm(ns @ lattice.T, axis=1).min()))
     return best
+
+
+def cell_grid(lattice: np.ndarray, width: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The single-level cell grid of the deforming-cell kernels' pair searches: cells at least
+    ``width`` wide along every lattice direction (at most MAX_CELLS_PER_PARTICLE per particle,
+    :func:`hardpack.geometry.neighbours.cell_counts`).
+
+    Parameters
+    ----------
+    lattice : numpy.ndarray of float, shape (d, d)
+        The cell H, lattice vectors as columns.
+    width : float
+        Smallest cell width (the largest pair reach searched).
+    n : int
+        Number of particles.
+
+    Returns
+    -------
+    n_cells, strides : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction and their flat-index strides.
+    """
+    n_cells = cell_counts(perpendicular_widths(lattice), [width], [n], MAX_CELLS_PER_PARTICLE)
+    return n_cells, c_strides(n_cells)
 
 
 def check_cell_options(applied_pressure, cell_step) -> None:
@@ -430,14 +454,15 @@ class DeformingSimulation:
         M = dk.image_ranges(self.H, lmin)
         img = dk.image_table(self.H, M)
         cfac = np.linalg.norm(Hinv, axis=1)
+        n_cells, cstr = cell_grid(self.H, 2.0 * (amax + float(skin.max())), n)
         saved = (self.X.copy(), self.V.copy())
         while True:
             nb = np.zeros((n, self.capacity), dtype=np.int64)
             acc = np.zeros(2)
             iacc = np.zeros(dk.N_COUNTERS, dtype=np.int64)
             status = dk.run_events(self.X, self.V, self.T, self.A, self.H, Hinv, M, img, cfac, lmin,
-                                   kappa, skin, self.bs, nb, self.nn, self.mark, self.cnt, self.ep, self.ei,
-                                   self.ec, self.tv, self.hkey, self.heap, self.hpos, self.kin,
+                                   n_cells, cstr, kappa, skin, self.bs, nb, self.nn, self.mark, self.cnt, self.ep,
+                                   self.ei, self.ec, self.tv, self.hkey, self.heap, self.hpos, self.kin,
                                    self.vir, acc, iacc, budget, t_cap)
             if status == dk.DeformingStatus.OVERFLOW:
                 self.X[:], self.V[:] = saved
@@ -456,7 +481,7 @@ class DeformingSimulation:
         amax = float(self.A.max())
         reach = 2.0 * SELF_CONTACT * 2.0 * amax
         _, gmin = dk.strain_limit(self.X, self.A, self.H, np.linalg.inv(self.H), np.zeros((self.d, self.d)),
-                                  reach, 2.0 * amax)
+                                  reach, 2.0 * amax, *cell_grid(self.H, reach, self.n))
         return gmin
 
     def _rescale(self) -> None:
@@ -517,7 +542,7 @@ class DeformingSimulation:
         Hinv = np.linalg.inv(self.H)
         self_sigma = SELF_CONTACT * 2.0 * float(self.A.max())
         reach = 2.0 * max(self_sigma, 2.0 * float(self.A.max()))
-        s, _ = dk.strain_limit(self.X, self.A, self.H, Hinv, e, reach, self_sigma)
+        s, _ = dk.strain_limit(self.X, self.A, self.H, Hinv, e, reach, self_sigma, *cell_grid(self.H, reach, self.n))
         H0, X0 = self.H.copy(), self.X.copy()
         for _ in range(MAX_HALVINGS + 1):
             if s <= 0.0:
@@ -527,7 +552,7 @@ class DeformingSimulation:
             self.X = np.array(X0 @ f.T)
             dk.wrap_into_cell(self.X, self.H, np.linalg.inv(self.H))
             _, gmin = dk.strain_limit(self.X, self.A, self.H, np.linalg.inv(self.H),
-                                         np.zeros((d, d)), reach, self_sigma)
+                                      np.zeros((d, d)), reach, self_sigma, *cell_grid(self.H, reach, self.n))
             if gmin >= 0.0:
                 return float(s * np.linalg.norm(e)), float(s)
             s *= 0.5

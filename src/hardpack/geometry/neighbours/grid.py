@@ -27,7 +27,9 @@ and is still found.
 
 Particles are sorted by (level, cell): those of flat cell c (levels one after the other, each in C order)
 are order[cell_start[c]:cell_start[c + 1]] (compressed rows; Ogarko uses a hash table of linked lists).
-Incremental use (random sequential addition, :mod:`.rsa`) keeps linked lists over the same cells instead.
+Incremental use (random sequential addition, :mod:`.rsa`; the neighbour lists of the deforming-cell MD,
+whose points move between cells) keeps linked lists over the same cells instead (:func:`point_cell`,
+:func:`link_point`, :func:`unlink_point`).
 """
 
 from __future__ import annotations
@@ -385,6 +387,83 @@ def next_cell(c, lo, hi):
             return True
         c[k] = lo[k]
     return False
+
+
+@numba.njit(cache=True)
+def point_cell(s, n_cells, strides, cell_offset, h, wrap):
+    """Flat index of the stored cell of level h that holds fractional point s, any s: the point is
+    seen as its image s - floor(s) in [0, 1) (``wrap`` receives floor(s)), and a point of the
+    unbounded cell c is at its own position plus the lattice image floor(c / n) - floor(s).
+
+    Parameters
+    ----------
+    s : numpy.ndarray of float, shape (d,)
+        Fractional point.
+    n_cells, strides : numpy.ndarray of int64, shape (L, d)
+        Cells per lattice direction and flat-index strides of every level.
+    cell_offset : numpy.ndarray of int64, shape (L + 1,)
+        First flat index of every level.
+    h : int
+        The level.
+    wrap : numpy.ndarray of int64, shape (d,)
+        Receives floor(s).
+
+    Returns
+    -------
+    int
+        The flat cell index.
+    """
+    flat = cell_offset[h]
+    for k in range(s.shape[0]):
+        w = np.floor(s[k])
+        wrap[k] = int(w)
+        c = min(int((s[k] - w) * n_cells[h, k]), n_cells[h, k] - 1)  # s - w rounds up to 1 at worst
+        flat += c * strides[h, k]
+    return flat
+
+
+@numba.njit(cache=True)
+def link_point(head, nxt, p, flat):
+    """Put point p first in the linked list of cell ``flat`` (``head[flat]`` its first point,
+    ``nxt[p]`` the one after p, -1 ends a list).
+
+    Parameters
+    ----------
+    head : numpy.ndarray of int64, shape (n_total,)
+        First point of every cell (-1: empty); modified in place.
+    nxt : numpy.ndarray of int64, shape (N,)
+        Next point of every point's cell; modified in place.
+    p : int
+        The point.
+    flat : int
+        Its flat cell index.
+    """
+    nxt[p] = head[flat]
+    head[flat] = p
+
+
+@numba.njit(cache=True)
+def unlink_point(head, nxt, p, flat):
+    """Take point p out of the linked list of cell ``flat`` (:func:`link_point`); it must be there.
+
+    Parameters
+    ----------
+    head : numpy.ndarray of int64, shape (n_total,)
+        First point of every cell; modified in place.
+    nxt : numpy.ndarray of int64, shape (N,)
+        Next point of every point's cell; modified in place.
+    p : int
+        The point.
+    flat : int
+        Its flat cell index.
+    """
+    q = head[flat]
+    if q == p:
+        head[flat] = nxt[p]
+        return
+    while nxt[q] != p:
+        q = nxt[q]
+    nxt[q] = nxt[p]
 
 
 @numba.njit(cache=True)
