@@ -135,11 +135,11 @@ def test_ellipse_glass_in_a_deforming_cell():
 
 
 def test_bad_input_is_refused():
-    # two spheroids 1 : 1 : sqrt 3 in a cell shorter than 1.1 bounding diameters
-    shape = Ellipsoids(np.tile(PROLATE, (2, 1)), np.tile([1.0, 0.0, 0.0, 0.0], (2, 1)))
-    tiny = Packing([[0.0, 0.0, 0.0], [1.5, 1.5, 1.5]], lattice=np.eye(3) * 3.5, shape=shape)
+    # spheres never collide with their own images: one sphere, or a cell below 1.1 diameters, is refused
+    with pytest.raises(InvalidInputError, match="at least 2"):
+        compress_deforming(Packing([[0.0, 0.0, 0.0]], [1.0], np.eye(3) * 3.0), 0.02, 0)
     with pytest.raises(InvalidInputError, match="too small"):
-        compress_deforming(tiny, 0.02, 0)
+        compress_deforming(Packing([[0.0, 0.0, 0.0], [0.54, 0.54, 1.08]], [0.5, 0.5], np.diag([1.08, 1.08, 2.16])), 0.02, 0)
     start = random_ellipsoid_packing(8, PROLATE, 0.2, seed=0)
     with pytest.raises(InvalidInputError, match="applied_pressure"):
         compress_deforming(start, 0.02, 0, applied_pressure=-1.0)

@@ -130,8 +130,14 @@ SELF_CONTACT = 1.1
 #: shortest lattice vector leaves); it grows while exits outnumber collisions (dilute fluids) and
 #: shrinks when they are below a tenth of them
 SHELL_START, SHELL_MIN, SHELL_MAX, SHELL_STEP = 0.3, 0.05, 3.0, 1.5
+#: fewest collisions of a window (small cells): a window's stress is measured from its collisions,
+#: and one without any reads Z = 1, whose strain would close every gap by half
+MIN_WINDOW_COLLISIONS = 10
 #: safety factor of the collision budget of a window that ends at a fixed time
 BUDGET_SLACK = 4
+#: the ellipsoid image table covers bounding diameters up to this factor above the window start's
+#: (and is enlarged by it when a bounding sphere outgrows it)
+REACH_SLACK = 1.25
 
 RECORD_FIELDS = ("time", "phi", "Z", "collisions", "kT_mean", "volume", "pressure", "shear",
                  "strain_step", "step_fraction", "mobility", "exits", "wall_time", "growth_rate")
@@ -225,14 +231,16 @@ def _check_packing(packing: Packing) -> None:
     if packing.boundary.kind != "periodic":
         raise InvalidInputError("a deforming cell needs a periodic boundary on every axis; this packing "
                                 f"has {packing.boundary}: drop --deforming-cell or use a periodic packing")
-    if packing.n_particles < 2:
-        raise InvalidInputError("MD in a periodic cell needs at least 2 particles")
+    spheres = packing.shape.kind == "sphere"
+    if spheres and packing.n_particles < 2:
+        raise InvalidInputError("sphere MD in a periodic cell needs at least 2 particles (a sphere never "
+                                "collides with its own images)")
     report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
     if report.n_overlapping:
         raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
                                 "hard-sphere MD needs a non-overlapping start")
     dmax = 2.0 * float(packing.shape.bounding_radii.max())
-    if shortest_vector(packing.lattice) <= SELF_CONTACT * dmax:
+    if spheres and shortest_vector(packing.lattice) <= SELF_CONTACT * dmax:
         raise InvalidInputError(
             f"the cell is too small: its shortest lattice vector {shortest_vector(packing.lattice):.4g} "
             f"must exceed {SELF_CONTACT} largest diameters ({SELF_CONTACT * dmax:.4g}); use more particles")
@@ -368,8 +376,11 @@ class DeformingSimulation:
         self._reduce_cell()
         kappa = self.relative_rates()
         if self.last_duration > 0.0:
-            t_cap = self.last_duration * coll_target / max(self.last_collisions, 1)
-            t_cap = min(t_cap, 2.0 * self.last_duration)
+            # twice the last window after one without collisions (with a budget of one collision the
+            # ratio would keep it at the length of a window that was too short)
+            t_cap = 2.0 * self.last_duration
+            if self.last_collisions > 0:
+                t_cap = min(t_cap, self.last_duration * coll_target / self.last_collisions)
             budget = BUDGET_SLACK * coll_target
         else:
             t_cap, budget = np.inf, coll_target
@@ -589,6 +600,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         self.P[:, cw:cii] = np.asarray(angular_velocities, dtype=float).reshape(n, -1)
         self.P[:, cii] = 1.0 / moments_of_inertia(shape.semiaxes)
         self.eps_f = float(eps_f)
+        self.self_collisions = 0
         self._init_run(packing, growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell)
 
     def _column(self, k: int) -> int:
@@ -641,23 +653,24 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         tensor into ``kin`` and ``vir``."""
         n, d = self.n, self.d
         Hinv = np.linalg.inv(self.H)
-        lmin = shortest_vector(self.H)
         rb = self.P[:, self._column(2)]
         rmax = float(rb.max())
-        skin = np.full(n, min(self.shell * float(rb.mean()), 0.45 * (lmin - 2.0 * rmax)))
-        M = dk.image_ranges(self.H, lmin)
-        img, cbits = edk.padded_image_table(self.H, M)
+        skin = np.full(n, self.shell * float(rb.mean()))
+        # the image table covers bounding spheres grown by REACH_SLACK (the kernel asks for more)
+        reach = 2.0 * (rmax + float(skin[0])) * REACH_SLACK
         cfac = np.linalg.norm(Hinv, axis=1)
         saved = self.P.copy()
         vir, kw = np.zeros((d, d)), np.zeros((d, d))
         while True:
+            M = dk.image_ranges(self.H, reach)
+            img, cbits = edk.padded_image_table(self.H, M)
             cap = self.capacity
             nb = np.zeros((n, cap), dtype=np.int64)
             acc = np.zeros(edk.N_ACC)
             acc[mdk.A_KE] = 0.5 * float(np.sum(self.V * self.V))
             iacc = np.zeros(edk.N_COUNTERS, dtype=np.int64)
             status = edk.run_events(
-                self.P, self.H, Hinv, M, img, cbits, cfac, lmin, float(kappa[0]), self.eps_f, skin, self.bs,
+                self.P, self.H, Hinv, M, img, cbits, cfac, reach, float(kappa[0]), self.eps_f, skin, self.bs,
                 nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey, self.heap, self.hpos,
                 np.empty(cap), np.empty(cap), np.empty(cap, dtype=np.int8), np.empty((cap, ek.PAIR_STATE)),
                 vir, kw, acc, iacc, budget, t_cap)
@@ -665,8 +678,19 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
                 self.P[:] = saved
                 self.capacity *= 2
                 continue
-            _refuse_window_end(status, lmin, 2 * rmax)
+            if status == dk.DeformingStatus.SELF_IMAGE:
+                if 2.0 * float(self.bs[:, d].max()) >= reach:  # a bounding sphere outgrew the table
+                    self.P[:] = saved
+                    reach *= REACH_SLACK
+                    continue
+                raise RuntimeError(
+                    f"at window time {acc[mdk.A_T]:.6g} a particle grew into its own periodic image along a "
+                    "contact normal on the centre line (r x n = 0), which no rotation can relieve; "
+                    "spheres-as-ellipsoids (equal semiaxes) cannot touch their own images: use more "
+                    "particles or a larger cell")
+            _refuse_window_end(status, 0.0, 2 * rmax)
             break
+        self.self_collisions += int(iacc[edk.I_SELF])
         duration = float(acc[mdk.A_T])
         ek.synchronise(self.P, duration, float(kappa[0]))
         v = self.V
@@ -694,8 +718,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         if not np.any(e):
             return 0.0, 1.0
         H0, P0 = self.H.copy(), self.P.copy()
-        floor = SELF_CONTACT * 2.0 * float(self.P[:, self._column(2)].max())
-        # every pair that F (or its volume correction) can bring within bounding reach
+        # every pair (own images included) that F (or its volume correction) can bring within bounding reach
         pairs = self._pairs(math.exp(2.0 * float(np.linalg.norm(e))) * 1.01)
         mu0, rate = edk.pair_scales(P0, H0, *pairs, e)
         # first-order step that keeps half of every approaching pair's zeta (as the sphere rule)
@@ -707,14 +730,13 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
                 break
             f = self._cell_map(s, e, H0)
             H1 = f @ H0
-            if shortest_vector(H1) > floor:
-                self.P[:, :d] = P0[:, :d] @ f.T
-                mu1, _ = edk.pair_scales(self.P, H1, *pairs, e)
-                if np.all(np.where(mu0 > 1.0, mu1 - 1.0 >= 0.5 * (mu0 - 1.0), mu1 >= mu0)):
-                    self.H = H1
-                    dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
-                    return float(s * np.linalg.norm(e)), float(s)
-                self.P[:] = P0
+            self.P[:, :d] = P0[:, :d] @ f.T
+            mu1, _ = edk.pair_scales(self.P, H1, *pairs, e)
+            if np.all(np.where(mu0 > 1.0, mu1 - 1.0 >= 0.5 * (mu0 - 1.0), mu1 >= mu0)):
+                self.H = H1
+                dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
+                return float(s * np.linalg.norm(e)), float(s)
+            self.P[:] = P0
             s *= 0.5
         self.H, self.P = H0, P0
         return 0.0, 0.0
@@ -838,7 +860,7 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
                                   growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell=adaptive_cell)
     started = time.perf_counter()
     while (reason := _stop_reason(stop, sim, started)) is None:
-        budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
+        budget = max(MIN_WINDOW_COLLISIONS, round(stage_window(sim.growth_rate) * sim.n))
         if stop.max_collisions is not None:
             budget = min(budget, int(stop.max_collisions) - sim.collisions)
         record = sim.run_window(budget)
