@@ -46,8 +46,9 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
    1.6e-4 below N kT Z / P0, 4 standard errors). ``adaptive_cell=False`` restores Donev's rule
    with the fixed 1 / Z mobility and the thermostat's window (step 6).
 3. s <= 1 is the largest step that leaves every pair at least half its gap along the linear
-   path (the first root of |r + s E r| = sigma + gap / 2 over the pairs within reach, and every particle's own images
-   with contact distance SELF_CONTACT times the largest diameter); after the map the packing is
+   path (the first root of |r + s E r| = sigma + gap / 2 over the pairs within reach, and for
+   spheres every particle's own images with contact distance SELF_CONTACT times the largest
+   diameter: a sphere never collides with its images); after the map the packing is
    checked for overlaps exactly, and the step halved (at most MAX_HALVINGS times, then skipped)
    if round-off made one. Velocities are not changed (the kinetic energy is conserved by a
    deformation).
@@ -81,7 +82,13 @@ Ellipsoids (:class:`EllipsoidDeformingSimulation`) use the same windows, strain 
 map, with the ellipsoid engine's prediction and collision law in the general cell
 (:mod:`hardpack.md._ellipsoid_deforming_kernel`, which also explains the stress of non-central
 contact forces), the map applied to the centres only, a Perram-Wertheim version of step 3 and a
-thermostat that sets the translational and rotational temperatures separately.
+thermostat that sets the translational and rotational temperatures separately. An ellipsoid
+collides with its own periodic images (spin only, derived in that module), so the cell may be
+small, down to one particle: every window then needs collisions to measure the stress, so a
+window has at least MIN_WINDOW_COLLISIONS collisions, and the next window after one without any
+is twice as long (its time cap would otherwise stay at the short length of the last one). With one
+particle the translational kinetic tensor v v^T is that of a single velocity (rank one): its
+anisotropy, kT / V, is a relative 1 / Z of the pressure and only matters far from jamming.
 
 This is an overdamped, deterministic barostat: it drives the mean stress to P0 I but does not
 sample the isobaric ensemble's volume fluctuations. Tests: an ideal-gas check that the mean
@@ -133,6 +140,9 @@ SHELL_START, SHELL_MIN, SHELL_MAX, SHELL_STEP = 0.3, 0.05, 3.0, 1.5
 #: fewest collisions of a window (small cells): a window's stress is measured from its collisions,
 #: and one without any reads Z = 1, whose strain would close every gap by half
 MIN_WINDOW_COLLISIONS = 10
+#: the first window lasts at most this many thermal flight times over a mean diameter per collision
+#: asked for (per particle)
+FIRST_WINDOW_FLIGHTS = 10.0
 #: safety factor of the collision budget of a window that ends at a fixed time
 BUDGET_SLACK = 4
 #: the ellipsoid image table covers bounding diameters up to this factor above the window start's
@@ -367,6 +377,10 @@ class DeformingSimulation:
             return np.full(self.n, self.growth_rate / (2.0 * float(self.A.mean())))
         return np.where(self.growing, self.growth_rate / (2.0 * self.A), 0.0)
 
+    def mean_diameter(self) -> float:
+        """Mean particle diameter (bounding diameter for ellipsoids)."""
+        return 2.0 * float(self.A.mean())
+
     def run_window(self, coll_target: int, max_time: float = np.inf) -> dict:
         """Run one window of about ``coll_target`` collisions (and at most ``max_time`` MD time)
         in the current cell, measure the stress, rescale velocities (growing runs), deform the
@@ -383,7 +397,11 @@ class DeformingSimulation:
                 t_cap = min(t_cap, self.last_duration * coll_target / self.last_collisions)
             budget = BUDGET_SLACK * coll_target
         else:
-            t_cap, budget = np.inf, coll_target
+            # the first window ends by FIRST_WINDOW_FLIGHTS thermal flights over a diameter per
+            # collision asked for, if not by its collisions (a cell in which no particle can reach
+            # another or its own image would otherwise never end it)
+            t_cap = FIRST_WINDOW_FLIGHTS * self.mean_diameter() * coll_target / n
+            budget = coll_target
         if kappa.min() < 0.0:
             t_cap = min(t_cap, 0.5 / -kappa.min())
         t_cap = min(t_cap, float(max_time))
@@ -557,8 +575,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
     the deformation is skipped) until every pair whose bounding spheres can meet keeps at least
     half its Perram-Wertheim gap, mu - 1 with mu = sqrt(1 + zeta) the scaling factor to tangency
     (Donev 2006, sec. 2.2.2.1; the sphere rule's half gap, since mu = r / (a_i + a_j) for
-    spheres), and the shortest lattice vector stays above SELF_CONTACT largest bounding
-    diameters (a particle never meets its own image).
+    spheres), a particle's own images included (they collide with it: any cell without overlaps
+    runs, N = 1 too).
 
     Parameters
     ----------
@@ -605,6 +623,9 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
 
     def _column(self, k: int) -> int:
         return ek.columns(self.d)[k]
+
+    def mean_diameter(self) -> float:
+        return 2.0 * float(self.P[:, self._column(2)].mean())
 
     @property
     def semiaxes(self) -> np.ndarray:
@@ -779,8 +800,9 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         Periodic packing of spheres (any d), ellipsoids (3D) or ellipses (2D) without overlaps
         (any lattice, sheared or not; ellipsoids run :class:`EllipsoidDeformingSimulation`, with
         uniform growth of the semiaxes, Gamma as in :func:`hardpack.md.ellipsoid.compress_ellipsoids`,
-        and velocities and angular velocities at kT = 1); its shortest lattice vector must exceed
-        SELF_CONTACT largest (bounding) diameters.
+        and velocities and angular velocities at kT = 1); for spheres N >= 2 and the shortest
+        lattice vector must exceed SELF_CONTACT largest diameters (ellipsoids collide with their
+        own images: any N >= 1 and cell).
     growth_rate : float
         Gamma = (d<D>/dt) / sqrt(kT/m) as in :func:`hardpack.md.compress`; >= 0 (0 needs a
         collision or time limit).
