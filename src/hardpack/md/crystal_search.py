@@ -22,11 +22,12 @@ structure the particles find. One run here (:func:`search_run`):
    the others at phi = 0.698 to 0.740 with 6 to 10 contacts; at Gamma = 1e-2 none did).
 
 Small cells need the collisions of a particle with its own periodic images, which the ellipsoid
-kernel has (:mod:`hardpack.md._ellipsoid_deforming_kernel`): with ``n`` = 1 the run ends at the
-densest lattice packing of the shape, the affine image of FCC, phi = pi / sqrt(18) for every
-aspect ratio. The result is compared with the laminate of the same aspect ratio
-(:func:`hardpack.geometry.ellipsoid_crystals.laminate`; phi(alpha) = phi(1 / alpha)): contacts
-are pairs within a Perram-Wertheim gap mu - 1 < ``contact_tol``
+kernel has (:mod:`hardpack.md._ellipsoid_deforming_kernel`): with ``n`` = 1 the run ends at
+(or, when the growth jams the cell first, step 4, below) the densest lattice packing of the
+shape, the affine image of FCC, phi = pi / sqrt(18) for every aspect ratio. The result is
+compared with the laminate of the same aspect ratio
+(:func:`hardpack.geometry.ellipsoid_crystals.laminate`; phi(alpha) = phi(1 / alpha)): contacts are
+pairs within a Perram-Wertheim gap mu - 1 < ``contact_tol``
 (:func:`hardpack.geometry.ellipsoid_stats.ellipsoid_contacts`, own images counted twice).
 """
 
