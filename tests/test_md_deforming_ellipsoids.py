@@ -12,6 +12,13 @@ Physics checked:
   to below 0.1), and no pair overlaps (checked independently with the Perram-Wertheim
   potential); LS from the expanded laminate returns to phi = 0.770732 with 14 contacts per
   particle; 2D ellipses run too;
+- a particle collides with its own periodic images: at zero growth one or two spheroids in a small
+  cell, where most or all collisions are with own images, conserve the kinetic energy to
+  round-off and the momentum exactly (one particle keeps its velocity: only its spin changes);
+- one spheroid per cell (N = 1), compressed from a random orientation in a cube, ends at the
+  densest lattice packing of the shape, the affine image of FCC: phi = pi / sqrt(18) exactly for
+  every aspect ratio (no lattice packing of spheroids is denser; Minkowski's problem for the
+  affine image of the ball), with the FCC coordination 12, prolate and oblate;
 - bad input is refused.
 """
 
@@ -25,7 +32,6 @@ from hardpack.errors import InvalidInputError
 from hardpack.geometry.ellipsoid_crystals import laminate
 from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts
 from hardpack.geometry.packing import Packing
-from hardpack.geometry.shapes import Ellipsoids
 from hardpack.initial import random_ellipsoid_packing
 from hardpack.md import StopCriteria, maxwell_boltzmann
 from hardpack.md.deforming import EllipsoidDeformingSimulation, compress_deforming
@@ -67,6 +73,40 @@ def test_kinetic_energy_is_conserved_across_windows_and_deformations():
     assert any(f > 0 for f in fractions)  # the cell did deform
     assert _total_kinetic_energy(sim) == pytest.approx(e0, rel=1e-10)
     assert sim.packing().overlap_report().n_overlapping == 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("n", [1, 2])
+def test_own_image_collisions_conserve_energy_and_momentum(n):
+    start = random_ellipsoid_packing(n, PROLATE, 0.4, seed=3)
+    sim = EllipsoidDeformingSimulation(
+        start, maxwell_boltzmann(n, 3, 1), random_angular_velocities(n, 3, moments_of_inertia(start.shape.semiaxes), 2),
+        0.0, cell_step=0.3)
+    e0, v0 = _total_kinetic_energy(sim), sim.V.copy()
+    fractions = [sim.run_window(50)["step_fraction"] for _ in range(30)]
+    assert sim.self_collisions > 200
+    assert any(f > 0 for f in fractions)  # the cell did deform
+    assert _total_kinetic_energy(sim) == pytest.approx(e0, rel=1e-12)
+    assert np.abs(sim.V.sum(axis=0) - v0.sum(axis=0)).max() < 1e-13
+    if n == 1:
+        assert sim.self_collisions == sim.collisions
+        assert np.array_equal(sim.V, v0)
+    assert sim.packing().overlap_report().n_overlapping == 0
+
+
+@pytest.mark.parametrize(("alpha", "seed"), [(np.sqrt(3.0), 0), (1.0 / np.sqrt(3.0), 2)])
+def test_one_spheroid_per_cell_ends_at_the_densest_lattice_packing(alpha, seed):
+    """Seeds on which the LS growth does not jam the cell early (it does on some: see
+    :mod:`hardpack.md.crystal_search`, step 4)."""
+    from hardpack.md.crystal_search import search_run
+
+    run = search_run(1, float(alpha), seed)
+    assert run["Z"] >= 1e9
+    assert run["phi"] == pytest.approx(np.pi / np.sqrt(18.0), abs=2e-5)
+    assert run["phi"] < np.pi / np.sqrt(18.0) + 1e-7
+    assert run["min_contacts"] == run["max_contacts"] == 12
+    assert run["n_overlapping"] == 0
+    assert run["packing"].n_particles == 1
 
 
 @pytest.mark.slow
@@ -135,11 +175,11 @@ def test_ellipse_glass_in_a_deforming_cell():
 
 
 def test_bad_input_is_refused():
-    # two spheroids 1 : 1 : sqrt 3 in a cell shorter than 1.1 bounding diameters
-    shape = Ellipsoids(np.tile(PROLATE, (2, 1)), np.tile([1.0, 0.0, 0.0, 0.0], (2, 1)))
-    tiny = Packing([[0.0, 0.0, 0.0], [1.5, 1.5, 1.5]], lattice=np.eye(3) * 3.5, shape=shape)
+    # spheres never collide with their own images: one sphere, or a cell below 1.1 diameters, is refused
+    with pytest.raises(InvalidInputError, match="at least 2"):
+        compress_deforming(Packing([[0.0, 0.0, 0.0]], [1.0], np.eye(3) * 3.0), 0.02, 0)
     with pytest.raises(InvalidInputError, match="too small"):
-        compress_deforming(tiny, 0.02, 0)
+        compress_deforming(Packing([[0.0, 0.0, 0.0], [0.54, 0.54, 1.08]], [0.5, 0.5], np.diag([1.08, 1.08, 2.16])), 0.02, 0)
     start = random_ellipsoid_packing(8, PROLATE, 0.2, seed=0)
     with pytest.raises(InvalidInputError, match="applied_pressure"):
         compress_deforming(start, 0.02, 0, applied_pressure=-1.0)

@@ -22,7 +22,7 @@ CORE_SUBCOMMANDS = ("init", "lattice", "laminate", "info", "combine")
 #: the module that registers each subcommand beyond the core ones (its ``register(subparsers)``);
 #: a command line imports only its own command's module, which keeps a job's start-up short
 SUBCOMMANDS: dict[str, str] = {
-    "compress": "hardpack.md.cli", "eos": "hardpack.md.cli",
+    "compress": "hardpack.md.cli", "eos": "hardpack.md.cli", "crystal-search": "hardpack.md.cli",
     "poly-jam": "hardpack.eos.cli", "poly-fluid": "hardpack.eos.cli", "poly-summary": "hardpack.eos.cli",
     "poly-equivalents": "hardpack.eos.cli",
     "hgrid-cost": "hardpack.hgrid.cli",

@@ -24,6 +24,29 @@ total force on each molecule), the point where a contact force acts on a body on
 angular momentum within it. The tensor sum r_ij J n^T is not symmetric for one collision (r_ij is
 not along n), its antisymmetric part is the torque sum, zero on average in a steady state; the
 driver uses the symmetric part.
+
+**Own images.** A particle also collides with its own images x_i + H n, n != 0 (in a small cell
+they are real neighbours: with N = 1 they are the only ones). Each pair of images +-n is listed
+once, as the entry (i, n) in i's own list (n the image with the larger code), out to the same
+bounding-sphere reach as the other pairs; the prediction is the ordinary pair prediction of i
+against its shifted self (both bodies share the state row: same velocity, orientation and spin).
+Derived here for the collision (:func:`self_collide`): in the periodic system i touches i + H n
+and, by periodicity, i - H n at the same moment, the contact points at +-r / 2 from its centre
+(r = H n; the two bodies are point symmetric about the midpoint) with normals +-n. The impulses
+-J n from the first contact and +J n from the second cancel on the translation, so the centre
+velocity of i never changes and the relative translation of i and its image is 0; the torques
+add, (r / 2) x (-J n) + (-r / 2) x (J n) = -J r x n, so w_i -= J (r x n) / I_i. The normal
+contact velocity is v_n = n . (w x (-r)) - g n . r = -w . (r x n) - g n . r (the spin term is
+that of the general law, w x (r_C - r_B) - w x (r_C - r_A) = w x (r_A - r_B), the growth term
+likewise), and it changes by J |r x n|^2 / I_i, so J = -2 v_n I_i / |r x n|^2 reverses it (the
+general law's denominator 2 + |r_A x n|^2 / I_A + |r_B x n|^2 / I_B would be wrong here: there is
+no translational response, and both lever arms turn the same body). Without growth the
+rotational energy, -J w . (r x n) + J^2 |r x n|^2 / (2 I_i), is unchanged; the translational
+momentum and energy are untouched. The contact belongs to one pair per cell, so it adds
+r (x) J n to the virial tensor and r . n J to the scalar virial once, and nothing to W. When
+r x n = 0 (spheres, or a spheroid whose contact normal lies along the centre line) no rotation
+can relieve an approaching self-contact: only the cell can, and the window ends with status
+SELF_IMAGE at that time.
 """
 
 from __future__ import annotations
@@ -36,9 +59,11 @@ from hardpack.md import _deforming_kernel as dk
 from hardpack.md import _ellipsoid_kernel as ek
 from hardpack.md._kernel import A_T, A_VIRIAL, end_window, kinetic_step
 
-#: integer counters (after :mod:`hardpack.md._deforming_kernel`'s): CHECK events
+#: integer counters (after :mod:`hardpack.md._deforming_kernel`'s): CHECK events, collisions of a
+#: particle with its own image (also counted in I_COLL)
 I_CHECK = dk.N_COUNTERS
-N_COUNTERS = dk.N_COUNTERS + 1
+I_SELF = dk.N_COUNTERS + 1
+N_COUNTERS = dk.N_COUNTERS + 2
 #: float accumulators of :mod:`hardpack.md._kernel` (A_T, A_VIRIAL, A_KEINT, A_KE, A_TKE) and the
 #: contact-function evaluations
 A_EVAL = 5
@@ -107,6 +132,81 @@ def _stress_step(P, i, j, t, jimp, ws, vir, kw):
 
 
 @njit(cache=True)
+def list_self(i, bs, img, m0, cbits, nb, nn):
+    """Append to i's list every own image whose bounding sphere overlaps i's (|H n| < 2 R_i, n != 0),
+    one entry i << cbits | code per pair +-n (the code above the centre's; the table ``img`` of
+    m0 images is point symmetric, code m0 - 1 - c holds -n); returns OVERFLOW when the list is
+    full, else 0."""
+    d = img.shape[1]
+    reach = 2.0 * bs[i, d]
+    for c in range((m0 - 1) // 2 + 1, m0):
+        r2 = 0.0
+        for k in range(d):
+            r2 += img[c, k] * img[c, k]
+        if r2 < reach * reach:
+            if nn[i] >= nb.shape[1]:
+                return dk.DeformingStatus.OVERFLOW
+            nb[i, nn[i]] = (i << cbits) | c
+            nn[i] += 1
+    return 0
+
+
+@njit(cache=True)
+def self_collide(P, i, t, sh, kappa, ws, wm):
+    """Collision of particle i (advanced to t) with its own image shifted by the lattice vector
+    ``sh`` (module docstring, "Own images"): only its spin changes.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows, row i modified in place.
+    i : int
+        The particle.
+    t : float
+        Window time of the collision.
+    sh : numpy.ndarray of float64, shape (d,)
+        The lattice vector r = H n of the image.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    ws, wm : numpy.ndarray
+        Scratch of :func:`hardpack.md._ellipsoid_kernel.work_arrays`; on return ws[5, :d] holds the
+        unit normal.
+
+    Returns
+    -------
+    impulse : float
+        J > 0 on the image along n; 0 for a pair that does not approach, -1 for an approaching
+        contact with r x n = 0 (no rotation can relieve it).
+    virial : float
+        r . n J.
+    """
+    d = sh.shape[0]
+    _, _, _, _, _, cw, cii, _ = ek.columns(d)
+    _, zdot, lam = ek.pair_zeta(P, i, i, sh, t, kappa, 0.5, ws, wm)
+    n = ws[5, :d]
+    nrm = 0.0
+    for k in range(d):
+        nrm += n[k] * n[k]
+    nrm = np.sqrt(nrm)
+    rn = 0.0
+    for k in range(d):
+        n[k] /= nrm
+        rn += sh[k] * n[k]
+    vn = zdot / (2.0 * lam * (1.0 - lam) * nrm)
+    if not vn < 0.0:
+        return 0.0, 0.0
+    c = ws[2]
+    cc = ek._cross_n(sh, n, c)
+    if cc <= 1e-24 * rn * rn:
+        return -1.0, 0.0
+    jimp = -2.0 * vn / (cc * P[i, cii])
+    nw = 3 if d == 3 else 1
+    for k in range(nw):
+        P[i, cw + k] -= jimp * P[i, cii] * c[k]
+    return jimp, rn * jimp
+
+
+@njit(cache=True)
 def _partner_image(P, i, j, t, nb, nn, img, cbits, ws, wm):
     """Code of the listed image of j (both advanced to t) with the smallest zeta (the one in
     contact), -1 if j is not listed."""
@@ -135,7 +235,7 @@ def _partner_image(P, i, j, t, nb, nn, img, cbits, ws, wm):
 
 
 @njit(cache=True)
-def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb, nn, mark, cnt, ep, ec,
+def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, nb, nn, mark, cnt, ep, ec,
                hkey, heap, hpos, tins, touts, done, pst, vir, kw, acc, iacc, coll_target, t_cap):
     """One window of ellipsoid MD in the fixed cell H from a synchronisation point (all particle
     times 0, centres wrapped into the cell): build all lists, predict, process events until
@@ -155,8 +255,10 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
         Bits of an image code.
     cfac : numpy.ndarray of float64, shape (d,)
         Row norms of H^-1.
-    lmin : float
-        Shortest lattice vector.
+    reach : float
+        Largest bounding-sphere diameter the image table covers (M = image_ranges(H, reach)): a
+        larger bounding sphere ends the window with status SELF_IMAGE (the driver enlarges the
+        table and repeats the window).
     kappa : float
         Relative growth rate of the semiaxes.
     eps_f : float
@@ -174,7 +276,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
         acc[A_KE] enters the translational kinetic energy; outputs A_T (end time), A_VIRIAL,
         A_KEINT (time integral of the translational kinetic energy), A_EVAL.
     iacc : numpy.ndarray of int64, shape (N_COUNTERS,)
-        Counters of :mod:`hardpack.md._deforming_kernel` and I_CHECK (added to).
+        Counters of :mod:`hardpack.md._deforming_kernel`, I_CHECK and I_SELF (added to).
     coll_target : int
         Stop after this many collisions.
     t_cap : float
@@ -183,7 +285,8 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
     Returns
     -------
     int
-        A :class:`hardpack.md._deforming_kernel.DeformingStatus`.
+        A :class:`hardpack.md._deforming_kernel.DeformingStatus`; SELF_IMAGE also for an
+        approaching self-contact that no rotation can relieve (module docstring; acc[A_T] its time).
     """
     n = P.shape[0]
     d = H.shape[0]
@@ -212,7 +315,9 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
             bs[i, k] = P[i, k]
         bs[i, d] = P[i, cr] + skin[i]
     for i in range(n):
-        st = dk.list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, lmin)
+        st = dk.list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach)
+        if st == 0:
+            st = list_self(i, bs, img, m0, cbits, nb, nn)
         if st != 0:
             return st
     hsize = 0
@@ -244,7 +349,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
             dk.wrap_one(P, i, H, Hinv, wrap)
             for e in range(nn[i]):  # drop i from its old neighbours' lists (each list once)
                 j = nb[i, e] >> cbits
-                if mark[j]:
+                if j == i or mark[j]:
                     continue
                 mark[j] = 1
                 q2 = 0
@@ -260,7 +365,9 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
             for k in range(d):
                 bs[i, k] = P[i, k]
             bs[i, d] = P[i, cr] * (1.0 + kappa * t) + skin[i]
-            st = dk.list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, lmin)
+            st = dk.list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach)
+            if st == 0:
+                st = list_self(i, bs, img, m0, cbits, nb, nn)
             if st != 0:
                 acc[A_T] = t
                 return st
@@ -269,6 +376,27 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
             iacc[I_CHECK] += 1
         elif p < 0 or ec[i] != cnt[p]:
             iacc[dk.I_STALE] += 1
+        elif p == i:
+            ek.advance(P, i, t, scratch)
+            code = _partner_image(P, i, i, t, nb, nn, img, cbits, ws, wm)
+            sh = ws[9, :d]
+            for k in range(d):
+                sh[k] = img[code, k]
+            jimp, vr = self_collide(P, i, t, sh, kappa, ws, wm)
+            if jimp < 0.0:
+                acc[A_T] = t
+                return dk.DeformingStatus.SELF_IMAGE
+            if jimp > 0.0:
+                acc[A_VIRIAL] += vr
+                n_ = ws[5, :d]
+                for a in range(d):
+                    for b in range(d):
+                        vir[a, b] += sh[a] * jimp * n_[b]
+                cnt[i] += 1
+                iacc[dk.I_COLL] += 1
+                iacc[I_SELF] += 1
+            else:
+                iacc[dk.I_GRAZE] += 1
         else:
             j = p
             ek.advance(P, i, t, scratch)
@@ -297,7 +425,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
             if partner >= 0:
                 ec[k] = cnt[partner]
             hsize = heap_set(hkey, heap, hpos, hsize, k, key)
-        if npred == 2 and iacc[dk.I_COLL] >= coll_target:
+        if (npred == 2 or p == i) and iacc[dk.I_COLL] >= coll_target:
             break
     end_window(acc, t)
     acc[A_EVAL] = ws[10, 0]
@@ -308,9 +436,9 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, lmin, kappa, eps_f, skin, bs, nb
 
 @njit(cache=True)
 def near_pairs(P, H, Hinv, scale):
-    """The pairs i < j and lattice images n whose centres are closer than ``scale`` times the sum
-    of their bounding radii (a particle's own images are not listed: the driver keeps them
-    apart by the shortest lattice vector). Centres need not be wrapped.
+    """The pairs i <= j and lattice images n whose centres are closer than ``scale`` times the sum
+    of their bounding radii, a particle's own images (i = j, n != 0) once per pair +-n (the n
+    whose last non-zero component is positive). Centres need not be wrapped.
 
     Parameters
     ----------
@@ -324,7 +452,7 @@ def near_pairs(P, H, Hinv, scale):
     Returns
     -------
     pi, pj : numpy.ndarray of int64, shape (K,)
-        The pairs.
+        The pairs (pi = pj for an own image).
     pn : numpy.ndarray of int64, shape (K, d)
         The image n of j (r_ij = x_j + H n - x_i).
     """
@@ -347,17 +475,23 @@ def near_pairs(P, H, Hinv, scale):
     pn = np.empty((cap, d), dtype=np.int64)
     count = 0
     for i in range(n):
-        for j in range(i + 1, n):
+        for j in range(i, n):
             reach = scale * (P[i, cr] + P[j, cr])
             total = dk._image_box(P[i, :d], P[j, :d], Hinv, reach, cfac, ds, lo, hi, od)
             for _ in range(total):
+                keep = True
+                if i == j:  # own image: n != 0 with its last non-zero component positive
+                    keep = False
+                    for k in range(d):
+                        if od[k] != 0:
+                            keep = od[k] > 0
                 rr = 0.0
                 for q in range(d):
                     a = 0.0
                     for k in range(d):
                         a += H[q, k] * (ds[k] + od[k])
                     rr += a * a
-                if rr < reach * reach:
+                if keep and rr < reach * reach:
                     if count == cap:
                         cap *= 2
                         pi2 = np.empty(cap, dtype=np.int64)

@@ -1,4 +1,5 @@
-"""``hardpack compress`` (Lubachevsky-Stillinger packing) and ``hardpack eos`` (equilibrium Z).
+"""``hardpack compress`` (Lubachevsky-Stillinger packing), ``hardpack eos`` (equilibrium Z) and
+``hardpack crystal-search`` (dense spheroid crystals from small deforming cells).
 
 Both read a start packing written by ``hardpack init`` (or any packing netCDF). ``compress``
 writes the final packing (with run statistics as attributes) and the per-window time series;
@@ -145,8 +146,32 @@ def cmd_eos(args) -> int:
     return 0
 
 
+def cmd_crystal_search(args) -> int:
+    """Dense spheroid crystals from random starts in small deforming cells (Donev 2006, ch. 8).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack crystal-search``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
+    from hardpack.io import write_dataset
+    from hardpack.md.crystal_search import crystal_search
+
+    protocol = {k: getattr(args, k) for k in ("pressure", "equilibration", "growth_rate", "max_pressure")}
+    ds = crystal_search(args.n, args.alpha, args.seeds, **protocol)
+    write_dataset(ds, args.out)
+    log.info("wrote %s: best phi %.6f (laminate %.6f), %d of %d runs match the laminate", args.out,
+             ds.attrs["phi_best"], ds.attrs["phi_laminate"], int(ds["laminate"].sum()), ds["laminate"].size)
+    return 0
+
+
 def register(subparsers) -> None:
-    """Add the subcommands ``compress``, ``eos`` to the ``hardpack`` command line.
+    """Add the subcommands ``compress``, ``eos``, ``crystal-search`` to the ``hardpack`` command line.
 
     Parameters
     ----------
@@ -208,6 +233,23 @@ def register(subparsers) -> None:
                            "--checkpoint-interval seconds and on Ctrl-C or SIGTERM, resumed if present, removed "
                            "once --out is written")
     p.set_defaults(func=cmd_eos)
+
+    from hardpack.md import crystal_search as cs
+
+    p = subparsers.add_parser("crystal-search", help=cmd_crystal_search.__doc__.split("\n\n")[0])
+    p.add_argument("--alpha", type=float, required=True, help="aspect ratio of the spheroids (alpha, 1, 1)")
+    p.add_argument("--n", type=int, nargs="+", required=True, help="spheroids per cell (one search per value)")
+    p.add_argument("--seeds", type=int, nargs="+", required=True, help="seeds (one run per n and seed)")
+    p.add_argument("--pressure", type=float, default=cs.PRESSURE,
+                   help=f"isobaric pressure p* = P v / kT of the ordering stage (default {cs.PRESSURE:g})")
+    p.add_argument("--equilibration", type=int, default=cs.EQUILIBRATION,
+                   help=f"collisions per particle of the ordering stage (default {cs.EQUILIBRATION})")
+    p.add_argument("--growth-rate", type=float, default=cs.GROWTH_RATE,
+                   help=f"LS growth rate of the final compression (default {cs.GROWTH_RATE:g})")
+    p.add_argument("--max-pressure", type=float, default=cs.MAX_PRESSURE,
+                   help=f"reduced pressure ending the compression (default {cs.MAX_PRESSURE:g})")
+    p.add_argument("--out", required=True, help="output netCDF (phi, contacts, laminate match per n and seed)")
+    p.set_defaults(func=cmd_crystal_search)
 
 
 def main(argv=None) -> int:

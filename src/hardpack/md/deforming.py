@@ -46,8 +46,9 @@ kept isotropic at a free volume. This shape freedom is what makes LS packings st
    1.6e-4 below N kT Z / P0, 4 standard errors). ``adaptive_cell=False`` restores Donev's rule
    with the fixed 1 / Z mobility and the thermostat's window (step 6).
 3. s <= 1 is the largest step that leaves every pair at least half its gap along the linear
-   path (the first root of |r + s E r| = sigma + gap / 2 over the pairs within reach, and every particle's own images
-   with contact distance SELF_CONTACT times the largest diameter); after the map the packing is
+   path (the first root of |r + s E r| = sigma + gap / 2 over the pairs within reach, and for
+   spheres every particle's own images with contact distance SELF_CONTACT times the largest
+   diameter: a sphere never collides with its images); after the map the packing is
    checked for overlaps exactly, and the step halved (at most MAX_HALVINGS times, then skipped)
    if round-off made one. Velocities are not changed (the kinetic energy is conserved by a
    deformation).
@@ -81,7 +82,13 @@ Ellipsoids (:class:`EllipsoidDeformingSimulation`) use the same windows, strain 
 map, with the ellipsoid engine's prediction and collision law in the general cell
 (:mod:`hardpack.md._ellipsoid_deforming_kernel`, which also explains the stress of non-central
 contact forces), the map applied to the centres only, a Perram-Wertheim version of step 3 and a
-thermostat that sets the translational and rotational temperatures separately.
+thermostat that sets the translational and rotational temperatures separately. An ellipsoid
+collides with its own periodic images (spin only, derived in that module), so the cell may be
+small, down to one particle: every window then needs collisions to measure the stress, so a
+window has at least MIN_WINDOW_COLLISIONS collisions, and the next window after one without any
+is twice as long (its time cap would otherwise stay at the short length of the last one). With one
+particle the translational kinetic tensor v v^T is that of a single velocity (rank one): its
+anisotropy, kT / V, is a relative 1 / Z of the pressure and only matters far from jamming.
 
 This is an overdamped, deterministic barostat: it drives the mean stress to P0 I but does not
 sample the isobaric ensemble's volume fluctuations. Tests: an ideal-gas check that the mean
@@ -131,8 +138,17 @@ SELF_CONTACT = 1.1
 #: shortest lattice vector leaves); it grows while exits outnumber collisions (dilute fluids) and
 #: shrinks when they are below a tenth of them
 SHELL_START, SHELL_MIN, SHELL_MAX, SHELL_STEP = 0.3, 0.05, 3.0, 1.5
+#: fewest collisions of a window (small cells): a window's stress is measured from its collisions,
+#: and one without any reads Z = 1, whose strain would close every gap by half
+MIN_WINDOW_COLLISIONS = 10
+#: the first window lasts at most this many thermal flight times over a mean diameter per collision
+#: asked for (per particle)
+FIRST_WINDOW_FLIGHTS = 10.0
 #: safety factor of the collision budget of a window that ends at a fixed time
 BUDGET_SLACK = 4
+#: the ellipsoid image table covers bounding diameters up to this factor above the window start's
+#: (and is enlarged by it when a bounding sphere outgrows it)
+REACH_SLACK = 1.25
 
 RECORD_FIELDS = ("time", "phi", "Z", "collisions", "kT_mean", "volume", "pressure", "shear",
                  "strain_step", "step_fraction", "mobility", "exits", "wall_time", "growth_rate")
@@ -249,14 +265,16 @@ def _check_packing(packing: Packing) -> None:
     if packing.boundary.kind != "periodic":
         raise InvalidInputError("a deforming cell needs a periodic boundary on every axis; this packing "
                                 f"has {packing.boundary}: drop --deforming-cell or use a periodic packing")
-    if packing.n_particles < 2:
-        raise InvalidInputError("MD in a periodic cell needs at least 2 particles")
+    spheres = packing.shape.kind == "sphere"
+    if spheres and packing.n_particles < 2:
+        raise InvalidInputError("sphere MD in a periodic cell needs at least 2 particles (a sphere never "
+                                "collides with its own images)")
     report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
     if report.n_overlapping:
         raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "
                                 "hard-sphere MD needs a non-overlapping start")
     dmax = 2.0 * float(packing.shape.bounding_radii.max())
-    if shortest_vector(packing.lattice) <= SELF_CONTACT * dmax:
+    if spheres and shortest_vector(packing.lattice) <= SELF_CONTACT * dmax:
         raise InvalidInputError(
             f"the cell is too small: its shortest lattice vector {shortest_vector(packing.lattice):.4g} "
             f"must exceed {SELF_CONTACT} largest diameters ({SELF_CONTACT * dmax:.4g}); use more particles")
@@ -383,6 +401,10 @@ class DeformingSimulation:
             return np.full(self.n, self.growth_rate / (2.0 * float(self.A.mean())))
         return np.where(self.growing, self.growth_rate / (2.0 * self.A), 0.0)
 
+    def mean_diameter(self) -> float:
+        """Mean particle diameter (bounding diameter for ellipsoids)."""
+        return 2.0 * float(self.A.mean())
+
     def run_window(self, coll_target: int, max_time: float = np.inf) -> dict:
         """Run one window of about ``coll_target`` collisions (and at most ``max_time`` MD time)
         in the current cell, measure the stress, rescale velocities (growing runs), deform the
@@ -392,11 +414,18 @@ class DeformingSimulation:
         self._reduce_cell()
         kappa = self.relative_rates()
         if self.last_duration > 0.0:
-            t_cap = self.last_duration * coll_target / max(self.last_collisions, 1)
-            t_cap = min(t_cap, 2.0 * self.last_duration)
+            # twice the last window after one without collisions (with a budget of one collision the
+            # ratio would keep it at the length of a window that was too short)
+            t_cap = 2.0 * self.last_duration
+            if self.last_collisions > 0:
+                t_cap = min(t_cap, self.last_duration * coll_target / self.last_collisions)
             budget = BUDGET_SLACK * coll_target
         else:
-            t_cap, budget = np.inf, coll_target
+            # the first window ends by FIRST_WINDOW_FLIGHTS thermal flights over a diameter per
+            # collision asked for, if not by its collisions (a cell in which no particle can reach
+            # another or its own image would otherwise never end it)
+            t_cap = FIRST_WINDOW_FLIGHTS * self.mean_diameter() * coll_target / n
+            budget = coll_target
         if kappa.min() < 0.0:
             t_cap = min(t_cap, 0.5 / -kappa.min())
         t_cap = min(t_cap, float(max_time))
@@ -571,8 +600,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
     the deformation is skipped) until every pair whose bounding spheres can meet keeps at least
     half its Perram-Wertheim gap, mu - 1 with mu = sqrt(1 + zeta) the scaling factor to tangency
     (Donev 2006, sec. 2.2.2.1; the sphere rule's half gap, since mu = r / (a_i + a_j) for
-    spheres), and the shortest lattice vector stays above SELF_CONTACT largest bounding
-    diameters (a particle never meets its own image).
+    spheres), a particle's own images included (they collide with it: any cell without overlaps
+    runs, N = 1 too).
 
     Parameters
     ----------
@@ -614,10 +643,14 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         self.P[:, cw:cii] = np.asarray(angular_velocities, dtype=float).reshape(n, -1)
         self.P[:, cii] = 1.0 / moments_of_inertia(shape.semiaxes)
         self.eps_f = float(eps_f)
+        self.self_collisions = 0
         self._init_run(packing, growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell)
 
     def _column(self, k: int) -> int:
         return ek.columns(self.d)[k]
+
+    def mean_diameter(self) -> float:
+        return 2.0 * float(self.P[:, self._column(2)].mean())
 
     @property
     def semiaxes(self) -> np.ndarray:
@@ -666,23 +699,24 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         tensor into ``kin`` and ``vir``."""
         n, d = self.n, self.d
         Hinv = np.linalg.inv(self.H)
-        lmin = shortest_vector(self.H)
         rb = self.P[:, self._column(2)]
         rmax = float(rb.max())
-        skin = np.full(n, min(self.shell * float(rb.mean()), 0.45 * (lmin - 2.0 * rmax)))
-        M = dk.image_ranges(self.H, lmin)
-        img, cbits = edk.padded_image_table(self.H, M)
+        skin = np.full(n, self.shell * float(rb.mean()))
+        # the image table covers bounding spheres grown by REACH_SLACK (the kernel asks for more)
+        reach = 2.0 * (rmax + float(skin[0])) * REACH_SLACK
         cfac = np.linalg.norm(Hinv, axis=1)
         saved = self.P.copy()
         vir, kw = np.zeros((d, d)), np.zeros((d, d))
         while True:
+            M = dk.image_ranges(self.H, reach)
+            img, cbits = edk.padded_image_table(self.H, M)
             cap = self.capacity
             nb = np.zeros((n, cap), dtype=np.int64)
             acc = np.zeros(edk.N_ACC)
             acc[mdk.A_KE] = 0.5 * float(np.sum(self.V * self.V))
             iacc = np.zeros(edk.N_COUNTERS, dtype=np.int64)
             status = edk.run_events(
-                self.P, self.H, Hinv, M, img, cbits, cfac, lmin, float(kappa[0]), self.eps_f, skin, self.bs,
+                self.P, self.H, Hinv, M, img, cbits, cfac, reach, float(kappa[0]), self.eps_f, skin, self.bs,
                 nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey, self.heap, self.hpos,
                 np.empty(cap), np.empty(cap), np.empty(cap, dtype=np.int8), np.empty((cap, ek.PAIR_STATE)),
                 vir, kw, acc, iacc, budget, t_cap)
@@ -690,8 +724,19 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
                 self.P[:] = saved
                 self.capacity *= 2
                 continue
-            _refuse_window_end(status, lmin, 2 * rmax)
+            if status == dk.DeformingStatus.SELF_IMAGE:
+                if 2.0 * float(self.bs[:, d].max()) >= reach:  # a bounding sphere outgrew the table
+                    self.P[:] = saved
+                    reach *= REACH_SLACK
+                    continue
+                raise RuntimeError(
+                    f"at window time {acc[mdk.A_T]:.6g} a particle grew into its own periodic image along a "
+                    "contact normal on the centre line (r x n = 0), which no rotation can relieve; "
+                    "spheres-as-ellipsoids (equal semiaxes) cannot touch their own images: use more "
+                    "particles or a larger cell")
+            _refuse_window_end(status, 0.0, 2 * rmax)
             break
+        self.self_collisions += int(iacc[edk.I_SELF])
         duration = float(acc[mdk.A_T])
         ek.synchronise(self.P, duration, float(kappa[0]))
         v = self.V
@@ -719,8 +764,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         if not np.any(e):
             return 0.0, 1.0
         H0, P0 = self.H.copy(), self.P.copy()
-        floor = SELF_CONTACT * 2.0 * float(self.P[:, self._column(2)].max())
-        # every pair that F (or its volume correction) can bring within bounding reach
+        # every pair (own images included) that F (or its volume correction) can bring within bounding reach
         pairs = self._pairs(math.exp(2.0 * float(np.linalg.norm(e))) * 1.01)
         mu0, rate = edk.pair_scales(P0, H0, *pairs, e)
         # first-order step that keeps half of every approaching pair's zeta (as the sphere rule)
@@ -732,14 +776,13 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
                 break
             f = self._cell_map(s, e, H0)
             H1 = f @ H0
-            if shortest_vector(H1) > floor:
-                self.P[:, :d] = P0[:, :d] @ f.T
-                mu1, _ = edk.pair_scales(self.P, H1, *pairs, e)
-                if np.all(np.where(mu0 > 1.0, mu1 - 1.0 >= 0.5 * (mu0 - 1.0), mu1 >= mu0)):
-                    self.H = H1
-                    dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
-                    return float(s * np.linalg.norm(e)), float(s)
-                self.P[:] = P0
+            self.P[:, :d] = P0[:, :d] @ f.T
+            mu1, _ = edk.pair_scales(self.P, H1, *pairs, e)
+            if np.all(np.where(mu0 > 1.0, mu1 - 1.0 >= 0.5 * (mu0 - 1.0), mu1 >= mu0)):
+                self.H = H1
+                dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
+                return float(s * np.linalg.norm(e)), float(s)
+            self.P[:] = P0
             s *= 0.5
         self.H, self.P = H0, P0
         return 0.0, 0.0
@@ -782,8 +825,9 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
         Periodic packing of spheres (any d), ellipsoids (3D) or ellipses (2D) without overlaps
         (any lattice, sheared or not; ellipsoids run :class:`EllipsoidDeformingSimulation`, with
         uniform growth of the semiaxes, Gamma as in :func:`hardpack.md.ellipsoid.compress_ellipsoids`,
-        and velocities and angular velocities at kT = 1); its shortest lattice vector must exceed
-        SELF_CONTACT largest (bounding) diameters.
+        and velocities and angular velocities at kT = 1); for spheres N >= 2 and the shortest
+        lattice vector must exceed SELF_CONTACT largest diameters (ellipsoids collide with their
+        own images: any N >= 1 and cell).
     growth_rate : float
         Gamma = (d<D>/dt) / sqrt(kT/m) as in :func:`hardpack.md.compress`; >= 0 (0 needs a
         collision or time limit).
@@ -863,7 +907,7 @@ def compress_deforming(packing: Packing, growth_rate: float, seed: int, stop: St
                                   growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell=adaptive_cell)
     started = time.perf_counter()
     while (reason := _stop_reason(stop, sim, started)) is None:
-        budget = max(1, round(stage_window(sim.growth_rate) * sim.n))
+        budget = max(MIN_WINDOW_COLLISIONS, round(stage_window(sim.growth_rate) * sim.n))
         if stop.max_collisions is not None:
             budget = min(budget, int(stop.max_collisions) - sim.collisions)
         record = sim.run_window(budget)

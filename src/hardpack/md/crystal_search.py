@@ -1,0 +1,237 @@
+"""Search for dense crystal packings of spheroids with small-cell deforming-cell MD (Donev 2006,
+ch. 8; Donev, Stillinger, Chaikin and Torquato, Phys. Rev. Lett. 92, 255506 (2004)).
+
+Donev found the SM2 laminate (phi = 0.770732 at aspect ratio sqrt(3), 14 contacts per particle)
+by compressing a few particles (4 to 16) per periodic cell from random starts with the
+deforming-cell MD (Donev 2006, sec. 3.2.4.2), whose cell takes the shape of the densest
+structure the particles find. One run here (:func:`search_run`):
+
+1. A random start: ``n`` spheroids with random orientations in a cube at volume fraction
+   ``phi_start`` (:func:`hardpack.initial.random_ellipsoid_packing`).
+2. Isobaric MD without growth at the applied pressure p* = P v / kT (v the particle volume)
+   for ``equilibration`` collisions per particle (:func:`hardpack.md.deforming.compress_deforming`
+   with ``applied_pressure`` P = p* / v): the cell relaxes its volume and shape, and a small
+   system at a solid-phase pressure orders in a few hundred collisions per particle.
+3. Lubachevsky-Stillinger growth at ``growth_rate`` in the shape-only mode (the cell keeps its
+   volume and relaxes its shape) to the reduced pressure ``max_pressure``, where the packing is
+   jammed to phi_J - phi ~ d phi / Z.
+4. ``cycles`` > 1 repeats steps 2 and 3 from the jammed packing (the isobaric stage melts or
+   expands it back to the density of p*, new velocities) and keeps the densest jammed packing:
+   LS growth can jam the cell in a lattice that a slower deformation would leave (one spheroid
+   per cell at Gamma = 1e-3 ended at pi / sqrt(18) in 3 of 4 prolate and 1 of 4 oblate seeds,
+   the others at phi = 0.698 to 0.740 with 6 to 10 contacts; at Gamma = 1e-2 none did).
+
+Small cells need the collisions of a particle with its own periodic images, which the ellipsoid
+kernel has (:mod:`hardpack.md._ellipsoid_deforming_kernel`): with ``n`` = 1 the run ends at
+(or, when the growth jams the cell first, step 4, below) the densest lattice packing of the
+shape, the affine image of FCC, phi = pi / sqrt(18) for every aspect ratio. The result is
+compared with the laminate of the same aspect ratio
+(:func:`hardpack.geometry.ellipsoid_crystals.laminate`; phi(alpha) = phi(1 / alpha)): contacts are
+pairs within a Perram-Wertheim gap mu - 1 < ``contact_tol``
+(:func:`hardpack.geometry.ellipsoid_stats.ellipsoid_contacts`, own images counted twice).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import xarray as xr
+
+from hardpack.errors import InvalidInputError
+from hardpack.md.compress import StopCriteria
+
+#: default protocol (module docstring): start density, isobaric pressure p* = P v / kT, its
+#: collisions per particle, the LS growth rate and the final reduced pressure
+PHI_START, PRESSURE, EQUILIBRATION, GROWTH_RATE, MAX_PRESSURE = 0.3, 30.0, 2000, 1e-3, 1e9
+#: contact tolerance on the Perram-Wertheim gap mu - 1, and the tolerance on phi of a match with
+#: the laminate
+CONTACT_TOL, MATCH_TOL = 1e-4, 1e-4
+
+
+def spheroid_semiaxes(alpha: float) -> np.ndarray:
+    """Semiaxes (alpha, 1, 1) of a spheroid with aspect ratio alpha (prolate above 1, oblate below).
+
+    Parameters
+    ----------
+    alpha : float
+        Aspect ratio, positive and finite.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        The semiaxes.
+
+    Raises
+    ------
+    InvalidInputError
+        If alpha is not a positive finite number.
+    """
+    if isinstance(alpha, bool) or not isinstance(alpha, (int, float, np.floating)) or not (
+            math.isfinite(alpha) and alpha > 0):
+        raise InvalidInputError(f"the aspect ratio alpha must be a positive finite number, got {alpha!r}")
+    return np.array([float(alpha), 1.0, 1.0])
+
+
+def laminate_reference(alpha: float) -> tuple[float, float]:
+    """phi and the mean contacts per particle of the laminate with aspect ratio alpha (Donev 2006,
+    sec. 8.2; phi(alpha) = phi(1 / alpha)).
+
+    Parameters
+    ----------
+    alpha : float
+        Aspect ratio.
+
+    Returns
+    -------
+    phi : float
+        Its density.
+    contacts : float
+        Its contacts per particle (14 at sqrt(3)).
+    """
+    from hardpack.geometry.ellipsoid_crystals import laminate
+    from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts
+
+    spheroid_semiaxes(alpha)
+    crystal = laminate(float(max(alpha, 1.0 / alpha)))
+    contacts = ellipsoid_contacts(crystal, tol=CONTACT_TOL, min_contacts=1)
+    return float(crystal.phi), float(contacts.degree.mean())
+
+
+def search_run(n: int, alpha: float, seed: int, *, phi_start: float = PHI_START, pressure: float = PRESSURE,
+               equilibration: int = EQUILIBRATION, growth_rate: float = GROWTH_RATE,
+               max_pressure: float = MAX_PRESSURE, contact_tol: float = CONTACT_TOL, cycles: int = 1) -> dict:
+    """One random-start crystal search run (module docstring).
+
+    Parameters
+    ----------
+    n : int
+        Spheroids per cell, >= 1.
+    alpha : float
+        Aspect ratio (semiaxes alpha, 1, 1).
+    seed : int
+        Seed of the start and of the velocities.
+    phi_start : float
+        Volume fraction of the random start.
+    pressure : float
+        Isobaric pressure p* = P v / kT of step 2 (> 0).
+    equilibration : int
+        Collisions per particle of step 2 (>= 0; 0 skips it).
+    growth_rate : float
+        LS growth rate of step 3 (> 0).
+    max_pressure : float
+        Reduced pressure at which step 3 stops.
+    contact_tol : float
+        Contact tolerance on mu - 1.
+    cycles : int
+        Isobaric-then-LS cycles (step 4), >= 1.
+
+    Returns
+    -------
+    dict
+        ``packing`` (the final Packing), ``phi``, ``Z`` (reduced pressure), ``contacts`` (mean per
+        particle), ``min_contacts``, ``max_contacts``, ``n_overlapping`` (Perram-Wertheim check of
+        the final packing), ``phi_equilibrated`` (after the first step 2), ``cpu_time`` (s),
+        ``collisions``, ``best_cycle`` (the cycle of the densest packing, from 0).
+
+    Raises
+    ------
+    InvalidInputError
+        For a bad n, alpha, pressure, equilibration or rate.
+    """
+    from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts
+    from hardpack.initial import random_ellipsoid_packing
+    from hardpack.md.deforming import compress_deforming
+
+    semiaxes = spheroid_semiaxes(alpha)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise InvalidInputError(f"n (spheroids per cell) must be an integer >= 1, got {n!r}")
+    if not (math.isfinite(pressure) and pressure > 0):
+        raise InvalidInputError(f"the isobaric pressure p* must be a positive finite number, got {pressure!r}")
+    if isinstance(equilibration, bool) or not isinstance(equilibration, (int, np.integer)) or equilibration < 0:
+        raise InvalidInputError(f"equilibration (collisions per particle) must be an integer >= 0, "
+                                f"got {equilibration!r}")
+    if not (math.isfinite(growth_rate) and growth_rate > 0):
+        raise InvalidInputError(f"the growth rate must be a positive finite number, got {growth_rate!r}")
+    if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 1:
+        raise InvalidInputError(f"cycles must be an integer >= 1, got {cycles!r}")
+    started = time.process_time()
+    packing = random_ellipsoid_packing(int(n), semiaxes, phi_start, seed=seed)
+    volume = 4.0 / 3.0 * math.pi * float(np.prod(semiaxes))
+    collisions = 0
+    best, best_cycle, phi_equilibrated = None, 0, float("nan")
+    for cycle in range(int(cycles)):
+        if equilibration > 0:
+            res = compress_deforming(packing, 0.0, seed + 2 * cycle,
+                                     StopCriteria(max_pressure=None, max_collisions=int(equilibration) * int(n)),
+                                     applied_pressure=pressure / volume)
+            packing = res.packing
+            collisions += res.stats["collisions"]
+        if cycle == 0:
+            phi_equilibrated = float(packing.phi)
+        res = compress_deforming(packing, growth_rate, seed + 2 * cycle + 1, StopCriteria(max_pressure=max_pressure))
+        collisions += int(res.stats["collisions"])
+        packing = res.packing
+        if best is None or packing.phi > best.packing.phi:
+            best, best_cycle = res, cycle
+    res = best
+    final = res.packing
+    contacts = ellipsoid_contacts(final, tol=contact_tol, min_contacts=1)
+    return {
+        "packing": final, "phi": float(final.phi), "Z": float(res.stats["Z"]),
+        "contacts": float(contacts.degree.mean()), "min_contacts": int(contacts.degree.min()),
+        "max_contacts": int(contacts.degree.max()),
+        "n_overlapping": int(final.overlap_report().n_overlapping), "phi_equilibrated": phi_equilibrated,
+        "cpu_time": time.process_time() - started, "collisions": collisions, "best_cycle": best_cycle,
+    }
+
+
+def crystal_search(ns, alpha: float, seeds, **protocol) -> xr.Dataset:
+    """Random-start crystal searches (:func:`search_run`) for every n per cell and seed, compared
+    with the laminate.
+
+    Parameters
+    ----------
+    ns : sequence of int
+        Spheroids per cell.
+    alpha : float
+        Aspect ratio.
+    seeds : sequence of int
+        Seeds.
+    **protocol
+        Keyword arguments of :func:`search_run`.
+
+    Returns
+    -------
+    xarray.Dataset
+        On (n, seed): ``phi``, ``Z``, ``contacts``, ``min_contacts``, ``max_contacts``,
+        ``n_overlapping``, ``phi_equilibrated``, ``cpu_time``, ``collisions`` and ``laminate``
+        (phi within MATCH_TOL of the laminate's and every particle with its contact count);
+        attributes the laminate's ``phi_laminate`` and ``contacts_laminate``, the best phi and
+        the protocol.
+    """
+    ns = [int(k) for k in ns]
+    seeds = [int(s) for s in seeds]
+    if not ns or not seeds:
+        raise InvalidInputError("give at least one n per cell and one seed")
+    phi_lam, z_lam = laminate_reference(alpha)
+    keys = ("phi", "Z", "contacts", "min_contacts", "max_contacts", "n_overlapping", "phi_equilibrated",
+            "cpu_time", "collisions", "best_cycle")
+    table = {k: np.full((len(ns), len(seeds)), np.nan) for k in keys}
+    for a, n in enumerate(ns):
+        for b, seed in enumerate(seeds):
+            run = search_run(n, alpha, seed, **protocol)
+            for k in keys:
+                table[k][a, b] = run[k]
+    match = (np.abs(table["phi"] - phi_lam) < MATCH_TOL) & (table["min_contacts"] == z_lam) \
+        & (table["max_contacts"] == z_lam)
+    data = {k: (("n", "seed"), v) for k, v in table.items()}
+    data["laminate"] = (("n", "seed"), match)
+    params = {"phi_start": PHI_START, "pressure": PRESSURE, "equilibration": EQUILIBRATION,
+              "growth_rate": GROWTH_RATE, "max_pressure": MAX_PRESSURE, "contact_tol": CONTACT_TOL, "cycles": 1}
+    params.update(protocol)
+    return xr.Dataset(data, coords={"n": ns, "seed": seeds}, attrs={
+        "hardpack_kind": "ellipsoid_crystal_search", "alpha": float(alpha), "phi_laminate": phi_lam,
+        "contacts_laminate": z_lam, "match_tol": MATCH_TOL, "phi_best": float(np.nanmax(table["phi"])),
+        **{k: float(v) for k, v in params.items()}})
