@@ -54,6 +54,8 @@ def test_shipped_configs_are_valid(name):
         (lambda c: c["ellipsoid_containers"].pop("shell_width"),
          "ellipsoid_containers: 'shell_width' is a required property"),
         (lambda c: c["containers"]["windows"].update(n_windows=1), "containers.windows.n_windows: 1 is less than"),
+        (lambda c: c["ellipsoid_crystals"]["search"].update(n=[0]), "ellipsoid_crystals.search.n.0: 0 is less than"),
+        (lambda c: c["ellipsoid_crystals"]["search"].update(alphas=[1.5, 1.5]), "ellipsoid_crystals.search.alphas: .*non-unique"),
     ],
 )
 def test_bad_configs_are_refused_naming_the_key(mutate, expected):
@@ -154,6 +156,7 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
     (lambda c: c["ellipsoid_containers"].update(core_margin=4), "ellipsoid_containers.core_margin = 4 a leaves no core"),
     (lambda c: c["containers"].update(fit_min_n=200), "fewer than 2 container sizes"),
     (lambda c: c["containers"]["windows"].update(fit_min_diameter=0.1), "fit_min_diameter must be >= min_diameter"),
+    (lambda c: c["ellipsoid_crystals"]["search"].update(alphas=[1.5, 1.0]), r"ellipsoid_crystals.search.alphas contains 1"),
 ])
 def test_contradicting_sections_are_refused_naming_the_key(mutate, expected):
     cfg = copy.deepcopy(load("smoke.yaml"))

@@ -7,7 +7,9 @@ Physics checked:
   :func:`hardpack.geometry.ellipsoid_crystals.laminate`);
 - one spheroid per cell ends at (seed 0) or below the densest lattice packing, phi = pi / sqrt(18),
   which is not the laminate (the search reports no match), through the command line;
-- bad input is refused.
+- the validation rows judge the densest run at sqrt 3 against Donev's phi ~ 0.7707 and 14 contacts,
+  and the laminate figure draws every run;
+- bad input is refused (also spheres, alpha = 1, whose own-image contact no spin can resolve).
 """
 
 from __future__ import annotations
@@ -63,3 +65,45 @@ def test_bad_input_is_refused():
         search_run(2, SQRT3, 0, pressure=0.0)
     with pytest.raises(InvalidInputError, match="seed"):
         crystal_search([2], SQRT3, [])
+    with pytest.raises(InvalidInputError, match="own periodic images"):
+        search_run(1, 1.0, 0)
+
+
+def _search(alpha, ns, phi, contacts):
+    """A search dataset with given phi and mean contacts on (n, seed), shaped as crystal_search's."""
+    import xarray as xr
+
+    phi, contacts = np.asarray(phi, float), np.asarray(contacts, float)
+    lam = (np.abs(phi - 0.7707316) < 1e-4) & (contacts == 14)
+    data = {"phi": (("n", "seed"), phi), "Z": (("n", "seed"), np.full(phi.shape, 1e9)),
+            "contacts": (("n", "seed"), contacts), "min_contacts": (("n", "seed"), contacts),
+            "max_contacts": (("n", "seed"), contacts), "laminate": (("n", "seed"), lam)}
+    return xr.Dataset(data, coords={"n": ns, "seed": np.arange(phi.shape[1])}, attrs={"alpha": alpha})
+
+
+def test_search_rows_judge_the_best_run_against_donevs_search():
+    from hardpack.validation.ellipsoids import crystal_search_rows
+
+    found = _search(SQRT3, [2, 4], [[0.7704, 0.7405], [0.770729, 0.7381]], [[12, 12], [14, 12]])
+    assert [r.status for r in crystal_search_rows([found])] == ["pass", "pass"]
+    fcc_only = _search(SQRT3, [4], [[0.740480, 0.7381]], [[12, 10]])
+    assert [r.status for r in crystal_search_rows([fcc_only])] == ["fail", "fail"]
+    # the second-best laminate-like run of phi 0.77064 is 9e-5 off the printed 0.7707: fails
+    near = _search(SQRT3, [4], [[0.77064, 0.7381]], [[14, 10]])
+    assert [r.status for r in crystal_search_rows([near])] == ["fail", "pass"]
+    one_per_cell = _search(SQRT3, [1], [[0.740480]], [[12]])
+    assert [r.status for r in crystal_search_rows([one_per_cell])] == ["n/a", "n/a"]
+    elsewhere = _search(1.5, [4], [[0.7573]], [[12]])
+    assert [r.status for r in crystal_search_rows([elsewhere])] == ["n/a", "n/a"]
+
+
+def test_laminate_figure_shows_the_search_runs():
+    from hardpack.geometry.ellipsoid_crystals import laminate_family
+    from hardpack.plots.ellipsoids import plot_laminate_family
+
+    found = _search(SQRT3, [2, 4], [[0.7704, 0.7405], [0.770729, 0.7381]], [[12, 12], [14, 12]])
+    fig = plot_laminate_family(laminate_family([1.0, 1.5, SQRT3, 2.0]), [found])
+    points = [line for line in fig.axes[0].lines if len(line.get_xdata()) and line.get_marker() in "sD"]
+    plotted = np.sort(np.concatenate([line.get_ydata() for line in points]))
+    assert plotted == pytest.approx(np.sort([0.7704, 0.7405, 0.770729, 0.7381]))
+    assert {"search, 2 per cell", "search, 4 per cell"} <= {t.get_text() for t in fig.axes[0].get_legend().get_texts()}

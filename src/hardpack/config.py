@@ -35,6 +35,7 @@ def check_config(config: dict) -> None:
     _check_freeenergy(ensembles, config.get("freeenergy"))
     _check_glass(config.get("glass"), config.get("microsegregated"))
     _check_ellipsoids(config.get("ellipsoids"))
+    _check_crystal_search((config.get("ellipsoid_crystals") or {}).get("search"))
     _check_containers(ensembles, config.get("containers"), config.get("ellipsoid_containers"))
 
 
@@ -123,6 +124,12 @@ def _check_ellipsoids(ellipsoids: dict | None) -> None:
     unknown = set(ellipsoids.get("near_sphere", {}).get("families", [])) - set(families)
     if unknown:
         _refuse(f"ellipsoids.near_sphere.families {sorted(unknown)} are not ellipsoids.families {sorted(families)}")
+
+
+def _check_crystal_search(search: dict | None) -> None:
+    if search and any(alpha == 1 for alpha in search["alphas"]):
+        _refuse("ellipsoid_crystals.search.alphas contains 1 (spheres): a sphere's collision with its own "
+                "periodic image cannot be resolved in a cell of one particle; give aspect ratios other than 1")
 
 
 def _check_containers(ensembles: dict, containers: dict | None, ellipsoid_containers: dict | None) -> None:

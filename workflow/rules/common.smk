@@ -48,6 +48,7 @@ GLASS = config.get("glass")
 MICROSEG = config.get("microsegregated")
 ELLIPSOIDS = config.get("ellipsoids")
 ELLIPSOID_CRYSTALS = config.get("ellipsoid_crystals")
+CRYSTAL_SEARCH = (ELLIPSOID_CRYSTALS or {}).get("search")
 CONTAINERS = config.get("containers")
 ELLIPSOID_CONTAINERS = config.get("ellipsoid_containers")
 STRICT_LS = config.get("strict_ls")
@@ -675,6 +676,11 @@ def figures():
     return [f"results/figures/{name}.pdf" for name in names]
 
 
+def crystal_search_outputs():
+    """The crystal-search datasets, one per aspect ratio of the config (none without a search)."""
+    return [f"results/ellipsoid_crystals/search/alpha{alpha}.nc" for alpha in (CRYSTAL_SEARCH or {}).get("alphas", [])]
+
+
 def validation_inputs():
     """Row-builder name -> the summaries it reads, for every study the config enables."""
     inputs = {
@@ -714,6 +720,8 @@ def validation_inputs():
         inputs["ellipsoid_jamming"] = [summary(key) for key in COMBINED if key.startswith("ellipsoids/verdicts")]
     if ELLIPSOID_CRYSTALS:
         inputs["ellipsoid_crystals"] = ["results/ellipsoid_crystals/laminate_family.nc"]
+        if CRYSTAL_SEARCH:
+            inputs["crystal_search"] = crystal_search_outputs()
     if CONTAINERS:
         inputs["containers"] = ["results/containers/profile_summary.nc", "results/containers/windows_summary.nc"]
     if ELLIPSOID_CONTAINERS:
@@ -817,6 +825,9 @@ EXPECTED_MINUTES = {
                                                          GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
     "glass_bcmd": glass_bcmd_minutes,
     "microseg_packing": microseg_minutes,
+    # per run at alpha = sqrt(3), CPU s: n = 1 about 2, n = 2 about 7, n = 4 8-10; oblate slower
+    "crystal_search": lambda w: 1.0 + len(CRYSTAL_SEARCH["seeds"]) * sum(0.05 * n for n in CRYSTAL_SEARCH["n"])
+    * (3.0 if float(w.alpha) < 1 else 1.0),
 }
 
 

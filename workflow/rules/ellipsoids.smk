@@ -177,10 +177,36 @@ rule laminate_family:
         " --out {output} > {log} 2>&1"
 
 
+rule crystal_search:
+    """Dense spheroid crystals from random starts in small deforming cells, every n per cell and
+    seed of one aspect ratio (Donev 2006, Sec. 8.2.1)."""
+    output:
+        "results/ellipsoid_crystals/search/alpha{alpha}.nc",
+    wildcard_constraints:
+        alpha=r"[0-9.]+",
+    params:
+        n=lambda w: " ".join(str(n) for n in CRYSTAL_SEARCH["n"]),
+        seeds=lambda w: " ".join(str(s) for s in CRYSTAL_SEARCH["seeds"]),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("crystal_search"),
+        runtime=job_runtime("crystal_search"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/crystal_search/alpha{alpha}.log",
+    benchmark:
+        "results/benchmarks/crystal_search/alpha{alpha}.tsv"
+    shell:
+        "hardpack crystal-search --alpha {wildcards.alpha} --n {params.n} --seeds {params.seeds}"
+        " --out {output} > {log} 2>&1"
+
+
 rule fig_laminate_crystals:
     """Density of the laminate crystals vs aspect ratio (after Donev 2006, Fig. 8.2)."""
     input:
-        "results/ellipsoid_crystals/laminate_family.nc",
+        family="results/ellipsoid_crystals/laminate_family.nc",
+        searches=crystal_search_outputs(),
     output:
         pdf="results/figures/laminate_crystals.pdf",
         png=report("results/figures/laminate_crystals.png", caption="../report/laminate_crystals.rst", category="6 ellipsoids"),

@@ -7,4 +7,6 @@ from hardpack.plots.ellipsoids import plot_laminate_family
 from hardpack.plots.style import save
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
-save(plot_laminate_family(load_dataset(snakemake.input[0])), snakemake.output.pdf, snakemake.output.png)
+family = load_dataset(snakemake.input.family)
+searches = [load_dataset(path) for path in snakemake.input.searches]
+save(plot_laminate_family(family, searches), snakemake.output.pdf, snakemake.output.png)

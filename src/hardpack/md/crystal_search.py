@@ -33,6 +33,7 @@ pairs within a Perram-Wertheim gap mu - 1 < ``contact_tol``
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 
@@ -48,6 +49,8 @@ PHI_START, PRESSURE, EQUILIBRATION, GROWTH_RATE, MAX_PRESSURE = 0.3, 30.0, 2000,
 #: contact tolerance on the Perram-Wertheim gap mu - 1, and the tolerance on phi of a match with
 #: the laminate
 CONTACT_TOL, MATCH_TOL = 1e-4, 1e-4
+
+log = logging.getLogger("hardpack.md")
 
 
 def spheroid_semiaxes(alpha: float) -> np.ndarray:
@@ -222,6 +225,9 @@ def crystal_search(ns, alpha: float, seeds, **protocol) -> xr.Dataset:
     for a, n in enumerate(ns):
         for b, seed in enumerate(seeds):
             run = search_run(n, alpha, seed, **protocol)
+            log.info("alpha %g, n = %d, seed %d: phi %.6f, contacts %d-%d, %.1f CPU-s (run %d of %d)", alpha, n,
+                     seed, run["phi"], run["min_contacts"], run["max_contacts"], run["cpu_time"],
+                     a * len(seeds) + b + 1, len(ns) * len(seeds))
             for k in keys:
                 table[k][a, b] = run[k]
     match = (np.abs(table["phi"] - phi_lam) < MATCH_TOL) & (table["min_contacts"] == z_lam) \

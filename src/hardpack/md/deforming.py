@@ -269,6 +269,10 @@ def _check_packing(packing: Packing) -> None:
     if spheres and packing.n_particles < 2:
         raise InvalidInputError("sphere MD in a periodic cell needs at least 2 particles (a sphere never "
                                 "collides with its own images)")
+    if (packing.shape.kind == "ellipsoid" and packing.n_particles == 1
+            and np.ptp(packing.shape.semiaxes) == 0):
+        raise InvalidInputError("one ellipsoid with equal semiaxes (a sphere) cannot resolve a contact with "
+                                "its own periodic images: use at least 2 particles or unequal semiaxes")
     report = packing.overlap_report(DEFAULT_OVERLAP_TOL)
     if report.n_overlapping:
         raise InvalidInputError(f"the start configuration has overlapping particles ({report}); "

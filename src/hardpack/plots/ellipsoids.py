@@ -152,18 +152,22 @@ def plot_snapshot(packing, slab: float | None = None):
     return fig
 
 
-def plot_laminate_family(family):
-    """Density of the laminate crystals vs the in-plane aspect ratio (after Donev 2006, Fig. 8.2).
+def plot_laminate_family(family, searches=()):
+    """Density of the laminate crystals vs the in-plane aspect ratio (after Donev 2006, Fig. 8.2),
+    with the crystals found by small-cell searches from random starts (Sec. 8.2.1).
 
     Both prolate (alpha) and oblate (1 / alpha) sides are drawn on a logarithmic axis (phi(alpha)
     = phi(1 / alpha)): the unstretched laminate (dashed), the densest known crystal of each shape
     (solid: the laminate up to sqrt(3), the stretched laminate beyond), FCC and the maximum
-    0.770732 with its 14 contacts.
+    0.770732 with its 14 contacts. Each search run is a marker at its aspect ratio (spread
+    sideways by particles per cell), filled where it matches the laminate.
 
     Parameters
     ----------
     family : xarray.Dataset
         :func:`hardpack.geometry.ellipsoid_crystals.laminate_family`.
+    searches : sequence of xarray.Dataset
+        :func:`hardpack.md.crystal_search.crystal_search` results, one per aspect ratio.
 
     Returns
     -------
@@ -186,6 +190,7 @@ def plot_laminate_family(family):
         phi = float(np.asarray(family["phi_laminate"].values, float)[order][densest][0])
         ax.plot([1 / peak, peak], [phi, phi], "o", color="C3", ms=5,
                 label=rf"$\phi = {phi:.6f}$, 14 contacts")
+    _plot_searches(ax, searches)
     ax.set_xscale("log")
     ticks = [(1 / 3, "1/3"), (1 / np.sqrt(3), r"$1/\sqrt{3}$"), (1.0, "1"), (np.sqrt(3), r"$\sqrt{3}$"),
              (3.0, "3")]
@@ -194,6 +199,24 @@ def plot_laminate_family(family):
     ax.minorticks_off()
     ax.set_xlabel(r"aspect ratio $\alpha$ (oblate $< 1 <$ prolate)")
     ax.set_ylabel(r"density $\phi$")
-    ax.legend(loc="lower center", fontsize="small")
+    ax.legend(loc="lower center", fontsize="small", ncol=2 if searches else 1)
     fig.tight_layout()
     return fig
+
+
+def _plot_searches(ax, searches) -> None:
+    """Markers of the crystal-search runs: one colour and sideways offset per particles per cell."""
+    ns = sorted({int(n) for ds in searches for n in ds["n"].values})
+    markers = "sD^vo"
+    for k, n in enumerate(ns):
+        offset = 1.0 + 0.012 * (k - (len(ns) - 1) / 2)
+        colour, marker = f"C{k + 4}", markers[k % len(markers)]
+        ax.plot([], [], marker, ms=4, mfc="none", color=colour, label=f"search, {n} per cell")
+        for ds in searches:
+            if n not in ds["n"].values:
+                continue
+            phi = np.asarray(ds["phi"].sel(n=n).values, float)
+            match = np.asarray(ds["laminate"].sel(n=n).values, bool)
+            x = np.full(phi.shape, float(ds.attrs["alpha"]) * offset)
+            ax.plot(x[~match], phi[~match], marker, ms=4, mfc="none", color=colour)
+            ax.plot(x[match], phi[match], marker, ms=4, color=colour)

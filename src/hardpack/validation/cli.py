@@ -21,7 +21,7 @@ from hardpack.io import load_dataset, write_dataset
 from hardpack.io.atomic import write_text
 from hardpack.validation.analytic import hgrid_rows, moment_table_rows
 from hardpack.validation.containers import container_rows
-from hardpack.validation.ellipsoids import crystal_rows, ellipsoid_jamming_rows, ellipsoid_rows
+from hardpack.validation.ellipsoids import crystal_rows, crystal_search_rows, ellipsoid_jamming_rows, ellipsoid_rows
 from hardpack.validation.freeenergy import (
     bcmd_rows,
     density_rows,
@@ -69,6 +69,7 @@ ROW_BUILDERS = {
     "ellipsoids": ellipsoid_rows,
     "ellipsoid_jamming": ellipsoid_jamming_rows,
     "ellipsoid_crystals": crystal_rows,
+    "crystal_search": crystal_search_rows,
     "containers": container_rows,
 }
 

@@ -150,6 +150,44 @@ def crystal_rows(families) -> list[Row]:
     return out
 
 
+def crystal_search_rows(searches) -> list[Row]:
+    """Rows of the small-cell crystal search at alpha = sqrt(3)
+    (:func:`hardpack.md.crystal_search.crystal_search`): the density and the contacts per particle
+    of the densest run over every cell size and seed (Donev 2006, Sec. 8.2.1). Cells of fewer
+    than 4 spheroids (Donev's smallest) leave the rows n/a.
+
+    Parameters
+    ----------
+    searches : iterable of xarray.Dataset
+        Search results, one per aspect ratio; those of other aspect ratios give no row.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
+    targets = load_targets()
+    ids = ("donev-8.2-search-phi-best", "donev-8.2-search-contacts-best")
+    at_peak = [ds for ds in searches if abs(float(ds.attrs["alpha"]) - math.sqrt(3.0)) < 1e-6]
+    if not at_peak:
+        return [evaluate(targets[tid], n=0, label="alpha = sqrt(3)", detail="no search at alpha = sqrt(3)")
+                for tid in ids]
+    out = []
+    for ds in at_peak:
+        phi = np.asarray(ds["phi"].values, float)
+        a, b = np.unravel_index(int(np.nanargmax(phi)), phi.shape)
+        best = ds.isel(n=a, seed=b)
+        n_max = int(ds["n"].max())
+        runs = f"{phi.size} runs, {', '.join(str(int(n)) for n in ds['n'].values)} per cell"
+        detail = (f"best of {runs}: n = {int(best['n'])}, seed {int(best['seed'])}, Z = {float(best['Z']):.3g}, "
+                  f"contacts {int(best['min_contacts'])}-{int(best['max_contacts'])} per particle, "
+                  f"{int(np.sum(ds['laminate'].values))} runs match the laminate")
+        out.append(evaluate(targets[ids[0]], float(best["phi"]), n=n_max, label="alpha = sqrt(3)", detail=detail))
+        out.append(evaluate(targets[ids[1]], float(best["contacts"]), n=n_max, label="alpha = sqrt(3)",
+                            detail=detail))
+    return out
+
+
 #: aspect ratios "near the sphere point" of the second-order claim (Donev 2006, Sec. 5.6, Fig. 5.10:
 #: semiaxes 1.025^-1 : 1 : 1.025)
 NEAR_SPHERE_ALPHA = 1.1
