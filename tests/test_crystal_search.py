@@ -103,7 +103,7 @@ def test_laminate_figure_shows_the_search_runs():
 
     found = _search(SQRT3, [2, 4], [[0.7704, 0.7405], [0.770729, 0.7381]], [[12, 12], [14, 12]])
     fig = plot_laminate_family(laminate_family([1.0, 1.5, SQRT3, 2.0]), [found])
-    points = [line for line in fig.axes[0].lines if len(line.get_xdata()) and line.get_marker() in "sD"]
+    points = [line for line in fig.axes[1].lines if len(line.get_xdata()) and line.get_marker() in "sD"]
     plotted = np.sort(np.concatenate([line.get_ydata() for line in points]))
     assert plotted == pytest.approx(np.sort([0.7704, 0.7405, 0.770729, 0.7381]))
-    assert {"search, 2 per cell", "search, 4 per cell"} <= {t.get_text() for t in fig.axes[0].get_legend().get_texts()}
+    assert {"2 per cell", "4 per cell"} <= {t.get_text() for t in fig.axes[1].get_legend().get_texts()}

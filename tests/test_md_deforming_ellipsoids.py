@@ -200,3 +200,38 @@ def test_cli_compresses_ellipsoids_in_a_deforming_cell(tmp_path):
     assert abs(np.linalg.det(final.lattice)) == pytest.approx(start.volume, rel=1e-12)
     assert final.phi > 0.5
     assert final.overlap_report().n_overlapping == 0
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_collision_between_tied_images_is_with_the_approaching_one(sign):
+    """Spheroid 0 midway between two images of spheroid 1 (at +r and -r), touching both: their
+    zeta are equal, and with 1 moving along r one image approaches and the other separates. The
+    collision must take the approaching image whichever is listed first (taking the first of the
+    tie made the collision law skip it as a graze, and a search run predicted the same collision
+    again without end)."""
+    from hardpack.geometry.shapes import Ellipsoids
+    from hardpack.md import _ellipsoid_deforming_kernel as edk
+    from hardpack.md import _ellipsoid_kernel as ek
+
+    rng = np.random.default_rng(7)
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    u = rng.normal(size=3)
+    u /= np.linalg.norm(u)
+    shape = Ellipsoids(np.tile([1.5, 1.0, 1.0], (2, 1)), np.tile(q, (2, 1)))
+    # two equal, equally oriented ellipsoids (r^T X r <= 1) touch at centre distance 2 / sqrt(u^T X u)
+    x = shape.shape_matrices()[0]
+    r = u * 2.0 / np.sqrt(u @ x @ u) * (1 + 1e-14)
+    centre = np.full(3, 5.0)
+    packing = Packing(np.array([centre, centre + r]), lattice=np.eye(3) * 10.0, shape=shape)
+    sim = EllipsoidDeformingSimulation(packing, np.array([np.zeros(3), sign * u]), np.zeros((2, 3)), 0.0)
+    img = np.array([np.zeros(3), -2.0 * r])  # codes 0 and 1: j at +r and at -r from i
+    nb = np.array([[1 << 1 | 0, 1 << 1 | 1]], dtype=np.int64)
+    nn = np.array([2], dtype=np.int64)
+    ws, wm = ek.work_arrays(3)
+    zeta = [ek.pair_zeta(sim.P, 0, 1, img[c].copy(), 0.0, 0.0, 0.5, ws, wm)[:2] for c in (0, 1)]
+    code = edk._partner_image(sim.P, 0, 1, 0.0, nb, nn, img, 1, ws, wm)
+    # moving along +r, 1's image at -r approaches 0 (code 1); along -r the one at +r (code 0)
+    assert code == (1 if sign > 0 else 0)
+    assert abs(zeta[0][0] - zeta[1][0]) < 1e-13 and abs(zeta[0][0]) < 1e-12
+    assert zeta[code][1] < 0 < zeta[1 - code][1]

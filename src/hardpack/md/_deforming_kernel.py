@@ -69,6 +69,7 @@ class DeformingStatus(enum.IntEnum):
     OVERFLOW = 2  # a neighbour list is full: enlarge the capacity and redo the window
     STUCK = 3  # no event can ever happen (nothing moves)
     SELF_IMAGE = 4  # a bounding sphere reaches its own periodic image: the cell is too small
+    STALLED = 5  # a long run of events at one time without progress (an engine failure)
 
 
 # integer counters

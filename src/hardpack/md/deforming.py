@@ -293,6 +293,9 @@ def _refuse_window_end(status, lmin: float, diameter: float) -> None:
             "use more particles")
     if status == dk.DeformingStatus.STUCK:
         raise RuntimeError("no event can ever happen: no particle moves and none grows")
+    if status == dk.DeformingStatus.STALLED:
+        raise RuntimeError("the event loop stalled: a long run of events at one time without a collision "
+                           "(an engine failure; please report the packing and seed)")
 
 
 class DeformingSimulation:

@@ -159,8 +159,9 @@ def plot_laminate_family(family, searches=()):
     Both prolate (alpha) and oblate (1 / alpha) sides are drawn on a logarithmic axis (phi(alpha)
     = phi(1 / alpha)): the unstretched laminate (dashed), the densest known crystal of each shape
     (solid: the laminate up to sqrt(3), the stretched laminate beyond), FCC and the maximum
-    0.770732 with its 14 contacts. Each search run is a marker at its aspect ratio (spread
-    sideways by particles per cell), filled where it matches the laminate.
+    0.770732 with its 14 contacts. With searches, a second panel zooms on the dense end: each run
+    is a marker at its aspect ratio (spread sideways by particles per cell), filled where it
+    matches the laminate.
 
     Parameters
     ----------
@@ -173,45 +174,58 @@ def plot_laminate_family(family, searches=()):
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure(1, 1, figsize=(5.0, 3.4))
+    if searches:
+        fig, (ax, zoom) = figure(2, 1, figsize=(5.0, 6.4), sharex=True, height_ratios=[1.0, 1.1])
+    else:
+        fig, ax = figure(1, 1, figsize=(5.0, 3.4))
     alpha = np.asarray(family["alpha"].values, float)
     order = np.argsort(alpha)
     alpha = alpha[order]
     both = np.concatenate([1 / alpha[::-1], alpha])
-    for name, style, label in (("phi_densest", "-", "densest known crystal (stretched beyond $\\sqrt{3}$)"),
-                               ("phi_laminate", "--", "laminate, unstretched")):
-        values = np.asarray(family[name].values, float)[order]
-        ax.plot(both, np.concatenate([values[::-1], values]), style, color="C0" if style == "-" else "C1",
-                label=label)
-    ax.axhline(np.pi / np.sqrt(18), color="0.5", ls=":", lw=1, label=r"FCC, $\pi/\sqrt{18}$")
+    panels = (ax, zoom) if searches else (ax,)
+    for axis in panels:
+        for name, style, label in (("phi_densest", "-", "densest known crystal (stretched beyond $\\sqrt{3}$)"),
+                                   ("phi_laminate", "--", "laminate, unstretched")):
+            values = np.asarray(family[name].values, float)[order]
+            axis.plot(both, np.concatenate([values[::-1], values]), style, color="C0" if style == "-" else "C1",
+                      label=label if axis is ax else None)
+        axis.axhline(np.pi / np.sqrt(18), color="0.5", ls=":", lw=1,
+                     label=r"FCC, $\pi/\sqrt{18}$" if axis is ax else None)
     peak = float(family.attrs.get("densest_alpha", np.sqrt(3)))
     densest = np.isclose(alpha, peak, atol=1e-12)
     if densest.any():
         phi = float(np.asarray(family["phi_laminate"].values, float)[order][densest][0])
         ax.plot([1 / peak, peak], [phi, phi], "o", color="C3", ms=5,
                 label=rf"$\phi = {phi:.6f}$, 14 contacts")
-    _plot_searches(ax, searches)
     ax.set_xscale("log")
     ticks = [(1 / 3, "1/3"), (1 / np.sqrt(3), r"$1/\sqrt{3}$"), (1.0, "1"), (np.sqrt(3), r"$\sqrt{3}$"),
              (3.0, "3")]
     ticks = [(x, t) for x, t in ticks if both.min() * (1 - 1e-9) <= x <= both.max() * (1 + 1e-9)]
     ax.set_xticks([x for x, _ in ticks], [t for _, t in ticks])
     ax.minorticks_off()
-    ax.set_xlabel(r"aspect ratio $\alpha$ (oblate $< 1 <$ prolate)")
     ax.set_ylabel(r"density $\phi$")
-    ax.legend(loc="lower center", fontsize="small", ncol=2 if searches else 1)
+    ax.legend(loc="lower center", fontsize="small")
+    if searches:
+        low = _plot_searches(zoom, searches)
+        zoom.set_ylim(min(low, np.pi / np.sqrt(18)) - 0.005, 0.775)
+        zoom.set_ylabel(r"density $\phi$ (dense end)")
+        zoom.set_title("random starts in small deforming cells (filled: the laminate)", fontsize="small")
+        zoom.legend(loc="upper center", fontsize="small", ncol=3)
+    panels[-1].set_xlabel(r"aspect ratio $\alpha$ (oblate $< 1 <$ prolate)")
     fig.tight_layout()
     return fig
 
 
-def _plot_searches(ax, searches) -> None:
-    """Markers of the crystal-search runs: one colour and sideways offset per particles per cell."""
+def _plot_searches(ax, searches) -> float:
+    """Markers of the crystal-search runs, one colour and sideways offset per particles per cell;
+    returns the lowest density drawn."""
     ns = sorted({int(n) for ds in searches for n in ds["n"].values})
     markers = "sD^vo"
+    low = np.inf
     for k, n in enumerate(ns):
-        offset = 1.0 + 0.012 * (k - (len(ns) - 1) / 2)
+        offset = 1.0 + 0.015 * (k - (len(ns) - 1) / 2)
         colour, marker = f"C{k + 4}", markers[k % len(markers)]
-        ax.plot([], [], marker, ms=4, mfc="none", color=colour, label=f"search, {n} per cell")
+        ax.plot([], [], marker, ms=4, mfc="none", color=colour, label=f"{n} per cell")
         for ds in searches:
             if n not in ds["n"].values:
                 continue
@@ -220,3 +234,5 @@ def _plot_searches(ax, searches) -> None:
             x = np.full(phi.shape, float(ds.attrs["alpha"]) * offset)
             ax.plot(x[~match], phi[~match], marker, ms=4, mfc="none", color=colour)
             ax.plot(x[match], phi[match], marker, ms=4, color=colour)
+            low = min(low, float(np.nanmin(phi)))
+    return low
