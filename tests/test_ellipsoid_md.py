@@ -616,3 +616,34 @@ def test_a_stalled_window_raises_the_ellipsoid_error_and_restores_the_start(monk
     with pytest.raises(EngineStalledError, match="particle 0 with particle 1"):
         eng.run_window(0.0, 0.1, 10, np.inf)
     assert np.array_equal(eng.P, start) and not eng.lists_valid
+
+
+@pytest.mark.parametrize("alpha", [1.0, 1.05])
+def test_growth_keeps_translational_and_rotational_kt_at_one_near_the_sphere_point(alpha):
+    """LS growth heats the translations, and spheres (or 1.05-spheroids) run as ellipsoids hardly
+    pass that heat to their rotations. The thermostat sets kT_trans and kT_rot each to 1 after
+    every window (:meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`), so
+    every window starts at kT_trans = 1. A window that starts at 1 and heats by h at a steady rate
+    averages 1 + h / 2 over its time: measured 1 + 0.43 h and 1 + 0.45 h over the last 20 of 60
+    windows (h = 0.64 and 0.37, 80 collisions of 16 particles per window at Gamma = 0.1), and the
+    test allows 1 + 0.6 h. One factor for translation and rotation moved the rotational energy into
+    the translations: the windows then started at kT_trans up to 2.0 (alpha = 1) and 1.76
+    (alpha = 1.05), averaging 1 + 0.79 h and 1 + 0.68 h, and kT_rot fell to 2e-9 and 0.24."""
+    packing = random_ellipsoid_packing(16, [1.0, 1.0, alpha], 0.2, seed=1)
+    inertia = moments_of_inertia(packing.shape.semiaxes)
+    sim = EllipsoidSimulation(packing, maxwell_boltzmann(16, 3, 1),
+                              random_angular_velocities(16, 3, inertia, 2), 0.1)
+    sim.engine.rescale_velocities(1.0)
+    kt_mean, kt_end, after = [], [], []
+    for _ in range(60):
+        rec = sim.run_window(80)
+        kt_mean.append(rec["kT_mean"])
+        kt_end.append(rec["kT"])
+        ket, ker = sim.engine.energies()
+        after.append((2.0 * ket / (3 * 16), 2.0 * ker / (3 * 16)))
+    after = np.array(after)
+    assert np.allclose(after, 1.0, rtol=1e-12, atol=0.0)
+    assert sim.engine.rescalings.tolist() == [61, 0, 0]
+    heating = np.mean(np.array(kt_end[-20:]) - 1.0)
+    assert heating > 0.2  # the bound below means something
+    assert 1.0 < np.mean(kt_mean[-20:]) < 1.0 + 0.6 * heating

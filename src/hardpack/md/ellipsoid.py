@@ -159,6 +159,15 @@ class EllipsoidSimulation(Simulation):
     def angular_velocities(self) -> np.ndarray:
         return self.engine.angular_velocities[self._inverse()].copy()
 
+    def state(self) -> dict:
+        """The sphere run state and the engine's thermostat counts
+        (:meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`)."""
+        return super().state() | {"rescalings": self.engine.rescalings.copy()}
+
+    def restore(self, state: dict) -> None:
+        super().restore(state)
+        self.engine.rescalings[:] = np.asarray(state.get("rescalings", np.zeros(3)), dtype=np.int64)
+
     def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
         """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the full
         (translational and rotational) kinetic temperature at the end of the window."""
@@ -332,6 +341,10 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
         "events": int(sim.events), "windows": int(sim.windows), "md_time": float(sim.time),
         "wall_time": float(sim.wall_time), "window_collisions_per_particle": stage_window(growth_rate),
         "overlap_tol": overlap_tol, "eps_f": float(eps_f),
+        # thermostat: rescalings with two factors, with one, left out (EllipsoidEngine.rescale_velocities)
+        "rescalings_two_factors": int(sim.engine.rescalings[0]),
+        "rescalings_one_factor": int(sim.engine.rescalings[1]),
+        "rescalings_left_out": int(sim.engine.rescalings[2]),
         "max_overlap": float(report.overlap), "n_overlapping": int(report.n_overlapping),
         "overlap_check": "passed", "mass": 1.0, "kT": 1.0,
         "moment_of_inertia": "spherically symmetric: (2/15)(a^2+b^2+c^2) in 3D, (a^2+b^2)/4 in 2D",
