@@ -2,10 +2,11 @@
 
 Event-driven MD with rotation and growing semiaxes (Donev 2006, dissertation sec. 3.5; kernels and
 physics in :mod:`hardpack.md._ellipsoid_kernel`), run window by window exactly as the sphere
-compression (:mod:`hardpack.md.compress`): velocities (translational and angular) rescaled to
-kT = 1 at every synchronisation of a growing run, the reduced pressure of each window from the
-collision virial, stop criteria (:class:`hardpack.md.StopCriteria`), checkpoint/resume bit for bit
-and progress lines.
+compression (:mod:`hardpack.md.compress`): translational and angular velocities rescaled to
+kT = 1 each at every synchronisation of a growing run
+(:meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`), the reduced pressure
+of each window from the collision virial, stop criteria (:class:`hardpack.md.StopCriteria`),
+checkpoint/resume bit for bit and progress lines.
 
 Conventions: masses 1, spherically symmetric moments of inertia
 (:func:`hardpack.md.ellipsoid_engine.moments_of_inertia`), kT = 2 (KE_trans + KE_rot) /
@@ -165,12 +166,13 @@ class EllipsoidSimulation(Simulation):
         return super().state() | {"rescalings": self.engine.rescalings.copy()}
 
     def restore(self, state: dict) -> None:
+        """Load a :meth:`state` (a checkpoint without thermostat counts starts them at 0)."""
         super().restore(state)
         self.engine.rescalings[:] = np.asarray(state.get("rescalings", np.zeros(3)), dtype=np.int64)
 
     def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
-        """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the full
-        (translational and rotational) kinetic temperature at the end of the window."""
+        """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the
+        translational temperature 2 KE_trans / (d N), at the end of the window and averaged over it."""
         record = super().run_window(coll_target, target_phi)
         return record
 
