@@ -216,12 +216,13 @@ class EllipsoidEngine(Engine):
         temperatures, kT_trans = 2 KE_trans / (d N) and kT_rot = 2 KE_rot / (d_rot N), each set
         to ``kt``. All velocities are scaled by the one factor s_t that sets kT_trans; the
         angular velocities of the particles whose last event was at the window end (the partners
-        of its last collision) by s_t as well, those of the others by the factor s_r' that then
-        sets kT_rot. When s_r' does not exist (those particles alone hold more than the target
-        rotational energy after scaling, or no other particle rotates) all angular velocities are
-        scaled by s_t; when even that would make a contact at the window end approach, nothing is
-        scaled. :attr:`rescalings` counts the three cases (both temperatures set, kT_rot not
-        set, left out). Rotations at rest stay at rest.
+        of its last collision) and of their partners in contacts at the window end (below) by
+        s_t as well, those of the others by the factor s_r' that then sets kT_rot. When s_r' does
+        not exist (the former alone hold more than the target rotational energy after scaling,
+        or no other particle rotates) all angular velocities are scaled by s_t; when even that
+        would make a contact at the window end approach, nothing is scaled. :attr:`rescalings`
+        counts the three cases (both temperatures set, kT_rot not set, left out). Rotations at
+        rest stay at rest.
 
         *Why two temperatures.* One factor for translation and rotation keeps their split, which
         is right only while the collisions keep equipartition. Near the sphere point they hardly
@@ -267,11 +268,16 @@ class EllipsoidEngine(Engine):
         """
         cv, _, _, _, _, cw, cii = self.cols
         d, n, P = self.d, self.n, self.P
+        contacts = np.zeros((0, 3), dtype=np.int64)
+        if self.ended.size and self.lists_valid:
+            contacts = ek.end_contacts(P, self.ended, self.imgvec, self.nb, self.nn, self.wmode, self.wspec)
+        at_end = np.zeros(n, dtype=bool)  # the particles scaled by one factor
+        if self.lists_valid:
+            at_end[self.ended] = True
+            at_end[contacts[contacts[:, 1] >= 0, 1]] = True
         ket, _ = self.energies()
         st = np.sqrt(0.5 * kt * d * n / ket) if ket > 0.0 else 1.0
         ke_rot = 0.5 * np.einsum("ij,ij->i", P[:, cw:cii], P[:, cw:cii]) / P[:, cii]
-        at_end = np.zeros(n, dtype=bool)
-        at_end[self.ended] = True
         ker_end = float(ke_rot[at_end].sum())
         ker_rest = float(ke_rot[~at_end].sum())
         target = 0.5 * kt * rotational_dof(d) * n
@@ -280,8 +286,6 @@ class EllipsoidEngine(Engine):
         if ker_rest > 0.0 and st * st * ker_end < target:
             rot[~at_end] = np.sqrt((target - st * st * ker_end) / ker_rest)
             choice = 0
-        contacts = ek.end_contacts(P, self.ended, self.imgvec, self.nb, self.nn, self.wmode, self.wspec) \
-            if self.ended.size and self.lists_valid else np.zeros((0, 3), dtype=np.int64)
         if len(contacts):
             before = ek.contact_rates(P, contacts, self.imgvec, self.end_kappa, self.wspec) >= 0.0
             trial = P.copy()
