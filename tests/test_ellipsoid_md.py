@@ -647,3 +647,40 @@ def test_growth_keeps_translational_and_rotational_kt_at_one_near_the_sphere_poi
     heating = np.mean(np.array(kt_end[-20:]) - 1.0)
     assert heating > 0.2  # the bound below means something
     assert 1.0 < np.mean(kt_mean[-20:]) < 1.0 + 0.6 * heating
+
+
+def test_the_contacts_at_a_window_end_and_their_normal_speeds_are_those_of_spheres():
+    """:func:`hardpack.md._ellipsoid_kernel.end_contacts` and ``contact_rates`` on unit spheres
+    (the thermostat's check, :meth:`EllipsoidEngine.rescale_velocities`): of three listed
+    spheres, the touching pair is a contact and the distant one is not, and the normal separation
+    speed is the sphere value n . (v_B - v_A) - 2 g (the surfaces approach at g a each, with the
+    relative growth rate g) whatever the spins; a sphere touching a container of radius 5 from
+    inside separates from it at -(n . v + g)."""
+    from hardpack.geometry.boundaries import SphericalContainer
+    from hardpack.md.engine import image_vectors
+
+    rng = np.random.default_rng(3)
+    pos = np.array([[10.0, 10, 10], [12.0, 10, 10], [20.0, 20, 20]])
+    v, w = rng.standard_normal((3, 3)), rng.standard_normal((3, 3))
+    box = np.full(3, 40.0)
+    eng = EllipsoidEngine(pos, v, np.ones((3, 3)), np.tile([1.0, 0, 0, 0], (3, 1)), w, box)
+    code = 1 + 4 + 16  # the zero shift
+    nb = np.array([[1 << 6 | code, 2 << 6 | code], [0 << 6 | code, 2 << 6 | code],
+                   [0 << 6 | code, 1 << 6 | code]], dtype=np.int32)
+    nn = np.full(3, 2, dtype=np.int32)
+    imgvec = image_vectors(box)
+    contacts = ek.end_contacts(eng.P, np.array([0, 2]), imgvec, nb, nn, ek.PERIODIC_MODE, eng.wspec)
+    assert contacts.tolist() == [[0, 1, code]]
+    g = 0.3
+    rate = ek.contact_rates(eng.P, contacts, imgvec, g, eng.wspec)
+    assert rate[0] == pytest.approx(v[1, 0] - v[0, 0] - 2 * g, rel=1e-12, abs=1e-12)
+
+    cont = SphericalContainer((10.0, 10, 10), 5.0)
+    one = EllipsoidEngine(np.array([[14.0, 10, 10]]), v[:1], np.ones((1, 3)), np.array([[1.0, 0, 0, 0]]),
+                          w[:1], np.full(3, 20.0), boundary=cont)
+    none = np.zeros((1, 0), dtype=np.int32)
+    contacts = ek.end_contacts(one.P, np.array([0]), one.imgvec, none, np.zeros(1, dtype=np.int32),
+                               ek.SPHERE_MODE, one.wspec)
+    assert contacts.tolist() == [[0, ek.WALL, 0]]
+    rate = ek.contact_rates(one.P, contacts, one.imgvec, g, one.wspec)
+    assert rate[0] == pytest.approx(-(v[0, 0] + g), rel=1e-12, abs=1e-12)

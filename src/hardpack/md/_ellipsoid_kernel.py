@@ -1955,8 +1955,8 @@ def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
                 sh[c] = imgvec[im, c]
                 dx = P[j, c] + sh[c] - P[i, c]
                 d2 += dx * dx
-            if d2 >= (P[i, cr] + P[j, cr]) ** 2:
-                continue
+            if d2 > (P[i, cr] + P[j, cr]) ** 2 * (1.0 + 4.0 * END_CONTACT_GAP):  # apart (spheres: at
+                continue  # contact, d2 = (R_i + R_j)^2 to round-off, on either side)
             zeta, _, _ = pair_zeta(P, i, j, sh, 0.0, 0.0, P[i, cr] / (P[i, cr] + P[j, cr]), ws, wm)
             if zeta <= END_CONTACT_GAP:
                 out[k, 0], out[k, 1], out[k, 2] = i, j, im
