@@ -245,8 +245,8 @@ class EllipsoidEngine(Engine):
         direction of the contact's velocities every window. With a budget of one collision per
         window (one ellipsoid in a container, Gamma = 0.1) this map of collision and rescaling
         drove the particle to graze the wall: after 370 windows it left the wall at 1e-9 thermal
-        speeds, windows lasted 2e-9 and phi stayed at 0.032 for more than 20000 windows (the
-        session-27 hang; exact sign checks alone did not help, the speed stayed positive).
+        speeds, windows lasted 2e-9 and phi stayed at 0.032 for more than 20000 windows (a check
+        of the sign alone does not prevent this: the speed stays positive).
         Scaling all velocities of the contact's particles by one factor s_t keeps their
         direction (as the one-factor thermostat does): v_n = s_t u + (1 - s_t) G, the
         collision's own separation shrunk with the energy, which is negative only when s_t < 1
