@@ -197,6 +197,39 @@ def test_a_packing_crossing_the_wall_is_refused_by_the_engine():
     assert res.stats["phi"] == pytest.approx(0.2) and res.timeseries["wall_collisions"].values.max() > 0
 
 
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_a_lone_ellipsoid_keeps_growing_under_the_two_temperature_thermostat(seed):
+    """One prolate spheroid in a container, one wall collision per window, so every window ends
+    with the particle at the wall. Rescaling translations and rotations by separate global
+    factors turned the direction of its velocities at every window, and the map of collision and
+    rescaling drove it to graze the wall: windows of 2e-9 time units or of none (seed 1: phi stuck
+    at 0.032 for 20000 windows; seeds 2-4 stopped as 'jammed' at phi = 0.055, 0.10, 0.17 by the
+    infinite pressure of a window of zero length). The thermostat scales the velocities of the
+    particles of the last collision by one factor
+    (:meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`): phi = 0.2 in 35-50
+    windows (the limit 0.25 is where the long semiaxis spans the container)."""
+    from hardpack.geometry.packing import Packing
+    from hardpack.md import StopCriteria
+    from hardpack.md.ellipsoid import compress_ellipsoids
+
+    shape = Ellipsoids([[1.0, 0.5, 0.5]], [[1, 0, 0, 0]])
+    p = Packing([[5, 5, 7.4]], lattice=10 * np.eye(3), shape=shape, boundary=SphericalContainer((5, 5, 5), 3.0))
+    def at_most_100_windows(record):  # wall collisions are not counted by max_collisions
+        assert len(durations) < 100, f"phi = {record['phi']} after 100 windows"
+        durations.append(record["time"])
+
+    durations = []
+    res = compress_ellipsoids(p, 0.1, seed, stop=StopCriteria(max_pressure=None, target_phi=0.2),
+                              progress=at_most_100_windows)
+    assert res.stats["stop_reason"] == "target_phi" and res.stats["phi"] == pytest.approx(0.2)
+    assert np.diff(durations).min() > 1e-3
+    # the lone particle is the partner of every window's last collision, so its rotations follow
+    # the translational factor (both are set at the start and after the last window, which ends
+    # at the target phi, not at a collision)
+    assert res.stats["rescalings_two_factors"] <= 2 and res.stats["rescalings_left_out"] == 0
+
+
 # ---------------------------------------------------------------- the M&M extrapolation and its row
 def _mm_packing(n, radius, phi_target):
     """n oblate spheroids 1 : 1.9 : 1.9 in a container of ``radius``; the particle size gives phi."""

@@ -616,3 +616,71 @@ def test_a_stalled_window_raises_the_ellipsoid_error_and_restores_the_start(monk
     with pytest.raises(EngineStalledError, match="particle 0 with particle 1"):
         eng.run_window(0.0, 0.1, 10, np.inf)
     assert np.array_equal(eng.P, start) and not eng.lists_valid
+
+
+@pytest.mark.parametrize("alpha", [1.0, 1.05])
+def test_growth_keeps_translational_and_rotational_kt_at_one_near_the_sphere_point(alpha):
+    """LS growth heats the translations, and spheres (or 1.05-spheroids) run as ellipsoids hardly
+    pass that heat to their rotations. The thermostat sets kT_trans and kT_rot each to 1 after
+    every window (:meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`), so
+    every window starts at kT_trans = 1. A window that starts at 1 and heats by h at a steady rate
+    averages 1 + h / 2 over its time: measured 1 + 0.43 h and 1 + 0.45 h over the last 20 of 60
+    windows (h = 0.64 and 0.37, 80 collisions of 16 particles per window at Gamma = 0.1), and the
+    test allows 1 + 0.6 h. One factor for translation and rotation moved the rotational energy into
+    the translations: the windows then started at kT_trans up to 2.0 (alpha = 1) and 1.76
+    (alpha = 1.05), averaging 1 + 0.79 h and 1 + 0.68 h, and kT_rot fell to 2e-9 and 0.24."""
+    packing = random_ellipsoid_packing(16, [1.0, 1.0, alpha], 0.2, seed=1)
+    inertia = moments_of_inertia(packing.shape.semiaxes)
+    sim = EllipsoidSimulation(packing, maxwell_boltzmann(16, 3, 1),
+                              random_angular_velocities(16, 3, inertia, 2), 0.1)
+    sim.engine.rescale_velocities(1.0)
+    kt_mean, kt_end, after = [], [], []
+    for _ in range(60):
+        rec = sim.run_window(80)
+        kt_mean.append(rec["kT_mean"])
+        kt_end.append(rec["kT"])
+        ket, ker = sim.engine.energies()
+        after.append((2.0 * ket / (3 * 16), 2.0 * ker / (3 * 16)))
+    after = np.array(after)
+    assert np.allclose(after, 1.0, rtol=1e-12, atol=0.0)
+    assert sim.engine.rescalings.tolist() == [61, 0, 0]
+    heating = np.mean(np.array(kt_end[-20:]) - 1.0)
+    assert heating > 0.2  # the bound below means something
+    assert 1.0 < np.mean(kt_mean[-20:]) < 1.0 + 0.6 * heating
+
+
+def test_the_contacts_at_a_window_end_and_their_normal_speeds_are_those_of_spheres():
+    """:func:`hardpack.md._ellipsoid_kernel.end_contacts` and ``contact_rates`` on unit spheres
+    (the thermostat's check, :meth:`EllipsoidEngine.rescale_velocities`): of three listed
+    spheres, the touching pair is a contact and the distant one is not, and the normal separation
+    speed is the sphere value n . (v_B - v_A) - 2 g (the surfaces approach at g a each, with the
+    relative growth rate g) whatever the spins; a sphere touching a container of radius 5 from
+    inside separates from it at -(n . v + g)."""
+    from hardpack.geometry.boundaries import SphericalContainer
+    from hardpack.md.engine import image_vectors
+
+    rng = np.random.default_rng(3)
+    pos = np.array([[10.0, 10, 10], [12.0, 10, 10], [20.0, 20, 20]])
+    v, w = rng.standard_normal((3, 3)), rng.standard_normal((3, 3))
+    box = np.full(3, 40.0)
+    eng = EllipsoidEngine(pos, v, np.ones((3, 3)), np.tile([1.0, 0, 0, 0], (3, 1)), w, box)
+    code = 1 + 4 + 16  # the zero shift
+    nb = np.array([[1 << 6 | code, 2 << 6 | code], [0 << 6 | code, 2 << 6 | code],
+                   [0 << 6 | code, 1 << 6 | code]], dtype=np.int32)
+    nn = np.full(3, 2, dtype=np.int32)
+    imgvec = image_vectors(box)
+    contacts = ek.end_contacts(eng.P, np.array([0, 2]), imgvec, nb, nn, ek.PERIODIC_MODE, eng.wspec)
+    assert contacts.tolist() == [[0, 1, code]]
+    g = 0.3
+    rate = ek.contact_rates(eng.P, contacts, imgvec, g, eng.wspec)
+    assert rate[0] == pytest.approx(v[1, 0] - v[0, 0] - 2 * g, rel=1e-12, abs=1e-12)
+
+    cont = SphericalContainer((10.0, 10, 10), 5.0)
+    one = EllipsoidEngine(np.array([[14.0, 10, 10]]), v[:1], np.ones((1, 3)), np.array([[1.0, 0, 0, 0]]),
+                          w[:1], np.full(3, 20.0), boundary=cont)
+    none = np.zeros((1, 0), dtype=np.int32)
+    contacts = ek.end_contacts(one.P, np.array([0]), one.imgvec, none, np.zeros(1, dtype=np.int32),
+                               ek.SPHERE_MODE, one.wspec)
+    assert contacts.tolist() == [[0, ek.WALL, 0]]
+    rate = ek.contact_rates(one.P, contacts, one.imgvec, g, one.wspec)
+    assert rate[0] == pytest.approx(-(v[0, 0] + g), rel=1e-12, abs=1e-12)

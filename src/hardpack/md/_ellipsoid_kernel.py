@@ -1892,3 +1892,119 @@ def max_overlap(P, imgvec, nb, nn):
             if ov > 0.0:
                 count += 1
     return worst, count
+
+
+#: a pair within this Perram-Wertheim zeta of contact, or a particle within this fraction of its
+#: bounding radius of the container wall, is a contact of :func:`end_contacts` (a collision located
+#: at the window end leaves its pair within ZETA_TOL, and its particle within 64 ulps of the wall)
+END_CONTACT_GAP = 1e-8
+
+
+@njit(cache=True)
+def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
+    """The contacts at a synchronisation point of the particles in ``ended`` (those whose last
+    event was at the window end): listed pairs with zeta <= END_CONTACT_GAP, and, in a container
+    (``wmode``), particles within END_CONTACT_GAP R_i of the wall.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows at a synchronisation point.
+    ended : numpy.ndarray of int64, shape (M,)
+        The particles searched.
+    imgvec : numpy.ndarray of float64, shape (4**d, d)
+        Periodic shift of each image code.
+    nb : numpy.ndarray of int, shape (N, cap)
+        Neighbour lists, entries j << 2d | image code.
+    nn : numpy.ndarray of int32, shape (N,)
+        List lengths.
+    wmode : tuple
+        PERIODIC_MODE or SPHERE_MODE.
+    wspec : numpy.ndarray of float64, shape (d + 1,)
+        Container centre and radius.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (K, 3)
+        Rows (i, j, image code) of the pairs (each pair once per list it is found in) and
+        (i, WALL, 0) of the wall contacts.
+    """
+    d = imgvec.shape[1]
+    cbits = 2 * d
+    _, _, cr, _, _, _, _, _ = columns(d)
+    ws, wm = work_arrays(d)
+    ww, wq = wall_arrays(d)
+    total = 0
+    for q in range(ended.shape[0]):
+        total += nn[ended[q]] + 1
+    out = np.empty((total, 3), dtype=np.int64)
+    k = 0
+    for q in range(ended.shape[0]):
+        i = np.int64(ended[q])
+        if len(wmode) > 0:
+            h, _ = wall_gap(P, i, 0.0, 0.0, wspec, ww, wq)
+            if h <= END_CONTACT_GAP * P[i, cr]:
+                out[k, 0], out[k, 1], out[k, 2] = i, WALL, 0
+                k += 1
+        for m in range(nn[i]):
+            j = np.int64(nb[i, m] >> cbits)
+            im = np.int64(nb[i, m] & ((1 << cbits) - 1))
+            sh = ws[9, :d]
+            d2 = 0.0
+            for c in range(d):
+                sh[c] = imgvec[im, c]
+                dx = P[j, c] + sh[c] - P[i, c]
+                d2 += dx * dx
+            if d2 > (P[i, cr] + P[j, cr]) ** 2 * (1.0 + 4.0 * END_CONTACT_GAP):  # apart (spheres: at
+                continue  # contact, d2 = (R_i + R_j)^2 to round-off, on either side)
+            zeta, _, _ = pair_zeta(P, i, j, sh, 0.0, 0.0, P[i, cr] / (P[i, cr] + P[j, cr]), ws, wm)
+            if zeta <= END_CONTACT_GAP:
+                out[k, 0], out[k, 1], out[k, 2] = i, j, im
+                k += 1
+    return out[:k]
+
+
+@njit(cache=True)
+def contact_rates(P, contacts, imgvec, kappa, wspec):
+    """Normal separation speed of each contact of :func:`end_contacts` at window time 0 with the
+    relative growth rate ``kappa``: n . v_C (module docstring, collision law; < 0 approaching) for a
+    pair, dh/dt (:func:`wall_gap`; < 0 approaching) for a wall contact.
+
+    Parameters
+    ----------
+    P : numpy.ndarray of float64, shape (N, ncol(d))
+        Particle state rows at a synchronisation point.
+    contacts : numpy.ndarray of int64, shape (K, 3)
+        From :func:`end_contacts`.
+    imgvec : numpy.ndarray of float64, shape (4**d, d)
+        Periodic shift of each image code.
+    kappa : float
+        Relative growth rate of the semiaxes.
+    wspec : numpy.ndarray of float64, shape (d + 1,)
+        Container centre and radius.
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (K,)
+        The separation speeds.
+    """
+    d = imgvec.shape[1]
+    _, _, cr, _, _, _, _, _ = columns(d)
+    ws, wm = work_arrays(d)
+    ww, wq = wall_arrays(d)
+    out = np.empty(contacts.shape[0])
+    for q in range(contacts.shape[0]):
+        i, j, im = contacts[q, 0], contacts[q, 1], contacts[q, 2]
+        if j == WALL:
+            _, out[q] = wall_gap(P, i, 0.0, kappa, wspec, ww, wq)
+            continue
+        sh = ws[9, :d]
+        for c in range(d):
+            sh[c] = imgvec[im, c]
+        _, zdot, lam = pair_zeta(P, i, j, sh, 0.0, kappa, P[i, cr] / (P[i, cr] + P[j, cr]), ws, wm)
+        n = ws[5, :d]
+        nrm = 0.0
+        for c in range(d):
+            nrm += n[c] * n[c]
+        out[q] = zdot / (2.0 * lam * (1.0 - lam) * np.sqrt(nrm))
+    return out

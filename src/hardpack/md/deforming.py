@@ -761,13 +761,15 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
 
     def _rescale(self) -> None:
         """Translational and angular velocities each to kT = 1 (equipartition imposed by the
-        thermostat). One factor for both (as :meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.
-        rescale_velocities`, which relies on the collisions to keep equipartition) fails for
-        near-spheres: their collisions hardly exchange energy with the rotations, so the growth
-        heats the translations only and every rescaling moves rotational energy into them; at
-        alpha = 1 the translational kT tends to 2 (measured: 2.0000 after 100 windows, 16
+        thermostat), by two global factors. One factor for both fails for near-spheres: their
+        collisions hardly exchange energy with the rotations, so the growth heats the
+        translations only and every rescaling moves rotational energy into them; at alpha = 1 the
+        translational kT tends to 2 (measured: 2.0000 after 100 windows, 16
         spheres-as-ellipsoids; at alpha = 1.2 it stays near 1.25 during a Gamma = 0.1 growth),
-        which slows the growth in units of the thermal speed by sqrt(2)."""
+        which slows the growth in units of the thermal speed by sqrt(2). (The fixed-cell
+        thermostat, :meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`,
+        scales the particles of a window's last collision by one factor: its windows end at a
+        collision, these end mostly at their time cap.)"""
         ket, ker, _, _ = ek.totals(self.P)
         cv, cw, cii = self._column(0), self._column(5), self._column(6)
         self.P[:, cv:cv + self.d] *= math.sqrt(0.5 * self.d * self.n / ket)

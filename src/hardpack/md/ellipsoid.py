@@ -2,10 +2,11 @@
 
 Event-driven MD with rotation and growing semiaxes (Donev 2006, dissertation sec. 3.5; kernels and
 physics in :mod:`hardpack.md._ellipsoid_kernel`), run window by window exactly as the sphere
-compression (:mod:`hardpack.md.compress`): velocities (translational and angular) rescaled to
-kT = 1 at every synchronisation of a growing run, the reduced pressure of each window from the
-collision virial, stop criteria (:class:`hardpack.md.StopCriteria`), checkpoint/resume bit for bit
-and progress lines.
+compression (:mod:`hardpack.md.compress`): translational and angular velocities rescaled to
+kT = 1 each at every synchronisation of a growing run
+(:meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`), the reduced pressure
+of each window from the collision virial, stop criteria (:class:`hardpack.md.StopCriteria`),
+checkpoint/resume bit for bit and progress lines.
 
 Conventions: masses 1, spherically symmetric moments of inertia
 (:func:`hardpack.md.ellipsoid_engine.moments_of_inertia`), kT = 2 (KE_trans + KE_rot) /
@@ -159,9 +160,19 @@ class EllipsoidSimulation(Simulation):
     def angular_velocities(self) -> np.ndarray:
         return self.engine.angular_velocities[self._inverse()].copy()
 
+    def state(self) -> dict:
+        """The sphere run state and the engine's thermostat counts
+        (:meth:`hardpack.md.ellipsoid_engine.EllipsoidEngine.rescale_velocities`)."""
+        return super().state() | {"rescalings": self.engine.rescalings.copy()}
+
+    def restore(self, state: dict) -> None:
+        """Load a :meth:`state` (a checkpoint without thermostat counts starts them at 0)."""
+        super().restore(state)
+        self.engine.rescalings[:] = np.asarray(state.get("rescalings", np.zeros(3)), dtype=np.int64)
+
     def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
-        """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the full
-        (translational and rotational) kinetic temperature at the end of the window."""
+        """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the
+        translational temperature 2 KE_trans / (d N), at the end of the window and averaged over it."""
         record = super().run_window(coll_target, target_phi)
         return record
 
@@ -332,6 +343,10 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
         "events": int(sim.events), "windows": int(sim.windows), "md_time": float(sim.time),
         "wall_time": float(sim.wall_time), "window_collisions_per_particle": stage_window(growth_rate),
         "overlap_tol": overlap_tol, "eps_f": float(eps_f),
+        # thermostat: rescalings with two factors, with one, left out (EllipsoidEngine.rescale_velocities)
+        "rescalings_two_factors": int(sim.engine.rescalings[0]),
+        "rescalings_one_factor": int(sim.engine.rescalings[1]),
+        "rescalings_left_out": int(sim.engine.rescalings[2]),
         "max_overlap": float(report.overlap), "n_overlapping": int(report.n_overlapping),
         "overlap_check": "passed", "mass": 1.0, "kT": 1.0,
         "moment_of_inertia": "spherically symmetric: (2/15)(a^2+b^2+c^2) in 3D, (a^2+b^2)/4 in 2D",

@@ -110,6 +110,13 @@ class EllipsoidEngine(Engine):
 
         self.imgvec = image_vectors(self.box)
         self.init_event_state(capacity)
+        #: particles whose last event was at the end of the last window, and the relative growth
+        #: rate there (what :meth:`rescale_velocities` checks)
+        self.ended = np.zeros(0, dtype=np.int64)
+        self.end_kappa = 0.0
+        #: rescalings so far with two factors, with one factor, and left out
+        #: (:meth:`rescale_velocities`)
+        self.rescalings = np.zeros(3, dtype=np.int64)
 
     # ----------------------------------------------------------------- views of the state
     @property
@@ -189,6 +196,8 @@ class EllipsoidEngine(Engine):
     def _window_result(self, acc, iacc, kappa):
         duration = float(acc[0])
         self.last_duration = duration
+        self.ended = np.flatnonzero(self.P[:, self.cols[1]] == duration).astype(np.int64)
+        self.end_kappa = kappa / (1.0 + kappa * duration)
         ek.synchronise(self.P, duration, kappa)
         worst, n_over = ek.max_overlap(self.P, self.imgvec, self.nb, self.nn)
         self.last_checks = int(iacc[ek.I_CHECK])
@@ -203,20 +212,88 @@ class EllipsoidEngine(Engine):
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:
-        """Scale translational and angular velocities by one factor so that
-        kT = 2 (KE_trans + KE_rot) / ((d + d_rot) N) equals ``kt`` (Donev 2006, sec. 3.2.4.1).
+        """The thermostat of LS growth (Donev 2006, sec. 3.2.4.1): translational and rotational
+        temperatures, kT_trans = 2 KE_trans / (d N) and kT_rot = 2 KE_rot / (d_rot N), each set
+        to ``kt``. All velocities are scaled by the one factor s_t that sets kT_trans; the
+        angular velocities of the particles whose last event was at the window end (the partners
+        of its last collision) and of their partners in contacts at the window end (below) by
+        s_t as well, those of the others by the factor s_r' that then sets kT_rot. When s_r' does
+        not exist (the former alone hold more than the target rotational energy after scaling,
+        or no other particle rotates) all angular velocities are scaled by s_t; when even that
+        would make a contact at the window end approach, nothing is scaled. :attr:`rescalings`
+        counts the three cases (both temperatures set, kT_rot not set, left out). Rotations at
+        rest stay at rest.
 
-        One factor keeps the split between translation and rotation, which is right only while
-        the collisions keep equipartition. Near the sphere point they hardly exchange energy with
-        the rotations, and LS growth heats the translations: measured with 16 spheres as
-        ellipsoids (alpha = 1) after 100 windows of growth at Gamma = 0.1, translational kT = 2.0
-        and rotational 1.6e-8; at alpha = 1.2 translational kT stayed near 1.25. The reduced
-        pressure uses the translational kT, so the jamming densities are unaffected, but the
-        growth rate in units of the thermal speed is then up to sqrt(2) smaller than nominal.
-        The deforming-cell driver (:class:`hardpack.md.deforming.EllipsoidDeformingSimulation`)
-        sets the two temperatures separately.
+        *Why two temperatures.* One factor for translation and rotation keeps their split, which
+        is right only while the collisions keep equipartition. Near the sphere point they hardly
+        exchange energy with the rotations, and LS growth heats the translations only: with one
+        factor s for all (kT_trans + kT_rot d_rot / d = (1 + d_rot / d) ``kt``), 16 spheres as
+        ellipsoids (alpha = 1) after 100 windows at Gamma = 0.1 had kT_trans = 2.0 and kT_rot =
+        2e-13 after the rescaling, so the growth was up to sqrt(2) slower than nominal in units
+        of the thermal speed.
+
+        *Why not two global factors (s_t, s_r).* The normal separation speed of a contact (the
+        collision law of :mod:`hardpack.md._ellipsoid_kernel`, < 0 approaching) is linear in the
+        velocities: v_n = s_t A + s_r B + G after the scaling, with A = n . (v_B - v_A) its
+        translational part, B = n . (w_B x r_B - w_A x r_A) its rotational part and
+        G = -g r_AB . n <= 0 that of the growth (g the relative growth rate at the window end,
+        which is the next window's kappa at the same Gamma: kappa' = Gamma / (2 <a(T)>) =
+        kappa / (1 + kappa T)); a wall contact likewise with the particle's own terms. The window
+        ends at its last collision, whose pair (or particle and wall) is exactly at contact,
+        separating at u = A + B + G > 0 (the law reverses the approach). For s_t != s_r,
+        s_t A + s_r B + G takes any sign and size when A and B have opposite signs: it turns the
+        direction of the contact's velocities every window. With a budget of one collision per
+        window (one ellipsoid in a container, Gamma = 0.1) this map of collision and rescaling
+        drove the particle to graze the wall: after 370 windows it left the wall at 1e-9 thermal
+        speeds, windows lasted 2e-9 and phi stayed at 0.032 for more than 20000 windows (a check
+        of the sign alone does not prevent this: the speed stays positive).
+        Scaling all velocities of the contact's particles by one factor s_t keeps their
+        direction (as the one-factor thermostat does): v_n = s_t u + (1 - s_t) G, the
+        collision's own separation shrunk with the energy, which is negative only when s_t < 1
+        and u < (1 - s_t) |G| / s_t (a collision at the resolution of the growth speed). The
+        contacts at the window end (:func:`hardpack.md._ellipsoid_kernel.end_contacts`: the
+        pairs within zeta <= END_CONTACT_GAP and the wall contacts of those particles; every
+        particle after a window of zero length) are therefore checked
+        (:func:`hardpack.md._ellipsoid_kernel.contact_rates`), and the window is left unscaled
+        when one that did not approach would. The velocities that change direction belong to
+        particles at a positive gap, whose collisions happen at a positive time of the next
+        window. kT_trans = kT_rot = ``kt`` needs only that the particles of the last collision
+        hold less than the target rotational energy: measured, both were set at every window of
+        a compression of 16 spheres or 1.05-spheroids (Gamma = 0.1; ``tests/test_ellipsoid_md.py``).
+
+        Parameters
+        ----------
+        kt : float
+            Target temperature.
         """
-        s = np.sqrt(kt / self.kinetic_temperature())
         cv, _, _, _, _, cw, cii = self.cols
-        self.P[:, cv:cv + self.d] *= s
-        self.P[:, cw:cii] *= s
+        d, n, P = self.d, self.n, self.P
+        contacts = np.zeros((0, 3), dtype=np.int64)
+        if self.ended.size and self.lists_valid:
+            contacts = ek.end_contacts(P, self.ended, self.imgvec, self.nb, self.nn, self.wmode, self.wspec)
+        at_end = np.zeros(n, dtype=bool)  # the particles scaled by one factor
+        if self.lists_valid:
+            at_end[self.ended] = True
+            at_end[contacts[contacts[:, 1] >= 0, 1]] = True
+        ket, _ = self.energies()
+        st = np.sqrt(0.5 * kt * d * n / ket) if ket > 0.0 else 1.0
+        ke_rot = 0.5 * np.einsum("ij,ij->i", P[:, cw:cii], P[:, cw:cii]) / P[:, cii]
+        ker_end = float(ke_rot[at_end].sum())
+        ker_rest = float(ke_rot[~at_end].sum())
+        target = 0.5 * kt * rotational_dof(d) * n
+        rot = np.full(n, st)
+        choice = 1
+        if ker_rest > 0.0 and st * st * ker_end < target:
+            rot[~at_end] = np.sqrt((target - st * st * ker_end) / ker_rest)
+            choice = 0
+        if len(contacts):
+            before = ek.contact_rates(P, contacts, self.imgvec, self.end_kappa, self.wspec) >= 0.0
+            trial = P.copy()
+            trial[:, cv:cv + d] *= st
+            trial[:, cw:cii] *= rot[:, None]
+            after = ek.contact_rates(trial, contacts, self.imgvec, self.end_kappa, self.wspec)
+            if np.any(before & (after < 0.0)):
+                st, rot, choice = 1.0, np.ones(n), 2
+        self.rescalings[choice] += 1
+        P[:, cv:cv + d] *= st
+        P[:, cw:cii] *= rot[:, None]
