@@ -230,7 +230,7 @@ def test_a_collision_between_tied_images_is_with_the_approaching_one(sign):
     nn = np.array([2], dtype=np.int64)
     ws, wm = ek.work_arrays(3)
     zeta = [ek.pair_zeta(sim.P, 0, 1, img[c].copy(), 0.0, 0.0, 0.5, ws, wm)[:2] for c in (0, 1)]
-    code = edk._partner_image(sim.P, 0, 1, 0.0, nb, nn, img, 1, ws, wm)
+    code = edk._partner_image(sim.P, 0, 1, 0.0, 0.0, nb, nn, img, 1, ws, wm)
     # moving along +r, 1's image at -r approaches 0 (code 1); along -r the one at +r (code 0)
     assert code == (1 if sign > 0 else 0)
     assert abs(zeta[0][0] - zeta[1][0]) < 1e-13 and abs(zeta[0][0]) < 1e-12

@@ -59,11 +59,6 @@ from hardpack.md import _deforming_kernel as dk
 from hardpack.md import _ellipsoid_kernel as ek
 from hardpack.md._kernel import A_T, A_VIRIAL, end_window, kinetic_step
 
-#: zeta (about twice the relative surface gap) within which of the smallest an image ties for the
-#: contact when a collision picks its partner image (:func:`_partner_image`): far above the
-#: round-off of a located contact (64 ulps), below the gaps of the densest packings made (about
-#: 3e-12 at Z = 1e12)
-CONTACT_ZETA = 1e-12
 #: integer counters (after :mod:`hardpack.md._deforming_kernel`'s): CHECK events, collisions of a
 #: particle with its own image (also counted in I_COLL)
 I_CHECK = dk.N_COUNTERS
@@ -212,18 +207,19 @@ def self_collide(P, i, t, sh, kappa, ws, wm):
 
 
 @njit(cache=True)
-def _partner_image(P, i, j, t, nb, nn, img, cbits, ws, wm):
-    """Code of the listed image of j (both advanced to t) that the collision at t is with, -1 if j
-    is not listed.
+def _partner_image(P, i, j, t, kappa, nb, nn, img, cbits, ws, wm):
+    """Code of the listed image of j (both advanced to t, growing at ``kappa``) that the collision
+    at t is with, -1 if j is not listed.
 
     The prediction names the partner j, not its image, and in a small cell i can touch several
-    images of j at once: with two particles per cell, j's images at r and -r from i (i midway
-    between them) have equal zeta, one approaching and one separating. Of the images within
-    CONTACT_ZETA of the smallest zeta the one approaching fastest (most negative zeta_dot) is
-    taken: the predicted one, or another approaching contact at the same instant; when none
-    approaches, the image of the smallest zeta (a graze). The smallest zeta alone picked the
-    separating image of such a tie, the collision law skipped it as a graze, and the same
-    collision was predicted again at the same time without end.
+    images of j at once, one approaching and others separating (with two particles per cell j's
+    images at r and -r from i have equal zeta). A predicted collision approaches (zeta_dot < 0,
+    the sign of the collision law's v_n), so the image taken is the approaching one of the
+    smallest zeta: the predicted one, or one at most as far that approaches too (a contact a
+    hair early); when none approaches, the image of the smallest zeta (a graze). The smallest
+    zeta alone picked a touching image that separates (two images within 1e-11 of contact
+    were seen), the collision law skipped it as a graze and the same collision was predicted
+    again at the same time without end.
     """
     d = img.shape[1]
     _, _, cr, _, _, _, _, _ = ek.columns(d)
@@ -231,27 +227,27 @@ def _partner_image(P, i, j, t, nb, nn, img, cbits, ws, wm):
     sh = ws[9, :d]
     best = np.inf
     code = -1
-    fastest = 0.0
-    for sweep in range(2):  # the smallest zeta, then the fastest approach among the images near it
-        for e in range(nn[i]):
-            if nb[i, e] >> cbits != j:
-                continue
-            c = nb[i, e] & cmask
-            d2 = 0.0
-            for k in range(d):
-                sh[k] = img[c, k]
-                dx = P[j, k] + sh[k] - P[i, k]
-                d2 += dx * dx
-            if d2 >= (P[i, cr] + P[j, cr]) ** 2 * 4.0 and (sweep == 1 or code >= 0):
-                continue
-            z, zdot, _ = ek.pair_zeta(P, i, j, sh, t, 0.0, 0.5, ws, wm)
-            if sweep == 0 and z < best:
-                best = z
-                code = c
-            elif sweep == 1 and z <= best + CONTACT_ZETA and zdot < fastest:
-                fastest = zdot
-                code = c
-    return code
+    best_in = np.inf
+    approaching = -1
+    for e in range(nn[i]):
+        if nb[i, e] >> cbits != j:
+            continue
+        c = nb[i, e] & cmask
+        d2 = 0.0
+        for k in range(d):
+            sh[k] = img[c, k]
+            dx = P[j, k] + sh[k] - P[i, k]
+            d2 += dx * dx
+        if code >= 0 and d2 >= (P[i, cr] + P[j, cr]) ** 2 * 4.0:
+            continue
+        z, zdot, _ = ek.pair_zeta(P, i, j, sh, t, kappa, 0.5, ws, wm)
+        if z < best:
+            best = z
+            code = c
+        if zdot < 0.0 and z < best_in:
+            best_in = z
+            approaching = c
+    return approaching if approaching >= 0 else code
 
 
 @njit(cache=True)
@@ -409,7 +405,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
             iacc[dk.I_STALE] += 1
         elif p == i:
             ek.advance(P, i, t, scratch)
-            code = _partner_image(P, i, i, t, nb, nn, img, cbits, ws, wm)
+            code = _partner_image(P, i, i, t, kappa, nb, nn, img, cbits, ws, wm)
             sh = ws[9, :d]
             for k in range(d):
                 sh[k] = img[code, k]
@@ -432,7 +428,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
             j = p
             ek.advance(P, i, t, scratch)
             ek.advance(P, j, t, scratch)
-            code = _partner_image(P, i, j, t, nb, nn, img, cbits, ws, wm)
+            code = _partner_image(P, i, j, t, kappa, nb, nn, img, cbits, ws, wm)
             sh = ws[9, :d]
             for k in range(d):
                 sh[k] = img[code, k]
