@@ -28,6 +28,11 @@ def test_laminate_reference_is_donevs_densest_crystal():
     assert phi == pytest.approx(0.770732, abs=1e-6)
     assert contacts == 14
     assert laminate_reference(1 / SQRT3) == pytest.approx((phi, contacts))
+    # beyond sqrt(3) the densest known crystal is the stretched laminate: 0.770732 and 14 contacts
+    # (Donev 2006, Sec. 8.2, Fig. 8.2), not the unstretched laminate of that alpha (0.6856 at 2)
+    assert laminate_reference(2.0) == pytest.approx((phi, 14), abs=1e-6)
+    assert laminate_reference(1 / 3.0) == pytest.approx((phi, 14), abs=1e-6)
+    assert laminate_reference(1.5)[0] == pytest.approx(0.7534, abs=5e-5)
 
 
 @pytest.mark.slow

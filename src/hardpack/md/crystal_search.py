@@ -25,8 +25,10 @@ Small cells need the collisions of a particle with its own periodic images, whic
 kernel has (:mod:`hardpack.md._ellipsoid_deforming_kernel`): with ``n`` = 1 the run ends at
 (or, when the growth jams the cell first, step 4, below) the densest lattice packing of the
 shape, the affine image of FCC, phi = pi / sqrt(18) for every aspect ratio. The result is
-compared with the laminate of the same aspect ratio
-(:func:`hardpack.geometry.ellipsoid_crystals.laminate`; phi(alpha) = phi(1 / alpha)): contacts are
+compared with the densest known crystal of the same aspect ratio, the laminate
+(:func:`hardpack.geometry.ellipsoid_crystals.laminate`), beyond sqrt(3) the laminate of sqrt(3)
+stretched (:func:`hardpack.geometry.ellipsoid_crystals.stretched_laminate`, phi = 0.770732;
+Donev 2006, Sec. 8.2, Fig. 8.2; phi(alpha) = phi(1 / alpha) for both): contacts are
 pairs within a Perram-Wertheim gap mu - 1 < ``contact_tol``
 (:func:`hardpack.geometry.ellipsoid_stats.ellipsoid_contacts`, own images counted twice).
 """
@@ -78,8 +80,10 @@ def spheroid_semiaxes(alpha: float) -> np.ndarray:
 
 
 def laminate_reference(alpha: float) -> tuple[float, float]:
-    """phi and the mean contacts per particle of the laminate with aspect ratio alpha (Donev 2006,
-    sec. 8.2; phi(alpha) = phi(1 / alpha)).
+    """phi and the mean contacts per particle of the densest known crystal of spheroids with
+    aspect ratio alpha: the laminate, and beyond sqrt(3) (below 1 / sqrt(3)) the laminate of
+    sqrt(3) stretched to alpha (Donev 2006, sec. 8.2, Eq. 8.3 and Fig. 8.2; phi(alpha) =
+    phi(1 / alpha)).
 
     Parameters
     ----------
@@ -89,15 +93,16 @@ def laminate_reference(alpha: float) -> tuple[float, float]:
     Returns
     -------
     phi : float
-        Its density.
+        Its density (0.770732 for every alpha >= sqrt(3)).
     contacts : float
-        Its contacts per particle (14 at sqrt(3)).
+        Its contacts per particle (14 from sqrt(3) on).
     """
-    from hardpack.geometry.ellipsoid_crystals import laminate
+    from hardpack.geometry.ellipsoid_crystals import DENSEST_ALPHA, laminate, stretch_for, stretched_laminate
     from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts
 
     spheroid_semiaxes(alpha)
-    crystal = laminate(float(max(alpha, 1.0 / alpha)))
+    prolate = float(max(alpha, 1.0 / alpha))
+    crystal = laminate(prolate) if prolate <= DENSEST_ALPHA else stretched_laminate(stretch_for(prolate))
     contacts = ellipsoid_contacts(crystal, tol=CONTACT_TOL, min_contacts=1)
     return float(crystal.phi), float(contacts.degree.mean())
 
