@@ -161,7 +161,7 @@ def plot_laminate_family(family, searches=()):
     (solid: the laminate up to sqrt(3), the stretched laminate beyond), FCC and the maximum
     0.770732 with its 14 contacts. With searches, a second panel zooms on the dense end: each run
     is a marker at its aspect ratio (spread sideways by particles per cell), filled where it
-    matches the laminate.
+    matches the densest known crystal.
 
     Parameters
     ----------
@@ -209,8 +209,8 @@ def plot_laminate_family(family, searches=()):
         low = _plot_searches(zoom, searches)
         zoom.set_ylim(min(low, np.pi / np.sqrt(18)) - 0.005, 0.775)
         zoom.set_ylabel(r"density $\phi$ (dense end)")
-        zoom.set_title("random starts in small deforming cells (filled: the laminate)", fontsize="small")
-        zoom.legend(loc="upper center", fontsize="small", ncol=3)
+        zoom.set_title("random starts in small deforming cells (filled: the densest known crystal)", fontsize="small")
+        zoom.legend(loc="lower left", fontsize="small")
     panels[-1].set_xlabel(r"aspect ratio $\alpha$ (oblate $< 1 <$ prolate)")
     fig.tight_layout()
     return fig
