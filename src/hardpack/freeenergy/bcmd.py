@@ -34,6 +34,8 @@ Donev 2006, dissertation sec. 6.3 (the journal version is Donev et al. 2007, Sec
 
 from __future__ import annotations
 
+import logging
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -45,6 +47,11 @@ from hardpack.freeenergy import _kernel as kern
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.neighbours import pairs_within
 from hardpack.geometry.packing import Packing
+
+log = logging.getLogger("hardpack.freeenergy")
+
+#: seconds of CPU time between progress lines of :func:`run_bcmd`
+PROGRESS_INTERVAL = 60.0
 
 FROZEN_MODES = ("particle", "cm")
 
@@ -379,7 +386,13 @@ def run_bcmd(
     ln_k = 0.0  # chained ln(K/K0)
     n_redraws = 0
     rows = []
+    steps = math.ceil(math.log(dmu_min / dmu_max) / math.log1p(-segment_fraction))
+    reported = time.process_time()
     for dmu, dmu_next, gamma, dt in shrink_schedule(dmu_max, dmu_min, gamma0, theta, segment_fraction):
+        if time.process_time() - reported >= PROGRESS_INTERVAL:
+            reported = time.process_time()
+            log.info("BCMD: cell step %d of about %d, dmu = %.4g (down to %.4g), %.3g events, kT = %.3g",
+                     len(rows), steps, dmu, dmu_min, float(iacc[kern.C_EVENTS]), kinetic(v) / (0.5 * n_f))
         facc[:] = 0.0
         ev_before = iacc[kern.C_EVENTS]
         k_start = kinetic(v)
