@@ -772,7 +772,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         collision, these end mostly at their time cap.)"""
         ket, ker, _, _ = ek.totals(self.P)
         cv, cw, cii = self._column(0), self._column(5), self._column(6)
-        self.P[:, cv:cv + self.d] *= math.sqrt(0.5 * self.d * self.n / ket)
+        if ket > 0.0:
+            self.P[:, cv:cv + self.d] *= math.sqrt(0.5 * self.d * self.n / ket)
         if ker > 0.0:
             self.P[:, cw:cii] *= math.sqrt(0.5 * rotational_dof(self.d) * self.n / ker)
 
