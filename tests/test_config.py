@@ -10,7 +10,7 @@ import jsonschema
 import pytest
 import yaml
 
-from hardpack.config import check_config
+from hardpack.config import check_config, validate_schema
 from hardpack.errors import InvalidInputError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -29,6 +29,24 @@ def errors(cfg):
 @pytest.mark.parametrize("name", ["config.yaml", "smoke.yaml"])
 def test_shipped_configs_are_valid(name):
     assert errors(load(name)) == []
+
+
+def test_validate_schema_fills_defaults_and_names_the_key_it_refuses():
+    """The workflow's validator (hardpack.config.validate_schema) against jsonschema's reference
+    validator above: the same verdicts, plus the schema's defaults filled in."""
+    schema = ROOT / "workflow/schemas/config.schema.yaml"
+    cfg = load("smoke.yaml")
+    cfg["validation"].pop("min_applicable", None)
+    validate_schema(cfg, schema)
+    assert cfg["validation"]["min_applicable"] == 30
+    cfg["ensembles"]["mono3d"]["grwoth_rate"] = 0.1
+    assert errors(cfg)
+    with pytest.raises(InvalidInputError, match=r"'grwoth_rate' was unexpected\) \(at ensembles.mono3d;"):
+        validate_schema(cfg, schema)
+    cfg = load("smoke.yaml")
+    cfg["glass"]["N"] = "many"
+    with pytest.raises(InvalidInputError, match="'many' is not of type 'integer' \\(at glass.N;"):
+        validate_schema(cfg, schema)
 
 
 @pytest.mark.parametrize(

@@ -23,6 +23,15 @@ except PackageNotFoundError:  # running from a source tree without installation
     __version__ = "0.0.0+unknown"
 
 from hardpack.errors import InvalidInputError  # noqa: E402
-from hardpack.geometry.packing import Packing  # noqa: E402
 
 __all__ = ["Packing", "InvalidInputError", "__version__"]
+
+
+def __getattr__(name):
+    """``hardpack.Packing``, imported on first use: the workflow's config checks import
+    :mod:`hardpack.config` in every Snakemake process, which must not pay for numba."""
+    if name == "Packing":
+        from hardpack.geometry.packing import Packing
+
+        return Packing
+    raise AttributeError(f"module 'hardpack' has no attribute {name!r}")

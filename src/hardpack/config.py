@@ -1,8 +1,8 @@
-"""Cross-reference checks of a workflow config, beyond what its JSON schema can express.
+"""Checks of a workflow config: its JSON schema, and cross references the schema cannot express.
 
 The workflow (``workflow/rules/common.smk``) validates a config against
-``workflow/schemas/config.schema.yaml`` (keys, types, ranges) and then calls :func:`check_config`,
-which refuses sections that contradict each other: a study that names an ensemble or seeds that do
+``workflow/schemas/config.schema.yaml`` (keys, types, ranges) with :func:`validate_schema` and
+then calls :func:`check_config`, which refuses sections that contradict each other: a study that names an ensemble or seeds that do
 not exist, a container study whose largest container has no core, and so on. Every message names
 the key to fix. The checks live in the library so that they are tested without building the DAG.
 """
@@ -12,7 +12,49 @@ from __future__ import annotations
 from hardpack.distributions import from_spec
 from hardpack.errors import InvalidInputError
 
-__all__ = ["check_config"]
+__all__ = ["check_config", "validate_schema"]
+
+
+def validate_schema(config: dict, schema_path) -> None:
+    """Validate a workflow config against its JSON schema (draft 2020-12), filling in the
+    schema's defaults, as ``snakemake.utils.validate`` does.
+
+    Every Snakemake process of a run (one or two per cluster job) parses the workflow and so
+    validates its config; Snakemake's own validator reads the schema with a pure-Python YAML
+    parser (0.45 s), this one with libyaml's (0.01 s).
+
+    Parameters
+    ----------
+    config : dict
+        The workflow config; defaults of the schema are set in place.
+    schema_path : str or path-like
+        The schema, YAML or JSON.
+
+    Raises
+    ------
+    InvalidInputError
+        When the config breaks the schema; the message names the key and what is wrong.
+    """
+    import jsonschema
+    import yaml
+
+    with open(schema_path) as fh:
+        schema = yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    base = jsonschema.Draft202012Validator
+    check_properties = base.VALIDATORS["properties"]
+
+    def properties_with_defaults(validator, properties, instance, subschema):
+        if isinstance(instance, dict):
+            for key, spec in properties.items():
+                if isinstance(spec, dict) and "default" in spec:
+                    instance.setdefault(key, spec["default"])
+        yield from check_properties(validator, properties, instance, subschema)
+
+    validator = jsonschema.validators.extend(base, {"properties": properties_with_defaults})(schema)
+    error = jsonschema.exceptions.best_match(validator.iter_errors(config))
+    if error is not None:
+        where = ".".join(str(k) for k in error.absolute_path) or "the top level"
+        _refuse(f"config: {error.message} (at {where}; the keys and their types are in {schema_path})")
 
 
 def check_config(config: dict) -> None:

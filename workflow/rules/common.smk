@@ -18,12 +18,10 @@ import os
 import re
 import shlex
 
-from snakemake.utils import validate
-
-from hardpack.config import check_config
+from hardpack.config import check_config, validate_schema
 
 
-validate(config, "../schemas/config.schema.yaml")
+validate_schema(config, os.path.join(workflow.basedir, "workflow", "schemas", "config.schema.yaml"))
 
 
 wildcard_constraints:
