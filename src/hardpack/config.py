@@ -2,9 +2,10 @@
 
 The workflow (``workflow/rules/common.smk``) validates a config against
 ``workflow/schemas/config.schema.yaml`` (keys, types, ranges) with :func:`validate_schema` and
-then calls :func:`check_config`, which refuses sections that contradict each other: a study that names an ensemble or seeds that do
-not exist, a container study whose largest container has no core, and so on. Every message names
-the key to fix. The checks live in the library so that they are tested without building the DAG.
+then calls :func:`check_config`, which refuses sections that contradict each other: a study that
+names an ensemble or seeds that do not exist, a container study whose largest container has no
+core, and so on. Every message names the key to fix. The checks live in the library so that they
+are tested without building the DAG.
 """
 
 from __future__ import annotations
