@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -137,3 +138,12 @@ def test_slurm_subset_covers_every_rule_with_the_cheapest_reruns(tmp_path):
     reruns = slurm_subset.rerun_jobs("results/a/init/seed2.nc", *slurm_subset.local_jobs(metadata)[::2])
     assert {job[0] for job in reruns} == {"init", "compress"}
     assert slurm_subset.rerun_cost("results/a/init/seed1.nc", *slurm_subset.local_jobs(metadata)) == 101.0
+
+
+def test_slurm_smoke_sizes_every_group_of_the_profile():
+    """--group-components on the command line replaces the profile's whole mapping: the CI run
+    must name every group of the profile, or the missing ones would run one job per cluster job."""
+    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
+    script = (ROOT / ".ci" / "slurm-smoke").read_text()
+    sizes = dict(item.split("=") for item in re.search(r"--group-components ((?:\w+=\d+ ?)+)", script).group(1).split())
+    assert set(sizes) == set(profile["group-components"])
