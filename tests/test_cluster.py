@@ -104,3 +104,15 @@ def test_no_job_group_holds_a_job_and_its_input(workflow_rules):
     for a, b in re.findall(r"^\s*(\d+) -> (\d+)", dot, re.M):
         ra, rb = rule_of[int(a)], rule_of[int(b)]
         assert not (ra in group and group.get(rb) == group[ra]), f"{ra} -> {rb} inside group {group[ra]}"
+
+
+@needs_snakemake
+def test_glass_bcmd_runs_with_the_thermostat_and_a_limit_for_it():
+    """glass.bcmd.reset_ratio reaches `hardpack bcmd`, and the cost model prices the run with the
+    thermostat (~5 min at N = 4096) rather than without it (~3 h: kT ~ 1 / dmu^2)."""
+    output = "results/glass/binary/bcmd/g1e-05/phi0.8/seed1.nc"
+    text = _dry_run("-p", output)
+    block = next(b for b in re.split(r"\n(?=\s*(?:local)?rule \w+:)", text) if f"output: {output}" in b)
+    assert "--reset-ratio 2 " in block
+    _, runtime, _ = _job_resources(text, output)
+    assert 4 <= runtime <= 30

@@ -153,6 +153,7 @@ rule glass_bcmd:
         "results/glass/{system}/bcmd/g{rate}/phi{phi}/seed{seed}.nc",
     params:
         b=GLASS["bcmd"] if GLASS else None,
+        thermostat=glass_bcmd_thermostat,
     wildcard_constraints:
         system="binary|mono",
         phi=GLASS_PHI,
@@ -168,7 +169,7 @@ rule glass_bcmd:
         "results/benchmarks/glass_bcmd/{system}/g{rate}/phi{phi}/seed{seed}.tsv"
     shell:
         "hardpack bcmd {input} --out {output} --delta {params.b[delta]} --dmu-max {params.b[dmu_max]} --gamma0 {params.b[gamma0]}"
-        " --theta {params.b[theta]} --seed {wildcards.seed} > {log} 2>&1"
+        " --theta {params.b[theta]} {params.thermostat} --seed {wildcards.seed} > {log} 2>&1"
 
 
 rule glass_entropy:
