@@ -529,7 +529,7 @@ def glass_bcmd_thermostat(w):
 
 def glass_bcmd_minutes(w):
     """BCMD from dmu_max to the disjoint point dmu_min ~ delta (the radii are shrunk by delta).
-    The cells shrink at the relative rate gamma0 dmu / dmu_max (theta = 1), so the run lasts
+    The cells shrink at d(dmu)/dt = -gamma0 dmu / dmu_max (theta = 1), so the run lasts
     ~dmu_max / gamma0 ln(dmu_max / dmu_min), and a disk in a cell of size dmu collides at a rate
     ~sqrt(kT) / dmu. With the re-draw thermostat kT stays put: events per disk
     ~c dmu_max / (gamma0 dmu_min); without it kT grows as 1 / dmu^2: ~c' dmu_max / (gamma0 dmu_min^2).
