@@ -54,9 +54,14 @@ def _dry_run(*args):
     return out.stdout + out.stderr
 
 
+def _job_block(text, output):
+    """The listing of the job writing ``output`` in a dry run's output."""
+    return next(b for b in re.split(r"\n(?=\s*(?:local)?rule \w+:)", text) if f"output: {output}" in b)
+
+
 def _job_resources(text, output):
     """(threads, runtime, mem_mb) of the job writing ``output`` in a dry run's listing."""
-    block = next(b for b in re.split(r"\n(?=\s*(?:local)?rule \w+:)", text) if f"output: {output}" in b)
+    block = _job_block(text, output)
     threads = re.search(r"^\s*threads: (\d+)", block, re.M)
     resources = re.search(r"resources: .*", block).group(0)
     runtime = int(re.search(r"\bruntime=(\d+)", resources).group(1))
@@ -112,7 +117,6 @@ def test_glass_bcmd_runs_with_the_thermostat_and_a_limit_for_it():
     thermostat (~5 min at N = 4096) rather than without it (~3 h: kT ~ 1 / dmu^2)."""
     output = "results/glass/binary/bcmd/g1e-05/phi0.8/seed1.nc"
     text = _dry_run("-p", output)
-    block = next(b for b in re.split(r"\n(?=\s*(?:local)?rule \w+:)", text) if f"output: {output}" in b)
-    assert "--reset-ratio 2 " in block
+    assert "--reset-ratio 2 " in _job_block(text, output)
     _, runtime, _ = _job_resources(text, output)
     assert 4 <= runtime <= 30
