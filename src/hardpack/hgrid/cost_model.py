@@ -33,6 +33,7 @@ text's "L = 3 is 43 % worse" is 47 % here; "L = 6 is 24 % worse" agrees.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -253,6 +254,13 @@ def constant_m_cells(system: PowerLawSystem, L: int, q: float = 1.0) -> np.ndarr
     if not (q > 0):
         raise InvalidInputError(f"q must be positive, got {q}")
     system._require_polydisperse()
+    return np.array(_constant_m_cells(system, L, float(q)))
+
+
+@functools.lru_cache(maxsize=1024)
+def _constant_m_cells(system: PowerLawSystem, L: int, q: float) -> tuple[float, ...]:
+    """:func:`constant_m_cells` (a pure function of its arguments, kept for the callers that ask
+    again)."""
     top, d = 2.0 * system.omega, system.d
 
     def advance(s_prev, target):
@@ -283,9 +291,9 @@ def constant_m_cells(system: PowerLawSystem, L: int, q: float = 1.0) -> np.ndarr
     # bracket: all targets tiny (s_L -> s_0) .. first level alone already beyond 2 r_max
     log_lo = math.log(1e-12) - (L - 1) * max(0.0, math.log(q))
     log_c = brentq(miss, log_lo, d * math.log(top) + 1.0, xtol=1e-13)
-    s = np.array(shoot(log_c))
+    s = shoot(log_c)
     s[-1] = top
-    return s
+    return tuple(float(x) for x in s)
 
 
 def _cells_from_free(z, omega):
@@ -321,10 +329,21 @@ def optimal_cells(system: PowerLawSystem, L: int, K: float = 0.2, method: str = 
     L = _check_levels(L)
     if L == 1:
         return np.array([2.0, 2.0 * system.omega])
+    if method not in METHODS:
+        raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
+    if not (K >= 0):
+        raise InvalidInputError(f"K must be >= 0, got {K}")
+    return _cells_from_free(np.array(_optimal_free(system, L, float(K), method)), system.omega)
+
+
+@functools.lru_cache(maxsize=256)
+def _optimal_free(system: PowerLawSystem, L: int, K: float, method: str) -> tuple[float, ...]:
+    """The free parameters of :func:`optimal_cells` (a pure function of its arguments, kept for
+    the callers that ask again, e.g. every ``hardpack validate`` of one process)."""
     start = np.log(np.diff(np.log(constant_m_cells(system, L))))
     z0 = start[:-1] - start[-1]
     res = minimize(lambda z: system.cost(_cells_from_free(z, system.omega), K, method), z0, method="BFGS")
-    return _cells_from_free(res.x, system.omega)
+    return tuple(float(x) for x in res.x)
 
 
 CELL_RULES = ("linear", "exponential", "constant-m", "optimal")
