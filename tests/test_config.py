@@ -2,6 +2,7 @@
 
 import copy
 import re
+import shlex
 import shutil
 import subprocess
 from pathlib import Path
@@ -84,12 +85,33 @@ def test_bad_configs_are_refused_naming_the_key(mutate, expected):
     assert any(__import__("re").search(expected, e) for e in found), found
 
 
+def _every_hardpack_command_parses(listing):
+    """Every `hardpack` shell command of a dry run's listing (-p) passes the command line's parser.
+    (A negative number in exponent notation, `--growth-rate -1e-05`, reads as an option: the full
+    study's glass decompression failed so, while the smoke's `-0.001` parsed.)"""
+    from hardpack.cli import build_parser
+
+    commands = [line.split("Shell command: ", 1)[1] for line in listing.splitlines()
+                if line.startswith("Shell command: hardpack ")]
+    assert len(commands) > 10, listing[-2000:]
+    parsers = {}
+    for command in commands:
+        words = shlex.split(command)
+        words = words[:next((k for k, w in enumerate(words) if w in {">", "|", "&&", ";", "2>&1"}), len(words))]
+        parser = parsers.setdefault(words[1], build_parser(words[1]))
+        try:
+            parser.parse_args(words[1:])
+        except SystemExit:
+            pytest.fail(f"the command line's parser refuses: {command}")
+
+
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
 @pytest.mark.parametrize("configfile", ["config/config.yaml", "config/smoke.yaml"])
 def test_snakemake_dry_run_lists_the_dag(configfile):
-    out = subprocess.run(["snakemake", "-n", "--forceall", "--configfile", configfile], cwd=ROOT,
+    out = subprocess.run(["snakemake", "-n", "-p", "--forceall", "--configfile", configfile], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
+    _every_hardpack_command_parses(out.stdout)
     assert re.search(r"^init +\d+$", out.stdout, re.M) and "fig_size_distributions" in out.stdout
     cfg = load(configfile.split("/")[1])["containers"]
     packings = len(cfg["N"]) * len(cfg["seeds"])

@@ -110,7 +110,7 @@ rule glass_decompress:
     benchmark:
         "results/benchmarks/glass_decompress/seed{seed}.tsv"
     shell:
-        "hardpack compress --init {input} --growth-rate -{params.rate} --seed {wildcards.seed}"
+        "hardpack compress --init {input} --growth-rate=-{params.rate} --seed {wildcards.seed}"
         " --target-phi {params.phi} --out {output.packing} --timeseries {output.timeseries}"
         " --checkpoint {params.checkpoint} > {log} 2>&1"
 
