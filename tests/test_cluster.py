@@ -84,6 +84,7 @@ def test_time_limits_cover_the_measured_jobs_of_the_full_study_twice():
         "results/slp_densest/d5/slp/seed0.nc": 6.3,                             # SLP 5D N = 243
         "results/ls/mono3d_large/verdict/seed1.nc": 5,                          # jamming test N = 1e4
         "results/poly_fluid/uniform_volume_w10/fluid.nc": 2.3,
+        "results/glass/binary/bcmd/g1e-05/phi0.7/seed2.nc": 2.7,                # glass BCMD N = 4096, thermostat
     }
     for output, minutes in measured.items():
         _, runtime, _ = _job_resources(text, output)
