@@ -98,7 +98,9 @@ def _every_hardpack_command_parses(listing):
     for command in commands:
         words = shlex.split(command)
         words = words[:next((k for k, w in enumerate(words) if w in {">", "|", "&&", ";", "2>&1"}), len(words))]
-        parser = parsers.setdefault(words[1], build_parser(words[1]))
+        if words[1] not in parsers:
+            parsers[words[1]] = build_parser(words[1])
+        parser = parsers[words[1]]
         try:
             parser.parse_args(words[1:])
         except SystemExit:

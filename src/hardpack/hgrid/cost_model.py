@@ -329,10 +329,6 @@ def optimal_cells(system: PowerLawSystem, L: int, K: float = 0.2, method: str = 
     L = _check_levels(L)
     if L == 1:
         return np.array([2.0, 2.0 * system.omega])
-    if method not in METHODS:
-        raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
-    if not (K >= 0):
-        raise InvalidInputError(f"K must be >= 0, got {K}")
     return _cells_from_free(np.array(_optimal_free(system, L, float(K), method)), system.omega)
 
 
