@@ -46,12 +46,53 @@ class Distribution:
     name = "distribution"
 
     def moment(self, k: float) -> float:
+        """Raw moment <a^k> of the radius distribution.
+
+        Parameters
+        ----------
+        k : float
+            Order of the moment (k >= 0; the continuous distributions take any real k).
+
+        Returns
+        -------
+        float
+            <a^k> = int a^k f(a) da (sum_s n_s a_s^k for a discrete mixture).
+        """
         raise NotImplementedError
 
     def ppf(self, q):
+        """Quantile function F^-1(q): the radius below which a fraction q of the particles lies.
+
+        Parameters
+        ----------
+        q : float or array_like of float
+            Cumulative number fractions, in [0, 1].
+
+        Returns
+        -------
+        float or numpy.ndarray of float
+            Radii, of the shape of ``q``.
+        """
         raise NotImplementedError
 
     def pdf(self, a):
+        """Number density f(a) of the radii.
+
+        Parameters
+        ----------
+        a : float or array_like of float
+            Radii.
+
+        Returns
+        -------
+        float or numpy.ndarray of float
+            f(a), of the shape of ``a``; 0 outside the support.
+
+        Raises
+        ------
+        InvalidInputError
+            For a discrete mixture, which has no density.
+        """
         raise NotImplementedError
 
     @property
@@ -59,15 +100,52 @@ class Distribution:
         raise NotImplementedError
 
     def sample(self, n: int, rng: np.random.Generator | None = None) -> np.ndarray:
-        """n radii by systematic sampling, sorted ascending (shuffle positions, not radii)."""
+        """n radii by systematic sampling, sorted ascending (shuffle positions, not radii).
+
+        Radius i is F^-1((i + u) / n) with one offset u (module docstring).
+
+        Parameters
+        ----------
+        n : int
+            Number of radii, a positive integer.
+        rng : numpy.random.Generator, optional
+            Draws the offset u in [0, 1); without it u = 1/2.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (n,)
+            The radii, ascending.
+
+        Raises
+        ------
+        InvalidInputError
+            If ``n`` is not a positive integer.
+        """
         return np.asarray(self.ppf(_systematic_u(n, rng)), dtype=float)
 
     def moments(self, kmax: int = 5) -> np.ndarray:
-        """Raw moments <a^k> for k = 0..kmax."""
+        """Raw moments <a^k> for k = 0..kmax.
+
+        Parameters
+        ----------
+        kmax : int, default 5
+            Highest order.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (kmax + 1,)
+            <a^0> = 1, <a>, ..., <a^kmax>.
+        """
         return np.array([self.moment(k) for k in range(kmax + 1)])
 
     def params(self) -> dict:
-        """Parameters as a flat dict (stored in dataset attributes)."""
+        """Parameters as a flat dict (stored in dataset attributes).
+
+        Returns
+        -------
+        dict
+            The constructor arguments by name.
+        """
         raise NotImplementedError
 
 
@@ -112,16 +190,52 @@ class Discrete(Distribution):
         object.__setattr__(self, "fractions", tuple(f[order].tolist()))
 
     def moment(self, k: float) -> float:
+        """Raw moment <a^k> = sum_s n_s a_s^k.
+
+        Parameters
+        ----------
+        k : float
+            Order of the moment (any real k; the radii are positive).
+
+        Returns
+        -------
+        float
+            <a^k>.
+        """
         r, f = np.asarray(self.radii), np.asarray(self.fractions)
         return float(np.sum(f * r**k))
 
     def ppf(self, q):
+        """Quantile function: the radius of the first species whose cumulative fraction exceeds q.
+
+        Parameters
+        ----------
+        q : float or array_like of float
+            Cumulative number fractions, in [0, 1]; q = 1 gives the largest radius.
+
+        Returns
+        -------
+        numpy.ndarray of float
+            Species radii, of the shape of ``q``.
+        """
         cum = np.cumsum(self.fractions)
         cum[-1] = 1.0
         idx = np.searchsorted(cum, np.asarray(q, float), side="right")
         return np.asarray(self.radii)[np.minimum(idx, len(cum) - 1)]
 
     def pdf(self, a):
+        """A discrete mixture has no density: always raises.
+
+        Parameters
+        ----------
+        a : float or array_like of float
+            Radii (unused).
+
+        Raises
+        ------
+        InvalidInputError
+            Always; use ``radii`` and ``fractions``.
+        """
         raise InvalidInputError("a discrete mixture has no density; use radii and fractions")
 
     @property
@@ -129,10 +243,29 @@ class Discrete(Distribution):
         return (self.radii[0], self.radii[-1])
 
     def species_of(self, radii: np.ndarray) -> np.ndarray:
-        """Species index (0 = smallest) of each sampled radius."""
+        """Species index (0 = smallest) of each sampled radius.
+
+        Parameters
+        ----------
+        radii : numpy.ndarray of float, shape (N,)
+            Radii equal to species radii (e.g. from :meth:`sample`); any other value gets its
+            insertion index in the ascending species radii.
+
+        Returns
+        -------
+        numpy.ndarray of int32, shape (N,)
+            The species indices.
+        """
         return np.searchsorted(np.asarray(self.radii), radii).astype(np.int32)
 
     def params(self):
+        """Parameters as a flat dict (stored in dataset attributes).
+
+        Returns
+        -------
+        dict
+            ``radii`` and ``fractions``, as lists in ascending order of radius.
+        """
         return {"radii": list(self.radii), "fractions": list(self.fractions)}
 
 
@@ -237,6 +370,18 @@ class PowerLaw(Distribution):
         return self.mean_radius / self._unit_moment(1)
 
     def moment(self, k: float) -> float:
+        """Raw moment <a^k> = a_min^k int_1^omega x^(k + alpha) dx / int_1^omega x^alpha dx.
+
+        Parameters
+        ----------
+        k : float
+            Order of the moment, any real number.
+
+        Returns
+        -------
+        float
+            <a^k>.
+        """
         return self.a_min**k * self._unit_moment(k)
 
     @property
@@ -244,6 +389,18 @@ class PowerLaw(Distribution):
         return (self.a_min, self.omega * self.a_min)
 
     def pdf(self, a):
+        """Normalised density f(a) = a^alpha / int_{a_min}^{a_max} x^alpha dx on the support.
+
+        Parameters
+        ----------
+        a : float or array_like of float
+            Radii.
+
+        Returns
+        -------
+        numpy.ndarray of float
+            f(a), of the shape of ``a``; 0 outside [a_min, a_max].
+        """
         a = np.asarray(a, float)
         lo, hi = self.support
         p = self.alpha + 1
@@ -254,6 +411,19 @@ class PowerLaw(Distribution):
         return np.where((a >= lo) & (a <= hi), a**self.alpha / norm, 0.0)
 
     def ppf(self, q):
+        """Quantile function F^-1(q) = (a_min^p + q (a_max^p - a_min^p))^(1/p), p = alpha + 1
+        (a_min (a_max / a_min)^q for p = 0).
+
+        Parameters
+        ----------
+        q : float or array_like of float
+            Cumulative number fractions, in [0, 1].
+
+        Returns
+        -------
+        numpy.ndarray of float
+            Radii, of the shape of ``q``.
+        """
         q = np.asarray(q, float)
         lo, hi = self.support
         p = self.alpha + 1
@@ -262,6 +432,13 @@ class PowerLaw(Distribution):
         return (lo**p + q * (hi**p - lo**p)) ** (1 / p)
 
     def params(self):
+        """Parameters as a flat dict (stored in dataset attributes).
+
+        Returns
+        -------
+        dict
+            ``omega``, ``alpha`` and ``mean_radius``.
+        """
         return {"omega": self.omega, "alpha": self.alpha, "mean_radius": self.mean_radius}
 
 
@@ -348,6 +525,18 @@ class LogNormal(Distribution):
         return self.mean_radius * math.exp(-0.5 * self.sigma**2)
 
     def moment(self, k: float) -> float:
+        """Raw moment <a^k> = a0^k exp(k^2 sigma^2 / 2) (Ogarko 2014, Eq. 3.47).
+
+        Parameters
+        ----------
+        k : float
+            Order of the moment, any real number.
+
+        Returns
+        -------
+        float
+            <a^k>.
+        """
         return self.a0**k * math.exp(0.5 * k * k * self.sigma**2)
 
     def _dist(self):
@@ -356,9 +545,33 @@ class LogNormal(Distribution):
         return stats.lognorm(s=self.sigma, scale=self.a0)
 
     def pdf(self, a):
+        """Density f(a) of Ogarko 2014, Eq. 3.46 (``scipy.stats.lognorm`` with s = sigma, scale = a0).
+
+        Parameters
+        ----------
+        a : float or array_like of float
+            Radii.
+
+        Returns
+        -------
+        float or numpy.ndarray of float
+            f(a), of the shape of ``a``; 0 for a <= 0.
+        """
         return self._dist().pdf(a)
 
     def ppf(self, q):
+        """Quantile function F^-1(q) = a0 exp(sigma sqrt(2) erfinv(2 q - 1)).
+
+        Parameters
+        ----------
+        q : float or array_like of float
+            Cumulative number fractions, in [0, 1] (q = 0 gives 0, q = 1 infinity).
+
+        Returns
+        -------
+        numpy.ndarray of float
+            Radii, of the shape of ``q``.
+        """
         from scipy.special import erfinv  # scipy costs every importer of this module 0.3 s
 
         return self.a0 * np.exp(self.sigma * math.sqrt(2) * erfinv(2 * np.asarray(q, float) - 1))
@@ -368,6 +581,13 @@ class LogNormal(Distribution):
         return (0.0, math.inf)
 
     def params(self):
+        """Parameters as a flat dict (stored in dataset attributes).
+
+        Returns
+        -------
+        dict
+            ``sigma`` and ``mean_radius``.
+        """
         return {"sigma": self.sigma, "mean_radius": self.mean_radius}
 
 
