@@ -114,19 +114,87 @@ class Periodic:
     name: ClassVar[str] = "periodic cells"
 
     def check(self, lattice: np.ndarray) -> None:
-        """Every lattice suits a periodic cell (the packing checks it is non-singular)."""
+        """Refuse a lattice that does not suit the boundary: every lattice suits a periodic cell.
+
+        The packing checks separately that the lattice is non-singular; :meth:`HardWalls.check` and
+        :meth:`SphericalContainer.check` raise InvalidInputError for lattices they do not suit.
+
+        Parameters
+        ----------
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice, columns = lattice vectors.
+        """
 
     def periodic_axes(self, d: int) -> np.ndarray:
+        """Which lattice vectors are periods: all of them.
+
+        Parameters
+        ----------
+        d : int
+            Dimension.
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (d,)
+            True for the lattice vectors that are periods (axes with periodic images).
+        """
         return np.ones(d, dtype=bool)
 
     def volume(self, lattice: np.ndarray) -> float:
+        """Volume of the region the particles fill: the cell, |det(lattice)|.
+
+        Parameters
+        ----------
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice, columns = lattice vectors.
+
+        Returns
+        -------
+        float
+            |det(lattice)|.
+        """
         return float(abs(np.linalg.det(lattice)))
 
     def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
+        """Relative overlap 1 - h / r of every particle with its worst wall; a periodic cell has none.
+
+        Parameters
+        ----------
+        positions : numpy.ndarray of float, shape (N, d)
+            Cartesian centres.
+        radii : numpy.ndarray of float, shape (N,)
+            Particle radii (unused here).
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice (checked by :meth:`check`).
+        tol : float
+            Relative tolerance: a particle crosses a wall when 1 - h / r > tol.
+
+        Returns
+        -------
+        ContainmentReport
+            n_outside = 0, no particle named (worst = -1), wall "no walls", overlap -inf.
+        """
         return _no_walls()
 
     def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
-        """No walls, no contacts."""
+        """Particle-wall contacts within relative gap ``rel_gap``; a periodic cell has no walls, so none.
+
+        Parameters
+        ----------
+        positions : numpy.ndarray of float, shape (N, d)
+            Cartesian centres.
+        radii : numpy.ndarray of float, shape (N,)
+            Sphere radii.
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice (checked by :meth:`check`).
+        rel_gap : float
+            Largest relative gap h / r - 1 of a contact.
+
+        Returns
+        -------
+        WallContacts
+            Empty (M = 0).
+        """
         d = positions.shape[1]
         return WallContacts(np.zeros(0, np.int64), np.zeros((0, d)), np.zeros(0))
 
@@ -168,7 +236,21 @@ class HardWalls:
         object.__setattr__(self, "axes", tuple(axes))
 
     def check(self, lattice: np.ndarray) -> None:
-        """Refuse a lattice that is not orthorhombic along the walled axes."""
+        """Refuse a lattice that is not orthorhombic along the walled axes.
+
+        Lattice vector k must be L_k e_k with L_k > 0 and no other lattice vector may have a
+        component along e_k, for every walled axis k.
+
+        Parameters
+        ----------
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice, columns = lattice vectors.
+
+        Raises
+        ------
+        InvalidInputError
+            If a walled axis is >= d or the lattice is not orthorhombic along it.
+        """
         d = lattice.shape[0]
         if self.axes[-1] >= d:
             raise InvalidInputError(f"hard-wall axis {self.axes[-1]} does not exist in {d} dimensions "
@@ -184,16 +266,60 @@ class HardWalls:
                 )
 
     def periodic_axes(self, d: int) -> np.ndarray:
+        """Which lattice vectors are periods: all but the walled axes.
+
+        Parameters
+        ----------
+        d : int
+            Dimension.
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (d,)
+            True for the lattice vectors that are periods (axes with periodic images).
+        """
         mask = np.ones(d, dtype=bool)
         mask[list(self.axes)] = False
         return mask
 
     def volume(self, lattice: np.ndarray) -> float:
+        """Volume of the region the particles fill: the cell between the walls, |det(lattice)|.
+
+        Parameters
+        ----------
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice, columns = lattice vectors.
+
+        Returns
+        -------
+        float
+            |det(lattice)|.
+        """
         return float(abs(np.linalg.det(lattice)))
 
     def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
-        """Relative overlap 1 - h / r of every particle with its worst wall (h = centre-wall distance;
-        r the radius (N,), or the particle's extent along each axis (N, d), e.g. of an ellipsoid)."""
+        """Relative overlap 1 - h / r of every particle with its worst wall.
+
+        h is the centre-wall distance x_k (wall at 0) or L_k - x_k (wall at L_k, L_k the diagonal
+        entry of the lattice), from the positions as given (not wrapped).
+
+        Parameters
+        ----------
+        positions : numpy.ndarray of float, shape (N, d)
+            Cartesian centres.
+        radii : numpy.ndarray of float, shape (N,) or (N, d)
+            Sphere radii, or the particle's extent along each axis (e.g. of an ellipsoid), of
+            which the walled axes are used.
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice (checked by :meth:`check`).
+        tol : float
+            Relative tolerance: a particle crosses a wall when 1 - h / r > tol.
+
+        Returns
+        -------
+        ContainmentReport
+            Particles with overlap > tol, and the worst particle with its wall and overlap.
+        """
         axes = list(self.axes)
         x = positions[:, axes]
         length = np.diag(lattice)[axes]
@@ -207,7 +333,24 @@ class HardWalls:
 
     def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
         """Every sphere within relative gap ``rel_gap`` of a wall (a sphere may touch several);
-        normals -e_k at x_k = 0 and +e_k at x_k = L_k."""
+        normals -e_k at x_k = 0 and +e_k at x_k = L_k.
+
+        Parameters
+        ----------
+        positions : numpy.ndarray of float, shape (N, d)
+            Cartesian centres.
+        radii : numpy.ndarray of float, shape (N,)
+            Sphere radii.
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice (checked by :meth:`check`).
+        rel_gap : float
+            Largest relative gap h / r - 1 of a contact.
+
+        Returns
+        -------
+        WallContacts
+            One entry per sphere and wall with h / r - 1 <= rel_gap.
+        """
         n, d = positions.shape
         axes = list(self.axes)
         length = np.diag(lattice)[axes]
@@ -256,7 +399,19 @@ class SphericalContainer:
         object.__setattr__(self, "radius", float(radius))
 
     def check(self, lattice: np.ndarray) -> None:
-        """Refuse a lattice that is not an orthorhombic box holding the container."""
+        """Refuse a lattice that is not an orthorhombic box [0, L_1] x ... x [0, L_d] holding the container.
+
+        Parameters
+        ----------
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice, columns = lattice vectors.
+
+        Raises
+        ------
+        InvalidInputError
+            If the centre does not have d coordinates, the lattice is not diagonal with positive
+            entries, or the container does not lie inside the box.
+        """
         d = lattice.shape[0]
         if len(self.centre) != d:
             raise InvalidInputError(f"the container centre has {len(self.centre)} coordinates; the packing "
@@ -275,21 +430,78 @@ class SphericalContainer:
             )
 
     def periodic_axes(self, d: int) -> np.ndarray:
+        """Which lattice vectors are periods: none.
+
+        Parameters
+        ----------
+        d : int
+            Dimension.
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (d,)
+            True for the lattice vectors that are periods (axes with periodic images).
+        """
         return np.zeros(d, dtype=bool)
 
     def volume(self, lattice: np.ndarray) -> float:
-        """The container's volume V_d(R) (the box is only a pseudo-boundary)."""
+        """The container's volume V_d(R) (the box is only a pseudo-boundary).
+
+        Parameters
+        ----------
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice, columns = lattice vectors.
+
+        Returns
+        -------
+        float
+            V_d(R), d = lattice.shape[0].
+        """
         return float(ball_volume(self.radius, lattice.shape[0]))
 
     def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
-        """Relative overlap 1 - (R - |x - c|) / r of every sphere with the container wall."""
+        """Relative overlap 1 - (R - |x - c|) / r of every sphere with the container wall.
+
+        Parameters
+        ----------
+        positions : numpy.ndarray of float, shape (N, d)
+            Cartesian centres.
+        radii : numpy.ndarray of float, shape (N,)
+            Sphere radii.
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice (checked by :meth:`check`).
+        tol : float
+            Relative tolerance: a particle crosses a wall when 1 - h / r > tol.
+
+        Returns
+        -------
+        ContainmentReport
+            Spheres with overlap > tol, and the worst sphere.
+        """
         dx = positions - np.array(self.centre)
         h = self.radius - np.sqrt(np.einsum("ij,ij->i", dx, dx))
         return _report(1.0 - h / radii, lambda i: "the container wall", tol)
 
     def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
         """Every sphere within relative gap ``rel_gap`` of the container wall; normal (x - c) / |x - c|
-        (a sphere at the centre can touch only a container of its own size and gets normal e_0)."""
+        (a sphere at the centre can touch only a container of its own size and gets normal e_0).
+
+        Parameters
+        ----------
+        positions : numpy.ndarray of float, shape (N, d)
+            Cartesian centres.
+        radii : numpy.ndarray of float, shape (N,)
+            Sphere radii.
+        lattice : numpy.ndarray of float, shape (d, d)
+            The packing's lattice (checked by :meth:`check`).
+        rel_gap : float
+            Largest relative gap h / r - 1 of a contact.
+
+        Returns
+        -------
+        WallContacts
+            One entry per sphere with (R - |x - c|) / r - 1 <= rel_gap.
+        """
         dx = positions - np.array(self.centre)
         dist = np.sqrt(np.einsum("ij,ij->i", dx, dx))
         normal = np.zeros_like(dx)

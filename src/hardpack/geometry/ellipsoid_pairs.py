@@ -47,7 +47,18 @@ class PotentialPairs:
         return np.sqrt(self.zeta + 1.0)
 
     def subset(self, mask) -> PotentialPairs:
-        """The pairs selected by ``mask``, in the same order."""
+        """The pairs selected by ``mask``, in the same order.
+
+        Parameters
+        ----------
+        mask : numpy.ndarray of bool, shape (M,), or of int
+            Selection (a boolean mask or indices) of the pairs.
+
+        Returns
+        -------
+        PotentialPairs
+            The selected pairs with their zeta and lam.
+        """
         return PotentialPairs(self.pairs.subset(mask), self.zeta[mask], self.lam[mask])
 
 

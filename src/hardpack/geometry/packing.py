@@ -282,8 +282,20 @@ class Packing:
         return bool(np.all(off == 0) and np.all(np.diag(self.lattice) > 0))
 
     def require_periodic_spheres(self, user: str) -> None:
-        """Refuse this packing, naming ``user`` (e.g. "the MD engine"), unless it is hard spheres
-        in a periodic cell: the only model the simulation and analysis modules handle so far."""
+        """Refuse this packing, naming ``user``, unless it is hard spheres in a periodic cell.
+
+        That is the only model the simulation and analysis modules that call this handle so far.
+
+        Parameters
+        ----------
+        user : str
+            Who refuses, for the message (e.g. "the MD engine").
+
+        Raises
+        ------
+        InvalidInputError
+            If the particles are not spheres or the boundary is not periodic.
+        """
         if self.shape.kind != "sphere":
             raise InvalidInputError(f"{self.shape.name} are not supported by {user} yet; it handles hard "
                                     "spheres only")
@@ -332,9 +344,27 @@ class Packing:
         return Packing(**fields)
 
     def tiled(self, reps) -> "Packing":
-        """The packing repeated ``reps`` times along each lattice vector (int or d ints):
-        N prod(reps) particles in the cell with columns reps_k * a_k, same phi and contacts.
-        Only periodic axes can be repeated (reps 1 along walled axes)."""
+        """The packing repeated ``reps`` times along each lattice vector.
+
+        N prod(reps) particles in the cell with columns reps_k a_k, same phi and contacts. Only periodic
+        axes can be repeated (reps 1 along walled axes).
+
+        Parameters
+        ----------
+        reps : int or sequence of int, shape (d,)
+            Positive repetitions per lattice vector.
+
+        Returns
+        -------
+        Packing
+            The tiled packing: copy t (t = 0..prod(reps) - 1, the translations in C order over
+            the lattice vectors) of particle i is particle t N + i; shapes and species are repeated.
+
+        Raises
+        ------
+        InvalidInputError
+            If ``reps`` are not positive integers or exceed 1 along an axis without periodic images.
+        """
         reps = np.broadcast_to(np.asarray(reps), (self.dim,))
         if not np.issubdtype(reps.dtype, np.integer) or (reps < 1).any():
             raise InvalidInputError(f"reps must be positive integers, one per lattice vector, got {reps.tolist()}")
@@ -351,12 +381,22 @@ class Packing:
         )
 
     def minimum_image(self, dx: np.ndarray) -> np.ndarray:
-        """Reduce separation vectors (..., d) by lattice vectors: s - round(s) in fractional space,
-        along the periodic axes only.
+        """Reduce separation vectors by lattice vectors: s - round(s) in fractional space, along the
+        periodic axes only.
 
         This is the exact minimum image for orthorhombic cells; for sheared cells it is the
         nearest image only when the cell is reasonably reduced. Use
         :func:`hardpack.geometry.neighbours.pairs_within` for an exact search with all images.
+
+        Parameters
+        ----------
+        dx : array_like of float, shape (..., d)
+            Cartesian separation vectors.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (..., d)
+            The reduced vectors.
         """
         dx = np.asarray(dx, dtype=float)
         s = np.linalg.solve(self.lattice, dx.reshape(-1, self.dim).T).T
@@ -368,7 +408,18 @@ class Packing:
         return (s @ self.lattice.T).reshape(dx.shape)
 
     def separation(self, i: int, j: int) -> np.ndarray:
-        """Minimum-image separation vector x_j - x_i."""
+        """Minimum-image separation vector x_j - x_i (:meth:`minimum_image`).
+
+        Parameters
+        ----------
+        i, j : int
+            Particle indices.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (d,)
+            x_j - x_i reduced by lattice vectors along the periodic axes.
+        """
         return self.minimum_image(self.positions[j] - self.positions[i])
 
     # ------------------------------------------------------------------ overlaps
@@ -379,6 +430,17 @@ class Packing:
         potential (module docstring) of the pairs whose bounding spheres overlap. The worst pair
         (largest relative overlap) is named even when it is within tolerance, so callers can report
         how close the packing is to touching.
+
+        Parameters
+        ----------
+        tol : float, default DEFAULT_OVERLAP_TOL
+            Relative tolerance.
+
+        Returns
+        -------
+        OverlapReport
+            Number of overlapping pairs and the worst pair (-1 and overlap -inf when no pair is in
+            contact range).
         """
         from hardpack.geometry.neighbours import pairs_within
 
@@ -409,6 +471,16 @@ class Packing:
         container, by the exact gap h = R - rho to the farthest surface point
         (:mod:`hardpack.geometry.ellipsoid_container`), as the relative overlap -h / a_max (the
         sphere's 1 - (R - |x - c|) / r for equal semiaxes).
+
+        Parameters
+        ----------
+        tol : float, default DEFAULT_OVERLAP_TOL
+            Relative tolerance.
+
+        Returns
+        -------
+        ContainmentReport
+            Particles outside beyond ``tol`` and the worst one; no particle named in a periodic cell.
         """
         if self.shape.kind == "sphere":
             return self.boundary.containment(self.positions, self.shape.radii, self.lattice, tol)

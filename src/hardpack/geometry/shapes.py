@@ -124,7 +124,18 @@ class Spheres:
         return len(self.radii)
 
     def volumes(self, d: int) -> np.ndarray:
-        """Volume of every particle in d dimensions, V_d(r_i)."""
+        """Volume of every particle in d dimensions, V_d(r_i).
+
+        Parameters
+        ----------
+        d : int
+            Dimension.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N,)
+            The volumes.
+        """
         return ball_volume(self.radii, d)
 
     @property
@@ -132,7 +143,18 @@ class Spheres:
         return self.radii
 
     def take(self, index) -> Spheres:
-        """The particles ``index`` (an integer or boolean array), in that order."""
+        """The particles ``index`` (an integer or boolean array), in that order.
+
+        Parameters
+        ----------
+        index : int array_like or numpy.ndarray of bool, shape (N,)
+            Indices (repeats allowed) or a mask.
+
+        Returns
+        -------
+        Spheres
+            The selected particles.
+        """
         return Spheres(self.radii[index])
 
     def __repr__(self) -> str:
@@ -194,7 +216,18 @@ class Ellipsoids:
         return "hard ellipses" if self.dim == 2 else "hard ellipsoids"
 
     def volumes(self, d: int) -> np.ndarray:
-        """Volume of every particle, V_d(1) prod_k a_k (pi a b in 2D, 4/3 pi a b c in 3D)."""
+        """Volume of every particle, V_d(1) prod_k a_k (pi a b in 2D, 4/3 pi a b c in 3D).
+
+        Parameters
+        ----------
+        d : int
+            Dimension (the shape's own, :attr:`dim`).
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N,)
+            The volumes.
+        """
         return unit_ball_volume(d) * np.prod(self.semiaxes, axis=1)
 
     @property
@@ -220,7 +253,18 @@ class Ellipsoids:
         return np.einsum("nki,nk,nkj->nij", q, self.semiaxes**-2.0, q)
 
     def take(self, index) -> Ellipsoids:
-        """The particles ``index`` (an integer or boolean array), in that order."""
+        """The particles ``index`` (an integer or boolean array), in that order.
+
+        Parameters
+        ----------
+        index : int array_like or numpy.ndarray of bool, shape (N,)
+            Indices (repeats allowed) or a mask.
+
+        Returns
+        -------
+        Ellipsoids
+            The selected particles with their semiaxes and orientations.
+        """
         return Ellipsoids(self.semiaxes[index], self.orientations[index])
 
     def __repr__(self) -> str:

@@ -58,7 +58,18 @@ class PairList:
         return self.distance / self.contact - 1.0
 
     def subset(self, mask) -> PairList:
-        """The pairs selected by ``mask`` (boolean (M,) or indices), in the same order."""
+        """The pairs selected by ``mask``, in the same order.
+
+        Parameters
+        ----------
+        mask : numpy.ndarray of bool, shape (M,), or of int
+            Selection (a boolean mask or indices) of the pairs.
+
+        Returns
+        -------
+        PairList
+            The selected pairs with all their arrays.
+        """
         return PairList(self.i[mask], self.j[mask], self.shift[mask], self.separation[mask],
                         self.distance[mask], self.contact[mask])
 
