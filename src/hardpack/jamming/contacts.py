@@ -105,7 +105,18 @@ class ContactArrays:
         return self.positions.shape[1]
 
     def among(self, active: np.ndarray | None) -> np.ndarray:
-        """Boolean mask of contacts whose both ends are ``active`` (all if None)."""
+        """Boolean mask of contacts whose both ends are ``active`` (all if None).
+
+        Parameters
+        ----------
+        active : numpy.ndarray of bool, shape (N,), or None
+            The particles kept.
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (M,)
+            True for the contacts between two active particles (a wall contact: its particle active).
+        """
         if active is None:
             return np.ones(self.n_contacts, dtype=bool)
         return active[self.i] & active[self.j]
@@ -197,14 +208,38 @@ class ContactNetwork(ContactArrays):
         return (self.i == self.j) & (self.wall < 0)
 
     def counts(self, active: np.ndarray | None = None) -> np.ndarray:
-        """Contacts per particle among ``active`` particles (a self-image contact counts twice:
-        the particle touches its image at +n and at -n; a wall contact once)."""
+        """Contacts per particle among ``active`` particles.
+
+        A self-image contact counts twice (the particle touches its image at +n and at -n), a wall
+        contact once.
+
+        Parameters
+        ----------
+        active : numpy.ndarray of bool, shape (N,), optional
+            Particles whose contacts count (contacts with both ends active); all if None.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (N,)
+            Contact number of every particle (0 for inactive ones).
+        """
         keep = self.among(active)
         n = self.n_particles
         return (np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep & (self.wall < 0)], minlength=n))
 
     def subset(self, mask: np.ndarray) -> ContactNetwork:
-        """The network of the contacts in ``mask`` (boolean (M,) or indices)."""
+        """The network of the contacts in ``mask``, in the same order.
+
+        Parameters
+        ----------
+        mask : numpy.ndarray of bool, shape (M,), or of int
+            Selection (a boolean mask or indices) of the contacts.
+
+        Returns
+        -------
+        ContactNetwork
+            The selected contacts, with the particle data (positions, lattice, delta, periodic axes, centre) unchanged.
+        """
         return ContactNetwork(
             i=self.i[mask], j=self.j[mask], shift=self.shift[mask], separation=self.separation[mask],
             distance=self.distance[mask], contact_distance=self.contact_distance[mask],

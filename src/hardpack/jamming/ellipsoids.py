@@ -193,7 +193,18 @@ class EllipsoidContacts(ContactArrays):
         return np.sqrt(np.maximum(self.zeta + 1.0, 0.0)) - 1.0
 
     def subset(self, mask) -> EllipsoidContacts:
-        """The network of the contacts in ``mask`` (boolean (M,) or indices)."""
+        """The network of the contacts in ``mask``, in the same order.
+
+        Parameters
+        ----------
+        mask : numpy.ndarray of bool, shape (M,), or of int
+            Selection (a boolean mask or indices) of the contacts.
+
+        Returns
+        -------
+        EllipsoidContacts
+            The selected contacts, with the particle data (positions, lattice, shapes, delta, container) unchanged.
+        """
         per = ("i", "j", "shift", "separation", "zeta", "lam", "normal", "raw_normal", "lever_i",
                "lever_j", "scale", "wall")
         kw = {k: getattr(self, k)[mask] for k in per}
@@ -202,8 +213,21 @@ class EllipsoidContacts(ContactArrays):
                                  centre=self.centre, radius=self.radius)
 
     def counts(self, active: np.ndarray | None = None) -> np.ndarray:
-        """Contacts per particle among ``active`` (a self-image contact counts twice, a wall contact
-        once)."""
+        """Contacts per particle among ``active`` particles.
+
+        A self-image contact counts twice (the particle touches its image at +n and at -n), a wall
+        contact once.
+
+        Parameters
+        ----------
+        active : numpy.ndarray of bool, shape (N,), optional
+            Particles whose contacts count (contacts with both ends active); all if None.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (N,)
+            Contact number of every particle (0 for inactive ones).
+        """
         keep = self.among(active)
         n = self.n_particles
         return np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep & (self.wall < 0)], minlength=n)

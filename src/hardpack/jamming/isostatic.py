@@ -84,6 +84,23 @@ class RigidBackbone:
 
     @classmethod
     def build(cls, net: ContactNetwork, backbone: np.ndarray) -> RigidBackbone | None:
+        """Factorise the backbone ``backbone`` of ``net`` and find its self-stresses (module docstring).
+
+        Parameters
+        ----------
+        net : ContactNetwork
+            The contact network of the packing.
+        backbone : numpy.ndarray of bool, shape (N,)
+            The backbone particles; its contacts are those of ``net`` among them.
+
+        Returns
+        -------
+        RigidBackbone or None
+            None (the callers use HiGHS) unless the backbone is rigid with 1 <= K <= MAX_SELF_STRESSES
+            self-stresses (K = M_b - N_f), a regular square subsystem is found (four random choices
+            of the removed columns), the self-stress basis is accurate, and a strictly positive
+            self-stress exists; also None for a container backbone on which not every rotation acts.
+        """
         d = net.dim
         contacts = net.among(backbone)
         m, nb = int(contacts.sum()), int(backbone.sum())
@@ -128,8 +145,25 @@ class RigidBackbone:
         return self.null.shape[1]
 
     def optimum(self, load: np.ndarray, d: int, box: float) -> tuple[np.ndarray, np.ndarray] | None:
-        """Optimal vertex of LP (4.10) for ``load`` (N, d): (displacement (N, d), forces (M,)),
-        or None when the vertex is degenerate or leaves the box (use HiGHS then)."""
+        """Optimal vertex of LP (4.10) of Donev 2006 for ``load``, through the self-stress space.
+
+        Parameters
+        ----------
+        load : numpy.ndarray of float, shape (N, d)
+            The load B on every particle (only the free coordinates are used).
+        d : int
+            Dimension.
+        box : float
+            Bound on every displacement component; a vertex beyond it is refused.
+
+        Returns
+        -------
+        tuple of (numpy.ndarray, numpy.ndarray) or None
+            (displacement (N, d), zero on the coordinates without variables; forces (M_b,) on the
+            backbone contacts, >= 0), or None when the LP in the self-stress coordinates fails, the
+            vertex is degenerate or leaves the box, or the slacks of the open contacts come out
+            singular or negative (use HiGHS then).
+        """
         m = self.f0.size
         y = np.zeros(m)
         rest = np.setdiff1d(np.arange(m), self.removed)
@@ -185,8 +219,27 @@ class RigidBackbone:
 
     def strain_mode(self, net: ContactNetwork, strain_load: np.ndarray, box: float,
                     cell_length: float) -> tuple[np.ndarray, np.ndarray] | None:
-        """A first-order floppy motion (dR, eps) with Tr eps = 0 along the random strain load,
-        or None when no strain is orthogonal to the trace and to every self-stress's stress."""
+        """A first-order floppy motion (dR, eps) with Tr eps = 0 along the random strain load, or None
+        when no strain is orthogonal to the trace and to every self-stress's stress (module docstring).
+
+        Parameters
+        ----------
+        net : ContactNetwork
+            The network the backbone was built from.
+        strain_load : numpy.ndarray of float, shape (d(d+1)/2,)
+            The random strain load, in the component order of
+            :func:`hardpack.jamming.rigidity.strain_pairs`.
+        box : float
+            LP box: the projected strain is scaled so that its largest component is box / cell_length.
+        cell_length : float
+            Scale L of the strain bound (:func:`hardpack.jamming.ideal.cell_length`).
+
+        Returns
+        -------
+        tuple of (numpy.ndarray, numpy.ndarray) or None
+            (displacement dR (N, d), zero on the coordinates without variables; strain eps (d, d),
+            symmetric and traceless), or None.
+        """
         d = net.dim
         coef = strain_coefficients(net)[self.contacts]  # (M, s): A_eps^T
         trace = np.array([1.0 if p == q else 0.0 for p, q in strain_pairs(d)])

@@ -51,6 +51,13 @@ class ForceComparison:
     md_virial_fraction: float  # share of the MD collisional virial carried by matched contacts
 
     def as_attrs(self) -> dict:
+        """The comparison as dataset attributes.
+
+        Returns
+        -------
+        dict
+            Every field, keyed ``md_force_<field>``.
+        """
         return {f"md_force_{k}": v for k, v in self.__dict__.items()}
 
 

@@ -29,7 +29,20 @@ class Verdict(enum.IntEnum):
 
     @classmethod
     def of(cls, jammed: bool | None, undetermined: bool = False) -> Verdict:
-        """The code of a verdict (``jammed`` None: the test was not run)."""
+        """The code of a verdict (``jammed`` None: the test was not run).
+
+        Parameters
+        ----------
+        jammed : bool or None
+            The test's verdict, None if it was not run.
+        undetermined : bool, default False
+            The test ran but could not decide; takes precedence over ``jammed``.
+
+        Returns
+        -------
+        Verdict
+            UNDETERMINED, NOT_RUN, JAMMED or NOT_JAMMED.
+        """
         if undetermined:
             return cls.UNDETERMINED
         return cls.NOT_RUN if jammed is None else cls.JAMMED if jammed else cls.NOT_JAMMED
@@ -157,10 +170,23 @@ class JammingResult:
         return float(self.statics.pressure_free_volume / self.md_pressure)
 
     def unjamming(self, test: str) -> dict:
-        """Size of the unjamming motion a test found, in mean diameters (0 when none): mean and
-        max of |dr_i| over the particles and the 2-norm of the strain. Ideal test: the first
-        motion that displaced something (LP rays stop at the box, so the size is the box's);
-        sequential test: the largest mean displacement over the loading sequences."""
+        """Size of the unjamming motion a test found, in mean diameters (0 when none).
+
+        Ideal test: the first motion that displaced something (LP rays stop at the box, so the size is
+        the box's); sequential test: the largest mean and largest maximum displacement over the
+        loading sequences, and the strain of the sequence with the largest mean displacement.
+
+        Parameters
+        ----------
+        test : str
+            "collective"; any other value means the strict test.
+
+        Returns
+        -------
+        dict
+            ``mean`` and ``max`` of |dr_i| over the particles, in mean diameters, and ``strain``, the
+            2-norm of the strain tensor (0 without strain); empty when the test was not run.
+        """
         out = self.collective_test if test == "collective" else self.strict_test
         if out is None:
             return {}

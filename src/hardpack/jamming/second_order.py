@@ -985,6 +985,14 @@ class EllipsoidJammingResult:
         return self.collective.n_constraints - self.collective.n_dof
 
     def summary(self) -> str:
+        """A few human-readable lines: the verdict and the order that decided it, counts, degrees of
+        freedom, self-stresses and floppy modes, wall contacts, the near self-stress and fallbacks.
+
+        Returns
+        -------
+        str
+            The lines, joined by newlines.
+        """
         c = self.collective
         nb = int(self.backbone.sum())
         lines = [

@@ -179,8 +179,19 @@ class SequentialOutcome:
     fallbacks: Counter = field(default_factory=Counter)  # hardpack.jamming.highs.FALLBACKS
 
     def size(self, sequence: int) -> float:
-        """How far loading sequence ``sequence`` unjammed the packing, compared with the
-        threshold (module docstring): the larger of its mean displacement / D and its strain."""
+        """How far loading sequence ``sequence`` unjammed the packing, compared with the threshold
+        (module docstring): the larger of its mean displacement / D and its strain.
+
+        Parameters
+        ----------
+        sequence : int
+            Index of the loading sequence.
+
+        Returns
+        -------
+        float
+            max(mean |dr_i| / D, |eps|_2) of that sequence.
+        """
         return max(self.mean_displacement[sequence], self.strain_norm[sequence])
 
     @property

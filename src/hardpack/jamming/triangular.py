@@ -72,7 +72,18 @@ class BlockSolver:
         self.perm_r, self.perm_c = lu.perm_r, lu.perm_c
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """x with A x = b, for b of shape (n, k)."""
+        """x with A x = b, by forward and backward substitution with the factors, BLOCK columns at a time.
+
+        Parameters
+        ----------
+        b : numpy.ndarray of float, shape (n, k)
+            Right-hand sides as columns.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (n, k)
+            The solutions.
+        """
         n, k = b.shape
         out = np.empty((n, k))
         for start in range(0, k, BLOCK):

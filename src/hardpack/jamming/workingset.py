@@ -152,11 +152,45 @@ class WarmStart:
 
     @classmethod
     def of(cls, sol: WorkingSetSolution, keys: np.ndarray) -> WarmStart:
+        """The warm start of an LP's optimum.
+
+        Parameters
+        ----------
+        sol : WorkingSetSolution
+            The optimum of :func:`solve_working_set`.
+        keys : numpy.ndarray of int, shape (M, 2 + d)
+            Keys (i, j, lattice image n) of that LP's M contact columns.
+
+        Returns
+        -------
+        WarmStart
+            Its basis and working set by column identity.
+        """
         return cls.from_columns(sol.basis, sol.working, keys, sol.x.size)
 
     @classmethod
     def from_columns(cls, b: np.ndarray, w: np.ndarray, keys: np.ndarray, n: int) -> WarmStart:
-        """From unified column indices (basis b, working set w) of an LP with n variables."""
+        """From unified column indices (basis b, working set w) of an LP with n variables.
+
+        Unified indices: 0..M-1 the contact columns, M + k the box column -e_k, M + n + k the box
+        column +e_k.
+
+        Parameters
+        ----------
+        b : numpy.ndarray of int
+            Unified indices of the basis.
+        w : numpy.ndarray of int
+            Unified indices of the working set.
+        keys : numpy.ndarray of int, shape (M, 2 + d)
+            Keys (i, j, lattice image n) of the contact columns.
+        n : int
+            Number of variables.
+
+        Returns
+        -------
+        WarmStart
+            The columns by identity.
+        """
         m = keys.shape[0]
 
         def box(idx):  # signed variable numbers: -(k+1) for -e_k, k+1 for +e_k
@@ -166,11 +200,22 @@ class WarmStart:
         return cls(keys[b[b < m]], box(b), keys[w[w < m]], box(w))
 
     def rewrapped(self, wraps: np.ndarray) -> WarmStart:
-        """The same columns after the particles were wrapped back into the cell by the integer
-        lattice vectors ``wraps`` (N, d): x_i -> x_i - lattice @ w_i. A contact key (i, j, n)
-        (``keys`` of :func:`hardpack.jamming.lp.solve_motion`: separation x_j + lattice @ n - x_i)
-        becomes (i, j, n + w_j - w_i); keys with i < 0 (the trace column) or j < 0 (a wall
-        contact) stay."""
+        """The same columns after the particles were wrapped back into the cell.
+
+        The particles moved by x_i -> x_i - lattice @ w_i. A contact key (i, j, n) (``keys`` of
+        :func:`hardpack.jamming.lp.solve_motion`: separation x_j + lattice @ n - x_i) becomes
+        (i, j, n + w_j - w_i); keys with i < 0 (the trace column) or j < 0 (a wall contact) stay.
+
+        Parameters
+        ----------
+        wraps : numpy.ndarray of int, shape (N, d)
+            The integer lattice vectors w_i.
+
+        Returns
+        -------
+        WarmStart
+            The moved keys; the box columns unchanged.
+        """
 
         def moved(keys):
             keys = keys.copy()
@@ -182,8 +227,22 @@ class WarmStart:
         return WarmStart(moved(self.basis_keys), self.basis_box, moved(self.working_keys), self.working_box)
 
     def locate(self, keys: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-        """(basis, working) as unified indices into the columns with these ``keys`` and n
-        variables (box columns of variables beyond n are dropped)."""
+        """(basis, working) as unified indices into the columns with these ``keys`` and n variables.
+
+        Contact columns absent from ``keys`` and box columns of variables beyond n are dropped.
+
+        Parameters
+        ----------
+        keys : numpy.ndarray of int, shape (M, 2 + d)
+            Keys of the new LP's contact columns.
+        n : int
+            Number of variables of the new LP.
+
+        Returns
+        -------
+        tuple of numpy.ndarray of int
+            Unified indices (as :meth:`from_columns`) of the basis and of the working set.
+        """
         m = keys.shape[0]
 
         def box(signed):
