@@ -126,7 +126,23 @@ class StopCriteria:
     max_wall_time: float | None = None
 
     def check(self, growth_rate: float, phi: float) -> None:
-        """Refuse impossible or never-ending combinations for this growth rate and start phi."""
+        """Refuse impossible or never-ending combinations for this growth rate and start phi.
+
+        Parameters
+        ----------
+        growth_rate : float
+            The run's growth rate Gamma (> 0 grows, < 0 shrinks, 0 fixed size).
+        phi : float
+            Volume fraction at the start.
+
+        Raises
+        ------
+        InvalidInputError
+            If a criterion is out of range (max_pressure not finite and > 1, target_phi outside
+            (0, 1), max_collisions not a positive integer, max_wall_time not positive); if growing
+            with target_phi not above phi or with no criterion at all; if shrinking without a
+            target_phi below phi; or at growth rate 0 without max_collisions or max_wall_time.
+        """
         if self.max_pressure is not None and not (math.isfinite(self.max_pressure) and self.max_pressure > 1):
             raise InvalidInputError(f"max_pressure must be a finite number > 1, got {self.max_pressure!r}")
         if self.target_phi is not None and not 0 < self.target_phi < 1:
@@ -207,7 +223,18 @@ class CompressResult:
         return packing_to_dataset(self.packing, self.stats, extra)
 
     def save(self, packing_path, timeseries_path=None, config=None):
-        """Write :meth:`to_dataset` and optionally the time series, atomically with provenance."""
+        """Write :meth:`to_dataset` and optionally the time series, atomically with provenance
+        (the seed of ``stats`` included).
+
+        Parameters
+        ----------
+        packing_path : str or os.PathLike
+            netCDF file of the final packing.
+        timeseries_path : str or os.PathLike, optional
+            netCDF file of :attr:`timeseries`; not written if None.
+        config : object, optional
+            Run parameters recorded as provenance (:func:`hardpack.io.write_dataset`).
+        """
         write_dataset(self.to_dataset(), packing_path, config=config, seed=self.stats.get("seed"))
         if timeseries_path is not None:
             write_dataset(self.timeseries, timeseries_path, config=config, seed=self.stats.get("seed"))

@@ -57,8 +57,19 @@ class ContactAccumulator:
         self.tables: deque = deque()  # (keys, sums (m, d + 1), counts, ke_integral, duration)
 
     def add(self, pairs: np.ndarray, values: np.ndarray, duration: float, ke_integral: float) -> None:
-        """One window's collisions: ``pairs`` (M, 2) in the caller's order, ``values`` (M, d + 1)
-        = (impulse on pairs[:, 1], r . J); keeps the last ``windows`` windows."""
+        """Add one window's collisions; keeps the last ``windows`` windows.
+
+        Parameters
+        ----------
+        pairs : numpy.ndarray of int, shape (M, 2)
+            The colliding pairs, in the caller's particle order.
+        values : numpy.ndarray of float, shape (M, d + 1)
+            Per collision, the impulse J on particle ``pairs[:, 1]`` (d entries) and r . J.
+        duration : float
+            MD time of the window.
+        ke_integral : float
+            Time integral of the total kinetic energy over the window.
+        """
         i, j = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
         sign = np.where(i < j, 1.0, -1.0)
         vals = values.copy()
@@ -71,6 +82,14 @@ class ContactAccumulator:
 
     # ----------------------------------------------------------------- checkpoint state
     def state(self) -> dict:
+        """The kept windows as flat arrays, for a checkpoint (:meth:`restore`).
+
+        Returns
+        -------
+        dict of numpy.ndarray
+            ``cf_window``, ``cf_key``, ``cf_sum`` (rows of d + 1), ``cf_count`` per pair and window,
+            and ``cf_ke_integral`` and ``cf_duration`` per window.
+        """
         t = list(self.tables)
         width = self.d + 1
         return {
@@ -82,6 +101,13 @@ class ContactAccumulator:
         }
 
     def restore(self, state: dict) -> None:
+        """Load a :meth:`state`, replacing the windows kept.
+
+        Parameters
+        ----------
+        state : dict
+            The arrays of :meth:`state` (e.g. read back from a checkpoint).
+        """
         win = np.asarray(state["cf_window"]).reshape(-1)
         key = np.asarray(state["cf_key"], dtype=np.int64).reshape(-1)
         sums = np.asarray(state["cf_sum"], dtype=float).reshape(-1, self.d + 1)
@@ -95,9 +121,22 @@ class ContactAccumulator:
 
     # ----------------------------------------------------------------- result
     def result(self, packing: Packing) -> xr.Dataset:
-        """The contact forces of the accumulated windows for the final ``packing`` (module
-        docstring): variables md_contact_{i, j, shift, force, virial, collisions} on dimension
-        ``md_contact`` and the window totals as attributes."""
+        """The contact forces of the accumulated windows for the final ``packing`` (module docstring).
+
+        Parameters
+        ----------
+        packing : Packing
+            The final packing, in the particle order of :meth:`add`; the shifts n are taken from
+            the diagonal of its lattice (an orthorhombic cell).
+
+        Returns
+        -------
+        xarray.Dataset
+            Variables md_contact_{i, j, collisions} on dimension ``md_contact`` and md_contact_{shift,
+            force} on (``md_contact``, ``dim``), md_contact_virial; attributes md_contact_windows,
+            md_contact_duration, md_contact_kT_mean, md_contact_Z and md_contact_total_collisions.
+            Forces, virials and Z are NaN when no kinetic energy was accumulated.
+        """
         n, d = self.n, self.d
         t = list(self.tables)
         if t:

@@ -386,6 +386,13 @@ class DeformingSimulation:
         return abs(float(np.linalg.det(self.H)))
 
     def phi(self) -> float:
+        """Volume fraction V_d(1) sum_i a_i^d / V of the current radii in the current cell.
+
+        Returns
+        -------
+        float
+            phi.
+        """
         return unit_ball_volume(self.d) * float(np.sum(self.A ** self.d)) / self.volume
 
     def packing(self) -> Packing:
@@ -415,7 +422,36 @@ class DeformingSimulation:
     def run_window(self, coll_target: int, max_time: float = np.inf) -> dict:
         """Run one window of about ``coll_target`` collisions (and at most ``max_time`` MD time)
         in the current cell, measure the stress, rescale velocities (growing runs), deform the
-        cell; returns the window record."""
+        cell (module docstring, steps 1-7).
+
+        Parameters
+        ----------
+        coll_target : int
+            Collisions asked for: the first window ends after ``coll_target`` collisions (or a time
+            cap), the later ones at a time cap (the previous window's time per collision times
+            ``coll_target``, at most twice its duration) or after BUDGET_SLACK ``coll_target``
+            collisions.
+        max_time : float, default inf
+            Longest MD time of the window.
+
+        Returns
+        -------
+        dict
+            The window record (keys RECORD_FIELDS), also appended to :attr:`records`: ``time``,
+            ``phi``, ``Z`` (inf when no time elapsed), ``collisions`` (total), ``kT_mean``,
+            ``volume``, ``pressure`` p = tr(sigma) / d (units of kT_mean / length^d), ``shear``
+            |sigma - p I| / p, ``strain_step`` |s E| and ``step_fraction`` s of the cell map,
+            ``mobility``, ``exits``, ``wall_time`` and ``growth_rate``.
+
+        Raises
+        ------
+        OverlapError
+            If a pair overlaps by more than the overlap tolerance at the end of the window.
+        InvalidInputError
+            If a particle grew to touch its own periodic image.
+        RuntimeError
+            If no event can ever happen or the event loop stalls.
+        """
         start = time.perf_counter()
         n, d = self.n, self.d
         self._reduce_cell()
@@ -526,7 +562,19 @@ class DeformingSimulation:
         self.V *= math.sqrt(self.d * self.n / (2.0 * ke))
 
     def imbalance(self, sigma: np.ndarray) -> np.ndarray:
-        """(sigma - P0 I) / max(p, P0), symmetric; traceless in the shape-only mode."""
+        """(sigma - P0 I) / max(p, P0), symmetric; traceless in the shape-only mode.
+
+        Parameters
+        ----------
+        sigma : numpy.ndarray of float, shape (d, d)
+            Measured stress tensor; p = tr(sigma) / d, and P0 the applied pressure (p in the
+            shape-only mode, ``applied_pressure`` None).
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (d, d)
+            The relative stress imbalance.
+        """
         d = self.d
         p = float(np.trace(sigma)) / d
         p0 = p if self.applied_pressure is None else float(self.applied_pressure)
@@ -538,7 +586,15 @@ class DeformingSimulation:
 
     def update_mobility(self, sigma: np.ndarray, z: float) -> None:
         """Adapt the mobility from the mean imbalances of the last two blocks of windows while
-        the particles grow in the shape-only mode; otherwise m = 1 (module docstring, step 2)."""
+        the particles grow in the shape-only mode; otherwise m = 1 (module docstring, step 2).
+
+        Parameters
+        ----------
+        sigma : numpy.ndarray of float, shape (d, d)
+            The window's stress tensor.
+        z : float
+            The window's reduced pressure Z; bounds the mobility by max(Z, 1) / cell_step.
+        """
         if not (self.adaptive_cell and self.applied_pressure is None and self.growth_rate > 0):
             self.mobility, self.block_sum, self.block_count, self.last_block = 1.0, 0.0, 0, None
             return
@@ -555,7 +611,21 @@ class DeformingSimulation:
         self.last_block, self.block_sum, self.block_count = mean, 0.0, 0
 
     def strain(self, sigma: np.ndarray, z: float) -> np.ndarray:
-        """The window's strain E (module docstring, step 2), capped at MAX_STRAIN."""
+        """The window's strain E (module docstring, step 2), capped at MAX_STRAIN.
+
+        Parameters
+        ----------
+        sigma : numpy.ndarray of float, shape (d, d)
+            The window's stress tensor.
+        z : float
+            The window's reduced pressure Z (values below 1 count as 1).
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (d, d)
+            E = cell_step m / max(Z, 1) :meth:`imbalance`, scaled down to Frobenius norm
+            MAX_STRAIN if larger.
+        """
         e = self.cell_step * self.mobility / max(z, 1.0) * self.imbalance(sigma)
         norm = float(np.linalg.norm(e))
         return e * (MAX_STRAIN / norm) if norm > MAX_STRAIN else e
@@ -657,6 +727,13 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         return ek.columns(self.d)[k]
 
     def mean_diameter(self) -> float:
+        """Mean bounding diameter, twice the mean largest semiaxis.
+
+        Returns
+        -------
+        float
+            The mean bounding diameter.
+        """
         return 2.0 * float(self.P[:, self._column(2)].mean())
 
     @property
@@ -671,11 +748,25 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         return self.P[:, cv:cv + self.d]
 
     def angular_velocities(self) -> np.ndarray:
+        """Lab-frame angular velocities, in the packing's particle order.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N, 3) in 3D, (N,) in 2D
+            A copy.
+        """
         cw, cii = self._column(5), self._column(6)
         w = self.P[:, cw:cii].copy()
         return w[:, 0] if self.d == 2 else w
 
     def phi(self) -> float:
+        """Volume fraction V_d(1) sum_i prod_k a_ik / V of the current semiaxes in the current cell.
+
+        Returns
+        -------
+        float
+            phi.
+        """
         return unit_ball_volume(self.d) * float(np.sum(np.prod(self.semiaxes, axis=1))) / self.volume
 
     def packing(self) -> Packing:

@@ -158,6 +158,13 @@ class EllipsoidSimulation(Simulation):
                                f"of its largest semiaxis > tolerance {self.overlap_tol:g}")
 
     def angular_velocities(self) -> np.ndarray:
+        """Lab-frame angular velocities in the caller's particle order.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N, 3) in 3D, (N,) in 2D
+            A copy.
+        """
         return self.engine.angular_velocities[self._inverse()].copy()
 
     def state(self) -> dict:
@@ -166,13 +173,54 @@ class EllipsoidSimulation(Simulation):
         return super().state() | {"rescalings": self.engine.rescalings.copy()}
 
     def restore(self, state: dict) -> None:
-        """Load a :meth:`state` (a checkpoint without thermostat counts starts them at 0)."""
+        """Load a :meth:`state` (a checkpoint without thermostat counts starts them at 0).
+
+        Parameters
+        ----------
+        state : dict
+            The arrays and scalars of :meth:`state`, from a run of the same system.
+
+        Raises
+        ------
+        InvalidInputError
+            If the state is of another system size.
+        """
         super().restore(state)
         self.engine.rescalings[:] = np.asarray(state.get("rescalings", np.zeros(3)), dtype=np.int64)
 
     def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
         """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the
-        translational temperature 2 KE_trans / (d N), at the end of the window and averaged over it."""
+        translational temperature 2 KE_trans / (d N), at the end of the window and averaged over it.
+
+        Parameters
+        ----------
+        coll_target : int
+            Most collisions in the window.
+        target_phi : float, optional
+            Volume fraction at which the window ends exactly, if the growth reaches it first (ignored
+            without growth or when phi moves away from it).
+
+        Returns
+        -------
+        dict
+            The window record, also appended to :attr:`records`: ``time`` (MD time since the start),
+            ``phi``, ``Z`` = pV / (NkT) from the collision virial (inf when no time elapsed),
+            ``phi_J_est`` = phi / (1 - d / Z), ``collisions`` and ``events`` (totals), ``kT`` (at the
+            end, before the rescaling) and ``kT_mean`` (over the window), ``stale``, ``exits``,
+            ``grazing``, ``max_overlap``, ``shell``, ``neighbours``, ``wall_time``, ``growth_rate``,
+            ``virial``, ``ke_integral``, and ``Z_wall`` (pressure on the walls, NaN in a periodic cell)
+            and ``wall_collisions`` (these two enter :attr:`records` only with walls).
+
+        Raises
+        ------
+        OverlapError
+            If a pair overlaps, or a particle crosses a wall, by more than the overlap tolerance at
+            the end of the window.
+        InvalidInputError
+            If the periodic box is too small for the particles.
+        RuntimeError
+            If no event can ever happen, or the event loop stalls (ellipsoids).
+        """
         record = super().run_window(coll_target, target_phi)
         return record
 
@@ -215,7 +263,18 @@ class EllipsoidCompressResult:
         return packing_to_dataset(self.packing, attrs=self.stats, extra=extra)
 
     def save(self, packing_path, timeseries_path=None, config=None):
-        """Write the packing (stats as attributes) and optionally the time series."""
+        """Write the packing (stats as attributes) and optionally the time series, atomically with
+        provenance; the velocities are not written (:meth:`to_dataset` has them).
+
+        Parameters
+        ----------
+        packing_path : str or os.PathLike
+            netCDF file of the final packing.
+        timeseries_path : str or os.PathLike, optional
+            netCDF file of :attr:`timeseries`; not written if None.
+        config : object, optional
+            Run parameters recorded as provenance (:func:`hardpack.io.write_dataset`).
+        """
         from hardpack.io import save_packing, write_dataset
 
         save_packing(self.packing, packing_path, attrs=self.stats, config=config, seed=self.stats.get("seed"))

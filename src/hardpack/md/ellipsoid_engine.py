@@ -159,6 +159,13 @@ class EllipsoidEngine(Engine):
         return float(ket), float(ker)
 
     def momentum(self) -> np.ndarray:
+        """Total translational momentum sum_i v_i (unit masses).
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (d,)
+            The momentum.
+        """
         return self.velocities.sum(axis=0)
 
     def kinetic_temperature(self) -> float:

@@ -218,7 +218,13 @@ class Engine:
     def init_event_state(self, capacity: int) -> None:
         """Arrays of the event loop (collision counters, predicted partners, heap, bounding
         spheres, neighbour lists of ``capacity`` entries, grid slots), shared by the sphere and
-        ellipsoid engines; the lists and grid are built at the first window."""
+        ellipsoid engines; the lists and grid are built at the first window.
+
+        Parameters
+        ----------
+        capacity : int
+            Neighbour-list entries per particle (doubled on overflow).
+        """
         n, d = self.n, self.d
         self.cnt = np.zeros(n, dtype=np.int32)  # 32-bit integers: less memory traffic
         self.ep = np.zeros(n, dtype=np.int32)
@@ -256,6 +262,13 @@ class Engine:
         return float(ke), float(s1), float(sd)
 
     def kinetic_energy(self) -> float:
+        """Total kinetic energy sum_i v_i^2 / 2 (unit masses; the translational one for ellipsoids).
+
+        Returns
+        -------
+        float
+            The kinetic energy.
+        """
         return self.totals()[0]
 
     def sort_spatially(self) -> np.ndarray:
@@ -271,20 +284,47 @@ class Engine:
         return order
 
     def neighbours(self, i: int) -> tuple[np.ndarray, np.ndarray]:
-        """Neighbour-list entries of particle i: partner indices and lattice shifts (k, d)."""
+        """Neighbour-list entries of particle i (in the engine's order).
+
+        Parameters
+        ----------
+        i : int
+            Particle index.
+
+        Returns
+        -------
+        partners : numpy.ndarray of int64, shape (k,)
+            Partner indices.
+        shifts : numpy.ndarray of int64, shape (k, d)
+            Lattice shift n of each partner's image (the image code decoded by :func:`image_shifts`).
+        """
         e = self.nb[i, : self.nn[i]].astype(np.int64)
         return e >> (2 * self.d), image_shifts(e & ((1 << 2 * self.d) - 1), self.d)
 
     # ----------------------------------------------------------------- set-up helpers
     def alloc_lists(self, capacity: int) -> None:
         """Neighbour lists of entries j << 2d | image code: int32 (half the memory traffic) while
-        N 4^d fits, int64 beyond (e.g. N > 5.2e5 in d = 6)."""
+        N 4^d fits, int64 beyond (e.g. N > 5.2e5 in d = 6).
+
+        Parameters
+        ----------
+        capacity : int
+            Entries per particle; the lists are zeroed (invalid until the next rebuild).
+        """
         self.capacity = int(capacity)
         dtype = np.int32 if self.n * 4**self.d < 2**31 else np.int64
         self.nb = np.zeros((self.n, self.capacity), dtype=dtype)
 
     def alloc_cells(self, capacity: int) -> None:
-        """Slots for ``capacity`` bounding spheres per grid cell (centre and radius copies)."""
+        """Slots for ``capacity`` bounding spheres per grid cell (centre and radius copies).
+
+        The grid (its cell offsets) must exist: called when the bounds are set up for a rebuild.
+
+        Parameters
+        ----------
+        capacity : int
+            Bounding spheres per cell.
+        """
         ncells = int(self.coff[-1])
         self.cell_capacity = int(capacity)
         self.ccount = np.zeros(ncells, dtype=np.int32)
@@ -368,11 +408,41 @@ class Engine:
         (``rebuild``), after a spatial sort, or when the particles have grown too close to the
         bounding-radius cap (or the requested skin exceeds what the cap allows). Every
         decision depends only on the state, so a restarted run repeats it exactly.
-        ``log``: optional (pairs (M, 2) int32, values (M, d + 1)) arrays, M >= coll_target, that
-        receive the window's collisions (:func:`hardpack.md._kernel.run_events`).
 
         The event kernel itself is called by :meth:`_run_events` and the result read by
         :meth:`_window_result`, the two places where the sphere and ellipsoid engines differ.
+
+        Parameters
+        ----------
+        kappa : float
+            Relative growth rate (da_i/dt) / a_i at the window start (< 0 shrinks; the window then
+            ends before t = 0.5 / -kappa).
+        skin : float
+            Requested skin of the bounding spheres (length; scaled per particle by
+            :meth:`skin_factors` and capped by the grid).
+        coll_target : int
+            Most collisions in the window.
+        t_cap : float
+            Longest window time (inf: none).
+        rebuild : bool, default False
+            Force a complete rebuild of the lists and grid.
+        log : tuple of numpy.ndarray, optional
+            (pairs (M, 2) int32, values (M, d + 1)) arrays, M >= coll_target, that receive the
+            window's collisions (:func:`hardpack.md._kernel.run_events`); not implemented for
+            ellipsoids.
+
+        Returns
+        -------
+        WindowResult
+            Duration, virial, kinetic energies, counts and the end-of-window overlap check.
+
+        Raises
+        ------
+        InvalidInputError
+            If the periodic box is too small for the particles (a complete rebuild).
+        RuntimeError
+            If no event can ever happen, or (ellipsoids, :class:`EngineStalledError`) the event
+            loop stalls; the state is then back at the window start.
         """
         if not rebuild and self.lists_valid:
             eff_skin = min(skin, self._room())
@@ -447,6 +517,12 @@ class Engine:
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:
-        """Scale all velocities so that kT = 2 KE / (d N) equals ``kt`` (Donev 2006, sec. 3.2.4.1)."""
+        """Scale all velocities so that kT = 2 KE / (d N) equals ``kt`` (Donev 2006, sec. 3.2.4.1).
+
+        Parameters
+        ----------
+        kt : float, default 1.0
+            Target kinetic temperature (m = 1).
+        """
         ke = self.kinetic_energy()
         self.P[:, self.d: 2 * self.d] *= np.sqrt(self.d * self.n * kt / (2.0 * ke))

@@ -214,6 +214,13 @@ class Simulation:
         return area
 
     def phi(self) -> float:
+        """Volume fraction V_d(1) sum_i a_i^d / V of the current radii (V: the box, or the container).
+
+        Returns
+        -------
+        float
+            phi.
+        """
         return unit_ball_volume(self.d) * self.engine.totals()[2] / self.volume
 
     def packing(self) -> Packing:
@@ -229,6 +236,13 @@ class Simulation:
                        boundary=self.boundary, overlap_tol=self.overlap_tol)
 
     def velocities(self) -> np.ndarray:
+        """Velocities in the caller's particle order.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N, d)
+            A copy.
+        """
         inv = np.empty(self.n, dtype=np.int64)
         inv[self.perm] = np.arange(self.n)
         return self.engine.velocities[inv].copy()
@@ -236,7 +250,39 @@ class Simulation:
     # ----------------------------------------------------------------- one window
     def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
         """Run one window of at most ``coll_target`` collisions (ending exactly when the volume
-        fraction reaches ``target_phi`` if that comes first), synchronise, measure, rescale."""
+        fraction reaches ``target_phi`` if that comes first), synchronise, measure, rescale.
+
+        The velocities are rescaled to kT = 1 at the end of a window of a growing or shrinking run.
+
+        Parameters
+        ----------
+        coll_target : int
+            Most collisions in the window.
+        target_phi : float, optional
+            Volume fraction at which the window ends exactly, if the growth reaches it first (ignored
+            without growth or when phi moves away from it).
+
+        Returns
+        -------
+        dict
+            The window record, also appended to :attr:`records`: ``time`` (MD time since the start),
+            ``phi``, ``Z`` = pV / (NkT) from the collision virial (inf when no time elapsed),
+            ``phi_J_est`` = phi / (1 - d / Z), ``collisions`` and ``events`` (totals), ``kT`` (at the
+            end, before the rescaling) and ``kT_mean`` (over the window), ``stale``, ``exits``,
+            ``grazing``, ``max_overlap``, ``shell``, ``neighbours``, ``wall_time``, ``growth_rate``,
+            ``virial``, ``ke_integral``, and ``Z_wall`` (pressure on the walls, NaN in a periodic cell)
+            and ``wall_collisions`` (these two enter :attr:`records` only with walls).
+
+        Raises
+        ------
+        OverlapError
+            If a pair overlaps, or a particle crosses a wall, by more than the overlap tolerance at
+            the end of the window.
+        InvalidInputError
+            If the periodic box is too small for the particles.
+        RuntimeError
+            If no event can ever happen, or the event loop stalls (ellipsoids).
+        """
         start = time.perf_counter()
         eng = self.engine
         rebuild = self.since_sort >= SORT_EVERY
@@ -353,7 +399,18 @@ class Simulation:
         return out
 
     def restore(self, state: dict) -> None:
-        """Load a :meth:`state` saved by a run of the same system (checked by the caller)."""
+        """Load a :meth:`state` saved by a run of the same system (checked by the caller).
+
+        Parameters
+        ----------
+        state : dict
+            The arrays and scalars of :meth:`state`.
+
+        Raises
+        ------
+        InvalidInputError
+            If the state is of another system size.
+        """
         if state["P"].shape != self.engine.P.shape:
             raise InvalidInputError("checkpoint state does not match this system's size")
         self.engine.P[:] = state["P"]
