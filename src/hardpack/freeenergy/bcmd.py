@@ -84,7 +84,18 @@ class Neighbours:
     ratio: np.ndarray
 
     def active_end(self, dmu: float) -> np.ndarray:
-        """End of each row's prefix of pairs whose cells of radius (1 + dmu) R can overlap."""
+        """End of each row's prefix of pairs whose cells of radius (1 + dmu) R can overlap.
+
+        Parameters
+        ----------
+        dmu : float
+            Relative cell size Delta mu; entries with ratio <= 1 + dmu (up to a relative 1e-12) count.
+
+        Returns
+        -------
+        numpy.ndarray of int64, shape (N,)
+            For particle i, the active entries are start[i]:end[i] (the rows are sorted by ratio).
+        """
         owner = np.repeat(np.arange(self.start.size - 1), np.diff(self.start))
         keep = self.ratio <= (1.0 + dmu) * (1.0 + 1e-12)
         counts = np.bincount(owner[keep], minlength=self.start.size - 1)

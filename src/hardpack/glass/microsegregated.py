@@ -353,7 +353,19 @@ class ExponentialFit:
         return self.s_ref * np.exp(-self.decay * (np.asarray(phi_j, float) - self.phi_ref))
 
     def to_attrs(self, prefix: str = "sc_fit_") -> dict:
-        """The fit as netCDF attributes (floats and the form), keys prefixed."""
+        """The fit as netCDF attributes (floats and the form), keys prefixed.
+
+        Parameters
+        ----------
+        prefix : str, default "sc_fit_"
+            Prefix of every key.
+
+        Returns
+        -------
+        dict
+            ``form``, ``phi_ref``, ``s_ref``, ``s_ref_err``, ``decay``, ``decay_err``,
+            ``correlation``, ``points`` (n_points) and ``rms_residual``, each with the prefix.
+        """
         values = {"form": self.FORM, "phi_ref": self.phi_ref, "s_ref": self.s_ref, "s_ref_err": self.s_ref_err,
                   "decay": self.decay, "decay_err": self.decay_err, "correlation": self.correlation,
                   "points": self.n_points, "rms_residual": self.rms_residual}
@@ -361,7 +373,20 @@ class ExponentialFit:
 
     @classmethod
     def from_attrs(cls, attrs, prefix: str = "sc_fit_"):
-        """The fit stored by :meth:`to_attrs`, or None when the attributes hold no fitted values."""
+        """The fit stored by :meth:`to_attrs`, or None when the attributes hold no fitted values.
+
+        Parameters
+        ----------
+        attrs : mapping
+            Attributes, e.g. of a summary dataset.
+        prefix : str, default "sc_fit_"
+            Prefix of the keys.
+
+        Returns
+        -------
+        ExponentialFit or None
+            None when a key is missing or ``s_ref`` is not finite (a fit that failed).
+        """
         keys = ("s_ref", "s_ref_err", "decay", "decay_err", "correlation", "phi_ref", "points", "rms_residual")
         if any(prefix + k not in attrs for k in keys) or not math.isfinite(float(attrs[prefix + "s_ref"])):
             return None

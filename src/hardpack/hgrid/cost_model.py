@@ -109,7 +109,27 @@ class PowerLawSystem:
             raise InvalidInputError("omega = 1 is monodisperse: only the single-level formula applies")
 
     def radius_moment(self, k: float, lo=1.0, hi=None):
-        """int_lo^hi r^k f(r) dr with the limits clipped to the support [1, omega]."""
+        """int_lo^hi r^k f(r) dr with the limits clipped to the support [1, omega].
+
+        Parameters
+        ----------
+        k : float
+            Power of r.
+        lo : float or array_like of float, default 1.0
+            Lower limits (units of r_min).
+        hi : float or array_like of float, optional
+            Upper limits; omega if None. An upper limit below the lower one gives 0.
+
+        Returns
+        -------
+        numpy.ndarray of float
+            The partial moments, of the broadcast shape of ``lo`` and ``hi`` (f normalised on [1, omega]).
+
+        Raises
+        ------
+        InvalidInputError
+            If omega = 1 (monodisperse).
+        """
         self._require_polydisperse()
         hi = self.omega if hi is None else hi
         lo_c, hi_c = np.clip(lo, 1.0, self.omega), np.clip(hi, 1.0, self.omega)
@@ -117,7 +137,23 @@ class PowerLawSystem:
         return _power_integral(k + self.alpha, lo_c, np.maximum(hi_c, lo_c)) / norm
 
     def cdf(self, r: float) -> float:
-        """F(r) = int_1^r f dr for a scalar r (Eq. 2.47), 0 below r_min and 1 above r_max."""
+        """F(r) = int_1^r f dr for a scalar r (Eq. 2.47), 0 below r_min and 1 above r_max.
+
+        Parameters
+        ----------
+        r : float
+            Radius in units of r_min.
+
+        Returns
+        -------
+        float
+            F(r).
+
+        Raises
+        ------
+        InvalidInputError
+            If omega = 1 (monodisperse).
+        """
         self._require_polydisperse()
         r = min(max(r, 1.0), self.omega)
         if abs(self.alpha + 1) < 1e-12:
@@ -143,13 +179,51 @@ class PowerLawSystem:
         return s
 
     def occupancy(self, cells) -> tuple[np.ndarray, np.ndarray]:
-        """(p_h, m_h) per level (Eqs. 2.17-2.19) for boundaries s_0..s_L."""
+        """(p_h, m_h) per level (Eqs. 2.17-2.19) for boundaries s_0..s_L.
+
+        Parameters
+        ----------
+        cells : array_like of float, shape (L + 1,)
+            Non-decreasing cell sizes s_0 = 2 .. s_L = 2 omega (units of r_min).
+
+        Returns
+        -------
+        p : numpy.ndarray of float, shape (L,)
+            Fraction of the particles on each level.
+        m : numpy.ndarray of float, shape (L,)
+            Mean number of the level's particles per level cell.
+
+        Raises
+        ------
+        InvalidInputError
+            If the boundaries are not as above, or omega = 1.
+        """
         s = self._check_cells(cells)
         p = self.radius_moment(0, s[:-1] / 2, s[1:] / 2)
         return p, self.nu * s[1:] ** self.d * p / self.particle_volume
 
     def cost(self, cells, K: float = 0.2, method: str = "top-down") -> float:
-        """Expected work per particle T/N, Eq. 2.35 with (2.31-2.34), for boundaries s_0..s_L."""
+        """Expected work per particle T/N, Eq. 2.35 with (2.31-2.34), for boundaries s_0..s_L.
+
+        Parameters
+        ----------
+        cells : array_like of float, shape (L + 1,)
+            Non-decreasing cell sizes s_0 = 2 .. s_L = 2 omega (units of r_min).
+        K : float, default 0.2
+            Cell access time over overlap-test time, >= 0.
+        method : {"top-down", "bottom-up"}, default "top-down"
+            Search direction across levels.
+
+        Returns
+        -------
+        float
+            T/N in units of one overlap test.
+
+        Raises
+        ------
+        InvalidInputError
+            If ``method`` is unknown, K is negative, the boundaries are not as above, or omega = 1.
+        """
         if method not in METHODS:
             raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
         if not (K >= 0):
@@ -181,7 +255,18 @@ class PowerLawSystem:
         return (2 * self.omega) ** self.d * self.nu / unit_ball_volume(self.d) * ratio
 
     def linked_cell_cost(self, K: float = 0.2) -> float:
-        """T/N of the single-level linked-cell method, (1/2 + n_c) m_1 + K (1 + n_c) (Eqs. 2.35, 2.39-2.40)."""
+        """T/N of the single-level linked-cell method, (1/2 + n_c) m_1 + K (1 + n_c) (Eqs. 2.35, 2.39-2.40).
+
+        Parameters
+        ----------
+        K : float, default 0.2
+            Cell access time over overlap-test time.
+
+        Returns
+        -------
+        float
+            T/N in units of one overlap test (omega = 1 allowed).
+        """
         nc = n_neighbour_cells(self.d)
         return (0.5 + nc) * self.linked_cell_m() + K * (1 + nc)
 

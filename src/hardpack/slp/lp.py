@@ -84,6 +84,23 @@ class Bounds:
             raise InvalidInputError("the strain bound must be positive, otherwise the cell cannot shrink")
 
     def scaled(self, s: float) -> "Bounds":
+        """The bounds multiplied by ``s``.
+
+        Parameters
+        ----------
+        s : float
+            Factor, > 0.
+
+        Returns
+        -------
+        Bounds
+            strain, shear and displacement times s.
+
+        Raises
+        ------
+        InvalidInputError
+            If the scaled bounds are invalid (s <= 0 or not finite).
+        """
         return Bounds(self.strain * s, self.shear * s, self.displacement * s)
 
 

@@ -58,6 +58,8 @@ class Target:
     tolerance : float
         Allowed |reproduced - published| before our own uncertainty is added (relative to the
         published value when ``relative``).
+    relative : bool
+        The tolerance is relative to |published|.
     tolerance_origin, tolerance_note
         Where the tolerance comes from (see ``targets.yaml``) and why.
     single_sample : bool
@@ -94,13 +96,39 @@ class Target:
     published_from: str | None = None
 
     def absolute_tolerance(self, published: float | None = None) -> float:
-        """The tolerance in the units of the quantity (relative ones scaled by |published|)."""
+        """The tolerance in the units of the quantity (relative ones scaled by |published|).
+
+        Parameters
+        ----------
+        published : float, optional
+            Published value to scale by; the target's own if None (e.g. a value evaluated from a fit).
+
+        Returns
+        -------
+        float
+            The tolerance.
+        """
         value = self.published if published is None else published
         return self.tolerance * abs(value) if self.relative else self.tolerance
 
     def not_applicable(self, n=None, seeds=None, sizes=None) -> str | None:
         """Why a measurement of ``n`` particles, ``seeds`` seeds and ``sizes`` distinct N cannot
-        be judged against this target, or None when it can."""
+        be judged against this target, or None when it can.
+
+        Parameters
+        ----------
+        n : int, optional
+            Particles (checked against min_n and max_n; not checked if None).
+        seeds : int, optional
+            Seeds (checked against min_seeds; not checked if None).
+        sizes : int, optional
+            Distinct system sizes (checked against min_sizes; not checked if None).
+
+        Returns
+        -------
+        str or None
+            The first reason, in words, or None.
+        """
         if n is not None and n < self.min_n:
             return f"N = {n} is below the N = {self.min_n} at which the tolerance means something"
         if n is not None and self.max_n is not None and n > self.max_n:
@@ -112,7 +140,21 @@ class Target:
         return None
 
     def covers(self, family: str, width: float) -> bool:
-        """True when the claim covers the distribution ``family`` at width ``width``."""
+        """True when the claim covers the distribution ``family`` at width ``width``.
+
+        Parameters
+        ----------
+        family : str
+            Distribution family (compared with ``domain["families"]``; any if absent).
+        width : float
+            Width of the distribution (compared with ``width_min``, ``width_max`` and
+            ``width_min_exclusive`` of ``domain``, where present).
+
+        Returns
+        -------
+        bool
+            Whether the target's domain holds the family and width.
+        """
         d = self.domain
         return (family in d.get("families", [family])
                 and width >= d.get("width_min", -math.inf) and width <= d.get("width_max", math.inf)
