@@ -192,15 +192,7 @@ class Discrete(Distribution):
     def moment(self, k: float) -> float:
         """Raw moment <a^k> = sum_s n_s a_s^k.
 
-        Parameters
-        ----------
-        k : float
-            Order of the moment (any real k; the radii are positive).
-
-        Returns
-        -------
-        float
-            <a^k>.
+        See :meth:`Distribution.moment` for the parameters and the return value.
         """
         r, f = np.asarray(self.radii), np.asarray(self.fractions)
         return float(np.sum(f * r**k))
@@ -208,15 +200,7 @@ class Discrete(Distribution):
     def ppf(self, q):
         """Quantile function: the radius of the first species whose cumulative fraction exceeds q.
 
-        Parameters
-        ----------
-        q : float or array_like of float
-            Cumulative number fractions, in [0, 1]; q = 1 gives the largest radius.
-
-        Returns
-        -------
-        numpy.ndarray of float
-            Species radii, of the shape of ``q``.
+        See :meth:`Distribution.ppf` for the parameters and the return value.
         """
         cum = np.cumsum(self.fractions)
         cum[-1] = 1.0
@@ -226,10 +210,7 @@ class Discrete(Distribution):
     def pdf(self, a):
         """A discrete mixture has no density: always raises.
 
-        Parameters
-        ----------
-        a : float or array_like of float
-            Radii (unused).
+        See :meth:`Distribution.pdf` for the parameters and the return value.
 
         Raises
         ------
@@ -261,10 +242,7 @@ class Discrete(Distribution):
     def params(self):
         """Parameters as a flat dict (stored in dataset attributes).
 
-        Returns
-        -------
-        dict
-            ``radii`` and ``fractions``, as lists in ascending order of radius.
+        See :meth:`Distribution.params` for the parameters and the return value.
         """
         return {"radii": list(self.radii), "fractions": list(self.fractions)}
 
@@ -372,15 +350,7 @@ class PowerLaw(Distribution):
     def moment(self, k: float) -> float:
         """Raw moment <a^k> = a_min^k int_1^omega x^(k + alpha) dx / int_1^omega x^alpha dx.
 
-        Parameters
-        ----------
-        k : float
-            Order of the moment, any real number.
-
-        Returns
-        -------
-        float
-            <a^k>.
+        See :meth:`Distribution.moment` for the parameters and the return value.
         """
         return self.a_min**k * self._unit_moment(k)
 
@@ -391,15 +361,7 @@ class PowerLaw(Distribution):
     def pdf(self, a):
         """Normalised density f(a) = a^alpha / int_{a_min}^{a_max} x^alpha dx on the support.
 
-        Parameters
-        ----------
-        a : float or array_like of float
-            Radii.
-
-        Returns
-        -------
-        numpy.ndarray of float
-            f(a), of the shape of ``a``; 0 outside [a_min, a_max].
+        See :meth:`Distribution.pdf` for the parameters and the return value.
         """
         a = np.asarray(a, float)
         lo, hi = self.support
@@ -414,15 +376,7 @@ class PowerLaw(Distribution):
         """Quantile function F^-1(q) = (a_min^p + q (a_max^p - a_min^p))^(1/p), p = alpha + 1
         (a_min (a_max / a_min)^q for p = 0).
 
-        Parameters
-        ----------
-        q : float or array_like of float
-            Cumulative number fractions, in [0, 1].
-
-        Returns
-        -------
-        numpy.ndarray of float
-            Radii, of the shape of ``q``.
+        See :meth:`Distribution.ppf` for the parameters and the return value.
         """
         q = np.asarray(q, float)
         lo, hi = self.support
@@ -434,10 +388,7 @@ class PowerLaw(Distribution):
     def params(self):
         """Parameters as a flat dict (stored in dataset attributes).
 
-        Returns
-        -------
-        dict
-            ``omega``, ``alpha`` and ``mean_radius``.
+        See :meth:`Distribution.params` for the parameters and the return value.
         """
         return {"omega": self.omega, "alpha": self.alpha, "mean_radius": self.mean_radius}
 
@@ -527,15 +478,7 @@ class LogNormal(Distribution):
     def moment(self, k: float) -> float:
         """Raw moment <a^k> = a0^k exp(k^2 sigma^2 / 2) (Ogarko 2014, Eq. 3.47).
 
-        Parameters
-        ----------
-        k : float
-            Order of the moment, any real number.
-
-        Returns
-        -------
-        float
-            <a^k>.
+        See :meth:`Distribution.moment` for the parameters and the return value.
         """
         return self.a0**k * math.exp(0.5 * k * k * self.sigma**2)
 
@@ -547,30 +490,14 @@ class LogNormal(Distribution):
     def pdf(self, a):
         """Density f(a) of Ogarko 2014, Eq. 3.46 (``scipy.stats.lognorm`` with s = sigma, scale = a0).
 
-        Parameters
-        ----------
-        a : float or array_like of float
-            Radii.
-
-        Returns
-        -------
-        float or numpy.ndarray of float
-            f(a), of the shape of ``a``; 0 for a <= 0.
+        See :meth:`Distribution.pdf` for the parameters and the return value.
         """
         return self._dist().pdf(a)
 
     def ppf(self, q):
         """Quantile function F^-1(q) = a0 exp(sigma sqrt(2) erfinv(2 q - 1)).
 
-        Parameters
-        ----------
-        q : float or array_like of float
-            Cumulative number fractions, in [0, 1] (q = 0 gives 0, q = 1 infinity).
-
-        Returns
-        -------
-        numpy.ndarray of float
-            Radii, of the shape of ``q``.
+        See :meth:`Distribution.ppf` for the parameters and the return value.
         """
         from scipy.special import erfinv  # scipy costs every importer of this module 0.3 s
 
@@ -583,10 +510,7 @@ class LogNormal(Distribution):
     def params(self):
         """Parameters as a flat dict (stored in dataset attributes).
 
-        Returns
-        -------
-        dict
-            ``sigma`` and ``mean_radius``.
+        See :meth:`Distribution.params` for the parameters and the return value.
         """
         return {"sigma": self.sigma, "mean_radius": self.mean_radius}
 

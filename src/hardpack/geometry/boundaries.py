@@ -106,27 +106,30 @@ def _report(overlap: np.ndarray, wall_of, tol: float) -> ContainmentReport:
     return ContainmentReport(int((overlap > tol).sum()), i, wall_of(i), float(overlap[i]))
 
 
-@dataclass(frozen=True)
-class Periodic:
-    """A periodic cell: every lattice vector is a period."""
+class Boundary:
+    """What a packing's boundary answers (:class:`Periodic`, :class:`HardWalls`,
+    :class:`SphericalContainer`); each method is documented here once."""
 
-    kind: ClassVar[str] = "periodic"
-    name: ClassVar[str] = "periodic cells"
+    kind: ClassVar[str]
+    name: ClassVar[str]
 
     def check(self, lattice: np.ndarray) -> None:
-        """Refuse a lattice that does not suit the boundary: every lattice suits a periodic cell.
-
-        The packing checks separately that the lattice is non-singular; :meth:`HardWalls.check` and
-        :meth:`SphericalContainer.check` raise InvalidInputError for lattices they do not suit.
+        """Refuse a lattice that does not suit the boundary.
 
         Parameters
         ----------
         lattice : numpy.ndarray of float, shape (d, d)
             The packing's lattice, columns = lattice vectors.
+
+        Raises
+        ------
+        InvalidInputError
+            If the boundary cannot hold a cell of this lattice.
         """
+        raise NotImplementedError
 
     def periodic_axes(self, d: int) -> np.ndarray:
-        """Which lattice vectors are periods: all of them.
+        """Which lattice vectors are periods.
 
         Parameters
         ----------
@@ -138,10 +141,10 @@ class Periodic:
         numpy.ndarray of bool, shape (d,)
             True for the lattice vectors that are periods (axes with periodic images).
         """
-        return np.ones(d, dtype=bool)
+        raise NotImplementedError
 
     def volume(self, lattice: np.ndarray) -> float:
-        """Volume of the region the particles fill: the cell, |det(lattice)|.
+        """Volume of the region the particles fill.
 
         Parameters
         ----------
@@ -151,33 +154,32 @@ class Periodic:
         Returns
         -------
         float
-            |det(lattice)|.
         """
-        return float(abs(np.linalg.det(lattice)))
+        raise NotImplementedError
 
     def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
-        """Relative overlap 1 - h / r of every particle with its worst wall; a periodic cell has none.
+        """Relative overlap of every particle with its worst wall.
 
         Parameters
         ----------
         positions : numpy.ndarray of float, shape (N, d)
             Cartesian centres.
         radii : numpy.ndarray of float, shape (N,)
-            Particle radii (unused here).
+            Particle radii.
         lattice : numpy.ndarray of float, shape (d, d)
             The packing's lattice (checked by :meth:`check`).
         tol : float
-            Relative tolerance: a particle crosses a wall when 1 - h / r > tol.
+            Relative tolerance: a particle crosses a wall when its relative overlap exceeds it.
 
         Returns
         -------
         ContainmentReport
-            n_outside = 0, no particle named (worst = -1), wall "no walls", overlap -inf.
+            The particles outside and the worst one (n_outside = 0, worst = -1 without walls).
         """
-        return _no_walls()
+        raise NotImplementedError
 
     def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
-        """Particle-wall contacts within relative gap ``rel_gap``; a periodic cell has no walls, so none.
+        """Particle-wall contacts within a relative gap.
 
         Parameters
         ----------
@@ -193,7 +195,52 @@ class Periodic:
         Returns
         -------
         WallContacts
-            Empty (M = 0).
+            The contacts: particle, outward wall normal, relative gap (M = 0 without walls).
+        """
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Periodic(Boundary):
+    """A periodic cell: every lattice vector is a period."""
+
+    kind: ClassVar[str] = "periodic"
+    name: ClassVar[str] = "periodic cells"
+
+    def check(self, lattice: np.ndarray) -> None:
+        """Refuse a lattice that does not suit the boundary: every lattice suits a periodic cell.
+
+        The packing checks separately that the lattice is non-singular; :meth:`HardWalls.check` and
+        :meth:`SphericalContainer.check` raise InvalidInputError for lattices they do not suit.
+
+        See :meth:`Boundary.check` for the parameters and the return value.
+        """
+
+    def periodic_axes(self, d: int) -> np.ndarray:
+        """Which lattice vectors are periods: all of them.
+
+        See :meth:`Boundary.periodic_axes` for the parameters and the return value.
+        """
+        return np.ones(d, dtype=bool)
+
+    def volume(self, lattice: np.ndarray) -> float:
+        """Volume of the region the particles fill: the cell, |det(lattice)|.
+
+        See :meth:`Boundary.volume` for the parameters and the return value.
+        """
+        return float(abs(np.linalg.det(lattice)))
+
+    def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
+        """Relative overlap 1 - h / r of every particle with its worst wall; a periodic cell has none.
+
+        See :meth:`Boundary.containment` for the parameters and the return value.
+        """
+        return _no_walls()
+
+    def wall_contacts(self, positions, radii, lattice, rel_gap: float) -> WallContacts:
+        """Particle-wall contacts within relative gap ``rel_gap``; a periodic cell has no walls, so none.
+
+        See :meth:`Boundary.wall_contacts` for the parameters and the return value.
         """
         d = positions.shape[1]
         return WallContacts(np.zeros(0, np.int64), np.zeros((0, d)), np.zeros(0))
@@ -203,7 +250,7 @@ class Periodic:
 
 
 @dataclass(frozen=True)
-class HardWalls:
+class HardWalls(Boundary):
     """Hard walls at x_k = 0 and x_k = L_k for every axis k in ``axes``; periodic along the others.
 
     Parameters
@@ -241,10 +288,7 @@ class HardWalls:
         Lattice vector k must be L_k e_k with L_k > 0 and no other lattice vector may have a
         component along e_k, for every walled axis k.
 
-        Parameters
-        ----------
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice, columns = lattice vectors.
+        See :meth:`Boundary.check` for the parameters and the return value.
 
         Raises
         ------
@@ -268,15 +312,7 @@ class HardWalls:
     def periodic_axes(self, d: int) -> np.ndarray:
         """Which lattice vectors are periods: all but the walled axes.
 
-        Parameters
-        ----------
-        d : int
-            Dimension.
-
-        Returns
-        -------
-        numpy.ndarray of bool, shape (d,)
-            True for the lattice vectors that are periods (axes with periodic images).
+        See :meth:`Boundary.periodic_axes` for the parameters and the return value.
         """
         mask = np.ones(d, dtype=bool)
         mask[list(self.axes)] = False
@@ -285,15 +321,7 @@ class HardWalls:
     def volume(self, lattice: np.ndarray) -> float:
         """Volume of the region the particles fill: the cell between the walls, |det(lattice)|.
 
-        Parameters
-        ----------
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice, columns = lattice vectors.
-
-        Returns
-        -------
-        float
-            |det(lattice)|.
+        See :meth:`Boundary.volume` for the parameters and the return value.
         """
         return float(abs(np.linalg.det(lattice)))
 
@@ -303,22 +331,9 @@ class HardWalls:
         h is the centre-wall distance x_k (wall at 0) or L_k - x_k (wall at L_k, L_k the diagonal
         entry of the lattice), from the positions as given (not wrapped).
 
-        Parameters
-        ----------
-        positions : numpy.ndarray of float, shape (N, d)
-            Cartesian centres.
-        radii : numpy.ndarray of float, shape (N,) or (N, d)
-            Sphere radii, or the particle's extent along each axis (e.g. of an ellipsoid), of
-            which the walled axes are used.
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice (checked by :meth:`check`).
-        tol : float
-            Relative tolerance: a particle crosses a wall when 1 - h / r > tol.
-
-        Returns
-        -------
-        ContainmentReport
-            Particles with overlap > tol, and the worst particle with its wall and overlap.
+        See :meth:`Boundary.containment` for the parameters and the return value. Here ``radii`` may
+        also have shape (N, d): each particle's extent along each axis (e.g. of an ellipsoid), of which
+        the walled axes are used.
         """
         axes = list(self.axes)
         x = positions[:, axes]
@@ -335,21 +350,7 @@ class HardWalls:
         """Every sphere within relative gap ``rel_gap`` of a wall (a sphere may touch several);
         normals -e_k at x_k = 0 and +e_k at x_k = L_k.
 
-        Parameters
-        ----------
-        positions : numpy.ndarray of float, shape (N, d)
-            Cartesian centres.
-        radii : numpy.ndarray of float, shape (N,)
-            Sphere radii.
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice (checked by :meth:`check`).
-        rel_gap : float
-            Largest relative gap h / r - 1 of a contact.
-
-        Returns
-        -------
-        WallContacts
-            One entry per sphere and wall with h / r - 1 <= rel_gap.
+        See :meth:`Boundary.wall_contacts` for the parameters and the return value.
         """
         n, d = positions.shape
         axes = list(self.axes)
@@ -365,7 +366,7 @@ class HardWalls:
 
 
 @dataclass(frozen=True)
-class SphericalContainer:
+class SphericalContainer(Boundary):
     """A hard spherical wall of ``radius`` about ``centre``, inside the orthorhombic lattice box.
 
     Parameters
@@ -401,10 +402,7 @@ class SphericalContainer:
     def check(self, lattice: np.ndarray) -> None:
         """Refuse a lattice that is not an orthorhombic box [0, L_1] x ... x [0, L_d] holding the container.
 
-        Parameters
-        ----------
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice, columns = lattice vectors.
+        See :meth:`Boundary.check` for the parameters and the return value.
 
         Raises
         ------
@@ -432,51 +430,21 @@ class SphericalContainer:
     def periodic_axes(self, d: int) -> np.ndarray:
         """Which lattice vectors are periods: none.
 
-        Parameters
-        ----------
-        d : int
-            Dimension.
-
-        Returns
-        -------
-        numpy.ndarray of bool, shape (d,)
-            True for the lattice vectors that are periods (axes with periodic images).
+        See :meth:`Boundary.periodic_axes` for the parameters and the return value.
         """
         return np.zeros(d, dtype=bool)
 
     def volume(self, lattice: np.ndarray) -> float:
         """The container's volume V_d(R) (the box is only a pseudo-boundary).
 
-        Parameters
-        ----------
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice, columns = lattice vectors.
-
-        Returns
-        -------
-        float
-            V_d(R), d = lattice.shape[0].
+        See :meth:`Boundary.volume` for the parameters and the return value.
         """
         return float(ball_volume(self.radius, lattice.shape[0]))
 
     def containment(self, positions, radii, lattice, tol: float) -> ContainmentReport:
         """Relative overlap 1 - (R - |x - c|) / r of every sphere with the container wall.
 
-        Parameters
-        ----------
-        positions : numpy.ndarray of float, shape (N, d)
-            Cartesian centres.
-        radii : numpy.ndarray of float, shape (N,)
-            Sphere radii.
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice (checked by :meth:`check`).
-        tol : float
-            Relative tolerance: a particle crosses a wall when 1 - h / r > tol.
-
-        Returns
-        -------
-        ContainmentReport
-            Spheres with overlap > tol, and the worst sphere.
+        See :meth:`Boundary.containment` for the parameters and the return value.
         """
         dx = positions - np.array(self.centre)
         h = self.radius - np.sqrt(np.einsum("ij,ij->i", dx, dx))
@@ -486,21 +454,7 @@ class SphericalContainer:
         """Every sphere within relative gap ``rel_gap`` of the container wall; normal (x - c) / |x - c|
         (a sphere at the centre can touch only a container of its own size and gets normal e_0).
 
-        Parameters
-        ----------
-        positions : numpy.ndarray of float, shape (N, d)
-            Cartesian centres.
-        radii : numpy.ndarray of float, shape (N,)
-            Sphere radii.
-        lattice : numpy.ndarray of float, shape (d, d)
-            The packing's lattice (checked by :meth:`check`).
-        rel_gap : float
-            Largest relative gap h / r - 1 of a contact.
-
-        Returns
-        -------
-        WallContacts
-            One entry per sphere with (R - |x - c|) / r - 1 <= rel_gap.
+        See :meth:`Boundary.wall_contacts` for the parameters and the return value.
         """
         dx = positions - np.array(self.centre)
         dist = np.sqrt(np.einsum("ij,ij->i", dx, dx))

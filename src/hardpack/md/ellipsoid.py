@@ -175,10 +175,7 @@ class EllipsoidSimulation(Simulation):
     def restore(self, state: dict) -> None:
         """Load a :meth:`state` (a checkpoint without thermostat counts starts them at 0).
 
-        Parameters
-        ----------
-        state : dict
-            The arrays and scalars of :meth:`state`, from a run of the same system.
+        See :meth:`hardpack.md.simulation.Simulation.restore` for the parameters and the return value.
 
         Raises
         ------
@@ -192,24 +189,7 @@ class EllipsoidSimulation(Simulation):
         """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the
         translational temperature 2 KE_trans / (d N), at the end of the window and averaged over it.
 
-        Parameters
-        ----------
-        coll_target : int
-            Most collisions in the window.
-        target_phi : float, optional
-            Volume fraction at which the window ends exactly, if the growth reaches it first (ignored
-            without growth or when phi moves away from it).
-
-        Returns
-        -------
-        dict
-            The window record, also appended to :attr:`records`: ``time`` (MD time since the start),
-            ``phi``, ``Z`` = pV / (NkT) from the collision virial (inf when no time elapsed),
-            ``phi_J_est`` = phi / (1 - d / Z), ``collisions`` and ``events`` (totals), ``kT`` (at the
-            end, before the rescaling) and ``kT_mean`` (over the window), ``stale``, ``exits``,
-            ``grazing``, ``max_overlap``, ``shell``, ``neighbours``, ``wall_time``, ``growth_rate``,
-            ``virial``, ``ke_integral``, and ``Z_wall`` (pressure on the walls, NaN in a periodic cell)
-            and ``wall_collisions`` (these two enter :attr:`records` only with walls).
+        See :meth:`hardpack.md.simulation.Simulation.run_window` for the parameters and the return value.
 
         Raises
         ------
