@@ -2,11 +2,14 @@
 the windows of the deforming-cell driver (:mod:`hardpack.md.deforming`).
 
 The event loop is the one of the sphere deforming-cell kernel (:mod:`hardpack.md._deforming_kernel`:
-lists of (partner, lattice image) entries built by scanning all N bounding spheres over every
-image within reach, so a small or sheared cell holds several images of one partner, and a
-bounding-sphere exit re-wraps the particle into the cell); the particle state, the pair
-prediction (trace event location of the Perram-Wertheim potential, best first over the
-neighbours: :func:`hardpack.md._ellipsoid_kernel._predict`) and the collision law
+lists of (partner, lattice image) entries of the overlapping bounding spheres (Donev 2006, sec.
+3.3.2), so a small or sheared cell holds several images of one partner, found on the same linked
+cell grid of the bounding-sphere centres
+(:func:`hardpack.md._deforming_kernel.list_particle_grid`: a complete build O(N), the rebuild of
+one list O(1) in a large cell), and a bounding-sphere exit re-wraps the particle into the cell and
+moves its centre to its new grid cell); the particle state, the pair prediction (trace event
+location of the Perram-Wertheim potential, best first over the neighbours:
+:func:`hardpack.md._ellipsoid_kernel._predict`) and the collision law
 (:func:`hardpack.md._ellipsoid_kernel.collide_at`) are the ellipsoid engine's (Donev 2006, sec.
 3.5). A list entry is j << cbits | code with the image vectors H n in a table padded to 2^cbits
 rows (the ellipsoid kernel's entry format); the predicted partner does not say which image it
@@ -251,8 +254,8 @@ def _partner_image(P, i, j, t, kappa, nb, nn, img, cbits, ws, wm):
 
 
 @njit(cache=True)
-def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, nb, nn, mark, cnt, ep, ec,
-               hkey, heap, hpos, tins, touts, done, pst, vir, kw, acc, iacc, coll_target, t_cap):
+def run_events(P, H, Hinv, M, img, cbits, cfac, reach, n_cells, cstr, kappa, eps_f, skin, bs, nb, nn, mark, cnt,
+               ep, ec, hkey, heap, hpos, tins, touts, done, pst, vir, kw, acc, iacc, coll_target, t_cap):
     """One window of ellipsoid MD in the fixed cell H from a synchronisation point (all particle
     times 0, centres wrapped into the cell): build all lists, predict, process events until
     ``coll_target`` collisions or ``t_cap``.
@@ -275,6 +278,11 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
         Largest bounding-sphere diameter the image table covers (M = image_ranges(H, reach)): a
         larger bounding sphere ends the window with status SELF_IMAGE (the driver enlarges the
         table and repeats the window).
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction of the grid of bounding-sphere centres that the lists are built
+        from (:func:`hardpack.md._deforming_kernel.list_particle_grid`; any counts >= 1 give the same
+        lists, cells about as wide as the largest bounding diameter the fewest tests) and their
+        flat-index strides.
     kappa : float
         Relative growth rate of the semiaxes.
     eps_f : float
@@ -327,12 +335,22 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
     hpos[:] = -1
     cnt[:] = 0
     upd = np.empty(2, dtype=np.int64)
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    gwrap = np.empty((n, d), dtype=np.int64)
+    gsw = np.empty((n, d))
+    ent = np.empty(nb.shape[1], dtype=np.int64)
+    rmax = 0.0  # largest bounding radius in the grid
     for i in range(n):
         for k in range(d):
             bs[i, k] = P[i, k]
         bs[i, d] = P[i, cr] + skin[i]
+        rmax = max(rmax, bs[i, d])
+    dk.link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw)
     for i in range(n):
-        st = dk.list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach)
+        st = dk.list_particle_grid(i, i, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach, rmax, n_cells, cstr,
+                                   head, nxt, gwrap, gsw, ent)
         if st == 0:
             st = list_self(i, bs, img, m0, cbits, nb, nn)
         if st != 0:
@@ -392,7 +410,10 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
             for k in range(d):
                 bs[i, k] = P[i, k]
             bs[i, d] = P[i, cr] * (1.0 + kappa * t) + skin[i]
-            st = dk.list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach)
+            rmax = max(rmax, bs[i, d])
+            dk.link_one(bs, i, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw, False)
+            st = dk.list_particle_grid(i, n, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach, rmax, n_cells,
+                                       cstr, head, nxt, gwrap, gsw, ent)
             if st == 0:
                 st = list_self(i, bs, img, m0, cbits, nb, nn)
             if st != 0:

@@ -712,6 +712,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         # the image table covers bounding spheres grown by REACH_SLACK (the kernel asks for more)
         reach = 2.0 * (rmax + float(skin[0])) * REACH_SLACK
         cfac = np.linalg.norm(Hinv, axis=1)
+        n_cells, cstr = cell_grid(self.H, 2.0 * (rmax + float(skin.max())), n)
         saved = self.P.copy()
         vir, kw = np.zeros((d, d)), np.zeros((d, d))
         while True:
@@ -723,8 +724,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
             acc[mdk.A_KE] = 0.5 * float(np.sum(self.V * self.V))
             iacc = np.zeros(edk.N_COUNTERS, dtype=np.int64)
             status = edk.run_events(
-                self.P, self.H, Hinv, M, img, cbits, cfac, reach, float(kappa[0]), self.eps_f, skin, self.bs,
-                nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey, self.heap, self.hpos,
+                self.P, self.H, Hinv, M, img, cbits, cfac, reach, n_cells, cstr, float(kappa[0]), self.eps_f, skin,
+                self.bs, nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey, self.heap, self.hpos,
                 np.empty(cap), np.empty(cap), np.empty(cap, dtype=np.int8), np.empty((cap, ek.PAIR_STATE)),
                 vir, kw, acc, iacc, budget, t_cap)
             if status == dk.DeformingStatus.OVERFLOW:
