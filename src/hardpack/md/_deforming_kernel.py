@@ -21,10 +21,10 @@ partial one O(1); the unbounded cell range visits every (centre, image) within r
 Along an axis where the range spans every cell (small or sheared cells, several images of one
 neighbour) the stored cells are visited once and a centre's images along it are the integers of
 the per-pair image box below; when it does so along every axis all particles are candidates,
-taken in index order. :func:`list_particle` is the exhaustive scan over all N particles and their
-image boxes (|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k, h_k the cell height 1 / |row k of H^-1|),
-O(N) per list; the ellipsoid kernel (:mod:`hardpack.md._ellipsoid_deforming_kernel`) builds its
-lists with it.
+taken in index order. The ellipsoid kernel (:mod:`hardpack.md._ellipsoid_deforming_kernel`)
+builds its lists on the same grid. :func:`list_particle` is the exhaustive scan over all N
+particles and their image boxes (|s_j,k - s_i,k + n_k| <= (R_i + R_j) / h_k, h_k the cell height
+1 / |row k of H^-1|), O(N) per list, whose entries and order the grid reproduces.
 
 A bounding-sphere exit re-wraps the particle into the cell and rebuilds its list; it also raises
 the particle's collision counter, so that predictions of others against it (whose image codes

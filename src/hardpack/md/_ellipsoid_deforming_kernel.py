@@ -2,11 +2,14 @@
 the windows of the deforming-cell driver (:mod:`hardpack.md.deforming`).
 
 The event loop is the one of the sphere deforming-cell kernel (:mod:`hardpack.md._deforming_kernel`:
-lists of (partner, lattice image) entries built by scanning all N bounding spheres over every
-image within reach, so a small or sheared cell holds several images of one partner, and a
-bounding-sphere exit re-wraps the particle into the cell); the particle state, the pair
-prediction (trace event location of the Perram-Wertheim potential, best first over the
-neighbours: :func:`hardpack.md._ellipsoid_kernel._predict`) and the collision law
+lists of (partner, lattice image) entries of the overlapping bounding spheres (Donev 2006, sec.
+3.3.2), so a small or sheared cell holds several images of one partner, found on the same linked
+cell grid of the bounding-sphere centres
+(:func:`hardpack.md._deforming_kernel.list_particle_grid`: a complete build O(N), the rebuild of
+one list O(1) in a large cell), and a bounding-sphere exit re-wraps the particle into the cell and
+moves its centre to its new grid cell); the particle state, the pair prediction (trace event
+location of the Perram-Wertheim potential, best first over the neighbours:
+:func:`hardpack.md._ellipsoid_kernel._predict`) and the collision law
 (:func:`hardpack.md._ellipsoid_kernel.collide_at`) are the ellipsoid engine's (Donev 2006, sec.
 3.5). A list entry is j << cbits | code with the image vectors H n in a table padded to 2^cbits
 rows (the ellipsoid kernel's entry format); the predicted partner does not say which image it
@@ -55,6 +58,7 @@ import numpy as np
 from numba import njit
 
 from hardpack.events.heap import heap_set
+from hardpack.geometry.neighbours.grid import image_cell, next_cell
 from hardpack.md import _deforming_kernel as dk
 from hardpack.md import _ellipsoid_kernel as ek
 from hardpack.md._kernel import A_T, A_VIRIAL, end_window, kinetic_step
@@ -251,8 +255,8 @@ def _partner_image(P, i, j, t, kappa, nb, nn, img, cbits, ws, wm):
 
 
 @njit(cache=True)
-def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, nb, nn, mark, cnt, ep, ec,
-               hkey, heap, hpos, tins, touts, done, pst, vir, kw, acc, iacc, coll_target, t_cap):
+def run_events(P, H, Hinv, M, img, cbits, cfac, reach, n_cells, cstr, kappa, eps_f, skin, bs, nb, nn, mark, cnt,
+               ep, ec, hkey, heap, hpos, tins, touts, done, pst, vir, kw, acc, iacc, coll_target, t_cap):
     """One window of ellipsoid MD in the fixed cell H from a synchronisation point (all particle
     times 0, centres wrapped into the cell): build all lists, predict, process events until
     ``coll_target`` collisions or ``t_cap``.
@@ -275,6 +279,11 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
         Largest bounding-sphere diameter the image table covers (M = image_ranges(H, reach)): a
         larger bounding sphere ends the window with status SELF_IMAGE (the driver enlarges the
         table and repeats the window).
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction of the grid of bounding-sphere centres that the lists are built
+        from (:func:`hardpack.md._deforming_kernel.list_particle_grid`; any counts >= 1 give the same
+        lists, cells about as wide as the largest bounding diameter the fewest tests) and their
+        flat-index strides.
     kappa : float
         Relative growth rate of the semiaxes.
     eps_f : float
@@ -327,12 +336,22 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
     hpos[:] = -1
     cnt[:] = 0
     upd = np.empty(2, dtype=np.int64)
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    gwrap = np.empty((n, d), dtype=np.int64)
+    gsw = np.empty((n, d))
+    ent = np.empty(nb.shape[1], dtype=np.int64)
+    rmax = 0.0  # largest bounding radius in the grid
     for i in range(n):
         for k in range(d):
             bs[i, k] = P[i, k]
         bs[i, d] = P[i, cr] + skin[i]
+        rmax = max(rmax, bs[i, d])
+    dk.link_cells(bs, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw)
     for i in range(n):
-        st = dk.list_particle(i, i, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach)
+        st = dk.list_particle_grid(i, i, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach, rmax, n_cells, cstr,
+                                   head, nxt, gwrap, gsw, ent)
         if st == 0:
             st = list_self(i, bs, img, m0, cbits, nb, nn)
         if st != 0:
@@ -392,7 +411,10 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
             for k in range(d):
                 bs[i, k] = P[i, k]
             bs[i, d] = P[i, cr] * (1.0 + kappa * t) + skin[i]
-            st = dk.list_particle(i, n, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach)
+            rmax = max(rmax, bs[i, d])
+            dk.link_one(bs, i, Hinv, n_cells, cstr, head, nxt, cell_of, gwrap, gsw, False)
+            st = dk.list_particle_grid(i, n, bs, H, Hinv, M, strides, nb, nn, m0, mul, cfac, reach, rmax, n_cells,
+                                       cstr, head, nxt, gwrap, gsw, ent)
             if st == 0:
                 st = list_self(i, bs, img, m0, cbits, nb, nn)
             if st != 0:
@@ -461,11 +483,28 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, kappa, eps_f, skin, bs, n
     return dk.DeformingStatus.DONE_COLLISIONS
 
 
+@njit(cache=True, inline="always")
+def _image_before(j1, n1, j2, n2):
+    """True when (j1, n1) comes before (j2, n2) in the order of :func:`near_pairs`: j ascending,
+    then the images n with the last component varying slowest (the image-code order)."""
+    if j1 != j2:
+        return j1 < j2
+    for k in range(n1.shape[0] - 1, -1, -1):
+        if n1[k] != n2[k]:
+            return n1[k] < n2[k]
+    return False
+
+
 @njit(cache=True)
-def near_pairs(P, H, Hinv, scale):
+def near_pairs(P, H, Hinv, scale, n_cells, cstr):
     """The pairs i <= j and lattice images n whose centres are closer than ``scale`` times the sum
     of their bounding radii, a particle's own images (i = j, n != 0) once per pair +-n (the n
     whose last non-zero component is positive). Centres need not be wrapped.
+
+    The candidates come from a single-level grid of the centres over the fractional coordinates
+    (:func:`hardpack.md._deforming_kernel.link_cells`; the cells within ``scale`` (R_i + max R) of
+    i's centre, every (particle, image) in them once, as in
+    :func:`hardpack.md._deforming_kernel.strain_limit`), so a call costs O(N) in a large cell.
 
     Parameters
     ----------
@@ -475,11 +514,15 @@ def near_pairs(P, H, Hinv, scale):
         The cell and its inverse.
     scale : float
         Reach in units of R_i + R_j.
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction of the grid (any counts >= 1 give the same pairs; cells about
+        2 ``scale`` max R wide the fewest tests) and their flat-index strides.
 
     Returns
     -------
     pi, pj : numpy.ndarray of int64, shape (K,)
-        The pairs (pi = pj for an own image).
+        The pairs (pi = pj for an own image), sorted by i, then j, then the image n with its last
+        component varying slowest.
     pn : numpy.ndarray of int64, shape (K, d)
         The image n of j (r_ij = x_j + H n - x_i).
     """
@@ -492,52 +535,120 @@ def near_pairs(P, H, Hinv, scale):
         for q in range(d):
             s2 += Hinv[k, q] * Hinv[k, q]
         cfac[k] = np.sqrt(s2)
+    rmax = 0.0
+    for i in range(n):
+        rmax = max(rmax, P[i, cr])
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    wrap = np.empty((n, d), dtype=np.int64)
+    sw = np.empty((n, d))
+    dk.link_cells(P, Hinv, n_cells, cstr, head, nxt, cell_of, wrap, sw)
+    coff = np.zeros(2, dtype=np.int64)
+    s = np.empty(d)
+    w = np.empty(d)
     ds = np.empty(d)
     lo = np.empty(d, dtype=np.int64)
     hi = np.empty(d, dtype=np.int64)
+    wide = np.empty(d, dtype=np.bool_)
+    c = np.empty(d, dtype=np.int64)
+    image = np.empty(d, dtype=np.int64)
+    blo = np.empty(d, dtype=np.int64)
+    bhi = np.empty(d, dtype=np.int64)
     od = np.empty(d, dtype=np.int64)
+    nv = np.empty(d, dtype=np.int64)
+    fcap = 64  # the pairs of one i, before sorting
+    fj = np.empty(fcap, dtype=np.int64)
+    fn = np.empty((fcap, d), dtype=np.int64)
     cap = 16 * n
     pi = np.empty(cap, dtype=np.int64)
     pj = np.empty(cap, dtype=np.int64)
     pn = np.empty((cap, d), dtype=np.int64)
     count = 0
     for i in range(n):
-        for j in range(i, n):
-            reach = scale * (P[i, cr] + P[j, cr])
-            total = dk._image_box(P[i, :d], P[j, :d], Hinv, reach, cfac, ds, lo, hi, od)
+        dk._fractional(P, i, Hinv, s)
+        every = dk._cell_range(s, scale * (P[i, cr] + rmax), cfac, n_cells, w, lo, hi, wide)
+        j = i  # every: the candidates are i .. n - 1
+        more = not every  # else those of the cells of the range, in turn
+        if more:
+            for k in range(d):
+                c[k] = lo[k]
+            j = -1
+        found = 0
+        while True:
+            if every:
+                if j >= n:
+                    break
+            else:
+                while j < 0 and more:
+                    flat = image_cell(c, n_cells, cstr, coff, 0, image)
+                    more = next_cell(c, lo, hi)
+                    j = head[flat]
+                if j < 0:
+                    break
+            jj = j
+            j = j + 1 if every else nxt[j]
+            if jj < i:
+                continue
+            total = dk._image_range(s, w, sw[jj], wide, image, blo, bhi, od)
+            if total > 0:
+                reach = scale * (P[i, cr] + P[jj, cr])
+                for k in range(d):
+                    acc = 0.0
+                    for q in range(d):
+                        acc += Hinv[k, q] * (P[jj, q] - P[i, q])
+                    ds[k] = acc
             for _ in range(total):
-                keep = True
-                if i == j:  # own image: n != 0 with its last non-zero component positive
+                for k in range(d):
+                    nv[k] = od[k] - wrap[jj, k]
+                next_cell(od, blo, bhi)
+                if i == jj:  # own image: n != 0 with its last non-zero component positive
                     keep = False
                     for k in range(d):
-                        if od[k] != 0:
-                            keep = od[k] > 0
+                        if nv[k] != 0:
+                            keep = nv[k] > 0
+                    if not keep:
+                        continue
                 rr = 0.0
                 for q in range(d):
                     a = 0.0
                     for k in range(d):
-                        a += H[q, k] * (ds[k] + od[k])
+                        a += H[q, k] * (ds[k] + nv[k])
                     rr += a * a
-                if keep and rr < reach * reach:
-                    if count == cap:
-                        cap *= 2
-                        pi2 = np.empty(cap, dtype=np.int64)
-                        pj2 = np.empty(cap, dtype=np.int64)
-                        pn2 = np.empty((cap, d), dtype=np.int64)
-                        pi2[:count] = pi[:count]
-                        pj2[:count] = pj[:count]
-                        pn2[:count] = pn[:count]
-                        pi, pj, pn = pi2, pj2, pn2
-                    pi[count] = i
-                    pj[count] = j
-                    for k in range(d):
-                        pn[count, k] = od[k]
-                    count += 1
+                if rr >= reach * reach:
+                    continue
+                if found == fcap:
+                    fcap *= 2
+                    fj2 = np.empty(fcap, dtype=np.int64)
+                    fn2 = np.empty((fcap, d), dtype=np.int64)
+                    fj2[:found] = fj[:found]
+                    fn2[:found] = fn[:found]
+                    fj, fn = fj2, fn2
+                fj[found] = jj
                 for k in range(d):
-                    od[k] += 1
-                    if od[k] <= hi[k]:
-                        break
-                    od[k] = lo[k]
+                    fn[found, k] = nv[k]
+                found += 1
+        if count + found > cap:
+            cap = 2 * (count + found)
+            pi2 = np.empty(cap, dtype=np.int64)
+            pj2 = np.empty(cap, dtype=np.int64)
+            pn2 = np.empty((cap, d), dtype=np.int64)
+            pi2[:count] = pi[:count]
+            pj2[:count] = pj[:count]
+            pn2[:count] = pn[:count]
+            pi, pj, pn = pi2, pj2, pn2
+        for a in range(found):  # insertion sort into the output
+            b = count + a
+            while b > count and _image_before(fj[a], fn[a], pj[b - 1], pn[b - 1]):
+                pj[b] = pj[b - 1]
+                for k in range(d):
+                    pn[b, k] = pn[b - 1, k]
+                b -= 1
+            pj[b] = fj[a]
+            for k in range(d):
+                pn[b, k] = fn[a, k]
+        pi[count:count + found] = i
+        count += found
     return pi[:count], pj[:count], pn[:count]
 
 

@@ -721,10 +721,19 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         self.P[:, cii] = 1.0 / moments_of_inertia(shape.semiaxes)
         self.eps_f = float(eps_f)
         self.self_collisions = 0
+        self._grid = None
         self._init_run(packing, growth_rate, applied_pressure, cell_step, overlap_tol, adaptive_cell)
 
     def _column(self, k: int) -> int:
         return ek.columns(self.d)[k]
+
+    def _cell_grid(self, width: float) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`cell_grid` of the current cell, made once per cell: the window's events and the
+        pair searches after it share it (any grid gives the same lists and pairs; ``width``, the
+        first asked for in the cell, only sets how many candidates are tested)."""
+        if self._grid is None or not np.array_equal(self._grid[0], self.H):
+            self._grid = (self.H.copy(), *cell_grid(self.H, width, self.n))
+        return self._grid[1], self._grid[2]
 
     def mean_diameter(self) -> float:
         """Mean bounding diameter, twice the mean largest semiaxis.
@@ -803,6 +812,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         # the image table covers bounding spheres grown by REACH_SLACK (the kernel asks for more)
         reach = 2.0 * (rmax + float(skin[0])) * REACH_SLACK
         cfac = np.linalg.norm(Hinv, axis=1)
+        n_cells, cstr = self._cell_grid(2.0 * (rmax + float(skin.max())))
         saved = self.P.copy()
         vir, kw = np.zeros((d, d)), np.zeros((d, d))
         while True:
@@ -814,8 +824,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
             acc[mdk.A_KE] = 0.5 * float(np.sum(self.V * self.V))
             iacc = np.zeros(edk.N_COUNTERS, dtype=np.int64)
             status = edk.run_events(
-                self.P, self.H, Hinv, M, img, cbits, cfac, reach, float(kappa[0]), self.eps_f, skin, self.bs,
-                nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey, self.heap, self.hpos,
+                self.P, self.H, Hinv, M, img, cbits, cfac, reach, n_cells, cstr, float(kappa[0]), self.eps_f, skin,
+                self.bs, nb, self.nn, self.mark, self.cnt, self.ep, self.ec, self.hkey, self.heap, self.hpos,
                 np.empty(cap), np.empty(cap), np.empty(cap, dtype=np.int8), np.empty((cap, ek.PAIR_STATE)),
                 vir, kw, acc, iacc, budget, t_cap)
             if status == dk.DeformingStatus.OVERFLOW:
@@ -843,7 +853,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         return duration, int(iacc[dk.I_COLL]), int(iacc[dk.I_EXIT]), float(acc[mdk.A_KEINT])
 
     def _pairs(self, scale: float):
-        return edk.near_pairs(self.P, self.H, np.linalg.inv(self.H), scale)
+        width = 2.0 * scale * float(self.P[:, self._column(2)].max())
+        return edk.near_pairs(self.P, self.H, np.linalg.inv(self.H), scale, *self._cell_grid(width))
 
     def _smallest_gap(self) -> float:
         """Smallest mu - 1 (Perram-Wertheim, relative) of the pairs at the window end."""
