@@ -121,6 +121,26 @@ class ContactArrays:
             return np.ones(self.n_contacts, dtype=bool)
         return active[self.i] & active[self.j]
 
+    def counts(self, active: np.ndarray | None = None) -> np.ndarray:
+        """Contacts per particle among ``active`` particles.
+
+        A self-image contact counts twice (the particle touches its image at +n and at -n), a wall
+        contact once.
+
+        Parameters
+        ----------
+        active : numpy.ndarray of bool, shape (N,), optional
+            Particles whose contacts count (contacts with both ends active); all if None.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (N,)
+            Contact number of every particle (0 for inactive ones).
+        """
+        keep = self.among(active)
+        n = self.n_particles
+        return (np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep & (self.wall < 0)], minlength=n))
+
 
 @dataclass(frozen=True)
 class ContactNetwork(ContactArrays):
@@ -206,26 +226,6 @@ class ContactNetwork(ContactArrays):
     @property
     def is_self_image(self) -> np.ndarray:
         return (self.i == self.j) & (self.wall < 0)
-
-    def counts(self, active: np.ndarray | None = None) -> np.ndarray:
-        """Contacts per particle among ``active`` particles.
-
-        A self-image contact counts twice (the particle touches its image at +n and at -n), a wall
-        contact once.
-
-        Parameters
-        ----------
-        active : numpy.ndarray of bool, shape (N,), optional
-            Particles whose contacts count (contacts with both ends active); all if None.
-
-        Returns
-        -------
-        numpy.ndarray of int, shape (N,)
-            Contact number of every particle (0 for inactive ones).
-        """
-        keep = self.among(active)
-        n = self.n_particles
-        return (np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep & (self.wall < 0)], minlength=n))
 
     def subset(self, mask: np.ndarray) -> ContactNetwork:
         """The network of the contacts in ``mask``, in the same order.

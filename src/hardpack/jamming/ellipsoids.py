@@ -212,26 +212,6 @@ class EllipsoidContacts(ContactArrays):
                                  shape_inv=self.shape_inv, semiaxes=self.semiaxes, delta=self.delta,
                                  centre=self.centre, radius=self.radius)
 
-    def counts(self, active: np.ndarray | None = None) -> np.ndarray:
-        """Contacts per particle among ``active`` particles.
-
-        A self-image contact counts twice (the particle touches its image at +n and at -n), a wall
-        contact once.
-
-        Parameters
-        ----------
-        active : numpy.ndarray of bool, shape (N,), optional
-            Particles whose contacts count (contacts with both ends active); all if None.
-
-        Returns
-        -------
-        numpy.ndarray of int, shape (N,)
-            Contact number of every particle (0 for inactive ones).
-        """
-        keep = self.among(active)
-        n = self.n_particles
-        return np.bincount(self.i[keep], minlength=n) + np.bincount(self.j[keep & (self.wall < 0)], minlength=n)
-
 
 @numba.njit(cache=True)
 def _pair_contacts(positions, shape_inv, bounding, ii, jj, sep):

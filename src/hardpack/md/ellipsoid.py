@@ -186,23 +186,11 @@ class EllipsoidSimulation(Simulation):
         self.engine.rescalings[:] = np.asarray(state.get("rescalings", np.zeros(3)), dtype=np.int64)
 
     def run_window(self, coll_target: int, target_phi: float | None = None) -> dict:
-        """As :meth:`hardpack.md.simulation.Simulation.run_window`; the kT fields are the
-        translational temperature 2 KE_trans / (d N), at the end of the window and averaged over it.
-
-        See :meth:`hardpack.md.simulation.Simulation.run_window` for the parameters and the return value.
-
-        Raises
-        ------
-        OverlapError
-            If a pair overlaps, or a particle crosses a wall, by more than the overlap tolerance at
-            the end of the window.
-        InvalidInputError
-            If the periodic box is too small for the particles.
-        RuntimeError
-            If no event can ever happen, or the event loop stalls (ellipsoids).
+        """As :meth:`hardpack.md.simulation.Simulation.run_window` (parameters, record, errors); the
+        kT fields are the translational temperature 2 KE_trans / (d N), at the end of the window
+        and averaged over it.
         """
-        record = super().run_window(coll_target, target_phi)
-        return record
+        return super().run_window(coll_target, target_phi)
 
 
 @dataclass
@@ -244,16 +232,8 @@ class EllipsoidCompressResult:
 
     def save(self, packing_path, timeseries_path=None, config=None):
         """Write the packing (stats as attributes) and optionally the time series, atomically with
-        provenance; the velocities are not written (:meth:`to_dataset` has them).
-
-        Parameters
-        ----------
-        packing_path : str or os.PathLike
-            netCDF file of the final packing.
-        timeseries_path : str or os.PathLike, optional
-            netCDF file of :attr:`timeseries`; not written if None.
-        config : object, optional
-            Run parameters recorded as provenance (:func:`hardpack.io.write_dataset`).
+        provenance; the velocities are not written (:meth:`to_dataset` has them). Parameters as
+        :meth:`hardpack.md.compress.CompressResult.save`.
         """
         from hardpack.io import save_packing, write_dataset
 
