@@ -14,6 +14,8 @@
   centre, moves it to another grid cell and rebuilds its list with a larger bounding sphere when
   the particle grows), the lists are still exactly the brute-force pairs of the bounding spheres,
   and the window is bit-identical on a grid of one cell and on a fine grid;
+- a window whose particles grow threefold in a small cell ends at its time cap with collisions
+  and no overlaps (the collision finds the image in contact however far the growth took it);
 - near_pairs gives the brute-force pairs and images, own images included, in its documented
   order (i, j, then the image with its last component slowest), with centres inside or outside
   the cell, on any grid.
@@ -252,3 +254,18 @@ def test_near_pairs_is_the_brute_force_enumeration(name, unwrapped):
             got = edk.near_pairs(P, H, Hinv, scale, n_cells, c_strides(n_cells))
             for a, b in zip(got, ref):
                 assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_fast_growth_in_a_small_cell_collides_with_the_far_image(seed):
+    # the semiaxes grow 3x (kappa = 0.5 to t = 4): the pair in contact is then farther apart than
+    # twice the bounding diameters of the window's start, and the collision must still find its
+    # image (a filter on the start radii skipped it, the collision law saw a separating image, took
+    # the event for a graze and the same collision was predicted again at one time: STALLED)
+    sim, skin = _simulation("small_3d", seed=seed)
+    skin *= 0.5
+    kappa, t_cap = 0.5, 4.0
+    _, _, _, _, iacc = _window(sim, skin, t_cap=t_cap, kappa=kappa)  # asserts DONE_TIME
+    assert iacc[dk.I_COLL] > 0
+    ek.synchronise(sim.P, t_cap, kappa)
+    assert sim.packing().overlap_report().n_overlapping == 0

@@ -220,10 +220,12 @@ def _partner_image(P, i, j, t, kappa, nb, nn, img, cbits, ws, wm):
     images at r and -r from i have equal zeta). A predicted collision approaches (zeta_dot < 0,
     the sign of the collision law's v_n), so the image taken is the approaching one of the
     smallest zeta: the predicted one, or one at most as far that approaches too (a contact a
-    hair early); when none approaches, the image of the smallest zeta (a graze). The smallest
-    zeta alone picked a touching image that separates (two images within 1e-11 of contact
-    were seen), the collision law skipped it as a graze and the same collision was predicted
-    again at the same time without end.
+    hair early); when none approaches, the image of the smallest zeta (a graze). Taking the
+    smallest zeta alone can pick a touching image that separates (two images within 1e-11 of
+    contact occur), which the collision law skips as a graze while the same collision is
+    predicted again at the same time. Images farther than twice the sum of the bounding radii
+    grown to t cannot touch and are skipped; the radii must be those at t, not at the window's
+    start, or a fast-growing pair's contact image is skipped in the same way.
     """
     d = img.shape[1]
     _, _, cr, _, _, _, _, _ = ek.columns(d)
@@ -233,6 +235,7 @@ def _partner_image(P, i, j, t, kappa, nb, nn, img, cbits, ws, wm):
     code = -1
     best_in = np.inf
     approaching = -1
+    far = ((P[i, cr] + P[j, cr]) * (1.0 + kappa * t)) ** 2 * 4.0  # (twice the grown radii sum)^2
     for e in range(nn[i]):
         if nb[i, e] >> cbits != j:
             continue
@@ -242,7 +245,7 @@ def _partner_image(P, i, j, t, kappa, nb, nn, img, cbits, ws, wm):
             sh[k] = img[c, k]
             dx = P[j, k] + sh[k] - P[i, k]
             d2 += dx * dx
-        if code >= 0 and d2 >= (P[i, cr] + P[j, cr]) ** 2 * 4.0:
+        if code >= 0 and d2 >= far:
             continue
         z, zdot, _ = ek.pair_zeta(P, i, j, sh, t, kappa, 0.5, ws, wm)
         if z < best:
