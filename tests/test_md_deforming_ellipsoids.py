@@ -15,10 +15,11 @@ Physics checked:
 - a particle collides with its own periodic images: at zero growth one or two spheroids in a small
   cell, where most or all collisions are with own images, conserve the kinetic energy to
   round-off and the momentum exactly (one particle keeps its velocity: only its spin changes);
-- one spheroid per cell (N = 1), compressed from a random orientation in a cube, ends at the
-  densest lattice packing of the shape, the affine image of FCC: phi = pi / sqrt(18) exactly for
-  every aspect ratio (no lattice packing of spheroids is denser; Minkowski's problem for the
-  affine image of the ball), with the FCC coordination 12, prolate and oblate;
+- one spheroid per cell (N = 1), compressed from a random orientation in a cube, never ends
+  above the densest lattice packing of the shape, the affine image of FCC, phi = pi / sqrt(18)
+  for every aspect ratio (no lattice packing of spheroids is denser; Minkowski's problem for the
+  affine image of the ball), and on at least half of the seeds ends on it with the FCC
+  coordination 12, prolate and oblate;
 - bad input is refused.
 """
 
@@ -94,19 +95,26 @@ def test_own_image_collisions_conserve_energy_and_momentum(n):
     assert sim.packing().overlap_report().n_overlapping == 0
 
 
-@pytest.mark.parametrize(("alpha", "seed"), [(np.sqrt(3.0), 0), (1.0 / np.sqrt(3.0), 2)])
-def test_one_spheroid_per_cell_ends_at_the_densest_lattice_packing(alpha, seed):
-    """Seeds on which the LS growth does not jam the cell early (it does on some: see
-    :mod:`hardpack.md.crystal_search`, step 4)."""
+@pytest.mark.parametrize(("alpha", "growth_rate"), [(np.sqrt(3.0), 1e-3), (1.0 / np.sqrt(3.0), 1e-4)])
+def test_one_spheroid_per_cell_ends_at_the_densest_lattice_packing(alpha, growth_rate):
+    """LS growth can jam the cell in a looser lattice first (:mod:`hardpack.md.crystal_search`,
+    step 4), so the claim is over seeds: none ends above pi / sqrt(18), and at least half of four
+    end on it with the FCC coordination 12. Measured on seeds 0-3: prolate at Gamma = 1e-3 three
+    (seed 0 ends at 0.680 with 8 contacts), oblate at Gamma = 1e-4 all four (at 1e-3 one)."""
     from hardpack.md.crystal_search import search_run
 
-    run = search_run(1, float(alpha), seed)
-    assert run["Z"] >= 1e9
-    assert run["phi"] == pytest.approx(np.pi / np.sqrt(18.0), abs=2e-5)
-    assert run["phi"] < np.pi / np.sqrt(18.0) + 1e-7
-    assert run["min_contacts"] == run["max_contacts"] == 12
-    assert run["n_overlapping"] == 0
-    assert run["packing"].n_particles == 1
+    bound = np.pi / np.sqrt(18.0)
+    reached = 0
+    for seed in range(4):
+        run = search_run(1, float(alpha), seed, growth_rate=growth_rate)
+        assert run["Z"] >= 1e9
+        assert run["phi"] < bound + 1e-7
+        assert run["n_overlapping"] == 0
+        assert run["packing"].n_particles == 1
+        if run["phi"] == pytest.approx(bound, abs=2e-5):
+            assert run["min_contacts"] == run["max_contacts"] == 12
+            reached += 1
+    assert reached >= 2
 
 
 @pytest.mark.slow

@@ -19,7 +19,11 @@ structure the particles find. One run here (:func:`search_run`):
    expands it back to the density of p*, new velocities) and keeps the densest jammed packing:
    LS growth can jam the cell in a lattice that a slower deformation would leave (one spheroid
    per cell at Gamma = 1e-3 ended at pi / sqrt(18) in 3 of 4 prolate and 1 of 4 oblate seeds,
-   the others at phi = 0.698 to 0.740 with 6 to 10 contacts; at Gamma = 1e-2 none did).
+   the others at phi = 0.680 to 0.740 with 6 to 10 contacts; at Gamma = 1e-2 none did; at
+   Gamma = 1e-4 all of 6 oblate seeds and none of 6 prolate ones, which stopped at phi =
+   0.737-0.739 with only 2-4 contacts within the contact tolerance, a cell frozen rather than a
+   jammed lattice). Which seeds end where depends on the last bits of the arithmetic (the numba
+   and numpy versions), so claims about the search are fractions over seeds.
 
 Small cells need the collisions of a particle with its own periodic images, which the ellipsoid
 kernel has (:mod:`hardpack.md._ellipsoid_deforming_kernel`): with ``n`` = 1 the run ends at
