@@ -16,6 +16,7 @@ def test_mixing_entropy_printed_value():
     assert thermo.mixing_entropy(1 / 3) == pytest.approx(math.log(3) - 2 / 3 * math.log(2), abs=1e-15)
     assert round(thermo.mixing_entropy(1 / 3), 4) == 0.6365
     assert thermo.mixing_entropy(0.0) == 0.0 == thermo.mixing_entropy(1.0)
+    assert math.copysign(1.0, thermo.mixing_entropy(1.0)) == 1.0  # +0, so a pure system prints "0.0000", not "-0.0000"
     with pytest.raises(InvalidInputError):
         thermo.mixing_entropy(1.2)
 

@@ -56,7 +56,7 @@ def mixing_entropy(x) -> float:
     x = float(x)
     if not 0.0 <= x <= 1.0:
         raise InvalidInputError(f"the number fraction x must be in [0, 1], got {x}")
-    return -sum(p * math.log(p) for p in (x, 1.0 - x) if p > 0)
+    return 0.0 - sum(p * math.log(p) for p in (x, 1.0 - x) if p > 0)  # +0.0, not -0.0, for a pure system
 
 
 def second_virial_slope(d: int = 2, size_ratio: float = 1.0, large_fraction: float = 0.0) -> float:
