@@ -236,11 +236,27 @@ def test_maker_gives_exact_isostatic_contacts():
 
 @pytest.mark.slow
 def test_maker_still_makes_the_stored_disks():
-    """The maker's packing is the stored one (bit for bit on the machine that stored it; to
-    1e-9 elsewhere) and exactly isostatic itself."""
+    """The maker's packing is the stored one and exactly isostatic itself: same cell and radii,
+    the same contact network, and the backbone at the same positions up to a rigid translation
+    (a zero mode of every periodic packing) to round-off. The minimisations' last bits differ
+    between hosts, which moves the whole packing (seen: 6e-6 of a side on another CPU) and the
+    two rattlers within their cages, so neither is compared."""
     made = make_jammed_disks()
     _check_exact_isostatic_contacts(made)
     stored = jammed_disks()
     np.testing.assert_allclose(made.lattice, stored.lattice, rtol=1e-12)
     np.testing.assert_allclose(made.radii, stored.radii, rtol=1e-12)
-    np.testing.assert_allclose(made.positions, stored.positions, atol=1e-9 * made.lattice[0, 0])
+
+    def network(p):
+        near = pairs_within(p, rel_gap=0.05)
+        tight = near.gap < 1e-12
+        return set(zip(near.i[tight].tolist(), near.j[tight].tolist()))
+
+    contacts = network(made)
+    assert contacts == network(stored)
+    backbone = np.unique(np.array(sorted(contacts)))
+    assert backbone.size == made.n_particles - 2  # the two rattlers of seed 3
+    side = made.lattice[0, 0]
+    shift = made.positions[backbone] - stored.positions[backbone]
+    shift -= side * np.round(shift / side)
+    np.testing.assert_allclose(shift, np.broadcast_to(shift.mean(axis=0), shift.shape), rtol=0, atol=1e-12 * side)
