@@ -163,6 +163,42 @@ def test_freezing_point_of_constructed_model():
     assert res.phi_precipitate * henderson(res.phi_precipitate) / 1.2**2 == pytest.approx(target, rel=1e-4)
 
 
+def _eos_summary(rel_err):
+    """An EOS summary in the layout of study.eos_dataset: a compression branch with Henderson's Z
+    and its integrated excess free energy, and a decompression branch without one."""
+    import xarray as xr
+
+    phi = np.arange(0.0025, 0.70, 0.005)
+    z = henderson(phi)
+    f, f_err = thermo.excess_free_energy(phi, z, rel_err * z)
+    nan = np.full_like(phi, np.nan)
+    data = {"phi_mean": np.stack([phi, phi]), "Z": np.stack([z, z]), "Z_err": np.stack([rel_err * z] * 2),
+            "excess": np.stack([f, nan]), "excess_err": np.stack([f_err, nan])}
+    return xr.Dataset({k: (("branch", "phi"), v) for k, v in data.items()},
+                      coords={"branch": ["1e-05", "decompression"]}, attrs={"slope0": 2.0})
+
+
+def test_bootstrap_draws_reproduce_the_exact_error_propagation():
+    # the freezing point's errors come from EOS summaries with every Z drawn from N(Z, Z_err) and
+    # the excess integrated again: over many draws the spread of the excess must equal the exact
+    # linear propagation of thermo.excess_free_energy (independent bins), and zero errors must
+    # leave the summary as it is
+    eos = _eos_summary(0.01)
+    rng = np.random.default_rng(5)
+    draws = [study._perturbed_eos(eos, rng) for _ in range(2000)]
+    excess = np.array([d["excess"].values[0] for d in draws])
+    z = np.array([d["Z"].values[1] for d in draws])
+    exact = eos["excess_err"].values[0]
+    assert np.all(np.isnan(np.array([d["excess"].values[1] for d in draws])))  # decompression: none
+    # the standard deviation of 2000 normal draws is known to 1.6 % (1 / sqrt(2 x 1999)); 5 sigma
+    np.testing.assert_allclose(excess.std(axis=0, ddof=1), exact, rtol=0.08)
+    np.testing.assert_allclose(z.std(axis=0, ddof=1), eos["Z_err"].values[1], rtol=0.08)
+    np.testing.assert_allclose(excess.mean(axis=0), eos["excess"].values[0], atol=5 * exact.max() / np.sqrt(2000))
+    same = study._perturbed_eos(_eos_summary(0.0), rng)
+    np.testing.assert_allclose(same["excess"].values[0], _eos_summary(0.0)["excess"].values[0], rtol=1e-14)
+    np.testing.assert_array_equal(same["Z"].values, _eos_summary(0.0)["Z"].values)
+
+
 def test_composition_derivative():
     mt = freezing.composition_derivative(lambda p: 2 * p, lambda p: p, 0.05)
     assert mt(0.5) == pytest.approx(0.5 / 0.1)

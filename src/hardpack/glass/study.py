@@ -21,6 +21,8 @@ from hardpack.geometry.packing import Packing
 from hardpack.glass import fits, thermo
 
 PHI_TRIANGULAR = math.pi / math.sqrt(12.0)
+#: bootstrap replicas of the freezing point's standard errors (:func:`freezing_dataset`) and their seed
+FREEZING_REPLICAS, FREEZING_SEED = 100, 20061
 
 
 def triangular_crystal(nx: int, ny: int, phi: float) -> Packing:
@@ -347,13 +349,21 @@ def joint_branch(eos: xr.Dataset, low: str, high: str, phi_join: float):
 
 
 def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | None, minus: xr.Dataset | None,
-                     *, kappa: float, x_large: float, dx: float, phi_join: float) -> xr.Dataset:
+                     *, kappa: float, x_large: float, dx: float, phi_join: float,
+                     replicas: int = FREEZING_REPLICAS) -> xr.Dataset:
     """Freezing of the mixture against the pure large-disk crystal (Eq. 13.2): phi_F and the
     precipitate's density. The monodisperse EOS joins the slowest compression below
     ``phi_join`` and the decompression of the crystal above; the mixture's EOS is its slowest
     compression; mu~_B from the mixtures at x_A +- dx (``plus``: x_A + dx, i.e. x_large - dx),
     or 0 without them (recorded in ``mu_tilde``). Data that do not allow a solution (too few
     points, no sign change) give NaN with the reason in ``status``.
+
+    Standard errors by a parametric bootstrap: ``replicas`` times, every binned Z of every
+    input is drawn from a normal distribution with its standard error Z_err (bins independent,
+    the model under which :func:`hardpack.glass.thermo.excess_free_energy` propagates them), the
+    excess free energies are integrated again and Eq. 13.2 solved again; the error of each
+    result is the standard deviation over the replicas that solve (their number is the attribute
+    ``replicas_solved``). The draws use a fixed seed, so the same inputs give the same errors.
 
     Parameters
     ----------
@@ -371,21 +381,57 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
         Composition step of ``plus`` and ``minus``.
     phi_join : float
         Where the monodisperse compression and decompression join.
+    replicas : int, default FREEZING_REPLICAS
+        Bootstrap replicas of the standard errors (0: no errors, NaN).
 
     Returns
     -------
     xarray.Dataset
-        Scalars phi_freeze, phi_precipitate, pressure, mu; attributes status and mu_tilde.
+        Scalars phi_freeze, phi_precipitate, pressure, mu and their standard errors (``*_err``);
+        attributes status, mu_tilde, replicas and replicas_solved.
     """
     attrs = {"hardpack_kind": "glass_freezing", "kappa": kappa, "x_large": x_large, "phi_join": phi_join,
              "n_particles": int(mixture.attrs.get("N", 0))}
+    names = ("phi_freeze", "phi_precipitate", "pressure", "mu")
+    errors = dict.fromkeys(names, math.nan)
+    solved = 0
     try:
         values, how = _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join)
         attrs.update(status="solved", mu_tilde=how)
+        rng = np.random.default_rng(FREEZING_SEED)
+        draws = []
+        for _ in range(int(replicas)):
+            inputs = [None if eos is None else _perturbed_eos(eos, rng) for eos in (mono, mixture, plus, minus)]
+            try:
+                draws.append(_solve_freezing(*inputs, kappa, x_large, dx, phi_join)[0])
+            except InvalidInputError:
+                continue
+        solved = len(draws)
+        if solved >= 2:
+            errors = {k: float(np.std([r[k] for r in draws], ddof=1)) for k in names}
     except InvalidInputError as exc:
-        values = dict.fromkeys(("phi_freeze", "phi_precipitate", "pressure", "mu"), math.nan)
+        values = dict.fromkeys(names, math.nan)
         attrs.update(status=f"not solved: {exc}", mu_tilde="-")
-    return xr.Dataset({k: ((), v) for k, v in values.items()}, attrs=attrs)
+    attrs.update(replicas=int(replicas), replicas_solved=solved)
+    data = {k: ((), values[k]) for k in names} | {f"{k}_err": ((), errors[k]) for k in names}
+    return xr.Dataset(data, attrs=attrs)
+
+
+def _perturbed_eos(eos: xr.Dataset, rng: np.random.Generator) -> xr.Dataset:
+    """A copy of an EOS summary with every finite Z drawn from N(Z, Z_err) and the excess free
+    energies of its compression branches integrated again over the same bins (as
+    :func:`eos_dataset` does)."""
+    out = eos.copy(deep=True)
+    z_all, err_all = out["Z"].values, out["Z_err"].values
+    excess_all, phi_all = out["excess"].values, out["phi_mean"].values
+    for b in range(z_all.shape[0]):
+        ok = np.isfinite(z_all[b])
+        z_all[b, ok] += rng.normal(size=int(ok.sum())) * np.nan_to_num(err_all[b, ok])
+        span = np.flatnonzero(ok & np.isfinite(excess_all[b]))
+        if span.size:
+            excess_all[b, span] = thermo.excess_free_energy(phi_all[b, span], z_all[b, span],
+                                                            slope0=float(eos.attrs["slope0"]))[0]
+    return out
 
 
 def _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join):

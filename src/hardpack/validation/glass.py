@@ -75,7 +75,8 @@ def eos_rows(ds) -> list[Row]:
 
 
 def freezing_rows(ds) -> list[Row]:
-    """phi_F and the precipitate density (Eq. 13.2); no error estimate (NaN).
+    """phi_F and the precipitate density (Eq. 13.2) with their bootstrap standard errors
+    (:func:`hardpack.glass.study.freezing_dataset`; NaN in a summary written without them).
 
     Parameters
     ----------
@@ -90,8 +91,16 @@ def freezing_rows(ds) -> list[Row]:
     targets = load_targets()
     n = int(ds.attrs.get("n_particles", 0))
     detail = f"N = {n}; {ds.attrs.get('status')}; mu~_B: {ds.attrs.get('mu_tilde')}"
-    return [evaluate(targets["donev-13.2-phi-freeze"], float(ds["phi_freeze"]), n=n, detail=detail),
-            evaluate(targets["donev-13.2-phi-precipitate"], float(ds["phi_precipitate"]), n=n, detail=detail)]
+    if "replicas_solved" in ds.attrs:
+        detail += f"; error: bootstrap, {ds.attrs['replicas_solved']} of {ds.attrs.get('replicas')} replicas solved"
+
+    def error(name):
+        return float(ds[f"{name}_err"]) if f"{name}_err" in ds else math.nan
+
+    return [evaluate(targets["donev-13.2-phi-freeze"], float(ds["phi_freeze"]), error("phi_freeze"), n=n,
+                     detail=detail),
+            evaluate(targets["donev-13.2-phi-precipitate"], float(ds["phi_precipitate"]), error("phi_precipitate"),
+                     n=n, detail=detail)]
 
 
 def entropy_rows(ds) -> list[Row]:
