@@ -80,6 +80,33 @@ def test_random_cases_agree_with_monte_carlo(d):
         assert abs(_volume(a, b, r) - est) <= 4 * se
 
 
+@pytest.mark.parametrize("d", [2, 3])
+def test_centres_on_the_axes_agree_with_monte_carlo_and_their_neighbours(d):
+    # a ball centre with exactly zero components in the particle's frame (on an axis or a plane of
+    # symmetry) is an ordinary valid case (a jammed container packing produced one); it must give
+    # the Monte Carlo volume and the volume of a centre 1e-7 away
+    rng = np.random.default_rng(11)
+    a = np.array([1.0, 2.0, 1.5][:d])
+    for b in ([0.3, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.4], [0.2, 0.0, 0.3], [0.0, 0.0, 0.0]):
+        b = np.array(b[:d])
+        for r in (0.6, 1.3, 1.9):
+            v = _volume(a, b, r)
+            est, se = _monte_carlo(a, b, r, 1_000_000, rng)
+            assert abs(v - est) <= 4 * se
+            assert v == pytest.approx(_volume(a, b + 1e-7, r), abs=1e-6 * np.prod(a))
+
+
+def test_a_circle_touching_the_ellipse_at_an_arcs_midpoint():
+    # the circle about (0.3, 0) of radius 1.3 touches the ellipse (1, 2) from inside at (-1, 0), the
+    # midpoint of its arc between the crossings; the disk there is inside the ellipse
+    rng = np.random.default_rng(12)
+    for u, v, p, q in ((0.3, 0.0, 1.0, 2.0), (0.0, 0.3, 2.0, 1.0)):
+        est, se = _monte_carlo(np.array([p, q]), np.array([u, v]), 1.3, 2_000_000, rng)
+        assert abs(ellipse_disk_area(p, q, u, v, 1.3) - est) <= 4 * se
+        assert ellipse_disk_area(p, q, u, v, 1.3) == pytest.approx(ellipse_disk_area(p, q, u + 1e-7, v + 1e-7, 1.3),
+                                                                   abs=1e-6)
+
+
 def test_against_an_independent_polar_quadrature():
     """An independent deterministic integral: about the ball's centre the ray of direction u meets
     the ellipsoid for t in [t_-, t_+] (a quadratic), and V = int (clip(t_+)^3 - clip(t_-)^3) / 3

@@ -94,10 +94,19 @@ def lens_area(r1, r2, s):
 def _secular_root(w_near, w_far, gap, sign, lo, hi):
     """u in [lo, hi] (lo > 0) with h(u) = w_near / u^2 + w_far / (gap + sign u)^2 = 1, h decreasing
     on the bracket: Newton on h^(-1/2) - 1 (nearly linear) kept in the bracket by geometric
-    bisection, which keeps the relative precision of u."""
+    bisection, which keeps the relative precision of u.
+
+    When the far weight is negligible (a centre on an axis, its zero component replaced by TINY)
+    the bracket's end next to the far pole rounds onto the pole itself, gap + sign u = 0, where h
+    is infinite in floating point although it is below 1 at the true end: that end is moved
+    inside by a bisection step."""
     u = hi
     for _ in range(200):
         den = gap + sign * u
+        if den == 0.0:
+            hi = u
+            u = np.sqrt(lo * hi)
+            continue
         h = w_near / (u * u) + w_far / (den * den)
         dh = -2.0 * w_near / (u * u * u) - 2.0 * sign * w_far / (den * den * den)
         if h > 1.0:
@@ -151,10 +160,11 @@ def _stationary_angles(p, q, u, v, out):
     ra, rb = np.cbrt(wa), np.cbrt(wb)
     if (ra + rb) ** 3 < gap * gap:
         ustar = gap * ra / (ra + rb)
+        vstar = gap * rb / (ra + rb)  # gap - ustar without the cancellation (ustar ~ gap on an axis)
         t = _secular_root(wa, wb, gap, -1.0, min(np.sqrt(wa), ustar), ustar)
         xa[n], xb[n] = -al * ca / t, be * cb / (gap - t)
         n += 1
-        t = _secular_root(wb, wa, gap, -1.0, min(np.sqrt(wb), gap - ustar), gap - ustar)
+        t = _secular_root(wb, wa, gap, -1.0, min(np.sqrt(wb), vstar), vstar)
         xa[n], xb[n] = -al * ca / (gap - t), be * cb / t
         n += 1
     for k in range(n):
@@ -253,16 +263,23 @@ def _ellipse_disk(p, q, u, v, r):
     for k in range(nr):
         t0 = roots[k]
         t1 = roots[k + 1] if k + 1 < nr else roots[0] + 2.0 * np.pi
-        if _excess(0.5 * (t0 + t1), p, q, u, v, r2) < 0.0:
+        # inside or outside the disk, judged at two points of the arc (one of them could be a
+        # point where the circle touches the ellipse); the one farther from the circle decides
+        e1 = _excess(t0 + (t1 - t0) / 3.0, p, q, u, v, r2)
+        e2 = _excess(t0 + 2.0 * (t1 - t0) / 3.0, p, q, u, v, r2)
+        if (e1 if abs(e1) >= abs(e2) else e2) < 0.0:
             area += 0.5 * p * q * (t1 - t0)
         phi[k] = np.arctan2(q * np.sin(t0) - v, p * np.cos(t0) - u)
     phi[:nr] = np.sort(phi[:nr])
     for k in range(nr):
         f0 = phi[k]
         f1 = phi[k + 1] if k + 1 < nr else phi[0] + 2.0 * np.pi
-        fm = 0.5 * (f0 + f1)
-        x, y = (u + r * np.cos(fm)) / p, (v + r * np.sin(fm)) / q
-        if x * x + y * y < 1.0:
+        g1, g2 = f0 + (f1 - f0) / 3.0, f0 + 2.0 * (f1 - f0) / 3.0  # as for the ellipse arcs
+        x, y = (u + r * np.cos(g1)) / p, (v + r * np.sin(g1)) / q
+        e1 = x * x + y * y - 1.0
+        x, y = (u + r * np.cos(g2)) / p, (v + r * np.sin(g2)) / q
+        e2 = x * x + y * y - 1.0
+        if (e1 if abs(e1) >= abs(e2) else e2) < 0.0:
             area += 0.5 * (r2 * (f1 - f0) + u * r * (np.sin(f1) - np.sin(f0)) - v * r * (np.cos(f1) - np.cos(f0)))
     return area, 10 + nr
 
