@@ -197,6 +197,10 @@ def test_bootstrap_draws_reproduce_the_exact_error_propagation():
     same = study._perturbed_eos(_eos_summary(0.0), rng)
     np.testing.assert_allclose(same["excess"].values[0], _eos_summary(0.0)["excess"].values[0], rtol=1e-14)
     np.testing.assert_array_equal(same["Z"].values, _eos_summary(0.0)["Z"].values)
+    for bad in (-1, 2.5, True):
+        with pytest.raises(InvalidInputError, match="replicas"):
+            study.freezing_dataset(eos, eos, None, None, kappa=1.4, x_large=1 / 3, dx=0.05, phi_join=0.7,
+                                   replicas=bad)
 
 
 def test_composition_derivative():

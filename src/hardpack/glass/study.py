@@ -389,7 +389,14 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
     xarray.Dataset
         Scalars phi_freeze, phi_precipitate, pressure, mu and their standard errors (``*_err``);
         attributes status, mu_tilde, replicas and replicas_solved.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``replicas`` is not an integer >= 0.
     """
+    if isinstance(replicas, bool) or not isinstance(replicas, (int, np.integer)) or replicas < 0:
+        raise InvalidInputError(f"replicas must be an integer >= 0 (0: no error estimate), got {replicas!r}")
     attrs = {"hardpack_kind": "glass_freezing", "kappa": kappa, "x_large": x_large, "phi_join": phi_join,
              "n_particles": int(mixture.attrs.get("N", 0))}
     names = ("phi_freeze", "phi_precipitate", "pressure", "mu")
