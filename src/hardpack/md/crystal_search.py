@@ -21,8 +21,12 @@ structure the particles find. One run here (:func:`search_run`):
    per cell at Gamma = 1e-3 ended at pi / sqrt(18) in 3 of 4 prolate and 1 of 4 oblate seeds,
    the others at phi = 0.680 to 0.740 with 6 to 10 contacts; at Gamma = 1e-2 none did; at
    Gamma = 1e-4 all of 6 oblate seeds and none of 6 prolate ones, which stopped at phi =
-   0.737-0.739 with only 2-4 contacts within the contact tolerance, a cell frozen rather than a
-   jammed lattice). Which seeds end where depends on the last bits of the arithmetic (the numba
+   0.737-0.739 with only 2-4 contacts within the contact tolerance, not a jammed lattice: the
+   spheroid touches its own image at its equator, the shortest lattice vector perpendicular to
+   its long axis to 1e-6, so the contact normal lies on the centre line, no spin can open the
+   gap, the impulses grow as 1 / |r x n|^2 and the reduced pressure, whose kinetic part is the
+   translational energy that a lone particle never exchanges, passes ``max_pressure`` before
+   the cell has relaxed). Which seeds end where depends on the last bits of the arithmetic (the numba
    and numpy versions), so claims about the search are fractions over seeds.
 
 Small cells need the collisions of a particle with its own periodic images, which the ellipsoid
