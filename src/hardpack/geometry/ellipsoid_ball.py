@@ -181,6 +181,14 @@ def _excess(t, p, q, u, v, r2):
     return x * x + y * y - r2
 
 
+@njit(cache=True, inline="always")
+def _decisive(e1, e2):
+    """Of the signed excesses of an arc's points at its thirds, the one farther from zero: it
+    says whether the arc is inside the other curve (one of the two could be a point where the
+    circle touches the ellipse, where the excess is zero)."""
+    return e1 if abs(e1) >= abs(e2) else e2
+
+
 @njit(cache=True)
 def ellipse_disk_area(p, q, u, v, r):
     """Area of the ellipse x^2 / p^2 + y^2 / q^2 <= 1 intersected with the disk of radius r about
@@ -263,23 +271,21 @@ def _ellipse_disk(p, q, u, v, r):
     for k in range(nr):
         t0 = roots[k]
         t1 = roots[k + 1] if k + 1 < nr else roots[0] + 2.0 * np.pi
-        # inside or outside the disk, judged at two points of the arc (one of them could be a
-        # point where the circle touches the ellipse); the one farther from the circle decides
         e1 = _excess(t0 + (t1 - t0) / 3.0, p, q, u, v, r2)
         e2 = _excess(t0 + 2.0 * (t1 - t0) / 3.0, p, q, u, v, r2)
-        if (e1 if abs(e1) >= abs(e2) else e2) < 0.0:
+        if _decisive(e1, e2) < 0.0:
             area += 0.5 * p * q * (t1 - t0)
         phi[k] = np.arctan2(q * np.sin(t0) - v, p * np.cos(t0) - u)
     phi[:nr] = np.sort(phi[:nr])
     for k in range(nr):
         f0 = phi[k]
         f1 = phi[k + 1] if k + 1 < nr else phi[0] + 2.0 * np.pi
-        g1, g2 = f0 + (f1 - f0) / 3.0, f0 + 2.0 * (f1 - f0) / 3.0  # as for the ellipse arcs
+        g1, g2 = f0 + (f1 - f0) / 3.0, f0 + 2.0 * (f1 - f0) / 3.0
         x, y = (u + r * np.cos(g1)) / p, (v + r * np.sin(g1)) / q
         e1 = x * x + y * y - 1.0
         x, y = (u + r * np.cos(g2)) / p, (v + r * np.sin(g2)) / q
         e2 = x * x + y * y - 1.0
-        if (e1 if abs(e1) >= abs(e2) else e2) < 0.0:
+        if _decisive(e1, e2) < 0.0:
             area += 0.5 * (r2 * (f1 - f0) + u * r * (np.sin(f1) - np.sin(f0)) - v * r * (np.cos(f1) - np.cos(f0)))
     return area, 10 + nr
 
