@@ -153,3 +153,35 @@ def test_fit_range_warnings_and_refusals():
         th.bmcsl(0.3, 0.8, 0.9)  # O2 > O1 is not a size distribution
     with pytest.raises(InvalidInputError):
         th.henderson(-0.1)
+
+
+def test_hard_disk_virial_b3_from_its_cluster_integral():
+    """B_3 = (1/3) x (measure of three mutually overlapping unit disks) = (1/3) int_0^1 2 pi r
+    A_lens(r) dr, A_lens the overlap area of two unit disks; B_2 = pi/2. The series' B_3 must match
+    that quadrature, and its low-density expansion must start 1 + 2 phi + 4 B_3/B_2^2 phi^2."""
+    from scipy.integrate import quad
+
+    def lens(d):
+        return 2 * math.acos(d / 2) - 0.5 * d * math.sqrt(4 - d * d)
+
+    b3 = quad(lambda r: 2 * math.pi * r * lens(r), 0, 1, epsabs=1e-13)[0] / 3
+    assert th.HARD_DISK_VIRIAL[1] == pytest.approx(b3 / (math.pi / 2) ** 2, rel=1e-10)
+    h = 1e-4
+    z = th.hard_disk_virial(np.array([h, 2 * h]))
+    c2 = (z[1] - 2 * z[0] + 1) / (2 * h**2)
+    c1 = (z[0] - 1) / h - c2 * h
+    assert c1 == pytest.approx(2.0, abs=1e-6) and c2 == pytest.approx(4 * th.HARD_DISK_VIRIAL[1], rel=1e-3)
+
+
+def test_hard_disk_virial_truncation_bounds_the_next_terms():
+    """The bound covers the series' missing B_11 x^10 for any B_11 <= r B_10 (the ratio trend) and
+    grows with phi; it is the docstring's 1e-4 at phi = 0.3."""
+    r = th.HARD_DISK_VIRIAL[-1] / th.HARD_DISK_VIRIAL[-2]
+    bounds = th.hard_disk_virial_truncation(np.array([0.1, 0.2, 0.3, 0.4]))
+    assert np.all(np.diff(bounds) > 0)
+    for phi in (0.1, 0.2, 0.3, 0.4):
+        x = 2 * phi
+        assert th.hard_disk_virial_truncation(phi) > r * th.HARD_DISK_VIRIAL[-1] * x**10
+    assert th.hard_disk_virial_truncation(0.3) == pytest.approx(1.0e-4, rel=0.01)
+    with pytest.raises(InvalidInputError, match=r"\[0, 0.5\)"):
+        th.hard_disk_virial(0.5)

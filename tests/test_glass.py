@@ -241,3 +241,81 @@ def test_bin_runs_mean_and_error():
     assert res["Z_err"][0] == pytest.approx(np.std([2.0, 4.0], ddof=1) / np.sqrt(2))
     assert res["Z"][1] == pytest.approx(4.0)
     assert res["phi"][0] == pytest.approx((0.115 + 0.12) / 2)
+
+
+# --- (e) validation rows of the EOS summaries ----------------------------------------------------
+
+def _summary(branches, x_large, n=4096):
+    """An EOS summary in the layout of study.eos_dataset from {branch: (Z(phi), rel_err)} on the
+    study's bins (phi~_J and its error from fits.estimated_jamming_density)."""
+    import xarray as xr
+
+    phi = np.arange(0.0025, 0.90, 0.005)
+    data = {k: [] for k in ("phi_mean", "Z", "Z_err", "phij", "phij_err", "n_runs")}
+    for z_of, rel in branches.values():
+        z = np.array([z_of(p) for p in phi])
+        pj, pe = fits.estimated_jamming_density(phi, z, rel * z, 2)
+        for k, v in zip(data, (phi, z, rel * z, pj, pe, np.where(np.isfinite(z), 2, 0))):
+            data[k].append(v)
+    rates = [float(b) if b[0].isdigit() else math.nan for b in branches]
+    ds = xr.Dataset({k: (("branch", "phi"), np.array(v)) for k, v in data.items()},
+                    coords={"branch": list(branches), "phi": phi, "growth_rate": ("branch", rates)},
+                    attrs={"N": n, "x_large": x_large, "bin_width": 0.005})
+    study._add_fits(ds, (0.70, 0.80), (0.80, 0.84))
+    return ds
+
+
+def _mono_z(flat_at):
+    """The virial series in the fluid, then a rising line whose slope dips from 40 to 2 at ``flat_at``."""
+    from hardpack.eos.theory import hard_disk_virial
+
+    def z(p):
+        if p < 0.45:
+            return float(hard_disk_virial(p))
+        return 6.0 + 40 * (p - 0.45) - 38 * 0.005 * math.sqrt(math.pi) * math.erf((p - flat_at) / 0.01)
+    return z
+
+
+def test_mono_eos_rows_judge_the_virial_series_and_the_transition():
+    from hardpack.validation.glass import eos_rows
+
+    rows = {r.target: r for r in eos_rows(_summary({"1e-05": (_mono_z(0.7125), 1e-5)}, 0.0))}
+    assert rows["hard-disk-virial-z-0.20"].status == "pass"
+    assert rows["hard-disk-virial-z-0.30"].status == "pass"
+    assert rows["donev-13.1-mono-transition"].status == "pass"
+    assert rows["donev-13.1-mono-transition"].reproduced == pytest.approx(0.7125, abs=0.003)
+    # 20 standard errors too high at phi = 0.2, and the flat stretch at 0.745: both rows fail
+    from hardpack.eos.theory import hard_disk_virial
+
+    def high(p):
+        return _mono_z(0.745)(p) * (1 + 2e-4 * (abs(p - 0.2) < 0.01))
+    bad = {r.target: r for r in eos_rows(_summary({"1e-05": (high, 1e-5)}, 0.0))}
+    assert bad["hard-disk-virial-z-0.20"].status == "fail"
+    assert bad["hard-disk-virial-z-0.30"].status == "pass"
+    assert bad["donev-13.1-mono-transition"].status == "fail"
+    assert float(hard_disk_virial(0.2)) == pytest.approx(bad["hard-disk-virial-z-0.20"].published)
+    small = {r.target: r for r in eos_rows(_summary({"1e-05": (_mono_z(0.7125), 1e-5)}, 0.0, n=256))}
+    assert small["hard-disk-virial-z-0.20"].status == "n/a"
+
+
+def test_rate_rows_bracket_where_the_compressions_part():
+    from hardpack.validation.glass import eos_rows
+
+    def liquid(p):
+        return 2 / (1 - p / 0.852)
+
+    def glass(p):  # out of equilibrium above 0.79: a higher pressure, a lower phi~_J
+        return 2 / (1 - p / (0.852 - 0.2 * max(0.0, p - 0.79)))
+
+    rows = {r.target: r for r in eos_rows(_summary({"0.001": (glass, 1e-3), "1e-05": (liquid, 1e-3)}, 1 / 3))}
+    assert rows["donev-13.3-rates-agree"].status == "pass"
+    assert rows["donev-13.3-rates-separate"].status == "pass"
+    same = {r.target: r for r in eos_rows(_summary({"0.001": (liquid, 1e-3), "1e-05": (liquid, 1e-3)}, 1 / 3))}
+    assert same["donev-13.3-rates-separate"].status == "fail"
+
+    def early(p):  # already parted at 0.70
+        return 2 / (1 - p / 0.845)
+    apart = {r.target: r for r in eos_rows(_summary({"0.001": (early, 1e-3), "1e-05": (liquid, 1e-3)}, 1 / 3))}
+    assert apart["donev-13.3-rates-agree"].status == "fail"
+    one = {r.target: r for r in eos_rows(_summary({"1e-05": (liquid, 1e-3)}, 1 / 3))}
+    assert one["donev-13.3-rates-agree"].status == "n/a"

@@ -721,7 +721,7 @@ def validation_inputs():
             inputs["bcmd_ellipse"] = [summary("bcmd_ellipse/ellipse")]
             inputs["bcmd_ellipse_ladder"] = ["results/bcmd_ellipse/ladder.nc"]
     if GLASS:
-        inputs["glass_eos"] = [summary("glass/binary/eos")]
+        inputs["glass_eos"] = [summary("glass/binary/eos"), summary("glass/mono/eos")]
         inputs["glass_entropy"] = [summary("glass/binary/entropy"), summary("glass/mono/entropy")]
         inputs["glass_freezing"] = [summary("glass/freezing")]
     if MICROSEG:

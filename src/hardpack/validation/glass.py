@@ -31,13 +31,173 @@ def _seeds(ds, branch) -> int:
 
 
 def eos_rows(ds) -> list[Row]:
+    """The rows of a glass EOS summary: :func:`mono_eos_rows` for monodisperse disks, else
+    :func:`binary_eos_rows`.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The glass EOS summary (attribute ``system``).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
+    if float(ds.attrs.get("x_large", 1.0)) == 0.0:
+        return mono_eos_rows(ds)
+    return binary_eos_rows(ds) + rate_rows(ds)
+
+
+def _slowest(ds):
+    rates = ds["growth_rate"].values
+    comp = np.flatnonzero(np.isfinite(rates) & (rates > 0))
+    if comp.size == 0:
+        return None, []
+    order = comp[np.argsort(rates[comp])]
+    return str(ds["branch"].values[order[0]]), [str(ds["branch"].values[b]) for b in order[1:]]
+
+
+def _z_at(row, phi: float) -> tuple[float, float, str]:
+    """Z and its error at ``phi`` by the quadratic through the three bins whose mean phi lie nearest
+    (a linear interpolation of the convex EOS would be biased by Z'' h^2/8 ~ 3e-5 at phi = 0.2);
+    NaN when they do not surround ``phi`` within two bins."""
+    x, z, e = row["phi_mean"].values, row["Z"].values, row["Z_err"].values
+    ok = np.flatnonzero(np.isfinite(x) & np.isfinite(z))
+    near = np.sort(ok[np.argsort(np.abs(x[ok] - phi))[:3]]) if ok.size >= 3 else ok
+    if near.size < 3 or not x[near[0]] <= phi <= x[near[-1]] or x[near[-1]] - x[near[0]] > 0.0105:
+        return math.nan, math.nan, f"no three adjacent bins around phi = {phi}"
+    xs = x[near]
+    w = np.array([np.prod([(phi - xs[m]) / (xs[k] - xs[m]) for m in range(3) if m != k]) for k in range(3)])
+    return (float(w @ z[near]), float(np.sqrt(np.sum((w * e[near]) ** 2))),
+            f"quadratic through the bins at phi = {', '.join(f'{v:.4f}' for v in xs)}")
+
+
+def mono_eos_rows(ds) -> list[Row]:
+    """Monodisperse disks (Donev 2006, sec. 13.1): Z of the slowest compression at phi = 0.20 and
+    0.30 against the hard-disk virial series (:func:`hardpack.eos.theory.hard_disk_virial`), and
+    the liquid-solid transition region, the phi of the flattest EOS between 0.65 and 0.76.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The glass EOS summary of the monodisperse system.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
+    from hardpack.eos.theory import hard_disk_virial
+
+    targets = load_targets()
+    n = int(ds.attrs.get("N", 0))
+    slow, _ = _slowest(ds)
+    out = []
+    for phi, tid in ((0.20, "hard-disk-virial-z-0.20"), (0.30, "hard-disk-virial-z-0.30")):
+        if slow is None:
+            out.append(evaluate(targets[tid], n=n, seeds=0, detail="no compression"))
+            continue
+        row = ds.sel(branch=slow)
+        z, err, how = _z_at(row, phi)
+        seeds = int(row["n_runs"].values.max())
+        out.append(evaluate(targets[tid], z, err, n=n, seeds=seeds, published=float(hard_disk_virial(phi)),
+                            detail=f"N = {n}, Gamma = {slow}, {seeds} seed(s); {how}"))
+    out.append(transition_row(ds, slow, n))
+    return out
+
+
+def transition_row(ds, branch, n) -> Row:
+    """phi at the smallest slope dZ/dphi (central differences over the bins' mean phi) of
+    ``branch`` between 0.65 and 0.76: the flat or looping part of the monodisperse EOS (Donev 2006,
+    sec. 13.1, "transition region phi ~ 0.70-0.72"). The error is the spread of that phi over
+    bootstrap replicas with every Z drawn from N(Z, Z_err); the decompression's value is reported.
+    """
+    target = load_targets()["donev-13.1-mono-transition"]
+    if branch is None:
+        return evaluate(target, n=n, seeds=0, detail="no compression")
+
+    def flattest(x, z):
+        slope = (z[2:] - z[:-2]) / (x[2:] - x[:-2])
+        return float(x[1:-1][np.argmin(slope)]) if slope.size else math.nan
+
+    def pick(name):
+        row = ds.sel(branch=name)
+        x, z, e = row["phi_mean"].values, row["Z"].values, row["Z_err"].values
+        ok = np.isfinite(x) & np.isfinite(z) & (x >= 0.65) & (x <= 0.76)
+        return x[ok], z[ok], np.nan_to_num(e[ok])
+
+    x, z, e = pick(branch)
+    if x.size < 3:
+        return evaluate(target, n=n, seeds=0, detail=f"Gamma = {branch}: fewer than 3 bins in 0.65..0.76")
+    rng = np.random.default_rng(20061)
+    boot = [flattest(x, z + e * rng.standard_normal(z.size)) for _ in range(200)]
+    seeds = int(ds.sel(branch=branch)["n_runs"].values.max())
+    detail = f"N = {n}, Gamma = {branch}, {seeds} seed(s), bins of {ds.attrs.get('bin_width')}"
+    if "decompression" in ds["branch"].values:
+        xd, zd, _ = pick("decompression")
+        if xd.size >= 3:
+            detail += f"; decompression of the crystal: {flattest(xd, zd):.4f}"
+    return evaluate(target, flattest(x, z), float(np.std(boot, ddof=1)), n=n, seeds=seeds, detail=detail)
+
+
+def rate_rows(ds) -> list[Row]:
+    """The mixture's compressions agree below phi = 0.775 and have separated by 0.80-0.825 (Donev
+    2006, sec. 13.3: "all rates agree below 0.775"; kinetic glass transition phi_g ~ 0.8): the mean
+    over the bins of each band of phi~_J(fastest) - phi~_J(slowest), with the error of that mean
+    from the bins' standard errors (bins taken as independent; phi~_J varies slowly with phi, so
+    the bins' different mean phi do not bias it).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The glass EOS summary of the mixture.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
+    targets = load_targets()
+    n = int(ds.attrs.get("N", 0))
+    slow, faster = _slowest(ds)
+    agree, apart = targets["donev-13.3-rates-agree"], targets["donev-13.3-rates-separate"]
+    if slow is None or not faster:
+        why = "needs at least two compression rates"
+        return [evaluate(agree, n=n, seeds=0, detail=why), evaluate(apart, n=n, seeds=0, detail=why)]
+    fast = faster[-1]
+    b = ds.sel(branch=slow)
+    seeds = int(min(ds.sel(branch=fast)["n_runs"].values.max(), b["n_runs"].values.max()))
+    phi = ds["phi"].values
+
+    def band(lo, hi, branch=fast):
+        a = ds.sel(branch=branch)
+        sel = (phi >= lo) & (phi < hi) & np.isfinite(a["phij"].values) & np.isfinite(b["phij"].values)
+        diff = a["phij"].values[sel] - b["phij"].values[sel]
+        err = np.hypot(a["phij_err"].values[sel], b["phij_err"].values[sel])
+        if diff.size == 0:
+            return math.nan, math.nan, 0
+        return float(diff.mean()), float(np.sqrt(np.sum(err**2)) / diff.size), int(diff.size)
+
+    how = f"N = {n}, Gamma = {fast} vs {slow}, {seeds} seed(s)"
+    d1, e1, k1 = band(0.70, 0.775)
+    d2, e2, k2 = band(0.80, 0.825)
+    verdict = float(d2 < -2 * e2) if math.isfinite(e2) and k2 else math.nan
+    others = "".join(f"; Gamma = {r}: {band(0.70, 0.775, r)[0]:.5f} +- {band(0.70, 0.775, r)[1]:.5f}"
+                     for r in faster[:-1])
+    return [evaluate(agree, d1, e1, n=n, seeds=seeds, detail=f"{how}; {k1} bins in [0.70, 0.775){others}"),
+            evaluate(apart, verdict, n=n, seeds=seeds,
+                     detail=f"{how}; {k2} bins in [0.80, 0.825): mean difference {d2:.5f} +- {e2:.5f}")]
+
+
+def binary_eos_rows(ds) -> list[Row]:
     """Eq. 13.3 coefficients (fit to the slowest compression) with their standard errors, phi~_J at
     0.75 of that compression, and alpha and phi_J of its glassy branch (Eq. 13.4).
 
     Parameters
     ----------
     ds : xarray.Dataset
-        The glass EOS summary.
+        The glass EOS summary of the mixture.
 
     Returns
     -------
