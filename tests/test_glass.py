@@ -319,3 +319,30 @@ def test_rate_rows_bracket_where_the_compressions_part():
     assert apart["donev-13.3-rates-agree"].status == "fail"
     one = {r.target: r for r in eos_rows(_summary({"1e-05": (liquid, 1e-3)}, 1 / 3))}
     assert one["donev-13.3-rates-agree"].status == "n/a"
+
+
+def _packing_attrs(seed, rate, phi_j, z, n=1024):
+    import xarray as xr
+
+    return xr.Dataset(attrs={"N": n, "seed": seed, "growth_rate": rate, "phi_J_est": phi_j, "Z": z})
+
+
+def test_relaxed_dataset_and_row():
+    from hardpack.validation.glass import relaxed_rows
+
+    fast = [_packing_attrs(s, r, 0.826 if r == 0.1 else 0.845, 1e4) for r in (0.1, 0.01) for s in (1, 2)]
+    jammed = [_packing_attrs(s, 1e-4, pj, 1e4) for pj, s in ((0.8474, 1), (0.8478, 2), (0.8455, 1), (0.8459, 2))]
+    ds = study.relaxed_dataset(fast, jammed, relax_collisions=1e4)
+    assert ds.attrs["recompress_rate"] == 1e-4 and ds.attrs["N"] == 1024
+    assert ds["phi_J"].values.tolist() == [0.8474, 0.8478, 0.8455, 0.8459]
+    row = relaxed_rows(ds)[0]
+    assert row.reproduced == pytest.approx(0.8476) and row.status == "pass"  # the fastest rate, 0.1
+    low = study.relaxed_dataset(fast, [_packing_attrs(s, 1e-4, 0.8440, 1e4) for s in (1, 2, 1, 2)],
+                                relax_collisions=1e4)
+    assert relaxed_rows(low)[0].status == "fail"
+    with pytest.raises(InvalidInputError, match="same order"):
+        study.relaxed_dataset(fast, jammed[::-1], relax_collisions=1e4)
+    with pytest.raises(InvalidInputError, match="one recompressed packing per fast"):
+        study.relaxed_dataset(fast, jammed[:3], relax_collisions=1e4)
+    with pytest.raises(InvalidInputError, match="one N"):
+        study.relaxed_dataset(fast, jammed[:3] + [_packing_attrs(2, 1e-4, 0.846, 1e4, n=256)], relax_collisions=1e4)

@@ -34,7 +34,8 @@ SUBCOMMANDS: dict[str, str] = {
     "bcmd-ladder": "hardpack.freeenergy.cli", "bcmd-ellipse": "hardpack.freeenergy.cli",
     "ellipse-lattice": "hardpack.freeenergy.cli", "bcmd-ellipse-ladder": "hardpack.freeenergy.cli",
     "glass-crystal": "hardpack.glass.cli", "glass-eos": "hardpack.glass.cli", "glass-entropy": "hardpack.glass.cli",
-    "glass-freezing": "hardpack.glass.cli", "glass-labels": "hardpack.glass.cli",
+    "glass-freezing": "hardpack.glass.cli", "glass-relaxed": "hardpack.glass.cli",
+    "glass-labels": "hardpack.glass.cli",
     "glass-labelled-crystal": "hardpack.glass.cli", "glass-microsegregated": "hardpack.glass.cli",
     "glass-microsegregated-summary": "hardpack.glass.cli",
 }

@@ -487,6 +487,14 @@ def microseg_minutes(w):
     return 0.3 + n * per_particle / 4e5 / 60
 
 
+def glass_relaxed_files(prefix):
+    """The relaxed-glass packings of every fast rate and seed: ``fast_`` after the fast compression,
+    ``""`` after the recompression (in the same order)."""
+    relaxed = GLASS.get("relaxed") or {}
+    return [f"results/glass/binary/relaxed/g{rate:g}/{prefix}seed{seed}.nc"
+            for rate in relaxed.get("rates", []) for seed in GLASS["seeds"]]
+
+
 def glass_bcmd_files(system):
     rate = min(GLASS_SYSTEMS[system]["rates"])
     return [f"results/glass/{system}/bcmd/g{rate:g}/phi{phi:g}/seed{seed}.nc"
@@ -724,6 +732,8 @@ def validation_inputs():
         inputs["glass_eos"] = [summary("glass/binary/eos"), summary("glass/mono/eos")]
         inputs["glass_entropy"] = [summary("glass/binary/entropy"), summary("glass/mono/entropy")]
         inputs["glass_freezing"] = [summary("glass/freezing")]
+        if GLASS.get("relaxed"):
+            inputs["glass_relaxed"] = [summary("glass/binary/relaxed")]
     if MICROSEG:
         inputs["glass_microsegregated"] = [summary("microseg/phij_sc")]
     poly = [summary(key) for key in EOS_SUMMARIES]
@@ -839,6 +849,8 @@ EXPECTED_MINUTES = {
     "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],
                                                          GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
     "glass_bcmd": glass_bcmd_minutes,
+    # N = 1024, Gamma = 0.1, 1e4 collisions per particle, recompression at 1e-4 to Z = 1e4: ~20 CPU-s
+    "glass_relaxed": lambda w: 0.3 + 0.5 * GLASS["N"] / 1024 * (1 + GLASS["relaxed"]["relax_collisions"] / 1e4),
     "microseg_packing": microseg_minutes,
     # per run at alpha = sqrt(3), CPU s: n = 1 about 2, n = 2 about 7, n = 4 8-10; oblate slower
     "crystal_search": lambda w: 1.0 + len(CRYSTAL_SEARCH["seeds"]) * sum(0.05 * n for n in CRYSTAL_SEARCH["n"])
@@ -867,8 +879,8 @@ PARTICLES = {
     "fcc_eos": lambda w: 4 * int(w.reps) ** 3,
     "bcmd_simplex": lambda w: SYSTEMS["ls"][w.ensemble]["N"],
     "poly_fluid": lambda w: POLY_FLUID["N"],
-    **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd"),
-                    lambda w: GLASS["N"]),
+    **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd",
+                     "glass_relaxed"), lambda w: GLASS["N"]),
     **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
     **dict.fromkeys(("ellipsoid_container_init", "ellipsoid_container_profile"),
                     lambda w: SYSTEMS["ellipsoid_containers"][w.name]["N"]),

@@ -229,6 +229,64 @@ rule glass_freezing:
         " --phi-join {params.join} --out {output} > {log} 2>&1"
 
 
+rule glass_relaxed:
+    """A fast glass of the mixture relaxed and recompressed (Donev 2006, Fig. 13.8): LS at growth rate {rate} to glass.relaxed.max_pressure, MD at fixed phi for glass.relaxed.relax_collisions collisions per particle, LS at glass.relaxed.rate to the same pressure."""
+    input:
+        "results/glass/binary/init/seed{seed}.nc",
+    output:
+        fast="results/glass/binary/relaxed/g{rate}/fast_seed{seed}.nc",
+        relaxed="results/glass/binary/relaxed/g{rate}/relaxed_seed{seed}.nc",
+        jammed="results/glass/binary/relaxed/g{rate}/seed{seed}.nc",
+    params:
+        r=GLASS.get("relaxed") if GLASS else None,
+        collisions=lambda w: math.ceil(GLASS["N"] * GLASS["relaxed"]["relax_collisions"]),
+    wildcard_constraints:
+        rate=r"[0-9.e+-]+",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_relaxed"),
+        runtime=job_runtime("glass_relaxed"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_relaxed/g{rate}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_relaxed/g{rate}/seed{seed}.tsv"
+    shell:
+        "(hardpack compress --init {input} --growth-rate {wildcards.rate} --seed {wildcards.seed}"
+        " --max-pressure {params.r[max_pressure]} --out {output.fast}"
+        " && hardpack compress --init {output.fast} --growth-rate 0 --seed {wildcards.seed}"
+        " --max-collisions {params.collisions} --max-pressure none --out {output.relaxed}"
+        " && hardpack compress --init {output.relaxed} --growth-rate {params.r[rate]} --seed {wildcards.seed}"
+        " --max-pressure {params.r[max_pressure]} --out {output.jammed}) > {log} 2>&1"
+
+
+rule glass_relaxed_summary:
+    """phi_J of the fast glasses before and after relaxation, over rates and seeds (Donev 2006, Fig. 13.8)."""
+    input:
+        fast=lambda w: glass_relaxed_files("fast_"),
+        jammed=lambda w: glass_relaxed_files(""),
+    output:
+        "results/glass/binary/relaxed_summary.nc",
+    params:
+        collisions=GLASS["relaxed"]["relax_collisions"] if GLASS and GLASS.get("relaxed") else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_relaxed_summary"),
+        runtime=job_runtime("glass_relaxed_summary"),
+    group:
+        "summaries"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_relaxed_summary.log",
+    benchmark:
+        "results/benchmarks/glass_relaxed_summary.tsv"
+    shell:
+        "hardpack glass-relaxed --fast {input.fast} --jammed {input.jammed}"
+        " --relax-collisions {params.collisions} --out {output} > {log} 2>&1"
+
+
 rule fig_glass_eos:
     """phi~_J(phi) of the compressions and decompression (mono, binary) with the published and fitted Eq. 13.3, 13.4 (Donev 2006, Figs. 13.1, 13.6)."""
     input:

@@ -2,7 +2,8 @@
 ``hardpack glass-eos``: binned EOS, fits (Eqs. 13.3-13.4) and free energies of one system from its
 compression (and decompression) time series; ``hardpack glass-entropy``: s_c - s_mix of the SOC
 glasses from the EOS summary and their BCMD results; ``hardpack glass-freezing``: phi_F by
-chemical-potential matching (Eq. 13.2); ``hardpack glass-labels``: level-cut Matérn labels of the
+chemical-potential matching (Eq. 13.2); ``hardpack glass-relaxed``: jamming densities of fast glasses
+before and after relaxation (Fig. 13.8); ``hardpack glass-labels``: level-cut Matérn labels of the
 micro-segregated packings and their window entropies (sec. 13.5); ``hardpack glass-labelled-crystal``:
 the triangular crystal carrying one realisation of those labels. Donev 2006, ch. 13
 (:mod:`hardpack.glass`).
@@ -152,6 +153,32 @@ def cmd_glass_freezing(args) -> int:
     return 0
 
 
+def cmd_glass_relaxed(args) -> int:
+    """Jamming densities of fast glasses before and after relaxation (Donev 2006, Fig. 13.8).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-relaxed``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
+    from hardpack.glass.study import relaxed_dataset
+    from hardpack.io import load_dataset, write_dataset
+
+    ds = relaxed_dataset([load_dataset(p, kind="packing") for p in args.fast],
+                         [load_dataset(p, kind="packing") for p in args.jammed], relax_collisions=args.relax_collisions)
+    write_dataset(ds, args.out)
+    for rate in np.unique(ds["rate"].values):
+        sel = ds["rate"].values == rate
+        log.info("Gamma = %g: phi_J %.4f before, %.4f after relaxation (%d runs)", rate,
+                 ds["phi_J_fast"].values[sel].mean(), ds["phi_J"].values[sel].mean(), sel.sum())
+    return 0
+
+
 def cmd_glass_labels(args) -> int:
     """Level-cut Matérn GRF labels and their window entropies s_{n,m} (Donev 2006, sec. 13.5).
 
@@ -276,7 +303,7 @@ def cmd_glass_microsegregated_summary(args) -> int:
 
 
 def register(subparsers) -> None:
-    """Add the subcommands ``glass-crystal``, ``glass-eos``, ``glass-entropy``, ``glass-freezing``,
+    """Add the subcommands ``glass-crystal``, ``glass-eos``, ``glass-entropy``, ``glass-freezing``, ``glass-relaxed``,
     ``glass-labels``, ``glass-labelled-crystal``, ``glass-microsegregated``,
     ``glass-microsegregated-summary`` to the ``hardpack`` command line.
 
@@ -325,6 +352,14 @@ def register(subparsers) -> None:
                    help="monodisperse EOS: compression below, decompression from here up (default 0.70)")
     p.add_argument("--out", required=True, help="freezing netCDF")
     p.set_defaults(func=cmd_glass_freezing)
+
+    p = subparsers.add_parser("glass-relaxed", help=cmd_glass_relaxed.__doc__.split("\n\n")[0])
+    p.add_argument("--fast", nargs="+", required=True, help="packings after the fast compressions")
+    p.add_argument("--jammed", nargs="+", required=True, help="the same runs after relaxation and recompression")
+    p.add_argument("--relax-collisions", type=float, required=True,
+                   help="collisions per particle of the relaxation at fixed phi (recorded)")
+    p.add_argument("--out", required=True, help="summary netCDF")
+    p.set_defaults(func=cmd_glass_relaxed)
 
     p = subparsers.add_parser("glass-labels", help=cmd_glass_labels.__doc__.split("\n\n")[0])
     p.add_argument("--shape", type=int, nargs=2, default=[64, 64], metavar=("ROWS", "COLS"),

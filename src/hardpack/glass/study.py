@@ -465,3 +465,53 @@ def _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join):
     res = fz.freezing_point(pure, mix_phase, fz.Mixture(kappa, x_large), mu_tilde)
     return {"phi_freeze": res.phi_freeze, "phi_precipitate": res.phi_precipitate,
             "pressure": res.pressure, "mu": res.mu}, how
+
+
+def relaxed_dataset(fast: list[xr.Dataset], jammed: list[xr.Dataset], *, relax_collisions: float) -> xr.Dataset:
+    """Jamming densities of fast glasses before and after relaxation (Donev 2006, sec. 13.3.1 and
+    Fig. 13.8: "fast compressions produce packings that are not truly jammed and subsequent
+    relaxation of these systems increases the density to around phi_J ~ 0.847").
+
+    Each run is a fast LS compression of the liquid to a high pressure (``fast``), then MD at fixed
+    phi for ``relax_collisions`` collisions per particle, then a slow compression to a high pressure
+    (``jammed``). phi_J of each is the packing's phi~_J = phi / (1 - d/Z) (Eq. 13.4's estimate).
+
+    Parameters
+    ----------
+    fast, jammed : list of xarray.Dataset
+        The packings after the fast compression and after the recompression, run by run.
+    relax_collisions : float
+        Collisions per particle of the relaxation at fixed phi (recorded).
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``run``: ``rate`` (the fast growth rate), ``seed``, ``phi_J_fast``, ``Z_fast``,
+        ``phi_J``, ``Z``; kind ``glass_relaxed``; attributes N, recompress_rate, relax_collisions.
+
+    Raises
+    ------
+    InvalidInputError
+        If the lists differ in length, are empty, or pair packings of different N or seed.
+    """
+    if not fast or len(fast) != len(jammed):
+        raise InvalidInputError(f"need one recompressed packing per fast packing; got {len(fast)} and {len(jammed)}")
+    cols = {k: [] for k in ("rate", "seed", "phi_J_fast", "Z_fast", "phi_J", "Z")}
+    n = {int(p.attrs["N"]) for p in fast + jammed}
+    slow = {float(p.attrs["growth_rate"]) for p in jammed}
+    if len(n) != 1 or len(slow) != 1:
+        raise InvalidInputError(f"all packings must have one N and the recompressions one rate; got N {sorted(n)}, "
+                                f"rates {sorted(slow)}")
+    for a, b in zip(fast, jammed):
+        if int(a.attrs["seed"]) != int(b.attrs["seed"]):
+            raise InvalidInputError(f"fast packing of seed {a.attrs['seed']} paired with a recompression of seed "
+                                    f"{b.attrs['seed']}: give them in the same order")
+        for key, value in (("rate", float(a.attrs["growth_rate"])), ("seed", int(a.attrs["seed"])),
+                           ("phi_J_fast", float(a.attrs["phi_J_est"])), ("Z_fast", float(a.attrs["Z"])),
+                           ("phi_J", float(b.attrs["phi_J_est"])), ("Z", float(b.attrs["Z"]))):
+            cols[key].append(value)
+    ds = xr.Dataset({k: ("run", np.array(v)) for k, v in cols.items() if k not in ("rate", "seed")},
+                    coords={"rate": ("run", np.array(cols["rate"])), "seed": ("run", np.array(cols["seed"]))})
+    ds.attrs.update(hardpack_kind="glass_relaxed", N=n.pop(), recompress_rate=slow.pop(),
+                    relax_collisions=float(relax_collisions))
+    return ds

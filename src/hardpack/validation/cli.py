@@ -30,7 +30,14 @@ from hardpack.validation.freeenergy import (
     ladder_rows,
     simplex_rows,
 )
-from hardpack.validation.glass import entropy_rows, eos_rows, freezing_rows, microsegregated_rows, smix_rows
+from hardpack.validation.glass import (
+    entropy_rows,
+    eos_rows,
+    freezing_rows,
+    microsegregated_rows,
+    relaxed_rows,
+    smix_rows,
+)
 from hardpack.validation.jamming import jamming_rows, strict_ls_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
 from hardpack.validation.polydisperse import polydisperse_rows
@@ -65,6 +72,7 @@ ROW_BUILDERS = {
     "glass_eos": lambda datasets: [row for ds in datasets for row in eos_rows(ds)],
     "glass_entropy": lambda datasets: [row for ds in datasets for row in entropy_rows(ds)],
     "glass_freezing": lambda datasets: [row for ds in datasets for row in freezing_rows(ds)],
+    "glass_relaxed": lambda datasets: [row for ds in datasets for row in relaxed_rows(ds)],
     "glass_microsegregated": lambda datasets: [row for ds in datasets for row in microsegregated_rows(ds)],
     "ellipsoids": ellipsoid_rows,
     "ellipsoid_jamming": ellipsoid_jamming_rows,

@@ -263,6 +263,35 @@ def freezing_rows(ds) -> list[Row]:
                      n=n, detail=detail)]
 
 
+def relaxed_rows(ds) -> list[Row]:
+    """phi_J of the fastest compression's glasses after relaxation and recompression against the
+    printed ~0.847 (Donev 2006, sec. 13.3.1, Fig. 13.8), mean and standard error over seeds; the
+    other rates and the unrelaxed phi_J in the detail.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The relaxed-glass summary (:func:`hardpack.glass.study.relaxed_dataset`).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
+    target = load_targets()["donev-13.3-phij-relaxed"]
+    n = int(ds.attrs.get("N", 0))
+    rates = np.unique(ds["rate"].values)
+    parts = []
+    for rate in rates[::-1]:
+        sel = ds["rate"].values == rate
+        before, after = ds["phi_J_fast"].values[sel].mean(), ds["phi_J"].values[sel].mean()
+        parts.append(f"Gamma = {rate:g}: {before:.4f} -> {after:.4f}")
+    detail = (f"N = {n}; relaxed {ds.attrs.get('relax_collisions'):g} collisions per particle at fixed phi, "
+              f"recompressed at {ds.attrs.get('recompress_rate'):g}; phi_J before -> after: {'; '.join(parts)}")
+    fastest = ds["rate"].values == rates.max()
+    return [evaluate(target, samples=ds["phi_J"].values[fastest], n=n, detail=detail, label=f"Gamma = {rates.max():g}")]
+
+
 def entropy_rows(ds) -> list[Row]:
     """s_c - s_mix of the snapshot at phi0 = 0.80 (binary) or 0.75 (monodisperse) of the slowest
     compression, mean and standard error over seeds.
