@@ -333,3 +333,27 @@ rule fig_glass_entropy:
         "results/benchmarks/fig_glass_entropy.tsv"
     script:
         "../scripts/plot_glass_entropy.py"
+
+
+rule fig_glass_jamming:
+    """Jamming densities of the mixture vs growth rate, before and after relaxation (Donev 2006, Fig. 13.8)."""
+    input:
+        eos="results/glass/binary/eos_summary.nc",
+        relaxed="results/glass/binary/relaxed_summary.nc",
+    output:
+        pdf="results/figures/glass_jamming.pdf",
+        png=report("results/figures/glass_jamming.png", caption="../report/glass_jamming.rst", category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_jamming"),
+        runtime=job_runtime("fig_glass_jamming"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_jamming.log",
+    benchmark:
+        "results/benchmarks/fig_glass_jamming.tsv"
+    script:
+        "../scripts/plot_glass_jamming.py"

@@ -83,6 +83,42 @@ def plot_glass_entropy(binary, mono):
     return fig
 
 
+def plot_glass_jamming(eos, relaxed):
+    """Jamming densities of the mixture vs growth rate (after Donev 2006, Fig. 13.8): the glassy
+    branch's phi_J (Eq. 13.4 fit) of every compression, and the fast glasses before and after
+    relaxation and recompression, per run, with the printed ~0.85 (slowest runs) and ~0.847 (relaxed
+    fast glasses).
+
+    Parameters
+    ----------
+    eos : xarray.Dataset
+        The glass_eos summary of the mixture.
+    relaxed : xarray.Dataset
+        The relaxed-glass summary (:func:`hardpack.glass.study.relaxed_dataset`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
+    fig, ax = figure(1, 1, figsize=(5.0, 3.6))
+    rates = eos["growth_rate"].values
+    comp = np.isfinite(rates) & (rates > 0)
+    ax.errorbar(rates[comp], eos["glass_phi_j"].values[comp], yerr=eos["glass_phi_j_err"].values[comp], fmt="o",
+                label="compression: glassy branch (Eq. 13.4 fit)")
+    ax.plot(relaxed["rate"], relaxed["phi_J_fast"], "v", mfc="none", label="fast compression (not truly jammed)")
+    ax.plot(relaxed["rate"], relaxed["phi_J"], "^",
+            label=f"relaxed ({relaxed.attrs['relax_collisions']:g} coll./disk), recompressed")
+    ax.axhline(0.85, color="k", lw=0.8, ls="--", label="Donev: slowest runs ~0.85")
+    ax.axhline(0.847, color="k", lw=0.8, ls=":", label="Donev: relaxed fast glasses ~0.847")
+    ax.set_xscale("log")
+    ax.set_xlabel("growth rate Gamma")
+    ax.set_ylabel("jamming density phi_J")
+    ax.set_title(f"binary disks, N = {relaxed.attrs['N']}")
+    ax.legend(loc="lower left", fontsize="small")
+    return fig
+
+
 def _value_error(value: float, error: float) -> str:
     """value +- error in mathtext, the error to two significant digits and the value to its decimals."""
     if not (np.isfinite(error) and error > 0):
