@@ -185,3 +185,17 @@ def test_hard_disk_virial_truncation_bounds_the_next_terms():
     assert th.hard_disk_virial_truncation(0.3) == pytest.approx(1.0e-4, rel=0.01)
     with pytest.raises(InvalidInputError, match=r"\[0, 0.5\)"):
         th.hard_disk_virial(0.5)
+
+
+def test_hard_disk_solid_is_the_free_volume_divergence_plus_constants():
+    """Near close packing Z -> 2/a + C_0 with a = phi_cp/phi - 1 (the 2D free-volume pole); at
+    phi = 0.84 the printed constants give 2/a + 1.90 + 0.67 a with error 0.01 + 0.07 a."""
+    cp = math.pi / math.sqrt(12)
+    for a in (1e-3, 0.05, 0.1):
+        z, err = th.hard_disk_solid(cp / (1 + a))
+        assert z == pytest.approx(2 / a + 1.90 + 0.67 * a, rel=1e-9)
+        assert err == pytest.approx(0.01 + 0.07 * a, rel=1e-12)
+    z, _ = th.hard_disk_solid(np.array([0.80, 0.84]))
+    assert np.all(np.diff(z) > 0) and z[1] == pytest.approx(27.07, abs=0.01)
+    with pytest.raises(InvalidInputError):
+        th.hard_disk_solid(0.91)

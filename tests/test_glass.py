@@ -296,6 +296,22 @@ def test_mono_eos_rows_judge_the_virial_series_and_the_transition():
     assert float(hard_disk_virial(0.2)) == pytest.approx(bad["hard-disk-virial-z-0.20"].published)
     small = {r.target: r for r in eos_rows(_summary({"1e-05": (_mono_z(0.7125), 1e-5)}, 0.0, n=256))}
     assert small["hard-disk-virial-z-0.20"].status == "n/a"
+    assert rows["hard-disk-solid-z-0.80"].status == "n/a"  # no decompression
+
+
+def test_crystal_rows_judge_the_decompression_against_alder_hoover_young():
+    from hardpack.eos.theory import hard_disk_solid
+    from hardpack.validation.glass import eos_rows
+
+    def crystal(shift):
+        return lambda p: float(hard_disk_solid(p)[0]) + shift if p > 0.7 else math.nan
+    mono = _mono_z(0.7125)
+    rows = {r.target: r for r in eos_rows(_summary({"1e-05": (mono, 1e-5), "decompression": (crystal(0.0), 1e-5)}, 0.0))}
+    assert rows["hard-disk-solid-z-0.80"].status == "pass" and rows["hard-disk-solid-z-0.84"].status == "pass"
+    assert rows["hard-disk-solid-z-0.84"].reproduced == pytest.approx(float(hard_disk_solid(0.84)[0]), abs=1e-3)
+    # 0.05 kT above, beyond the stated errors 0.019 and 0.016
+    high = {r.target: r for r in eos_rows(_summary({"1e-05": (mono, 1e-5), "decompression": (crystal(0.05), 1e-5)}, 0.0))}
+    assert high["hard-disk-solid-z-0.80"].status == "fail" and high["hard-disk-solid-z-0.84"].status == "fail"
 
 
 def test_rate_rows_bracket_where_the_compressions_part():
@@ -346,3 +362,24 @@ def test_relaxed_dataset_and_row():
         study.relaxed_dataset(fast, jammed[:3], relax_collisions=1e4)
     with pytest.raises(InvalidInputError, match="one N"):
         study.relaxed_dataset(fast, jammed[:3] + [_packing_attrs(2, 1e-4, 0.846, 1e4, n=256)], relax_collisions=1e4)
+
+
+def test_printed_freezing_pair_against_eq_13_3_and_the_crystal_eos():
+    """The known deviation of donev-13.2-phi-precipitate: equal pressures pi = phi p / <v> with
+    Eq. 13.3 at the printed phi_F = 0.775 and the Alder-Hoover-Young crystal put the large-disk
+    precipitate at 0.8440, not the printed 0.8415 (which needs freezing at 0.7714)."""
+    from scipy.optimize import brentq
+
+    from hardpack.eos.theory import hard_disk_solid
+
+    kd, mean_v = 1.4**2, 2 / 3 + 1.4**2 / 3
+
+    def pi_mixture(phi):
+        return phi * 2 / (1 - phi / float(fits.cubic_phij(phi))) / mean_v
+
+    pi_f = pi_mixture(0.775)
+    assert pi_f == pytest.approx(12.40, abs=0.005)
+    phi_b = brentq(lambda p: p * float(hard_disk_solid(p)[0]) / kd - pi_f, 0.80, 0.90)
+    assert phi_b == pytest.approx(0.8440, abs=5e-5)
+    pi_printed = 0.8415 * float(hard_disk_solid(0.8415)[0]) / kd
+    assert brentq(lambda p: pi_mixture(p) - pi_printed, 0.74, 0.78) == pytest.approx(0.7714, abs=5e-5)

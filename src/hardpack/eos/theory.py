@@ -191,6 +191,42 @@ def hard_disk_virial_truncation(phi):
     return HARD_DISK_VIRIAL[-1] * x**9 * r * x / (1 - r * x)
 
 
+#: (C_0, error, C_1, error) of the hard-disk solid EOS of Alder, Hoover & Young 1968, Eq. 1
+AHY_DISK_SOLID = (1.90, 0.01, 0.67, 0.07)
+
+
+def hard_disk_solid(phi):
+    """The high-density hard-disk crystal EOS of Alder, Hoover & Young, J. Chem. Phys. 49, 3688
+    (1968), Eq. 1: Z = 2/a + C_0 + C_1 a with a = V/V_0 - 1 = phi_cp/phi - 1, phi_cp = pi/sqrt(12),
+    C_0 = 1.90 +- 0.01, C_1 = 0.67 +- 0.07 (:data:`AHY_DISK_SOLID`). 2/a is the free-volume
+    divergence; the fit describes the triangular crystal from close packing down to its melting.
+
+    Parameters
+    ----------
+    phi : array_like
+        Area fraction(s), in (0, pi/sqrt(12)).
+
+    Returns
+    -------
+    z : numpy.ndarray or float
+        Z = PA/(N k_B T) at each phi.
+    error : numpy.ndarray or float
+        The stated errors of C_0 and C_1 at each phi, dC_0 + dC_1 a (added linearly).
+
+    Raises
+    ------
+    InvalidInputError
+        If phi is not finite or outside (0, pi/sqrt(12)).
+    """
+    cp = np.pi / np.sqrt(12)
+    x = _phi(phi, upper=cp)
+    if np.any(x <= 0):
+        raise InvalidInputError("phi must be positive for the crystal EOS")
+    a = cp / x - 1
+    c0, e0, c1, e1 = AHY_DISK_SOLID
+    return 2 / a + c0 + c1 * a, e0 + e1 * a
+
+
 def bmcsl(phi, O1=1.0, O2=1.0):
     """Boublik-Mansoori-Carnahan-Starling-Leland, Ogarko 2014, Eq. 3.9:
     Z = 1/(1 - phi) + 3 O1 phi/(1 - phi)^2 + O2 phi^2 (3 - phi)/(1 - phi)^3 = 1 + 4 phi g_eff (Eqs. 3.7-3.8).

@@ -58,10 +58,12 @@ def _slowest(ds):
     return str(ds["branch"].values[order[0]]), [str(ds["branch"].values[b]) for b in order[1:]]
 
 
-def _z_at(row, phi: float) -> tuple[float, float, str]:
+def _z_at(row, phi: float, pole: float | None = None) -> tuple[float, float, str]:
     """Z and its error at ``phi`` by the quadratic through the three bins whose mean phi lie nearest
     (a linear interpolation of the convex EOS would be biased by Z'' h^2/8 ~ 3e-5 at phi = 0.2);
-    NaN when they do not surround ``phi`` within two bins."""
+    with ``pole``, of Z (1 - phi/pole) instead, which removes a free-volume pole (the crystal's
+    Z ~ 2/(1 - phi/phi_cp), whose quadratic interpolation is biased by ~5e-3 at phi = 0.84).
+    NaN when the bins do not surround ``phi`` within two bins."""
     x, z, e = row["phi_mean"].values, row["Z"].values, row["Z_err"].values
     ok = np.flatnonzero(np.isfinite(x) & np.isfinite(z))
     near = np.sort(ok[np.argsort(np.abs(x[ok] - phi))[:3]]) if ok.size >= 3 else ok
@@ -69,14 +71,19 @@ def _z_at(row, phi: float) -> tuple[float, float, str]:
         return math.nan, math.nan, f"no three adjacent bins around phi = {phi}"
     xs = x[near]
     w = np.array([np.prod([(phi - xs[m]) / (xs[k] - xs[m]) for m in range(3) if m != k]) for k in range(3)])
+    scale = np.ones(3) if pole is None else (1 - xs / pole) / (1 - phi / pole)
+    w = w * scale
     return (float(w @ z[near]), float(np.sqrt(np.sum((w * e[near]) ** 2))),
-            f"quadratic through the bins at phi = {', '.join(f'{v:.4f}' for v in xs)}")
+            f"quadratic through the bins at phi = {', '.join(f'{v:.4f}' for v in xs)}"
+            + ("" if pole is None else f" of Z (1 - phi/{pole:.4f})"))
 
 
 def mono_eos_rows(ds) -> list[Row]:
     """Monodisperse disks (Donev 2006, sec. 13.1): Z of the slowest compression at phi = 0.20 and
-    0.30 against the hard-disk virial series (:func:`hardpack.eos.theory.hard_disk_virial`), and
-    the liquid-solid transition region, the phi of the flattest EOS between 0.65 and 0.76.
+    0.30 against the hard-disk virial series (:func:`hardpack.eos.theory.hard_disk_virial`), the
+    liquid-solid transition region, the phi of the flattest EOS between 0.65 and 0.76, and Z of
+    the decompressed crystal at phi = 0.80 and 0.84 against the crystal EOS of Alder, Hoover &
+    Young (:func:`hardpack.eos.theory.hard_disk_solid`).
 
     Parameters
     ----------
@@ -88,7 +95,7 @@ def mono_eos_rows(ds) -> list[Row]:
     list of Row
         Validation rows (:class:`hardpack.validation.rows.Row`).
     """
-    from hardpack.eos.theory import hard_disk_virial
+    from hardpack.eos.theory import hard_disk_solid, hard_disk_virial
 
     targets = load_targets()
     n = int(ds.attrs.get("N", 0))
@@ -104,6 +111,15 @@ def mono_eos_rows(ds) -> list[Row]:
         out.append(evaluate(targets[tid], z, err, n=n, seeds=seeds, published=float(hard_disk_virial(phi)),
                             detail=f"N = {n}, Gamma = {slow}, {seeds} seed(s); {how}"))
     out.append(transition_row(ds, slow, n))
+    for phi, tid in ((0.80, "hard-disk-solid-z-0.80"), (0.84, "hard-disk-solid-z-0.84")):
+        if "decompression" not in ds["branch"].values:
+            out.append(evaluate(targets[tid], n=n, seeds=0, detail="no decompression of the crystal"))
+            continue
+        row = ds.sel(branch="decompression")
+        z, err, how = _z_at(row, phi, pole=math.pi / math.sqrt(12))
+        seeds = int(row["n_runs"].values.max())
+        out.append(evaluate(targets[tid], z, err, n=n, seeds=seeds, published=float(hard_disk_solid(phi)[0]),
+                            detail=f"N = {n}, decompression of the triangular crystal, {seeds} seed(s); {how}"))
     return out
 
 
