@@ -128,6 +128,20 @@ def transition_row(ds, branch, n) -> Row:
     ``branch`` between 0.65 and 0.76: the flat or looping part of the monodisperse EOS (Donev 2006,
     sec. 13.1, "transition region phi ~ 0.70-0.72"). The error is the spread of that phi over
     bootstrap replicas with every Z drawn from N(Z, Z_err); the decompression's value is reported.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The glass EOS summary of the monodisperse system.
+    branch : str or None
+        The compression branch judged (the slowest); None gives an n/a row.
+    n : int
+        Disks per system.
+
+    Returns
+    -------
+    Row
+        The validation row (:class:`hardpack.validation.rows.Row`).
     """
     target = load_targets()["donev-13.1-mono-transition"]
     if branch is None:
