@@ -7,14 +7,15 @@ import textwrap
 import numpy as np
 from matplotlib import rc_context
 
+from hardpack.eos.theory import hard_disk_solid
 from hardpack.glass import fits
 from hardpack.plots.style import RC, figure
 
 
 def plot_glass_eos(binary, mono):
     """phi~_J(phi) = phi / (1 - 2/Z) of every compression branch (and the crystal decompression),
-    with the published Eq. 13.3 cubic, our fit of it, and the glassy branches of Eq. 13.4 (after
-    Donev 2006, Figs. 13.1 and 13.6).
+    with the published Eq. 13.3 cubic, our fit of it, the glassy branches of Eq. 13.4 and the
+    hard-disk crystal EOS of Alder, Hoover & Young 1968 (after Donev 2006, Figs. 13.1 and 13.6).
 
     Parameters
     ----------
@@ -40,6 +41,8 @@ def plot_glass_eos(binary, mono):
         ax.set_ylabel("phi~_J = phi / (1 - 2/p)")
         ax.set_xlim(0.6, 0.9)
         ax.set_ylim(0.8, 0.92)
+    x = np.linspace(0.74, 0.89, 60)
+    axes[0].plot(x, x / (1 - 2 / hard_disk_solid(x)[0]), "k-", lw=0.8, label="crystal, Alder-Hoover-Young 1968")
     x = np.linspace(0.70, 0.80, 50)
     axes[1].plot(x, fits.cubic_phij(x), "k-", label="Eq. 13.3 (published)")
     if np.all(np.isfinite(binary["cubic"].values)):
