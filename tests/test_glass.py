@@ -365,7 +365,7 @@ def test_relaxed_dataset_and_row():
 
 
 def test_printed_freezing_pair_against_eq_13_3_and_the_crystal_eos():
-    """The known deviation of donev-13.2-phi-precipitate: equal pressures pi = phi p / <v> with
+    """The known deviation of donev-13.2-phi-freeze: equal pressures pi = phi p / <v> with
     Eq. 13.3 at the printed phi_F = 0.775 and the Alder-Hoover-Young crystal put the large-disk
     precipitate at 0.8440, not the printed 0.8415 (which needs freezing at 0.7714)."""
     from scipy.optimize import brentq
