@@ -213,8 +213,7 @@ def rate_rows(ds) -> list[Row]:
     d1, e1, k1 = band(0.70, 0.775)
     d2, e2, k2 = band(0.80, 0.825)
     verdict = float(d2 < -2 * e2) if math.isfinite(e2) and k2 else math.nan
-    others = "".join(f"; Gamma = {r}: {band(0.70, 0.775, r)[0]:.5f} +- {band(0.70, 0.775, r)[1]:.5f}"
-                     for r in faster[:-1])
+    others = "".join("; Gamma = {}: {:.5f} +- {:.5f}".format(r, *band(0.70, 0.775, r)[:2]) for r in faster[:-1])
     return [evaluate(agree, d1, e1, n=n, seeds=seeds, detail=f"{how}; {k1} bins in [0.70, 0.775){others}"),
             evaluate(apart, verdict, n=n, seeds=seeds,
                      detail=f"{how}; {k2} bins in [0.80, 0.825): mean difference {d2:.5f} +- {e2:.5f}")]
