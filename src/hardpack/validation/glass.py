@@ -37,7 +37,7 @@ def eos_rows(ds) -> list[Row]:
     Parameters
     ----------
     ds : xarray.Dataset
-        The glass EOS summary (attribute ``system``).
+        The glass EOS summary (attribute ``x_large``: 0 for monodisperse disks).
 
     Returns
     -------
@@ -100,27 +100,25 @@ def mono_eos_rows(ds) -> list[Row]:
     targets = load_targets()
     n = int(ds.attrs.get("N", 0))
     slow, _ = _slowest(ds)
-    out = []
-    for phi, tid in ((0.20, "hard-disk-virial-z-0.20"), (0.30, "hard-disk-virial-z-0.30")):
-        if slow is None:
-            out.append(evaluate(targets[tid], n=n, seeds=0, detail="no compression"))
-            continue
-        row = ds.sel(branch=slow)
-        z, err, how = _z_at(row, phi)
-        seeds = int(row["n_runs"].values.max())
-        out.append(evaluate(targets[tid], z, err, n=n, seeds=seeds, published=float(hard_disk_virial(phi)),
-                            detail=f"N = {n}, Gamma = {slow}, {seeds} seed(s); {how}"))
-    out.append(transition_row(ds, slow, n))
+    crystal = "decompression" if "decompression" in ds["branch"].values else None
+    cp = math.pi / math.sqrt(12)
+    out = [_z_row(targets["hard-disk-virial-z-0.20"], ds, slow, 0.20, float(hard_disk_virial(0.20)), None, n),
+           _z_row(targets["hard-disk-virial-z-0.30"], ds, slow, 0.30, float(hard_disk_virial(0.30)), None, n),
+           transition_row(ds, slow, n)]
     for phi, tid in ((0.80, "hard-disk-solid-z-0.80"), (0.84, "hard-disk-solid-z-0.84")):
-        if "decompression" not in ds["branch"].values:
-            out.append(evaluate(targets[tid], n=n, seeds=0, detail="no decompression of the crystal"))
-            continue
-        row = ds.sel(branch="decompression")
-        z, err, how = _z_at(row, phi, pole=math.pi / math.sqrt(12))
-        seeds = int(row["n_runs"].values.max())
-        out.append(evaluate(targets[tid], z, err, n=n, seeds=seeds, published=float(hard_disk_solid(phi)[0]),
-                            detail=f"N = {n}, decompression of the triangular crystal, {seeds} seed(s); {how}"))
+        out.append(_z_row(targets[tid], ds, crystal, phi, float(hard_disk_solid(phi)[0]), cp, n))
     return out
+
+
+def _z_row(target, ds, branch, phi, published, pole, n) -> Row:
+    """Z of ``branch`` at ``phi`` (:func:`_z_at`) against ``published``; n/a without the branch."""
+    if branch is None:
+        return evaluate(target, n=n, seeds=0, detail="no such branch in the summary")
+    z, err, how = _z_at(ds.sel(branch=branch), phi, pole)
+    seeds = _seeds(ds, branch)
+    what = "decompression of the triangular crystal" if branch == "decompression" else f"Gamma = {branch}"
+    return evaluate(target, z, err, n=n, seeds=seeds, published=published,
+                    detail=f"N = {n}, {what}, {seeds} seed(s); {how}")
 
 
 def transition_row(ds, branch, n) -> Row:
@@ -162,7 +160,7 @@ def transition_row(ds, branch, n) -> Row:
         return evaluate(target, n=n, seeds=0, detail=f"Gamma = {branch}: fewer than 3 bins in 0.65..0.76")
     rng = np.random.default_rng(20061)
     boot = [flattest(x, z + e * rng.standard_normal(z.size)) for _ in range(200)]
-    seeds = int(ds.sel(branch=branch)["n_runs"].values.max())
+    seeds = _seeds(ds, branch)
     detail = f"N = {n}, Gamma = {branch}, {seeds} seed(s), bins of {ds.attrs.get('bin_width')}"
     if "decompression" in ds["branch"].values:
         xd, zd, _ = pick("decompression")
@@ -197,7 +195,7 @@ def rate_rows(ds) -> list[Row]:
         return [evaluate(agree, n=n, seeds=0, detail=why), evaluate(apart, n=n, seeds=0, detail=why)]
     fast = faster[-1]
     b = ds.sel(branch=slow)
-    seeds = int(min(ds.sel(branch=fast)["n_runs"].values.max(), b["n_runs"].values.max()))
+    seeds = min(_seeds(ds, fast), _seeds(ds, slow))
     phi = ds["phi"].values
 
     def band(lo, hi, branch=fast):
