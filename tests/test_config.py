@@ -191,6 +191,8 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
     (lambda c: c["rates"].update(ensemble="mono9d"), "rates.ensemble 'mono9d' is not one of the ensembles"),
     (lambda c: c["glass"].update(N=c["glass"]["N"] + 1), "glass.N = .* must be even"),
     (lambda c: c["glass"].update(phi_end=0.5), "glass.phi_end must be above every glass.snapshots"),
+    (lambda c: c["glass"].update(slow={"rate": 1.0, "from_phi": 0.70}), r"glass.slow.rate = 1 must be below every"),
+    (lambda c: c["glass"].update(slow={"rate": 1e-9, "from_phi": 0.71}), r"glass.slow.from_phi = 0.71 must be one of"),
     (lambda c: c["ellipsoids"].update(near_sphere={"families": ["cube"]}), r"near_sphere.families \['cube'\]"),
     (lambda c: c["ellipsoids"]["mm"].update(family="cube"), "ellipsoids.mm.family 'cube' is not one of"),
     (lambda c: c["containers"]["windows"].update(ensemble="binary2d"), "must be a monodisperse 3D ensemble"),

@@ -383,3 +383,97 @@ def test_printed_freezing_pair_against_eq_13_3_and_the_crystal_eos():
     assert phi_b == pytest.approx(0.8440, abs=5e-5)
     pi_printed = 0.8415 * float(hard_disk_solid(0.8415)[0]) / kd
     assert brentq(lambda p: pi_mixture(p) - pi_printed, 0.74, 0.78) == pytest.approx(0.7714, abs=5e-5)
+
+
+# --- (f) a compression that continues another (the pipeline's slow branch) -----------------------
+
+def _stage(phi_start, phi_end, z_of, rate, seed):
+    """A synthetic compression stage: windows of 0.001 in phi from phi_start to phi_end, Z = z_of(phi)."""
+    import xarray as xr
+
+    phi = np.linspace(phi_start, phi_end, round((phi_end - phi_start) / 0.001) + 1)[1:]
+    mid = 0.5 * (np.concatenate([[phi_start], phi[:-1]]) + phi)
+    return xr.Dataset({"phi": ("window", phi), "Z": ("window", z_of(mid))},
+                      attrs={"hardpack_kind": "md_timeseries", "phi_start": phi_start, "growth_rate": rate,
+                             "seed": seed, "N": 64, "d": 2})
+
+
+def _liquid(phi):
+    return 1.0 + 2.0 * phi / (1.0 - phi) ** 2
+
+
+def _denser(phi):
+    return _liquid(phi) * (1.0 + 0.5 * np.clip(phi - 0.70, 0.0, None))
+
+
+def test_continued_run_takes_the_parent_up_to_its_start():
+    parent = [_stage(0.70, 0.80, _liquid, 1e-5, 1), _stage(0.05, 0.50, _liquid, 1e-5, 1),
+              _stage(0.50, 0.70, _liquid, 1e-5, 1)]
+    slow = [_stage(0.75, 0.80, _denser, 1e-6, 1), _stage(0.70, 0.75, _denser, 1e-6, 1)]
+    run = study.continued_run(slow, parent)
+    assert [ts.attrs["phi_start"] for ts in run] == [0.05, 0.50, 0.70, 0.75]
+    assert [ts.attrs["growth_rate"] for ts in run] == [1e-5, 1e-5, 1e-6, 1e-6]
+    # the EOS integral of the continuation starts at low density and leaves the parent's at 0.70
+    edges = np.linspace(0.0, 0.80, 161)
+    ds = study.eos_dataset({"1e-06": [run], "1e-05": [parent]}, edges)
+    low, high = ds["phi"].values < 0.70, ds["phi"].values > 0.71
+    f_slow, f_parent = ds["excess"].sel(branch="1e-06").values, ds["excess"].sel(branch="1e-05").values
+    assert np.all(np.isfinite(f_slow[ds["phi"].values > 0.06]))
+    np.testing.assert_array_equal(f_slow[low], f_parent[low])
+    assert np.all(f_slow[high] > f_parent[high])
+
+
+def test_continued_run_refuses_a_start_where_no_parent_stage_ends():
+    parent = [_stage(0.05, 0.70, _liquid, 1e-5, 1)]
+    with pytest.raises(InvalidInputError, match="starts at phi = 0.710000, where no stage of its parent ends"):
+        study.continued_run([_stage(0.71, 0.80, _liquid, 1e-6, 1)], parent)
+
+
+def test_glass_eos_cli_continues_a_branch(tmp_path):
+    import xarray as xr
+
+    from hardpack.cli import main
+
+    files = []
+    for seed in (1, 2):
+        for k, ts in enumerate([_stage(0.05, 0.70, _liquid, 1e-5, seed), _stage(0.70, 0.80, _liquid, 1e-5, seed),
+                                _stage(0.70, 0.80, _denser, 1e-6, seed)]):
+            files.append(tmp_path / f"ts{seed}_{k}.nc")
+            ts.to_netcdf(files[-1])
+    out = tmp_path / "eos.nc"
+    common = ["glass-eos", *map(str, files), "--system", "binary", "--kappa", "1.4", "--x-large", "0.3333",
+              "--bin-width", "0.01", "--phi-max", "0.8"]
+    assert main([*common, "--continues", "1e-6", "1e-5", "--out", str(out)]) == 0
+    ds = xr.load_dataset(out)
+    assert ds.attrs["continued_branches"] == "1e-06 from 1e-05"
+    assert ds.attrs["cubic_branch"] == "1e-06"
+    f = ds["excess"].sel(branch="1e-06").values
+    assert np.isfinite(f[ds["phi"].values > 0.06]).all()
+    # without --continues the slow branch has no EOS integral below its start
+    assert main([*common, "--out", str(tmp_path / "plain.nc")]) == 0
+    plain = xr.load_dataset(tmp_path / "plain.nc")
+    assert np.isnan(plain["excess"].sel(branch="1e-06").values[plain["phi"].values < 0.69]).all()
+    assert main([*common, "--continues", "1e-7", "1e-5", "--out", str(out)]) != 0
+
+
+def test_entropy_rows_take_the_slowest_compression_that_has_the_snapshot():
+    import xarray as xr
+
+    from hardpack.validation.glass import entropy_rows
+
+    # the slow branch starts at 0.775: its 0.80 snapshots are judged, and the 0.75 ones of the parent
+    phi0 = [0.75, 0.75, 0.80, 0.80, 0.80, 0.80]
+    rate = [1e-5, 1e-5, 1e-5, 1e-5, 1e-6, 1e-6]
+    sc = [0.001, -0.001, 0.05, 0.07, 0.002, -0.002]
+
+    def summary(x_large):
+        return xr.Dataset({"sc_minus_smix": ("sample", sc), "glass_excess": ("sample", np.ones(6)),
+                           "liquid_excess": ("sample", np.ones(6)), "n_particles": ("sample", np.full(6, 4096))},
+                          coords={"phi0": ("sample", phi0), "growth_rate": ("sample", rate),
+                                  "seed": ("sample", [1, 2] * 3)}, attrs={"x_large": x_large})
+
+    (binary,) = entropy_rows(summary(1 / 3))
+    (mono,) = entropy_rows(summary(0.0))
+    assert binary.reproduced == pytest.approx(0.0) and "Gamma = 1e-06, phi = 0.8" in binary.detail
+    assert mono.reproduced == pytest.approx(0.0) and "Gamma = 1e-05, phi = 0.75" in mono.detail
+    assert binary.status == mono.status == "pass"

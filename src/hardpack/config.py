@@ -145,6 +145,14 @@ def _check_glass(glass: dict | None, microseg: dict | None) -> None:
         dx = glass["composition"]["dx"]
         if not (0 < glass["x_large"] - dx and glass["x_large"] + dx < 1):
             _refuse("glass.x_large -+ glass.composition.dx must stay in (0, 1)")
+        slow = glass.get("slow")
+        if slow:
+            if not slow["rate"] < min(glass["rates"]):
+                _refuse(f"glass.slow.rate = {slow['rate']:g} must be below every glass.rates (it continues "
+                        f"the slowest of them, {min(glass['rates']):g})")
+            if slow["from_phi"] not in glass["snapshots"]:
+                _refuse(f"glass.slow.from_phi = {slow['from_phi']:g} must be one of glass.snapshots "
+                        f"{sorted(glass['snapshots'])} (the slow branch starts from that snapshot)")
     if microseg:
         rows, cols = microseg["shape"]
         if rows % 2:

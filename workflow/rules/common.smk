@@ -412,13 +412,19 @@ def poly_jam_files(protocol, family):
 # for mu~_B. A compression runs in stages through its snapshot densities, each stage a
 # `hardpack compress` from the previous stage's packing:
 #   results/glass/{system}/g{rate}/phi{phi}/seed{seed}.nc (+ ts_seed{seed}.nc, its time series)
+# The optional slow branch (glass.slow) of `binary` and `mono` starts from the slowest of
+# glass.rates at its from_phi snapshot and has only the stages above it.
+
+GLASS_SLOW = (GLASS or {}).get("slow")
+
 
 def _glass_systems():
     if not GLASS:
         return {}
     x, dx = GLASS["x_large"], GLASS["composition"]["dx"]
     comp = GLASS["composition"]
-    full = dict(rates=GLASS["rates"], stages=sorted(GLASS["snapshots"]) + [GLASS["phi_end"]])
+    rates = GLASS["rates"] + ([GLASS_SLOW["rate"]] if GLASS_SLOW else [])
+    full = dict(rates=rates, stages=sorted(GLASS["snapshots"]) + [GLASS["phi_end"]])
     return {
         "binary": dict(kappa=GLASS["kappa"], x=x, **full),
         "mono": dict(kappa=1.0, x=0.0, **full),
@@ -437,19 +443,43 @@ def glass_distribution(wildcards):
     return json.dumps({"kind": "bidisperse", "size_ratio": spec["kappa"], "large_fraction": spec["x"]})
 
 
+def glass_stages(system, rate):
+    """The stage densities of a compression at ``rate`` (the slow branch: those above its from_phi)."""
+    stages = GLASS_SYSTEMS[system]["stages"]
+    if GLASS_SLOW and float(rate) == GLASS_SLOW["rate"]:
+        return [p for p in stages if p > GLASS_SLOW["from_phi"]]
+    return stages
+
+
+def glass_snapshot(system, rate, phi, seed):
+    """The packing of the compression at ``rate`` at ``phi``; the slow branch's snapshots at or
+    below its from_phi are those of the slowest of glass.rates, where it starts."""
+    if GLASS_SLOW and float(rate) == GLASS_SLOW["rate"] and float(phi) <= GLASS_SLOW["from_phi"]:
+        rate = min(GLASS["rates"])
+    return f"results/glass/{system}/g{float(rate):g}/phi{float(phi):g}/seed{seed}.nc"
+
+
+def glass_continues_option(wildcards):
+    """The `hardpack glass-eos --continues` option of a system with the slow branch."""
+    if GLASS_SLOW and GLASS_SLOW["rate"] in GLASS_SYSTEMS[wildcards.system]["rates"]:
+        return f"--continues {GLASS_SLOW['rate']:g} {min(GLASS['rates']):g}"
+    return ""
+
+
 def glass_previous(wildcards):
-    """The packing a compression stage starts from: the previous stage's or the RSA start."""
+    """The packing a compression stage starts from: the previous stage's, the RSA start, or (the
+    slow branch's first stage) the slowest of glass.rates at from_phi."""
     stages = GLASS_SYSTEMS[wildcards.system]["stages"]
     k = [f"{p:g}" for p in stages].index(wildcards.phi)
     if k == 0:
         return f"results/glass/{wildcards.system}/init/seed{wildcards.seed}.nc"
-    return f"results/glass/{wildcards.system}/g{wildcards.rate}/phi{stages[k - 1]:g}/seed{wildcards.seed}.nc"
+    return glass_snapshot(wildcards.system, wildcards.rate, stages[k - 1], wildcards.seed)
 
 
 def glass_timeseries(system):
     spec = GLASS_SYSTEMS[system]
     files = [f"results/glass/{system}/g{rate:g}/phi{phi:g}/ts_seed{seed}.nc"
-             for rate in spec["rates"] for phi in spec["stages"] for seed in GLASS["seeds"]]
+             for rate in spec["rates"] for phi in glass_stages(system, rate) for seed in GLASS["seeds"]]
     if system == "mono":
         files += [f"results/glass/mono/decompression/ts_seed{seed}.nc" for seed in GLASS["seeds"]]
     return files
@@ -496,9 +526,11 @@ def glass_relaxed_files(prefix):
 
 
 def glass_bcmd_files(system):
+    """BCMD of the snapshots of the slowest compression (:func:`glass_snapshot`)."""
     rate = min(GLASS_SYSTEMS[system]["rates"])
-    return [f"results/glass/{system}/bcmd/g{rate:g}/phi{phi:g}/seed{seed}.nc"
-            for phi in sorted(GLASS["snapshots"]) for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
+    snaps = [glass_snapshot(system, rate, phi, "{seed}") for phi in sorted(GLASS["snapshots"])]
+    return [path.replace(f"results/glass/{system}/", f"results/glass/{system}/bcmd/").format(seed=seed)
+            for path in snaps for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
 
 
 def glass_crystal_cells():

@@ -125,6 +125,7 @@ rule glass_eos:
         kappa=lambda w: GLASS_SYSTEMS[w.system]["kappa"],
         x=lambda w: GLASS_SYSTEMS[w.system]["x"],
         e=GLASS["eos"] if GLASS else None,
+        continues=glass_continues_option,
     wildcard_constraints:
         system=one_of(GLASS_SYSTEMS),
     threads: 1
@@ -142,7 +143,8 @@ rule glass_eos:
     shell:
         "hardpack glass-eos {input} --system {wildcards.system} --kappa {params.kappa} --x-large {params.x}"
         " --bin-width {params.e[bin_width]} --liquid-range {params.e[liquid_range][0]} {params.e[liquid_range][1]}"
-        " --glass-range {params.e[glass_range][0]} {params.e[glass_range][1]} --out {output} > {log} 2>&1"
+        " --glass-range {params.e[glass_range][0]} {params.e[glass_range][1]} {params.continues}"
+        " --out {output} > {log} 2>&1"
 
 
 rule glass_bcmd:

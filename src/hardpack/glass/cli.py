@@ -60,7 +60,7 @@ def cmd_glass_eos(args) -> int:
     int
         Exit status 0 (errors raise).
     """
-    from hardpack.glass.study import eos_dataset
+    from hardpack.glass.study import continued_run, eos_dataset
     from hardpack.glass.thermo import second_virial_slope
     from hardpack.io import load_dataset, write_dataset
 
@@ -71,6 +71,16 @@ def cmd_glass_eos(args) -> int:
         rate, seed = float(ts.attrs["growth_rate"]), int(ts.attrs["seed"])
         runs[_branch_name(rate)][seed].append(ts)
         n, d = int(ts.attrs["N"]), int(ts.attrs["d"])
+    for rate, parent in args.continues or []:
+        name, pname = _branch_name(rate), _branch_name(parent)
+        if name not in runs or pname not in runs:
+            raise InvalidInputError(f"--continues {rate:g} {parent:g}: no time series of growth rate "
+                                    f"{rate if name not in runs else parent:g} among the files")
+        for seed, series in runs[name].items():
+            if seed not in runs[pname]:
+                raise InvalidInputError(f"--continues {rate:g} {parent:g}: seed {seed} has no time series "
+                                        f"at growth rate {parent:g}")
+            runs[name][seed] = continued_run(series, runs[pname][seed])
     branches = {}
     for name in sorted(runs, key=lambda s: (s == "decompression", -float(s) if s != "decompression" else 0)):
         branches[name] = [sorted(series, key=lambda ts: float(ts["phi"].values[0]), reverse=name == "decompression")
@@ -82,7 +92,9 @@ def cmd_glass_eos(args) -> int:
     slope0 = second_virial_slope(d, args.kappa, args.x_large)
     ds = eos_dataset(branches, edges, d=d, slope0=slope0, liquid_range=tuple(args.liquid_range),
                      glass_range=tuple(args.glass_range),
-                     attrs={"system": args.system, "kappa": args.kappa, "x_large": args.x_large, "N": n})
+                     attrs={"system": args.system, "kappa": args.kappa, "x_large": args.x_large, "N": n,
+                            "continued_branches": "; ".join(f"{_branch_name(r)} from {_branch_name(p)}"
+                                                            for r, p in args.continues or [])})
     write_dataset(ds, args.out)
     c, ce = ds["cubic"].values, ds["cubic_err"].values
     log.info("%s: branches %s; Eq. 13.3 fit %s +- %s; alpha %s", args.system, list(branches),
@@ -331,6 +343,9 @@ def register(subparsers) -> None:
                    help="phi range of the Eq. 13.3 cubic fit (default 0.70 0.80)")
     p.add_argument("--glass-range", type=float, nargs=2, default=[0.80, 0.84],
                    help="phi range of the Eq. 13.4 glass-branch fit (default 0.80 0.84)")
+    p.add_argument("--continues", type=float, nargs=2, action="append", metavar=("RATE", "PARENT"),
+                   help="the compression at RATE starts from a stage of the one at PARENT (same seeds): "
+                        "its EOS integral runs along the parent's time series up to there (repeatable)")
     p.add_argument("--out", required=True, help="EOS summary netCDF")
     p.set_defaults(func=cmd_glass_eos)
 

@@ -80,6 +80,46 @@ def window_points(ts: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (phi_start + phi_end), ts["Z"].values
 
 
+def continued_run(series: list[xr.Dataset], parent: list[xr.Dataset], *, tol: float = 1e-6) -> list[xr.Dataset]:
+    """One run of a compression that continues another from one of its stages: the parent's time
+    series up to where the continuation starts, then the continuation's, so that its EOS integral
+    starts at low density (the slow branch of the pipeline, started from the equilibrium liquid of
+    a faster compression).
+
+    Parameters
+    ----------
+    series : list of xarray.Dataset
+        The continuation's time series (one run, any order).
+    parent : list of xarray.Dataset
+        The parent compression's time series of the same seed (any order).
+    tol : float, default 1e-6
+        How far the parent's last phi before the continuation may be from its start.
+
+    Returns
+    -------
+    list of xarray.Dataset
+        The parent's series that end at or before the continuation's start, then the continuation's,
+        in order of phi.
+
+    Raises
+    ------
+    InvalidInputError
+        When no parent series ends where the continuation starts.
+    """
+    def first(ts):
+        return float(ts.attrs.get("phi_start", ts["phi"].values[0]))
+
+    series = sorted(series, key=first)
+    start = first(series[0])
+    prefix = sorted((ts for ts in parent if float(ts["phi"].values[-1]) <= start + tol), key=first)
+    if not prefix or abs(float(prefix[-1]["phi"].values[-1]) - start) > tol:
+        ends = sorted(round(float(ts["phi"].values[-1]), 6) for ts in parent)
+        raise InvalidInputError(f"the continued compression starts at phi = {start:.6f}, where no stage of its "
+                                f"parent ends (parent stages end at {ends}); give the parent's time series of "
+                                f"the same seed up to that snapshot")
+    return prefix + series
+
+
 def bin_runs(runs: list[list[xr.Dataset]], edges: np.ndarray) -> dict[str, np.ndarray]:
     """Mean Z per phi bin of each run (a run: its time series, e.g. consecutive segments), then
     the mean and standard error over runs (module docstring).

@@ -321,7 +321,7 @@ def relaxed_rows(ds) -> list[Row]:
 
 def entropy_rows(ds) -> list[Row]:
     """s_c - s_mix of the snapshot at phi0 = 0.80 (binary) or 0.75 (monodisperse) of the slowest
-    compression, mean and standard error over seeds.
+    compression that has one, mean and standard error over seeds.
 
     Parameters
     ----------
@@ -335,12 +335,13 @@ def entropy_rows(ds) -> list[Row]:
     """
     mono = float(ds.attrs.get("x_large", 0.0)) == 0.0
     tid, phi0 = ("donev-13.4-sc-mono", 0.75) if mono else ("donev-13.4-sc-binary", 0.80)
-    rate = float(np.min(ds["growth_rate"].values))
-    sel = np.flatnonzero(np.isclose(ds["phi0"].values, phi0) & np.isclose(ds["growth_rate"].values, rate))
+    at_phi0 = np.isclose(ds["phi0"].values, phi0)
     n = int(ds["n_particles"].values.max())
     target = load_targets()[tid]
-    if sel.size == 0:
+    if not at_phi0.any():
         return [evaluate(target, n=n, detail=f"no snapshot at phi = {phi0}")]
+    rate = float(np.min(ds["growth_rate"].values[at_phi0]))
+    sel = np.flatnonzero(at_phi0 & np.isclose(ds["growth_rate"].values, rate))
     samples = ds["sc_minus_smix"].values[sel]
     detail = (f"N = {n}, Gamma = {rate:g}, phi = {phi0}: Delta f_g = "
               f"{np.round(ds['glass_excess'].values[sel], 4).tolist()}, Delta f_L = "
