@@ -477,3 +477,14 @@ def test_entropy_rows_take_the_slowest_compression_that_has_the_snapshot():
     assert binary.reproduced == pytest.approx(0.0) and "Gamma = 1e-06, phi = 0.8" in binary.detail
     assert mono.reproduced == pytest.approx(0.0) and "Gamma = 1e-05, phi = 0.75" in mono.detail
     assert binary.status == mono.status == "pass"
+
+
+def test_continued_run_without_the_start_attribute_extrapolates_the_first_window():
+    parent = [_stage(0.05, 0.70, _liquid, 1e-5, 1), _stage(0.70, 0.80, _liquid, 1e-5, 1)]
+    slow = _stage(0.70, 0.80, _denser, 1e-6, 1)
+    del slow.attrs["phi_start"]
+    assert len(study.continued_run([slow], parent)) == 2
+    late = _stage(0.703, 0.80, _denser, 1e-6, 1)
+    del late.attrs["phi_start"]
+    with pytest.raises(InvalidInputError, match="where no stage of its parent ends"):
+        study.continued_run([late], parent)

@@ -90,6 +90,9 @@ def test_target_phi_is_hit_exactly(mono3d):
     result = compress(mono3d, 0.05, seed=1, stop=StopCriteria(max_pressure=None, target_phi=0.5))
     assert result.stats["stop_reason"] == "target_phi"
     assert result.packing.phi == pytest.approx(0.5, rel=1e-12)
+    # the time series records where it started (its first window's lower end)
+    assert result.timeseries.attrs["phi_start"] == mono3d.phi
+    assert result.timeseries["phi"].values[-1] == pytest.approx(0.5, rel=1e-12)
     # sizes stay proportional to the start sizes (monodisperse here: all equal)
     assert np.ptp(result.packing.radii) < 1e-12
 

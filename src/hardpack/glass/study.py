@@ -93,7 +93,9 @@ def continued_run(series: list[xr.Dataset], parent: list[xr.Dataset], *, tol: fl
     parent : list of xarray.Dataset
         The parent compression's time series of the same seed (any order).
     tol : float, default 1e-6
-        How far the parent's last phi before the continuation may be from its start.
+        How far the parent's last phi before the continuation may be from its start (the
+        ``phi_start`` attribute; without it, the start of the first window extrapolated from the
+        first two, and the tolerance widened by one window).
 
     Returns
     -------
@@ -107,11 +109,16 @@ def continued_run(series: list[xr.Dataset], parent: list[xr.Dataset], *, tol: fl
         When no parent series ends where the continuation starts.
     """
     def first(ts):
-        return float(ts.attrs.get("phi_start", ts["phi"].values[0]))
+        return float(ts["phi"].values[0])
 
     series = sorted(series, key=first)
-    start = first(series[0])
-    prefix = sorted((ts for ts in parent if float(ts["phi"].values[-1]) <= start + tol), key=first)
+    phi = series[0]["phi"].values
+    if "phi_start" in series[0].attrs:
+        start = float(series[0].attrs["phi_start"])
+    else:
+        width = phi[1] - phi[0] if phi.size > 1 else 0.0
+        start, tol = phi[0] - width, tol + width
+    prefix = sorted((ts for ts in parent if float(ts["phi"].values[-1]) <= phi[0] + tol), key=first)
     if not prefix or abs(float(prefix[-1]["phi"].values[-1]) - start) > tol:
         ends = sorted(round(float(ts["phi"].values[-1]), 6) for ts in parent)
         raise InvalidInputError(f"the continued compression starts at phi = {start:.6f}, where no stage of its "

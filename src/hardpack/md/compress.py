@@ -704,7 +704,7 @@ def compress(packing: Packing, growth_rate: float, seed: int, stop: StopCriteria
         stats.update(contacts.attrs)
     ts_attrs = {k: stats[k] for k in ("growth_rate", "seed", "stop_reason", "final_growth_rate",
                                       "switch_pressure") if k in stats}
-    ts = timeseries_dataset(sim, ts_attrs | {"N": sim.n, "d": sim.d})
+    ts = timeseries_dataset(sim, ts_attrs | {"N": sim.n, "d": sim.d, "phi_start": float(packing.phi)})
     if checkpoint is not None and not keep_checkpoint:
         ckpt.remove(checkpoint)
     return CompressResult(final, sim.velocities(), ts, stats, contacts)
