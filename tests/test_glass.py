@@ -410,12 +410,14 @@ def test_continued_run_takes_the_parent_up_to_its_start():
     parent = [_stage(0.70, 0.80, _liquid, 1e-5, 1), _stage(0.05, 0.50, _liquid, 1e-5, 1),
               _stage(0.50, 0.70, _liquid, 1e-5, 1)]
     slow = [_stage(0.75, 0.80, _denser, 1e-6, 1), _stage(0.70, 0.75, _denser, 1e-6, 1)]
-    run = study.continued_run(slow, parent)
+    run, start = study.continued_run(slow, parent)
+    assert start == pytest.approx(0.70, abs=1e-12)
     assert [ts.attrs["phi_start"] for ts in run] == [0.05, 0.50, 0.70, 0.75]
     assert [ts.attrs["growth_rate"] for ts in run] == [1e-5, 1e-5, 1e-6, 1e-6]
     # the EOS integral of the continuation starts at low density and leaves the parent's at 0.70
     edges = np.linspace(0.0, 0.80, 161)
-    ds = study.eos_dataset({"1e-06": [run], "1e-05": [parent]}, edges)
+    ds = study.eos_dataset({"1e-06": [run], "1e-05": [parent]}, edges, starts={"1e-06": start})
+    assert ds["start_phi"].sel(branch="1e-06") == start and np.isnan(ds["start_phi"].sel(branch="1e-05"))
     low, high = ds["phi"].values < 0.70, ds["phi"].values > 0.71
     f_slow, f_parent = ds["excess"].sel(branch="1e-06").values, ds["excess"].sel(branch="1e-05").values
     assert np.all(np.isfinite(f_slow[ds["phi"].values > 0.06]))
@@ -447,6 +449,7 @@ def test_glass_eos_cli_continues_a_branch(tmp_path):
     ds = xr.load_dataset(out)
     assert ds.attrs["continued_branches"] == "1e-06 from 1e-05"
     assert ds.attrs["cubic_branch"] == "1e-06"
+    assert float(ds["start_phi"].sel(branch="1e-06")) == pytest.approx(0.70)
     f = ds["excess"].sel(branch="1e-06").values
     assert np.isfinite(f[ds["phi"].values > 0.06]).all()
     # without --continues the slow branch has no EOS integral below its start
@@ -483,7 +486,7 @@ def test_continued_run_without_the_start_attribute_extrapolates_the_first_window
     parent = [_stage(0.05, 0.70, _liquid, 1e-5, 1), _stage(0.70, 0.80, _liquid, 1e-5, 1)]
     slow = _stage(0.70, 0.80, _denser, 1e-6, 1)
     del slow.attrs["phi_start"]
-    assert len(study.continued_run([slow], parent)) == 2
+    assert len(study.continued_run([slow], parent)[0]) == 2
     late = _stage(0.703, 0.80, _denser, 1e-6, 1)
     del late.attrs["phi_start"]
     with pytest.raises(InvalidInputError, match="where no stage of its parent ends"):

@@ -71,6 +71,7 @@ def cmd_glass_eos(args) -> int:
         rate, seed = float(ts.attrs["growth_rate"]), int(ts.attrs["seed"])
         runs[_branch_name(rate)][seed].append(ts)
         n, d = int(ts.attrs["N"]), int(ts.attrs["d"])
+    starts = {}
     for rate, parent in args.continues or []:
         name, pname = _branch_name(rate), _branch_name(parent)
         if name not in runs or pname not in runs:
@@ -80,7 +81,7 @@ def cmd_glass_eos(args) -> int:
             if seed not in runs[pname]:
                 raise InvalidInputError(f"--continues {rate:g} {parent:g}: seed {seed} has no time series "
                                         f"at growth rate {parent:g}")
-            runs[name][seed] = continued_run(series, runs[pname][seed])
+            runs[name][seed], starts[name] = continued_run(series, runs[pname][seed])
     branches = {}
     for name in sorted(runs, key=lambda s: (s == "decompression", -float(s) if s != "decompression" else 0)):
         branches[name] = [sorted(series, key=lambda ts: float(ts["phi"].values[0]), reverse=name == "decompression")
@@ -91,7 +92,7 @@ def cmd_glass_eos(args) -> int:
     edges = np.linspace(args.phi_min, args.phi_max, round((args.phi_max - args.phi_min) / args.bin_width) + 1)
     slope0 = second_virial_slope(d, args.kappa, args.x_large)
     ds = eos_dataset(branches, edges, d=d, slope0=slope0, liquid_range=tuple(args.liquid_range),
-                     glass_range=tuple(args.glass_range),
+                     glass_range=tuple(args.glass_range), starts=starts,
                      attrs={"system": args.system, "kappa": args.kappa, "x_large": args.x_large, "N": n,
                             "continued_branches": "; ".join(f"{_branch_name(r)} from {_branch_name(p)}"
                                                             for r, p in args.continues or [])})

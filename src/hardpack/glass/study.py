@@ -80,7 +80,8 @@ def window_points(ts: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (phi_start + phi_end), ts["Z"].values
 
 
-def continued_run(series: list[xr.Dataset], parent: list[xr.Dataset], *, tol: float = 1e-6) -> list[xr.Dataset]:
+def continued_run(series: list[xr.Dataset], parent: list[xr.Dataset], *,
+                  tol: float = 1e-6) -> tuple[list[xr.Dataset], float]:
     """One run of a compression that continues another from one of its stages: the parent's time
     series up to where the continuation starts, then the continuation's, so that its EOS integral
     starts at low density (the slow branch of the pipeline, started from the equilibrium liquid of
@@ -99,9 +100,11 @@ def continued_run(series: list[xr.Dataset], parent: list[xr.Dataset], *, tol: fl
 
     Returns
     -------
-    list of xarray.Dataset
+    run : list of xarray.Dataset
         The parent's series that end at or before the continuation's start, then the continuation's,
         in order of phi.
+    start : float
+        The volume fraction where the continuation starts (the parent's end there).
 
     Raises
     ------
@@ -124,7 +127,7 @@ def continued_run(series: list[xr.Dataset], parent: list[xr.Dataset], *, tol: fl
         raise InvalidInputError(f"the continued compression starts at phi = {start:.6f}, where no stage of its "
                                 f"parent ends (parent stages end at {ends}); give the parent's time series of "
                                 f"the same seed up to that snapshot")
-    return prefix + series
+    return prefix + series, float(prefix[-1]["phi"].values[-1])
 
 
 def bin_runs(runs: list[list[xr.Dataset]], edges: np.ndarray) -> dict[str, np.ndarray]:
@@ -186,7 +189,8 @@ class _quiet:
 
 
 def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float = 2.0,
-                liquid_range=(0.70, 0.80), glass_range=(0.80, 0.84), attrs: dict | None = None) -> xr.Dataset:
+                liquid_range=(0.70, 0.80), glass_range=(0.80, 0.84), starts: dict | None = None,
+                attrs: dict | None = None) -> xr.Dataset:
     """The EOS summary of one system: Z(phi) per branch (growth rate, or "decompression") with
     phi~_J, the excess free energy Delta f(phi) integrated from the ideal gas along each
     compression branch, and the fits of Eq. 13.3 (to the slowest compression) and Eq. 13.4
@@ -206,6 +210,10 @@ def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float 
         (Z - 1)/phi at phi = 0 (:func:`hardpack.glass.thermo.second_virial_slope`).
     liquid_range, glass_range : (float, float)
         phi ranges of the Eq. 13.3 and Eq. 13.4 fits.
+    starts : dict, optional
+        Branch name -> the phi where a compression that continues another starts (its runs hold
+        the parent's series below it, :func:`continued_run`); stored as ``start_phi`` (NaN for the
+        other branches).
     attrs : dict, optional
         Attributes to add (system, kappa, x_large, N, ...).
 
@@ -240,7 +248,8 @@ def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float 
             vars_["excess"][b, span], vars_["excess_err"][b, span] = f, fe
     ds = xr.Dataset(
         {k: (("branch", "phi"), v) for k, v in vars_.items()} | {"n_runs": (("branch", "phi"), n_runs)},
-        coords={"branch": names, "phi": centres, "growth_rate": ("branch", np.array(rates))},
+        coords={"branch": names, "phi": centres, "growth_rate": ("branch", np.array(rates)),
+                "start_phi": ("branch", np.array([(starts or {}).get(b, math.nan) for b in names], float))},
     )
     ds.attrs.update({"hardpack_kind": "glass_eos", "bin_width": float(edges[1] - edges[0]), "d": d,
                      "slope0": slope0, **(attrs or {})})

@@ -13,9 +13,10 @@ from hardpack.plots.style import RC, figure
 
 
 def plot_glass_eos(binary, mono):
-    """phi~_J(phi) = phi / (1 - 2/Z) of every compression branch (and the crystal decompression),
-    with the published Eq. 13.3 cubic, our fit of it, the glassy branches of Eq. 13.4 and the
-    hard-disk crystal EOS of Alder, Hoover & Young 1968 (after Donev 2006, Figs. 13.1 and 13.6).
+    """phi~_J(phi) = phi / (1 - 2/Z) of every compression branch (and the crystal decompression; a
+    branch continued from another from where it starts), with the published Eq. 13.3 cubic, our
+    fit of it, the glassy branches of Eq. 13.4 and the hard-disk crystal EOS of Alder, Hoover &
+    Young 1968 (after Donev 2006, Figs. 13.1 and 13.6).
 
     Parameters
     ----------
@@ -31,6 +32,9 @@ def plot_glass_eos(binary, mono):
     for ax, ds, title in ((axes[0], mono, "monodisperse disks"), (axes[1], binary, "binary disks, kappa = 1.4")):
         for b in ds["branch"].values:
             row = ds.sel(branch=b)
+            if "start_phi" in row.coords and np.isfinite(float(row["start_phi"])):
+                # a compression continued from another: its points below the start are the parent's
+                row = row.where(row["phi_mean"] >= float(row["start_phi"]))
             label = "decompression" if b == "decompression" else f"Gamma = {b}"
             ax.errorbar(row["phi_mean"], row["phij"], yerr=row["phij_err"], fmt=".", ms=3, label=label)
             if np.isfinite(float(row["alpha"])):
