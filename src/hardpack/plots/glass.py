@@ -32,11 +32,13 @@ def plot_glass_eos(binary, mono):
     for ax, ds, title in ((axes[0], mono, "monodisperse disks"), (axes[1], binary, "binary disks, kappa = 1.4")):
         for b in ds["branch"].values:
             row = ds.sel(branch=b)
+            phi, phij, err = (row[k].values for k in ("phi_mean", "phij", "phij_err"))
             if "start_phi" in row.coords and np.isfinite(float(row["start_phi"])):
                 # a compression continued from another: its points below the start are the parent's
-                row = row.where(row["phi_mean"] >= float(row["start_phi"]))
+                own = phi >= float(row["start_phi"])
+                phi, phij, err = phi[own], phij[own], err[own]
             label = "decompression" if b == "decompression" else f"Gamma = {b}"
-            ax.errorbar(row["phi_mean"], row["phij"], yerr=row["phij_err"], fmt=".", ms=3, label=label)
+            ax.errorbar(phi, phij, yerr=err, fmt=".", ms=3, label=label)
             if np.isfinite(float(row["alpha"])):
                 x = np.linspace(*ds.attrs["glass_fit_range"], 20)
                 ax.plot(x, fits.glass_phij(x, float(row["glass_phi_j"]), float(row["alpha"])), "k:", lw=0.8)
