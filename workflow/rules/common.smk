@@ -528,9 +528,8 @@ def glass_relaxed_files(prefix):
 def glass_bcmd_files(system):
     """BCMD of the snapshots of the slowest compression (:func:`glass_snapshot`)."""
     rate = min(GLASS_SYSTEMS[system]["rates"])
-    snaps = [glass_snapshot(system, rate, phi, "{seed}") for phi in sorted(GLASS["snapshots"])]
-    return [path.replace(f"results/glass/{system}/", f"results/glass/{system}/bcmd/").format(seed=seed)
-            for path in snaps for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
+    return [glass_snapshot(system, rate, phi, seed).replace(f"glass/{system}/", f"glass/{system}/bcmd/", 1)
+            for phi in sorted(GLASS["snapshots"]) for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
 
 
 def glass_crystal_cells():
