@@ -114,14 +114,17 @@ def test_periodic_image_collision():
 
 @pytest.mark.parametrize("d, kappa, omega, n, phi, skin", [
     (2, 0.05, 1.0, 150, 0.25, 0.3), (3, 0.0, 1.0, 150, 0.25, 0.3), (3, 0.02, 10.0, 600, 0.25, 0.3),
-    (3, 0.0, 1.0, 20, 0.15, 0.5), pytest.param(4, 0.02, 1.0, 150, 0.15, 0.3, marks=pytest.mark.slow)])
+    (3, 0.0, 1.0, 20, 0.15, 0.5), pytest.param(4, 0.02, 1.0, 150, 0.15, 0.3, marks=pytest.mark.slow),
+    (5, 0.0, 1.0, 243, 0.12, 0.3)])
 def test_neighbour_lists_match_brute_force_after_many_partial_updates(d, kappa, omega, n, phi, skin):
     """Invariants of the bounding-sphere lists (Donev sec. 2.9): every particle lies inside its
     bounding sphere, and i lists j (with the minimum-image shift) exactly when their bounding
     spheres overlap. Checked by brute force after windows full of partial updates; omega = 10
     (radii uniform in volume over a factor 10) puts the spheres on several grid levels. The box of
     n = 20 at phi = 0.15 (L = 4.1) is smaller than 2 (R_i + R_j) plus the moves of two bounding
-    centres (R = 1, skin 0.5): a kept pair of neighbours changes periodic image without a wrap."""
+    centres (R = 1, skin 0.5): a kept pair of neighbours changes periodic image without a wrap.
+    In d = 5 (N = 243, L = 3.2 diameters) image codes reach 682, so old and new codes of a pair can
+    differ by a multiple of 256 (a scratch mark narrower than the code missed such a change)."""
     from hardpack.distributions import monodisperse, uniform_volume
     from hardpack.initial import random_packing
     from hardpack.md.simulation import maxwell_boltzmann

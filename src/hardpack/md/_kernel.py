@@ -518,9 +518,10 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
         particle i's.
     nn : numpy.ndarray of int32, shape (N,)
         Neighbour lists: length of each list (reset on a rebuild).
-    mark : numpy.ndarray of int8, shape (N,)
+    mark : numpy.ndarray of int32, shape (N,)
         Neighbour lists: scratch of a partial update, image code + 1 of the old neighbours
-        (reset at entry).
+        (reset at entry; the codes reach 4^d - 1, so a narrower integer would alias codes that
+        differ by a multiple of its range and miss a change of image in d >= 5).
 
     cnt : numpy.ndarray of int32, shape (N,)
         Heap / events: collision counter of every particle (lazy invalidation).

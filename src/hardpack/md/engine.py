@@ -234,7 +234,8 @@ class Engine:
         self.hpos = np.zeros(n, dtype=np.int32)
         self.bs = np.zeros((n, d + 1))  # bounding spheres: centre, radius
         self.nn = np.zeros(n, dtype=np.int32)
-        self.mark = np.zeros(n, dtype=np.int8)
+        # image code + 1 of the old neighbours in a partial list update: codes reach 4^d - 1
+        self.mark = np.zeros(n, dtype=np.int32)
         self.slot_of = np.zeros(n, dtype=np.int32)
         self.cell_capacity = 0
         #: smallest cell capacity of any grid (doubled after a full cell; part of the run state)
