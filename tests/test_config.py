@@ -189,6 +189,7 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
     (lambda c: c["freeenergy"]["simplex"].update(ensemble="mono9d"), r"freeenergy.simplex.ensemble 'mono9d' is not one"),
     (lambda c: c["freeenergy"]["simplex"].update(seeds=[1, 7]), r"freeenergy.simplex.seeds \[7\] are not seeds"),
     (lambda c: c["rates"].update(ensemble="mono9d"), "rates.ensemble 'mono9d' is not one of the ensembles"),
+    (lambda c: c["ls_densest"]["runs"].append(dict(c["ls_densest"]["runs"][0])), "ls_densest.runs lists a dimension twice"),
     (lambda c: c["glass"].update(N=c["glass"]["N"] + 1), "glass.N = .* must be even"),
     (lambda c: c["glass"].update(phi_end=0.5), "glass.phi_end must be above every glass.snapshots"),
     (lambda c: c["glass"].update(slow={"rate": 1.0, "from_phi": 0.70}), r"glass.slow.rate = 1 must be below every"),

@@ -75,6 +75,7 @@ def check_config(config: dict) -> None:
     ensembles = config["ensembles"]
     _check_ensembles(ensembles, config)
     _check_slp(ensembles, config.get("slp", {}))
+    _check_ls_densest(config.get("ls_densest"))
     _check_freeenergy(ensembles, config.get("freeenergy"))
     _check_glass(config.get("glass"), config.get("microsegregated"))
     _check_ellipsoids(config.get("ellipsoids"))
@@ -99,6 +100,11 @@ def _check_ensembles(ensembles: dict, config: dict) -> None:
     rates = config.get("rates")
     if rates and rates["ensemble"] not in ensembles:
         _refuse(f"rates.ensemble {rates['ensemble']!r} is not one of the ensembles {sorted(ensembles)}")
+
+
+def _check_ls_densest(ls_densest: dict | None) -> None:
+    if ls_densest and len({run["d"] for run in ls_densest["runs"]}) != len(ls_densest["runs"]):
+        _refuse("ls_densest.runs lists a dimension twice")
 
 
 def _check_slp(ensembles: dict, slp: dict) -> None:

@@ -50,6 +50,7 @@ CRYSTAL_SEARCH = (ELLIPSOID_CRYSTALS or {}).get("search")
 CONTAINERS = config.get("containers")
 ELLIPSOID_CONTAINERS = config.get("ellipsoid_containers")
 STRICT_LS = config.get("strict_ls")
+LS_DENSEST = config.get("ls_densest")
 VALIDATION = config.get("validation", {})
 MONODISPERSE = {"kind": "monodisperse"}
 
@@ -65,6 +66,7 @@ check_config(config)
 #   ls_rates       the growth-rate scan, single-stage LS from an ensemble's starts
 #   slp_mrj        SLP MRJ packings beside LS ensembles and of the SLP-only systems (Table I)
 #   slp_densest    SLP from N = 3^d starts (Table II), names d{d}
+#   ls_densest     LS from N = 3^d starts (Table II, LS column), names d{d}
 #   slp_order_map  starts n{N}, one SLP run per setting s{k} (Fig. 6)
 #   slp_diluted    diluted-MRJ rounds from an ensemble's SLP MRJ packings (Sec. VI)
 #   ellipsoids     LS packings of ellipsoids {family}_a{alpha} and binary ellipses ellipses_a{alpha}
@@ -136,6 +138,21 @@ def _systems():
     systems["containers"] = _container_systems()
     systems["ellipsoid_containers"] = _ellipsoid_container_systems()
     systems["strict_ls"] = _strict_ls_systems()
+    systems["ls_densest"] = _ls_densest_systems()
+    return systems
+
+
+def _ls_densest_systems():
+    """LS from N = 3^d equal spheres (Torquato & Jiao 2010, Table II, LS column), one system d{d} per
+    run: one growth rate to max_pressure, in a deforming cell where the run says so."""
+    if not LS_DENSEST:
+        return {}
+    systems = {}
+    for run in LS_DENSEST["runs"]:
+        compress = f"--growth-rate {run['growth_rate']} --max-pressure {LS_DENSEST['max_pressure']}"
+        compress += " --deforming-cell" if run.get("deforming_cell") else ""
+        systems[f"d{run['d']}"] = _system(run.get("N", 3 ** run["d"]), run["d"], run["seeds"], run["init_phi"],
+                                          attrs={}, compress=compress, deforming=bool(run.get("deforming_cell")))
     return systems
 
 
@@ -629,6 +646,10 @@ def _combined_summaries():
                                                  ["n_steps", "wall_seconds", "cpu_seconds"], attrs)
         table[f"slp_mrj/{name}/verdict"] = _combined(seed_files("slp_mrj", name, "verdict"), ["seed"],
                                                      JAMMING_VARIABLES, attrs)
+    if LS_DENSEST:
+        table["ls_densest/jammed"] = _combined(
+            [path for name in SYSTEMS["ls_densest"] for path in seed_files("ls_densest", name, "jammed")],
+            ["d", "seed"], ["Z", "collisions", "wall_time", "growth_rate"])
     if SLP_DENSEST:
         table["slp_densest/slp"] = _combined(
             [path for name in SYSTEMS["slp_densest"] for path in seed_files("slp_densest", name, "slp")],
@@ -745,6 +766,8 @@ def validation_inputs():
     }
     if SLP_DENSEST:
         inputs["slp_densest"] = [summary("slp_densest/slp")]
+    if LS_DENSEST:
+        inputs["ls_densest"] = [summary("ls_densest/jammed")]
     if SLP_MRJ:
         inputs["slp_mrj"] = [summary(f"slp_mrj/{name}/slp") for name in SYSTEMS["slp_mrj"]]
         inputs["slp_jamming"] = [summary(f"slp_mrj/{name}/verdict") for name in SYSTEMS["slp_mrj"]]

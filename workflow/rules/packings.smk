@@ -16,7 +16,7 @@ rule init:
         attrs=lambda w: attr_options(system(w)["attrs"]),
         shape=init_shape,
     wildcard_constraints:
-        study="ls|slp_mrj|slp_densest|slp_order_map|ellipsoids|strict_ls",
+        study="ls|slp_mrj|slp_densest|slp_order_map|ellipsoids|strict_ls|ls_densest",
     threads: 1
     resources:
         mem_mb=job_mem_mb("init"),
@@ -49,7 +49,7 @@ rule compress:
         options=lambda w: system(w)["compress"],
         checkpoint=checkpoint_option,
     wildcard_constraints:
-        study="ls|ls_rates|ellipsoids|containers|ellipsoid_containers|strict_ls",
+        study="ls|ls_rates|ellipsoids|containers|ellipsoid_containers|strict_ls|ls_densest",
     threads: 1
     resources:
         mem_mb=job_mem_mb("compress"),

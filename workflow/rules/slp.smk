@@ -50,9 +50,10 @@ rule slp_diluted_summary:
 
 
 rule fig_slp_densest:
-    """Table II: SLP densities from N = 3^d starts against the densest known packings."""
+    """Table II: SLP (and LS, where the config runs them) densities from N = 3^d starts against the densest known packings."""
     input:
-        summary("slp_densest/slp"),
+        slp=summary("slp_densest/slp"),
+        ls=[summary("ls_densest/jammed")] if LS_DENSEST else [],
     output:
         pdf="results/figures/slp_densest.pdf",
         png=report("results/figures/slp_densest.png", caption="../report/slp_densest.rst", category="6 SLP"),

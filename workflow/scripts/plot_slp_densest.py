@@ -1,4 +1,4 @@
-"""Snakemake script: Table II figure from the SLP densest-packing summary."""
+"""Snakemake script: Table II figure from the SLP (and LS) densest-packing summaries."""
 
 import logging
 
@@ -7,4 +7,6 @@ from hardpack.plots.slp import plot_densest
 from hardpack.plots.style import save
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
-save(plot_densest(load_dataset(snakemake.input[0], kind="ensemble")), snakemake.output.pdf, snakemake.output.png)
+ls = [load_dataset(path, kind="ensemble") for path in snakemake.input.ls]
+save(plot_densest(load_dataset(snakemake.input.slp, kind="ensemble"), ls[0] if ls else None),
+     snakemake.output.pdf, snakemake.output.png)

@@ -11,13 +11,16 @@ from hardpack.slp.published import TABLE_II
 from hardpack.validation.targets import load_targets
 
 
-def plot_densest(summary):
+def plot_densest(summary, ls=None):
     """phi / phi_densest-known per dimension: every seed, the best, and the paper's SLP and LS values.
 
     Parameters
     ----------
     summary : xarray.Dataset
         SLP summary over seeds (variables d and phi).
+    ls : xarray.Dataset, optional
+        LS summary over (d, seed) (variables d, phi and growth_rate): each seed and the best,
+        labelled with its growth rate.
 
     Returns
     -------
@@ -38,9 +41,24 @@ def plot_densest(summary):
             label="Torquato & Jiao SLP (Table II)")
     ax.plot(dims, [TABLE_II[k][1] / TABLE_II[k][3] for k in dims], "^:", color="C2", mfc="none",
             label="Torquato & Jiao LS (Table II)")
+    lowest = float(np.min(phi / exact))
+    if ls is not None:
+        d_ls = ls["d"].values.astype(int)
+        phi_ls = ls["phi"].values / np.array([TABLE_II[k][3] for k in d_ls])
+        rate = ls["growth_rate"].values
+        ax.scatter(d_ls + 0.15 + 0.05 * rng.standard_normal(d_ls.size), phi_ls, s=14, marker="D", color="C1",
+                   alpha=0.6, label="hardpack LS, each seed")
+        dims_ls = np.unique(d_ls)
+        ax.plot(dims_ls + 0.15, [phi_ls[d_ls == k].max() for k in dims_ls], "D-", color="C1", mfc="none",
+                label="hardpack LS, best seed")
+        for k in dims_ls:
+            ax.annotate(f"{rate[d_ls == k][0]:.0e}", (k + 0.15, phi_ls[d_ls == k].min()), xytext=(0, -11),
+                        textcoords="offset points", ha="center", fontsize=7, color="C1")
+        dims = np.union1d(dims, dims_ls)
+        lowest = min(lowest, float(phi_ls.min()))
     ax.axhline(1.0, color="k", lw=0.8)
     ax.ticklabel_format(axis="y", useOffset=False)
-    ax.set_ylim(min(0.85, float(np.min(phi / exact)) - 0.02), 1.02)
+    ax.set_ylim(min(0.85, lowest - 0.04), 1.02)
     ax.set_xticks(dims)
     ax.set_xticklabels([f"{k}\n{TABLE_II[k][4]}, N={TABLE_II[k][0]}" for k in dims])
     ax.set_xlabel("dimension d (densest known packing, N = 3^d)")

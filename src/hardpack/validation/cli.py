@@ -42,7 +42,7 @@ from hardpack.validation.jamming import jamming_rows, strict_ls_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
 from hardpack.validation.polydisperse import polydisperse_rows
 from hardpack.validation.rows import from_dataset, gate, headline, to_dataset, to_markdown
-from hardpack.validation.slp import densest_rows, diluted_rows, mrj_jamming_rows, order_map_rows
+from hardpack.validation.slp import densest_rows, diluted_rows, ls_densest_rows, mrj_jamming_rows, order_map_rows
 from hardpack.validation.structure import structure_rows
 from hardpack.validation.targets import load_targets
 
@@ -56,6 +56,7 @@ ROW_BUILDERS = {
     "ls": ls_rows,
     "slp_mrj": slp_mrj_rows,
     "slp_densest": lambda datasets: [row for ds in datasets for row in densest_rows(ds)],
+    "ls_densest": lambda datasets: [row for ds in datasets for row in ls_densest_rows(ds)],
     "slp_jamming": mrj_jamming_rows,
     "slp_order_map": lambda datasets: [row for ds in datasets for row in order_map_rows(ds)],
     "slp_diluted": lambda datasets: [row for ds in datasets for row in diluted_rows(ds)],
