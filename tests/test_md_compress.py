@@ -45,6 +45,18 @@ def test_3d_monodisperse_jams_in_the_published_window(jammed3d):
     _assert_clean(jammed3d)
 
 
+@pytest.mark.parametrize("d, n, phi0, low, high", [(5, 243, 0.12, 0.28, 0.33), (6, 729, 0.06, 0.18, 0.22)])
+def test_high_dimensional_ls_in_small_boxes_jams_near_mrj(d, n, phi0, low, high):
+    # Torquato & Jiao's Table II cells (N = 3^d, a box of ~3 diameters): image codes of the
+    # neighbour lists reach 4^d - 1 here. phi_J of fast LS: 0.31 (d = 5) and 0.20 (d = 6) (Donev
+    # 2006, Table 11.1); at Z = 1e3 phi is a few tenths of a percent below it.
+    run = compress(random_packing(n, d, monodisperse(0.5), phi0, seed=1), 0.02, seed=1,
+                   stop=StopCriteria(max_pressure=1e3))
+    assert run.stats["stop_reason"] == "max_pressure"
+    assert low <= run.stats["phi"] <= high
+    _assert_clean(run)
+
+
 def test_free_volume_law_near_jamming(jammed3d):
     """p (1 - phi/phi_J) -> d: median over windows with 1e4 < Z < 1e8 within 10 % of d = 3
     (rattlers and the finite rate make it approach d from either side by a few percent)."""
