@@ -98,8 +98,9 @@ def cmd_glass_eos(args) -> int:
                                                             for r, p in args.continues or [])})
     write_dataset(ds, args.out)
     c, ce = ds["cubic"].values, ds["cubic_err"].values
-    log.info("%s: branches %s; Eq. 13.3 fit %s +- %s; alpha %s", args.system, list(branches),
-             np.round(c, 4).tolist(), np.round(ce, 4).tolist(), np.round(ds["alpha"].values, 4).tolist())
+    log.info("%s: branches %s; Eq. 13.3 fit up to phi = %.4f: %s +- %s; alpha %s", args.system, list(branches),
+             ds.attrs["liquid_fit_max"], np.round(c, 4).tolist(), np.round(ce, 4).tolist(),
+             np.round(ds["alpha"].values, 4).tolist())
     return 0
 
 
@@ -341,7 +342,8 @@ def register(subparsers) -> None:
     p.add_argument("--phi-min", type=float, default=0.0, help="lowest bin edge (default 0)")
     p.add_argument("--phi-max", type=float, default=0.9, help="highest bin edge (default 0.9)")
     p.add_argument("--liquid-range", type=float, nargs=2, default=[0.70, 0.80],
-                   help="phi range of the Eq. 13.3 cubic fit (default 0.70 0.80)")
+                   help="phi range of the Eq. 13.3 cubic fit (default 0.70 0.80); the fit stops earlier where "
+                        "the slowest compression and the next faster one separate (Donev 2006, sec. 13.3.1)")
     p.add_argument("--glass-range", type=float, nargs=2, default=[0.80, 0.84],
                    help="phi range of the Eq. 13.4 glass-branch fit (default 0.80 0.84)")
     p.add_argument("--continues", type=float, nargs=2, action="append", metavar=("RATE", "PARENT"),

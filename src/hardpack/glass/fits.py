@@ -189,6 +189,49 @@ def weighted_polyfit(x, y, y_err, degree: int) -> LinearFit:
     return LinearFit(coef, cov, chi2, dof)
 
 
+def equilibrium_limit(phi, slow, slow_err, faster, faster_err, phi_max: float) -> float:
+    """The density up to which slowing a compression down does not change its pressure (Donev
+    2006, sec. 13.3.1: Eq. 13.3 is fitted to the slowest runs "up to the density where slowing
+    down the compression by an order of magnitude does not change the observed pressure (within
+    statistical variability)").
+
+    The binned phi~_J of the slowest compression and of the next faster one count as different
+    in a bin when they differ by more than twice their combined standard error (the convention
+    of the validation rows); the limit is the last bin below the first one from which they
+    differ in every bin up to ``phi_max`` (a single differing bin followed by agreeing ones is
+    noise of the bins' errors, which a few seeds estimate poorly). Bins where either is missing
+    are skipped.
+
+    Parameters
+    ----------
+    phi : array_like of float
+        Bin centres, increasing.
+    slow, slow_err : array_like of float
+        phi~_J of the slowest compression and its standard errors.
+    faster, faster_err : array_like of float
+        The same for the compression an order of magnitude faster.
+    phi_max : float
+        Largest density considered.
+
+    Returns
+    -------
+    float
+        The limit (``phi_max`` when they never separate for good).
+    """
+    phi = np.asarray(phi, float)
+    a, ae, b, be = (np.asarray(v, float) for v in (slow, slow_err, faster, faster_err))
+    keep = (phi <= phi_max) & np.isfinite(a) & np.isfinite(b)
+    phi, a, ae, b, be = phi[keep], a[keep], ae[keep], b[keep], be[keep]
+    err = np.hypot(np.nan_to_num(ae), np.nan_to_num(be))
+    apart = np.abs(a - b) > 2.0 * err
+    limit = phi_max
+    for k in range(phi.size - 1, -1, -1):  # walk down while they stay apart
+        if not apart[k]:
+            break
+        limit = float(phi[k - 1]) if k > 0 else -np.inf
+    return limit
+
+
 def fit_liquid_cubic(phi, phij, phij_err=None, phi_max: float = 0.8) -> LinearFit:
     """Eq. 13.3: the cubic phi~_J(phi) fitted to the points with phi <= ``phi_max``.
 

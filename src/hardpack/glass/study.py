@@ -209,7 +209,8 @@ def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float 
     slope0 : float, default 2.0
         (Z - 1)/phi at phi = 0 (:func:`hardpack.glass.thermo.second_virial_slope`).
     liquid_range, glass_range : (float, float)
-        phi ranges of the Eq. 13.3 and Eq. 13.4 fits.
+        phi ranges of the Eq. 13.3 and Eq. 13.4 fits (Eq. 13.3 stops earlier where the slowest
+        compression and the next faster one separate, :func:`_add_fits`).
     starts : dict, optional
         Branch name -> the phi where a compression that continues another starts (its runs hold
         the parent's series below it, :func:`continued_run`); stored as ``start_phi`` (NaN for the
@@ -259,20 +260,32 @@ def eos_dataset(branches: dict, edges: np.ndarray, *, d: int = 2, slope0: float 
 
 def _add_fits(ds: xr.Dataset, liquid_range, glass_range) -> None:
     """Eq. 13.3 to the slowest compression, Eq. 13.4 to every compression (NaN where too few
-    points); coefficients and errors as variables, the ranges as attributes."""
+    points); coefficients and errors as variables, the ranges as attributes.
+
+    The cubic is fitted over ``liquid_range`` up to where the slowest compression and the next
+    faster one separate (:func:`hardpack.glass.fits.equilibrium_limit`, the text's rule; stored as
+    ``liquid_fit_max``)."""
     rates = ds["growth_rate"].values
     comp = np.flatnonzero(np.isfinite(rates) & (rates > 0))
     cubic = np.full(4, np.nan)
     cubic_err = np.full(4, np.nan)
+    fit_max = float(liquid_range[1])
     if comp.size:
         slow = comp[np.argmin(rates[comp])]
         row = ds.isel(branch=slow)
         phi, pj, pe = row["phi_mean"].values, row["phij"].values, row["phij_err"].values
-        sel = (phi >= liquid_range[0]) & (phi <= liquid_range[1]) & np.isfinite(pj)
+        faster = comp[rates[comp] > rates[slow]]
+        if faster.size:
+            other = ds.isel(branch=faster[np.argmin(rates[faster])])
+            fit_max = fits.equilibrium_limit(ds["phi"].values, pj, pe, other["phij"].values,
+                                             other["phij_err"].values, fit_max)
+            ds.attrs["liquid_fit_compared"] = str(other["branch"].values)
+        sel = (phi >= liquid_range[0]) & (phi <= liquid_range[1]) & (ds["phi"].values <= fit_max) & np.isfinite(pj)
         if sel.sum() > 4:
-            fit = fits.fit_liquid_cubic(phi[sel], pj[sel], pe[sel], phi_max=liquid_range[1])
+            fit = fits.fit_liquid_cubic(phi[sel], pj[sel], pe[sel], phi_max=np.inf)
             cubic, cubic_err = fit.coefficients, fit.errors
         ds.attrs["cubic_branch"] = str(ds["branch"].values[slow])
+    ds.attrs["liquid_fit_max"] = fit_max
     ds["cubic"] = ("power", cubic)
     ds["cubic_err"] = ("power", cubic_err)
     alpha = np.full(rates.size, np.nan)

@@ -236,10 +236,13 @@ def binary_eos_rows(ds) -> list[Row]:
     slow = ds.attrs.get("cubic_branch")
     seeds = _seeds(ds, slow) if slow is not None else 0
     how = f"N = {n}, slowest Gamma = {slow}, {seeds} seed(s)"
+    fit_to = ds.attrs.get("liquid_fit_max")
+    fit_how = how if fit_to is None else (f"{how}; fitted up to phi = {fit_to:.4g} (above it Gamma = "
+                                          f"{ds.attrs.get('liquid_fit_compared', '-')} separates)")
     out = []
     for k in range(4):
         out.append(evaluate(targets[f"donev-eq13.3-c{k}"], float(ds["cubic"][k]), float(ds["cubic_err"][k]),
-                            n=n, seeds=seeds, detail=how))
+                            n=n, seeds=seeds, detail=fit_how))
     value = err = math.nan
     if slow is not None:
         row = ds.sel(branch=slow)
