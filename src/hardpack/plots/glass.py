@@ -46,15 +46,21 @@ def plot_glass_eos(binary, mono):
         ax.set_xlabel("phi")
         ax.set_ylabel("phi~_J = phi / (1 - 2/p)")
         ax.set_xlim(0.6, 0.9)
-        ax.set_ylim(0.8, 0.92)
+    axes[0].set_ylim(0.8, 0.92)
+    axes[1].set_ylim(0.84, 0.875)  # the binary branches differ by ~1e-3: zoom in
     x = np.linspace(0.74, 0.89, 60)
     axes[0].plot(x, x / (1 - 2 / hard_disk_solid(x)[0]), "k-", lw=0.8, label="crystal, Alder-Hoover-Young 1968")
     x = np.linspace(0.70, 0.80, 50)
     axes[1].plot(x, fits.cubic_phij(x), "k-", label="Eq. 13.3 (published)")
     if np.all(np.isfinite(binary["cubic"].values)):
-        axes[1].plot(x, fits.cubic_phij(x, binary["cubic"].values), "r--", label="Eq. 13.3 refitted")
-    for ax in axes:
-        ax.legend(loc="lower left")
+        # solid over the fitted range (up to where a ten times faster compression separates), dashed beyond
+        top = min(float(binary.attrs.get("liquid_fit_max", 0.80)), 0.80)
+        inside = x <= top
+        axes[1].plot(x[inside], fits.cubic_phij(x[inside], binary["cubic"].values), "r-",
+                     label=f"Eq. 13.3 refitted (to phi = {top:.3f})")
+        axes[1].plot(x[~inside], fits.cubic_phij(x[~inside], binary["cubic"].values), "r--")
+    axes[0].legend(loc="lower right", fontsize=8)
+    axes[1].legend(loc="upper left", fontsize=8)
     return fig
 
 
