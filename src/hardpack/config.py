@@ -75,7 +75,7 @@ def check_config(config: dict) -> None:
     ensembles = config["ensembles"]
     _check_ensembles(ensembles, config)
     _check_slp(ensembles, config.get("slp", {}))
-    _check_ls_densest(config.get("ls_densest"))
+    _check_one_run_per_dimension("ls_densest", config.get("ls_densest"))
     _check_freeenergy(ensembles, config.get("freeenergy"))
     _check_glass(config.get("glass"), config.get("microsegregated"))
     _check_ellipsoids(config.get("ellipsoids"))
@@ -102,15 +102,14 @@ def _check_ensembles(ensembles: dict, config: dict) -> None:
         _refuse(f"rates.ensemble {rates['ensemble']!r} is not one of the ensembles {sorted(ensembles)}")
 
 
-def _check_ls_densest(ls_densest: dict | None) -> None:
-    if ls_densest and len({run["d"] for run in ls_densest["runs"]}) != len(ls_densest["runs"]):
-        _refuse("ls_densest.runs lists a dimension twice")
+def _check_one_run_per_dimension(where: str, section: dict | None) -> None:
+    if section and len({run["d"] for run in section["runs"]}) != len(section["runs"]):
+        _refuse(f"{where}.runs lists a dimension twice")
 
 
 def _check_slp(ensembles: dict, slp: dict) -> None:
     densest, mrj, diluted = slp.get("densest"), slp.get("mrj"), slp.get("diluted")
-    if densest and len({run["d"] for run in densest["runs"]}) != len(densest["runs"]):
-        _refuse("slp.densest.runs lists a dimension twice")
+    _check_one_run_per_dimension("slp.densest", densest)
     if mrj:
         for name in mrj["ensembles"]:
             if name not in ensembles:

@@ -280,9 +280,9 @@ def _add_fits(ds: xr.Dataset, liquid_range, glass_range) -> None:
             fit_max = fits.equilibrium_limit(ds["phi"].values, pj, pe, other["phij"].values,
                                              other["phij_err"].values, fit_max)
             ds.attrs["liquid_fit_compared"] = str(other["branch"].values)
-        sel = (phi >= liquid_range[0]) & (phi <= liquid_range[1]) & (ds["phi"].values <= fit_max) & np.isfinite(pj)
+        sel = (phi >= liquid_range[0]) & (ds["phi"].values <= fit_max) & np.isfinite(pj)
         if sel.sum() > 4:
-            fit = fits.fit_liquid_cubic(phi[sel], pj[sel], pe[sel], phi_max=np.inf)
+            fit = fits.fit_liquid_cubic(phi[sel], pj[sel], pe[sel], phi_max=liquid_range[1])
             cubic, cubic_err = fit.coefficients, fit.errors
         ds.attrs["cubic_branch"] = str(ds["branch"].values[slow])
     ds.attrs["liquid_fit_max"] = fit_max
