@@ -8,7 +8,9 @@ import pytest
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.lattices import lattice_packing
+from hardpack.geometry.packing import Packing
 from hardpack.structure.order import (
+    coordination_defects,
     crystallinity,
     order_map,
     psi6,
@@ -44,6 +46,20 @@ def test_psi6_triangular_and_square():
     assert abs(float(ds.psi6_global) - 1) < 1e-12
     np.testing.assert_allclose(ds.psi6_abs.values, 1.0, atol=1e-12)
     assert float(psi6(lattice_packing("square", 6)).psi6_local_mean) < 1e-12  # 1 - 1 + 1 - 1
+
+
+def test_coordination_defects_of_the_triangular_lattice_and_of_a_vacancy():
+    crystal = lattice_packing("triangular", (8, 9))  # 72 disks
+    assert coordination_defects(crystal) == 0.0
+    # a vacancy: its six neighbours lose a bond and the triangulation of the hexagonal hole adds
+    # three diagonals, so 3 to 6 of the 71 disks are not six-fold (which depends on the diagonals).
+    # The shrunken, jittered disks make the triangulation unique (the perfect hole is cocircular).
+    jitter = np.random.default_rng(0).uniform(-1e-3, 1e-3, crystal.positions.shape)
+    keep = np.arange(1, crystal.n_particles)
+    vacancy = Packing(crystal.positions[keep] + jitter[keep], 0.99 * crystal.radii[keep], crystal.lattice)
+    assert 3 / 71 <= coordination_defects(vacancy) <= 6 / 71
+    with pytest.raises(InvalidInputError, match="2"):
+        coordination_defects(lattice_packing("fcc", 2))
 
 
 @pytest.mark.parametrize("name, reps", [("fcc", 4), ("triangular", (8, 9)), ("D4", 2)])

@@ -118,24 +118,28 @@ def cmd_glass_entropy(args) -> int:
         Exit status 0 (errors raise).
     """
     from hardpack.glass.study import entropy_dataset
-    from hardpack.io import load_dataset, write_dataset
+    from hardpack.io import dataset_to_packing, load_dataset, write_dataset
+    from hardpack.structure.order import coordination_defects
 
     eos = load_dataset(args.eos, kind="glass_eos")
     bcmd = []
     for path in args.bcmd:
         ds = load_dataset(path, kind="bcmd")
-        snap = load_dataset(ds.attrs["source"], kind="packing").attrs
+        snapshot = load_dataset(ds.attrs["source"], kind="packing")
+        snap = snapshot.attrs
+        defects = coordination_defects(dataset_to_packing(snapshot, ds.attrs["source"]))
         # the snapshot's density as targeted (a stage reaches its target exactly unless it jammed)
         ds.attrs.update(phi0=round(float(snap["phi"]), 4), growth_rate=float(snap["growth_rate"]),
-                        seed=int(snap["seed"]))
+                        seed=int(snap["seed"]), coordination_defects=defects)
         bcmd.append(ds)
     ds = entropy_dataset(eos, bcmd, x_large=float(eos.attrs["x_large"]), attrs={"system": eos.attrs["system"]})
     write_dataset(ds, args.out)
     for i in range(ds.sizes["sample"]):
         r = ds.isel(sample=i)
-        log.info("phi0 = %.3f seed %d: Delta f_g = %.4f, Delta f_L = %.4f, s_c - s_mix = %.4f +- %.4f",
+        log.info("phi0 = %.3f seed %d: Delta f_g = %.4f, Delta f_L = %.4f, s_c - s_mix = %.4f +- %.4f, "
+                 "%.2f %% of the disks without six neighbours",
                  float(r["phi0"]), int(r["seed"]), float(r["glass_excess"]), float(r["liquid_excess"]),
-                 float(r["sc_minus_smix"]), float(r["sc_minus_smix_err"]))
+                 float(r["sc_minus_smix"]), float(r["sc_minus_smix_err"]), 100 * float(r["coordination_defects"]))
     return 0
 
 

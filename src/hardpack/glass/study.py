@@ -350,7 +350,8 @@ def entropy_dataset(eos: xr.Dataset, bcmd: list[xr.Dataset], *, x_large: float,
         The system's EOS summary (:func:`eos_dataset`); Delta f_L from its slowest compression.
     bcmd : list of xarray.Dataset
         BCMD results of the glass snapshots (:func:`hardpack.freeenergy.run_bcmd`), each with the
-        attributes ``phi0``, ``growth_rate`` and ``seed`` of its snapshot.
+        attributes ``phi0``, ``growth_rate`` and ``seed`` of its snapshot, and optionally its
+        ``coordination_defects`` (:func:`hardpack.structure.coordination_defects`; NaN if absent).
     x_large : float
         Number fraction of the large disks (0 for a monodisperse system): s_mix.
 
@@ -359,7 +360,7 @@ def entropy_dataset(eos: xr.Dataset, bcmd: list[xr.Dataset], *, x_large: float,
     xarray.Dataset
         Over ``sample`` (indexed by phi0, growth_rate, seed): ``glass_excess``, ``liquid_excess``,
         ``liquid_excess_err``, ``sc_minus_smix``, ``sc_minus_smix_err``, ``sc``, ``dmu_min``,
-        ``n_events``, ``seconds``; attributes ``s_mix``.
+        ``n_events``, ``seconds``, ``coordination_defects``; attributes ``s_mix``.
     """
     if not bcmd:
         raise InvalidInputError("no BCMD results given")
@@ -374,11 +375,13 @@ def entropy_dataset(eos: xr.Dataset, bcmd: list[xr.Dataset], *, x_large: float,
         s, s_err = thermo.configurational_entropy_excess(a["excess"], f_l, 0.0, f_l_err)
         rows.append((float(a["phi0"]), float(a["growth_rate"]), int(a["seed"]), float(a["phi"]),
                      float(a["excess"]), f_l, f_l_err, float(s), float(s_err), float(a["dmu_min"]),
-                     int(a["n_events"]), float(a["seconds"]), int(a["n_particles"])))
+                     int(a["n_events"]), float(a["seconds"]), int(a["n_particles"]),
+                     float(a.get("coordination_defects", math.nan))))
     rows.sort()
     arr = list(zip(*rows))
     names = ("phi0", "growth_rate", "seed", "phi", "glass_excess", "liquid_excess", "liquid_excess_err",
-             "sc_minus_smix", "sc_minus_smix_err", "dmu_min", "n_events", "seconds", "n_particles")
+             "sc_minus_smix", "sc_minus_smix_err", "dmu_min", "n_events", "seconds", "n_particles",
+             "coordination_defects")
     data = {n: ("sample", np.asarray(v)) for n, v in zip(names, arr) if n not in ("phi0", "growth_rate", "seed")}
     data["sc"] = ("sample", np.asarray(arr[7]) + s_mix)
     coords = {n: ("sample", np.asarray(v)) for n, v in zip(names[:3], arr[:3])}

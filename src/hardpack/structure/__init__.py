@@ -19,6 +19,7 @@ from hardpack.structure.containers import (
 )
 from hardpack.structure.order import (
     bond_harmonics,
+    coordination_defects,
     crystallinity,
     local_qlm,
     order_map,
@@ -58,6 +59,7 @@ __all__ = [
     "bond_harmonics",
     "channel_histogram",
     "channel_radii",
+    "coordination_defects",
     "crystallinity",
     "cumulative_coordination",
     "cutoff_neighbours",

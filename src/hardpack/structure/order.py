@@ -12,6 +12,10 @@ neighbours), SC 0.3536.
 **psi_6** (2D): psi_6(i) = (1/N_b(i)) sum_j exp(6 i theta_ij); reported as the global |<psi_6(i)>|
 and the mean local |psi_6(i)|; both are 1 for the triangular lattice.
 
+**Coordination defects** (2D): the fraction of disks whose number of neighbours in the regular
+(weighted Delaunay) triangulation is not six; 0 for the triangular lattice, and the topological
+defects (5-7 pairs, vacancies, grain boundaries) of a frozen disk crystal otherwise.
+
 **Translational order T** (Torquato, Truskett & Debenedetti 2000, as used by Torquato & Jiao 2010,
 Sec. VI, Eq. 22): T = |sum_i (n_i - n_i^ideal)| / sum_i (n_i^ref - n_i^ideal) over the
 first N_s neighbour shells of the reference crystal at the packing's number density (FCC in 3D;
@@ -189,6 +193,30 @@ def psi6(packing, neighbours=1.2) -> xr.Dataset:
         psi6_global=((), float(np.abs(np.nanmean(local)))),
         psi6_local_mean=((), float(np.nanmean(np.abs(local)))),
         psi6_abs=("particle", np.abs(local)), n_bonds=("particle", nl.counts)))
+
+
+def coordination_defects(packing) -> float:
+    """Fraction of the disks of a 2D packing that do not have six neighbours in the regular
+    (weighted Delaunay) triangulation: the topological defects of a disk crystal.
+
+    Parameters
+    ----------
+    packing : Packing
+        A 2D periodic disk packing.
+
+    Returns
+    -------
+    float
+        The fraction, in [0, 1]; 0 for the triangular lattice.
+
+    Raises
+    ------
+    InvalidInputError
+        If the packing is not 2D.
+    """
+    _require_dim(packing, (2,), "coordination defects")
+    counts = neighbour_list(packing, "delaunay").counts
+    return float(np.mean(counts != 6))
 
 
 _REFERENCE = {2: "triangular", 3: "fcc"}

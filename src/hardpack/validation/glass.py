@@ -324,7 +324,8 @@ def relaxed_rows(ds) -> list[Row]:
 
 def entropy_rows(ds) -> list[Row]:
     """s_c - s_mix of the snapshot at phi0 = 0.80 (binary) or 0.75 (monodisperse) of the slowest
-    compression that has one, mean and standard error over seeds.
+    compression that has one, mean and standard error over seeds; for the monodisperse crystal
+    the detail names each snapshot's coordination defects (the cause of a positive s_c).
 
     Parameters
     ----------
@@ -349,6 +350,10 @@ def entropy_rows(ds) -> list[Row]:
     detail = (f"N = {n}, Gamma = {rate:g}, phi = {phi0}: Delta f_g = "
               f"{np.round(ds['glass_excess'].values[sel], 4).tolist()}, Delta f_L = "
               f"{np.round(ds['liquid_excess'].values[sel], 4).tolist()}")
+    if mono and "coordination_defects" in ds:
+        defects = ds["coordination_defects"].values[sel]
+        if np.isfinite(defects).all():
+            detail += f"; % of disks without six neighbours {np.round(100 * defects, 2).tolist()}"
     return [evaluate(target, samples=samples, n=n, detail=detail)]
 
 
