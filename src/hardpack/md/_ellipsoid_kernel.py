@@ -431,10 +431,10 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     return zeta, zdot, lam
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _hermite_min(z0, z1, d0, d1):
     """Minimum over s in (0, 1] of the cubic Hermite interpolant with values z0, z1 and
-    derivatives d0, d1 (per unit s) at s = 0, 1, and the first root s in (0, 1] (or 2.0)."""
+    derivatives d0, d1 (per unit s) at s = 0, 1."""
     # H(s) = z0 + d0 s + c2 s^2 + c3 s^3
     c2 = 3.0 * (z1 - z0) - 2.0 * d0 - d1
     c3 = 2.0 * (z0 - z1) + d0 + d1
@@ -453,24 +453,41 @@ def _hermite_min(z0, z1, d0, d1):
             for s in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)):
                 if 0.0 < s < 1.0:
                     hmin = min(hmin, z0 + s * (d0 + s * (c2 + s * c3)))
-    root = 2.0
-    if hmin <= 0.0:  # first sign change on a fine grid, then bisection
-        prev = 0.0
-        m = 16
-        for q in range(1, m + 1):
-            s = q / m
-            if z0 + s * (d0 + s * (c2 + s * c3)) <= 0.0:
-                lo, hi = prev, s
-                for _ in range(40):
-                    mid = 0.5 * (lo + hi)
-                    if z0 + mid * (d0 + mid * (c2 + mid * c3)) <= 0.0:
-                        hi = mid
-                    else:
-                        lo = mid
-                root = hi
-                break
-            prev = s
-    return hmin, root
+    return hmin
+
+
+@njit(cache=True)
+def _hermite_root(z0, z1, d0, d1):
+    """First root s in (0, 1] of the cubic Hermite interpolant of :func:`_hermite_min` (z0 > 0),
+    or 2.0 when it stays positive: the first sign change on a grid of 16, then safeguarded Newton
+    on the cubic inside that cell (bisection when a step leaves it) to a few ulps of s."""
+    c2 = 3.0 * (z1 - z0) - 2.0 * d0 - d1
+    c3 = 2.0 * (z0 - z1) + d0 + d1
+    prev = 0.0
+    m = 16
+    for q in range(1, m + 1):
+        s = q / m
+        if z0 + s * (d0 + s * (c2 + s * c3)) <= 0.0:
+            lo, hi = prev, s
+            x = hi
+            for _ in range(60):
+                f = z0 + x * (d0 + x * (c2 + x * c3))
+                if f <= 0.0:
+                    hi = x
+                else:
+                    lo = x
+                fp = d0 + x * (2.0 * c2 + 3.0 * x * c3)
+                nx = x - f / fp if fp != 0.0 else -1.0
+                if lo <= nx <= hi and abs(nx - x) <= 4.0 * EPS:
+                    return nx
+                if not (lo < nx < hi):
+                    nx = 0.5 * (lo + hi)
+                if hi - lo <= 4.0 * EPS:
+                    break
+                x = nx
+            return hi
+        prev = s
+    return 2.0
 
 
 @njit(cache=True)
@@ -924,12 +941,12 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
                 break
             if zm <= zc or z1 <= zc:  # a crossing of zc from above
                 if zm <= zc:
-                    _, root = _hermite_min(z0 - zc, zm - zc, d0 * 0.5 * h, dm * 0.5 * h)
+                    root = _hermite_root(z0 - zc, zm - zc, d0 * 0.5 * h, dm * 0.5 * h)
                     tc, dc, thi, zhi, dhi, lamhi = _refine(
                         P, i, j, shift, t, kappa, zc, t0, d0, tm, zm, dm, lamm,
                         t0 + 0.5 * h * min(root, 1.0), lam, ws, wm)
                 else:
-                    _, root = _hermite_min(zm - zc, z1 - zc, dm * 0.5 * h, d1 * 0.5 * h)
+                    root = _hermite_root(zm - zc, z1 - zc, dm * 0.5 * h, d1 * 0.5 * h)
                     tc, dc, thi, zhi, dhi, lamhi = _refine(
                         P, i, j, shift, t, kappa, zc, tm, dm, t1, z1, d1, lam1,
                         t0 + 0.5 * h * (1.0 + min(root, 1.0)), lamm, ws, wm)
@@ -942,7 +959,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
                 accepted = True
                 break
             err = abs(0.5 * (z0 + z1) + 0.125 * h * (d0 - d1) - zm)
-            hmin, root = _hermite_min(z0 - zc, z1 - zc, d0 * h, d1 * h)
+            hmin = _hermite_min(z0 - zc, z1 - zc, d0 * h, d1 * h)
             tol = max(eps_f, RELATIVE_TOL * hmin)
             if (err <= tol and hmin > 2.0 * err) or h <= hfloor:
                 touching = False
@@ -1206,11 +1223,11 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
             continue
         if hm <= hc or h1 <= hc:  # a crossing of hc from above
             if hm <= hc:
-                _, root = _hermite_min(h0 - hc, hm - hc, d0 * 0.5 * step, dm * 0.5 * step)
+                root = _hermite_root(h0 - hc, hm - hc, d0 * 0.5 * step, dm * 0.5 * step)
                 tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, t0, d0, tm, hm, dm,
                                                      t0 + 0.5 * step * min(root, 1.0), ww, wq)
             else:
-                _, root = _hermite_min(hm - hc, h1 - hc, dm * 0.5 * step, d1 * 0.5 * step)
+                root = _hermite_root(hm - hc, h1 - hc, dm * 0.5 * step, d1 * 0.5 * step)
                 tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, tm, dm, t1, h1, d1,
                                                      tm + 0.5 * step * min(root, 1.0), ww, wq)
             if dc < -rate_tol:
@@ -1220,7 +1237,7 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
             t0, h0, d0 = thi, hhi, dhi
             continue
         err = abs(0.5 * (h0 + h1) + 0.125 * step * (d0 - d1) - hm)
-        hmn, _ = _hermite_min(h0 - hc, h1 - hc, d0 * step, d1 * step)
+        hmn = _hermite_min(h0 - hc, h1 - hc, d0 * step, d1 * step)
         tol = max(tol_abs, RELATIVE_TOL * hmn)
         if (err <= tol and hmn > 2.0 * err) or step <= hfloor:
             touching = False
