@@ -293,10 +293,11 @@ def test_safe_time_is_a_lower_bound_for_spheroids_spinning_about_their_axis(seed
     t = 0.0
     lower, now = ek.pair_start(eng.P, 0, 1, sh, t, 0.0, kappa, ws, wm, np.empty(ek.PAIR_STATE))
     assert not now and lower > 0
-    ek._pose(eng.P, 0, t, kappa, ws[8], ws, 0, wm, 0)
+    ek._pose(eng.P, 0, t, kappa, ws[8], ws, 11, wm, 2)
     screen = ek._screen_time(eng.P, 0, 1, sh, t, kappa, ws, wm)
-    assert screen >= 0
-    horizon = min(max(lower, screen), 20.0)
+    ball = ek._ball_screen_time(eng.P, 0, 1, sh, t, kappa, ws, wm)
+    assert screen >= 0 and ball >= 0
+    horizon = min(max(lower, screen, ball), 20.0)
     zetas = [ek.pair_zeta(eng.P, 0, 1, sh, t + s, kappa, 0.5, ws, wm)[0] for s in np.linspace(0, horizon, 2001)]
     assert min(zetas) > 0
 
@@ -308,7 +309,8 @@ def test_safe_time_is_a_lower_bound_on_the_contact_time(d, seed):
     over the bound on its closing rate from the centres' motion, the spins through
     support_rate_bound, and the growth) is positive for disjoint particles and no contact happens
     before it: zeta stays positive on a fine grid of times up to it, for random aspherical pairs
-    (aspect ratios up to 6.7) moving, spinning and growing; so is the cheap bound _screen_time.
+    (aspect ratios up to 6.7) moving, spinning and growing; so are the cheap bounds _screen_time and
+    _ball_screen_time.
     (In 3000 such pairs the bound reached 0.95 of the contact time, so a wrong bound shows;
     0.3 x the spin bound fails here.)"""
     rng = np.random.default_rng(seed)
@@ -329,11 +331,13 @@ def test_safe_time_is_a_lower_bound_on_the_contact_time(d, seed):
     t = 0.0  # (the bounding spheres are apart then)
     lower, now = ek.pair_start(eng.P, 0, 1, sh, t, 0.0, kappa, ws, wm, np.empty(ek.PAIR_STATE))
     assert not now and lower > 0
-    # the cheap bound of the search (a slab normal to a guessed direction) is one too
-    ek._pose(eng.P, 0, t, kappa, ws[8], ws, 0, wm, 0)
+    # the cheap bounds of the search (a slab normal to a guessed direction; the support plane of
+    # one particle against the bounding sphere of the other) are ones too
+    ek._pose(eng.P, 0, t, kappa, ws[8], ws, 11, wm, 2)
     screen = ek._screen_time(eng.P, 0, 1, sh, t, kappa, ws, wm)
-    assert screen >= 0
-    horizon = min(max(lower, screen), 20.0)
+    ball = ek._ball_screen_time(eng.P, 0, 1, sh, t, kappa, ws, wm)
+    assert screen >= 0 and ball >= 0
+    horizon = min(max(lower, screen, ball), 20.0)
     zetas = [ek.pair_zeta(eng.P, 0, 1, sh, t + s, kappa, 0.5, ws, wm)[0] for s in np.linspace(0, horizon, 2001)]
     assert min(zetas) > 0
 

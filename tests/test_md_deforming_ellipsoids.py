@@ -85,7 +85,7 @@ def test_own_image_collisions_conserve_energy_and_momentum(n):
         0.0, cell_step=0.3)
     e0, v0 = _total_kinetic_energy(sim), sim.V.copy()
     fractions = [sim.run_window(50)["step_fraction"] for _ in range(30)]
-    assert sim.self_collisions > 200
+    assert sim.self_collisions > 150  # n = 2: 188-227 of ~1500 over seeds 3-10 (a chaotic count)
     assert any(f > 0 for f in fractions)  # the cell did deform
     assert _total_kinetic_energy(sim) == pytest.approx(e0, rel=1e-12)
     assert np.abs(sim.V.sum(axis=0) - v0.sum(axis=0)).max() < 1e-13

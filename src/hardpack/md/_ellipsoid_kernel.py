@@ -279,8 +279,9 @@ def advance(P, i, t, scratch):
 
 @njit(cache=True)
 def work_arrays(d):
-    """Scratch arrays (ws, wm) of :func:`pair_zeta` and the kernels that call it: ws (11, 4) with
-    row 8 zeros, wm (4, d, d).
+    """Scratch arrays (ws, wm) of :func:`pair_zeta` and the kernels that call it: ws (12, 4) with
+    row 8 zeros, wm (4, d, d) (ws[11] and wm[2] hold the pose of the particle that
+    :func:`_predict` screens for).
 
     Parameters
     ----------
@@ -289,12 +290,12 @@ def work_arrays(d):
 
     Returns
     -------
-    ws : numpy.ndarray of float64, shape (11, 4)
+    ws : numpy.ndarray of float64, shape (12, 4)
         Zeroed vector scratch (row 8 must stay zero: the null shift).
     wm : numpy.ndarray of float64, shape (4, d, d)
         Matrix scratch.
     """
-    return np.zeros((11, 4)), np.empty((4, d, d))
+    return np.zeros((12, 4)), np.empty((4, d, d))
 
 
 @njit(cache=True, inline="always")
@@ -431,10 +432,10 @@ def pair_zeta(P, i, j, shift, t, kappa, lam0, ws, wm):
     return zeta, zdot, lam
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _hermite_min(z0, z1, d0, d1):
     """Minimum over s in (0, 1] of the cubic Hermite interpolant with values z0, z1 and
-    derivatives d0, d1 (per unit s) at s = 0, 1, and the first root s in (0, 1] (or 2.0)."""
+    derivatives d0, d1 (per unit s) at s = 0, 1."""
     # H(s) = z0 + d0 s + c2 s^2 + c3 s^3
     c2 = 3.0 * (z1 - z0) - 2.0 * d0 - d1
     c3 = 2.0 * (z0 - z1) + d0 + d1
@@ -453,24 +454,41 @@ def _hermite_min(z0, z1, d0, d1):
             for s in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)):
                 if 0.0 < s < 1.0:
                     hmin = min(hmin, z0 + s * (d0 + s * (c2 + s * c3)))
-    root = 2.0
-    if hmin <= 0.0:  # first sign change on a fine grid, then bisection
-        prev = 0.0
-        m = 16
-        for q in range(1, m + 1):
-            s = q / m
-            if z0 + s * (d0 + s * (c2 + s * c3)) <= 0.0:
-                lo, hi = prev, s
-                for _ in range(40):
-                    mid = 0.5 * (lo + hi)
-                    if z0 + mid * (d0 + mid * (c2 + mid * c3)) <= 0.0:
-                        hi = mid
-                    else:
-                        lo = mid
-                root = hi
-                break
-            prev = s
-    return hmin, root
+    return hmin
+
+
+@njit(cache=True)
+def _hermite_root(z0, z1, d0, d1):
+    """First root s in (0, 1] of the cubic Hermite interpolant of :func:`_hermite_min` (z0 > 0),
+    or 2.0 when it stays positive: the first sign change on a grid of 16, then safeguarded Newton
+    on the cubic inside that cell (bisection when a step leaves it) to a few ulps of s."""
+    c2 = 3.0 * (z1 - z0) - 2.0 * d0 - d1
+    c3 = 2.0 * (z0 - z1) + d0 + d1
+    prev = 0.0
+    m = 16
+    for q in range(1, m + 1):
+        s = q / m
+        if z0 + s * (d0 + s * (c2 + s * c3)) <= 0.0:
+            lo, hi = prev, s
+            x = hi
+            for _ in range(60):
+                f = z0 + x * (d0 + x * (c2 + x * c3))
+                if f <= 0.0:
+                    hi = x
+                else:
+                    lo = x
+                fp = d0 + x * (2.0 * c2 + 3.0 * x * c3)
+                nx = x - f / fp if fp != 0.0 else -1.0
+                if lo <= nx <= hi and abs(nx - x) <= 4.0 * EPS:
+                    return nx
+                if not (lo < nx < hi):
+                    nx = 0.5 * (lo + hi)
+                if hi - lo <= 4.0 * EPS:
+                    break
+                x = nx
+            return hi
+        prev = s
+    return 2.0
 
 
 @njit(cache=True)
@@ -534,11 +552,11 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
     u = Y(lam)^-1 r for the guess lam = h_i / (h_i + h_j) (h the support functions along r, exact
     for spheres) bounds their distance from below (any u does; this one is nearly the contact
     normal), and :func:`_safe_time` turns its width into a time. 0 when the slab is empty. The
-    pose of i at t is in ws[0], wm[0] (:func:`_pose`); ws[1], ws[3], ws[5:8], wm[1:] are
+    pose of i at t is in ws[11], wm[2] (:func:`_pose`); ws[1], ws[5:8], wm[1], wm[3] are
     overwritten."""
     d = shift.shape[0]
     cv, _, cr, _, _, _, _, _ = columns(d)
-    xi, mi, xj, mj = ws[0, :d], wm[0], ws[1, :d], wm[1]
+    xi, mi, xj, mj = ws[11, :d], wm[2], ws[1, :d], wm[1]
     _pose(P, j, t, kappa, shift, ws, 1, wm, 1)
     r = ws[7, :d]
     for k in range(d):
@@ -567,6 +585,32 @@ def _screen_time(P, i, j, shift, t, kappa, ws, wm):
         return 0.0
     spin = _spin_rate(P, i, u, 1.0) + _spin_rate(P, j, u, 1.0)
     return _safe_time(width, sep, spin, abs(kappa) * (P[i, cr] + P[j, cr]), kappa, t)
+
+
+@njit(cache=True, inline="always")
+def _ball_screen_time(P, i, j, shift, t, kappa, ws, wm):
+    """A cheaper and weaker lower bound than :func:`_screen_time` (no pose of j): the slab between
+    the support plane of i normal to the centre line and the bounding sphere of j (radius R_j,
+    turning does not move it), turned into a time by :func:`_safe_time` with the spin of i only.
+    0 when the slab is empty. The pose of i at t is in ws[11], wm[2]; ws[7] is overwritten."""
+    d = shift.shape[0]
+    cv, ct, cr, _, _, _, _, _ = columns(d)
+    xi, mi = ws[11, :d], wm[2]
+    r = ws[7, :d]
+    dtj = t - P[j, ct]
+    rr = 0.0
+    for k in range(d):
+        r[k] = P[j, k] + P[j, cv + k] * dtj + shift[k] - xi[k]
+        rr += r[k] * r[k]
+    rn = np.sqrt(rr)
+    width = rn - np.sqrt(_quad(mi, r)) / rn - P[j, cr] * (1.0 + kappa * t)
+    if width <= 0.0:
+        return 0.0
+    sep = 0.0
+    for k in range(d):
+        r[k] /= rn
+        sep += r[k] * (P[j, cv + k] - P[i, cv + k])
+    return _safe_time(width, sep, _spin_rate(P, i, r, 1.0), abs(kappa) * (P[i, cr] + P[j, cr]), kappa, t)
 
 
 @njit(cache=True, inline="always")
@@ -834,7 +878,8 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
         return t + tin, 0
     if lower >= min(tout, tmax - t):
         return np.inf, 0
-    return pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, np.inf)
+    tc, kind = pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, np.inf)
+    return (np.inf, 0) if kind == 3 else (tc, kind)
 
 
 @njit(cache=True)
@@ -843,14 +888,17 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
     min(t + tout, tmax): (time, kind) as :func:`predict_pair`, or, after at least one step, a
     suspension (lower bound on the collision time, 2) as soon as that lower bound (the time
     reached plus its safe time) is at or after window time ``tyield``; ``st`` then holds the state
-    to continue from.
+    to continue from. When tmax comes before t + tout and no event is found before it, the state
+    is saved as well and the result is (lower bound, 3): nothing before tmax, a trace to a later
+    tmax may continue from ``st``.
 
     Parameters
     ----------
     P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm
         As in :func:`predict_pair`.
     st : numpy.ndarray of float64, shape (PAIR_STATE,)
-        Trace state of :func:`pair_start` or of a suspended trace, updated on a suspension.
+        Trace state of :func:`pair_start` or of a suspended trace, updated on a suspension or a
+        stop at tmax.
     tyield : float
         Window time from which the trace suspends (inf: never).
 
@@ -859,7 +907,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
     time : float
         Window time of the event or suspension bound, inf for none.
     kind : int
-        0 a collision, 1 a CHECK, 2 a suspension.
+        0 a collision, 1 a CHECK, 2 a suspension, 3 a stop at tmax.
     """
     end = min(tout, tmax - t)
     t0, z0, d0, lam, gap0, sep0, zc = st[0], st[1], st[2], st[3], st[4], st[5], st[6]
@@ -874,17 +922,21 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
         # that holds no event the time can resolve, and every CHECK advances the time
         hfloor = max(hmin_step, 8.0 * EPS * abs(t + t0))
         if end - t0 <= hfloor:
+            if end < tout:
+                st[0], st[1], st[2], st[3], st[4], st[5], st[6] = t0, z0, d0, lam, gap0, sep0, zc
+                st[7], st[8], st[11], st[13] = 1.0 if touching else 0.0, spin0, h, steps
+                return t + t0, 3
             return np.inf, 0
         if steps >= MAX_TRACE_STEPS:
             return t + t0, 1
         # a safe step: no contact before the distance bound is used up (Donev 2006, sec. 3.5.1)
         safe = _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + t0)
-        if t0 + safe >= end:
+        if t0 + safe >= end or (steps > steps0 and t + t0 + safe >= tyield):
+            if t0 + safe < end or end < tout:
+                st[0], st[1], st[2], st[3], st[4], st[5], st[6] = t0, z0, d0, lam, gap0, sep0, zc
+                st[7], st[8], st[11], st[13] = 1.0 if touching else 0.0, spin0, h, steps
+                return t + t0 + safe, 2 if t0 + safe < end else 3
             return np.inf, 0
-        if steps > steps0 and t + t0 + safe >= tyield:
-            st[0], st[1], st[2], st[3], st[4], st[5], st[6] = t0, z0, d0, lam, gap0, sep0, zc
-            st[7], st[8], st[11], st[13] = 1.0 if touching else 0.0, spin0, h, steps
-            return t + t0 + safe, 2
         h = min(max(h, hfloor), end - t0)
         if safe > h:
             t1 = t0 + safe
@@ -924,12 +976,12 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
                 break
             if zm <= zc or z1 <= zc:  # a crossing of zc from above
                 if zm <= zc:
-                    _, root = _hermite_min(z0 - zc, zm - zc, d0 * 0.5 * h, dm * 0.5 * h)
+                    root = _hermite_root(z0 - zc, zm - zc, d0 * 0.5 * h, dm * 0.5 * h)
                     tc, dc, thi, zhi, dhi, lamhi = _refine(
                         P, i, j, shift, t, kappa, zc, t0, d0, tm, zm, dm, lamm,
                         t0 + 0.5 * h * min(root, 1.0), lam, ws, wm)
                 else:
-                    _, root = _hermite_min(zm - zc, z1 - zc, dm * 0.5 * h, d1 * 0.5 * h)
+                    root = _hermite_root(zm - zc, z1 - zc, dm * 0.5 * h, d1 * 0.5 * h)
                     tc, dc, thi, zhi, dhi, lamhi = _refine(
                         P, i, j, shift, t, kappa, zc, tm, dm, t1, z1, d1, lam1,
                         t0 + 0.5 * h * (1.0 + min(root, 1.0)), lamm, ws, wm)
@@ -942,7 +994,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
                 accepted = True
                 break
             err = abs(0.5 * (z0 + z1) + 0.125 * h * (d0 - d1) - zm)
-            hmin, root = _hermite_min(z0 - zc, z1 - zc, d0 * h, d1 * h)
+            hmin = _hermite_min(z0 - zc, z1 - zc, d0 * h, d1 * h)
             tol = max(eps_f, RELATIVE_TOL * hmin)
             if (err <= tol and hmin > 2.0 * err) or h <= hfloor:
                 touching = False
@@ -1206,11 +1258,11 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
             continue
         if hm <= hc or h1 <= hc:  # a crossing of hc from above
             if hm <= hc:
-                _, root = _hermite_min(h0 - hc, hm - hc, d0 * 0.5 * step, dm * 0.5 * step)
+                root = _hermite_root(h0 - hc, hm - hc, d0 * 0.5 * step, dm * 0.5 * step)
                 tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, t0, d0, tm, hm, dm,
                                                      t0 + 0.5 * step * min(root, 1.0), ww, wq)
             else:
-                _, root = _hermite_min(hm - hc, h1 - hc, dm * 0.5 * step, d1 * 0.5 * step)
+                root = _hermite_root(hm - hc, h1 - hc, dm * 0.5 * step, d1 * 0.5 * step)
                 tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, tm, dm, t1, h1, d1,
                                                      tm + 0.5 * step * min(root, 1.0), ww, wq)
             if dc < -rate_tol:
@@ -1220,7 +1272,7 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
             t0, h0, d0 = thi, hhi, dhi
             continue
         err = abs(0.5 * (h0 + h1) + 0.125 * step * (d0 - d1) - hm)
-        hmn, _ = _hermite_min(h0 - hc, h1 - hc, d0 * step, d1 * step)
+        hmn = _hermite_min(h0 - hc, h1 - hc, d0 * step, d1 * step)
         tol = max(tol_abs, RELATIVE_TOL * hmn)
         if (err <= tol and hmn > 2.0 * err) or step <= hfloor:
             touching = False
@@ -1305,6 +1357,19 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
 @njit(cache=True)
 def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm, wmode, wspec,
              ww, wq):
+    """:func:`_predict_shared` without a shared pair: (time, partner) of the next event of i."""
+    return _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm, wmode,
+                           wspec, ww, wq, -1, 0, ws[10])
+
+
+#: length of the record of a shared pair (:func:`_predict_shared`): key, status, result time and
+#: kind, the shift of the partner, the trace state
+SHARE_LEN = 8 + PAIR_STATE
+
+
+@njit(cache=True)
+def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm, wmode, wspec,
+                    ww, wq, other, shmode, share):
     """Next event of particle i from window time t: (time, partner), partner EXIT, CHECK or a
     particle index (Algorithm 5 with NNLs). The pairs are searched best first: each has a key, a
     lower bound on its collision time, first the start t_in of its bounding-sphere overlap (or,
@@ -1313,11 +1378,22 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     time, then the lower bound its trace has reached; the pair of the smallest key is started
     or, if started, traced one stretch (:func:`pair_trace`, suspended once its lower bound passes
     the second smallest key), until the smallest key is after the earliest event found (``done``:
-    0 new, 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs). In a
+    0 new, 4 screened by the sphere bound of :func:`_ball_screen_time` (the slab bound comes
+    next), 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs). In a
     container (``wmode``) the wall collision (:func:`wall_predict`) before the exit comes first
     and bounds the pair search (partner WALL, or CHECK when its trace reached the step cap).
     ``imgvec`` has 2^c rows for image codes of c bits (4^d for the orthorhombic box; the general
-    cells of :mod:`hardpack.md._ellipsoid_deforming_kernel` use longer tables)."""
+    cells of :mod:`hardpack.md._ellipsoid_deforming_kernel` use longer tables).
+
+    *A shared pair.* After a collision of i and j both particles predict, and both would search the
+    pair (i, j) from the same time. With ``shmode`` 1 (i's prediction, ``other`` = j) the search
+    state of that pair at the end is written to ``share`` (SHARE_LEN entries: its key, status, the
+    result of a finished trace, j's shift and the trace state; a trace stopped by i's earliest
+    event keeps its state, :func:`pair_trace` kind 3); with ``shmode`` 2 (j's prediction,
+    ``other`` = i) j's search takes the pair from there instead of starting it again, with the
+    pair functions called as (i, j) and i's shift (the negative of j's), as i traced it (``done``
+    5, or 6 once stopped by j's earliest event; 7 for a pair of i stopped by i's earliest event,
+    whose state a shared record keeps). ``shmode`` 0: no shared pair."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 0  # list entries are j << cbits | image code, 2^cbits the length of imgvec
@@ -1396,16 +1472,44 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
                     den = b + np.sqrt(disc)
                     touts[m] = -c / den if den > 0.0 else 0.0
     sh = ws[9, :d]
-    # screen the pairs whose bounding spheres overlap now with a cheap bound (_screen_time)
+    oq = -1  # the slot of the shared pair
+    o_time, o_kind = np.inf, 0
+    if shmode != 0:
+        for m in range(m_n):
+            if nb[i, m] >> cbits == other:
+                oq = m
+                break
+    if shmode == 2 and oq >= 0 and share[SHARE_LEN - 1] == 1.0:
+        ok = True  # the same pair: j's shift is the negative of i's
+        for k in range(d):
+            ok = ok and share[4 + k] == -imgvec[nb[i, oq] & cmask, k]
+        if ok:  # share[1]: 3 not started, 1 a trace state (5 here: started by the other particle), 2 done
+            done[oq] = 5 if share[1] == 1.0 else np.int8(share[1])
+            tins[oq] = share[0]
+            for k in range(PAIR_STATE):
+                pst[oq, k] = share[8 + k]
+            if share[1] == 2.0 and share[2] < best:
+                best = share[2]
+                partner = other if share[3] == 0.0 else CHECK
+        else:
+            oq = -1
+    # screen the pairs whose bounding spheres overlap now with cheap bounds: the sphere bound of
+    # _ball_screen_time, the slab of _screen_time once that pair comes first (or now, when the
+    # sphere bound is 0)
     posed = False
     for m in range(m_n):
-        if tins[m] == 0.0 and t < min(best, horizon):
+        if tins[m] == 0.0 and done[m] == 0 and t < min(best, horizon):
             if not posed:
-                _pose(P, i, t, kappa, ws[8], ws, 0, wm, 0)
+                _pose(P, i, t, kappa, ws[8], ws, 11, wm, 2)
                 posed = True
             e = nb[i, m]
             for k in range(d):
                 sh[k] = imgvec[e & cmask, k]
+            lower = _ball_screen_time(P, i, e >> cbits, sh, t, kappa, ws, wm)
+            if lower > 0.0:
+                tins[m] = lower
+                done[m] = 4
+                continue
             lower = _screen_time(P, i, e >> cbits, sh, t, kappa, ws, wm)
             if lower > 0.0:
                 tins[m] = lower
@@ -1415,7 +1519,7 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
         tq = np.inf
         t2 = np.inf  # the second smallest key
         for m in range(m_n):
-            if done[m] != 2:
+            if done[m] != 2 and done[m] < 6:
                 if tins[m] < tq:
                     t2 = tq
                     tq = tins[m]
@@ -1429,6 +1533,10 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
         im = e & cmask
         for k in range(d):
             sh[k] = imgvec[im, k]
+        if done[q] == 4:  # the slab bound, no earlier than the sphere bound
+            tins[q] = max(tq, _screen_time(P, i, j, sh, t, kappa, ws, wm))
+            done[q] = 3
+            continue
         if done[q] == 0 or done[q] == 3:
             # no contact before the key (t_in or the screening bound): the trace starts there
             if tq >= touts[q]:
@@ -1437,6 +1545,8 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
             lower, now = pair_start(P, i, j, sh, t, tq, kappa, ws, wm, pst[q])
             if now:
                 done[q] = 2
+                if q == oq:
+                    o_time, o_kind = t + tq, 0
                 if t + tq < best:
                     best = t + tq
                     partner = j
@@ -1445,11 +1555,21 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
                 done[q] = 1 if lower < touts[q] else 2
                 tins[q] = lower
             continue
-        tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q],
-                              t + t2)
-        if kind == 2:  # suspended: its lower bound is now after the second smallest key
+        if done[q] == 5:  # a pair traced by the other particle: the pair functions as (other, i)
+            for k in range(d):
+                sh[k] = -sh[k]
+            tc, kind = pair_trace(P, j, i, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q],
+                                  t + t2)
+        else:
+            tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q],
+                                  t + t2)
+        if kind == 2 or kind == 3:  # suspended: its lower bound is now after the second smallest key
             tins[q] = tc - t
+            if kind == 3:  # nothing before the earliest event (a state to go on from when shared)
+                done[q] = 6 if done[q] == 5 else 7
             continue
+        if q == oq:
+            o_time, o_kind = tc, kind
         done[q] = 2
         if tc < best:
             best = tc
@@ -1457,6 +1577,18 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
     if horizon < best:  # the inscribed spheres of a pair touch, yet no collision was located
         best = horizon
         partner = CHECK
+    if shmode == 1:
+        share[SHARE_LEN - 1] = 0.0
+        if oq >= 0:
+            dq = done[oq]
+            share[0] = tins[oq]
+            share[1] = 2.0 if dq == 2 else (1.0 if dq == 1 or dq == 7 else 3.0)
+            share[2], share[3] = o_time, o_kind
+            for k in range(d):
+                share[4 + k] = imgvec[nb[i, oq] & cmask, k]
+            for k in range(PAIR_STATE):
+                share[8 + k] = pst[oq, k]
+            share[SHARE_LEN - 1] = 1.0
     return best, partner
 
 
@@ -1661,6 +1793,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
     done = np.empty(cap, dtype=np.int8)
     scratch = np.empty(4)
     upd = np.empty(2, dtype=np.int64)
+    share = np.zeros(SHARE_LEN)
     mark[:] = 0
     hpos[:] = -1
     hsize = 0
@@ -1745,10 +1878,10 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
                 iacc[I_GRAZE] += 1
             upd[1] = j
             npred = 2
-        for q in range(npred):
+        for q in range(npred):  # after a collision the pair is searched once (_predict_shared)
             k = upd[q]
-            key, partner = _predict(k, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done,
-                                    pst, ws, wm, wmode, wspec, ww, wq)
+            key, partner = _predict_shared(k, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst,
+                                           ws, wm, wmode, wspec, ww, wq, upd[1 - q], npred - 1 + q, share)
             ep[k] = partner
             if partner >= 0:
                 ec[k] = cnt[partner]
