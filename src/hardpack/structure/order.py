@@ -199,6 +199,10 @@ def coordination_defects(packing) -> float:
     """Fraction of the disks of a 2D packing that do not have six neighbours in the regular
     (weighted Delaunay) triangulation: the topological defects of a disk crystal.
 
+    Four or more cocircular centres (a vacancy in a perfect lattice) have no unique triangulation
+    (:func:`hardpack.structure.tessellation.regular_neighbours`), so the count around them is one
+    of several; packings from simulations are not degenerate.
+
     Parameters
     ----------
     packing : Packing
