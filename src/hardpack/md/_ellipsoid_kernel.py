@@ -1880,8 +1880,9 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             npred = 2
         for q in range(npred):  # after a collision the pair is searched once (_predict_shared)
             k = upd[q]
+            shmode = 0 if npred == 1 else q + 1  # 1: the first of the pair writes it, 2: the second reads it
             key, partner = _predict_shared(k, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst,
-                                           ws, wm, wmode, wspec, ww, wq, upd[1 - q], npred - 1 + q, share)
+                                           ws, wm, wmode, wspec, ww, wq, upd[1 - q], shmode, share)
             ep[k] = partner
             if partner >= 0:
                 ec[k] = cnt[partner]
