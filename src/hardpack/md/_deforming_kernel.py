@@ -364,6 +364,96 @@ def _fractional(Y, i, Hinv, s):
         s[k] = acc
 
 
+@njit(cache=True, inline="always")
+def _fractional_difference(Y, i, j, Hinv, ds):
+    """ds = H^-1 (y_j - y_i) (rows i and j of Y, columns 0 .. d - 1)."""
+    d = Hinv.shape[0]
+    for k in range(d):
+        acc = 0.0
+        for q in range(d):
+            acc += Hinv[k, q] * (Y[j, q] - Y[i, q])
+        ds[k] = acc
+
+
+@njit(cache=True, inline="always")
+def _image_vector(H, ds, n, r):
+    """r = H (ds + n), the separation of an image n at fractional difference ``ds``; returns |r|^2."""
+    d = H.shape[0]
+    rr = 0.0
+    for q in range(d):
+        acc = 0.0
+        for k in range(d):
+            acc += H[q, k] * (ds[k] + n[k])
+        r[q] = acc
+        rr += acc * acc
+    return rr
+
+
+@njit(cache=True)
+def cell_heights_inverse(Hinv):
+    """1 / h_k, the row norms of H^-1 (h_k the cell's height along lattice direction k).
+
+    Parameters
+    ----------
+    Hinv : numpy.ndarray of float64, shape (d, d)
+        Inverse of the cell.
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (d,)
+        The row norms.
+    """
+    d = Hinv.shape[0]
+    cfac = np.empty(d)
+    for k in range(d):
+        s2 = 0.0
+        for q in range(d):
+            s2 += Hinv[k, q] * Hinv[k, q]
+        cfac[k] = np.sqrt(s2)
+    return cfac
+
+
+@njit(cache=True)
+def linked_grid(Y, Hinv, n_cells, cstr):
+    """A new single-level grid of the points Y (:func:`link_cells`).
+
+    Parameters
+    ----------
+    Y : numpy.ndarray of float64, shape (N, >= d)
+        Cartesian points in columns 0 .. d - 1.
+    Hinv : numpy.ndarray of float64, shape (d, d)
+        Inverse of the cell.
+    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
+        Cells per lattice direction and their flat-index strides.
+
+    Returns
+    -------
+    head, nxt, wrap, sw : numpy.ndarray
+        The grid's linked lists, the wrap of every point and its wrapped fractional coordinates
+        (:func:`link_cells`).
+    """
+    n = Y.shape[0]
+    d = Hinv.shape[0]
+    head = np.empty(n_cells[0].prod(), dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell_of = np.empty(n, dtype=np.int64)
+    wrap = np.empty((n, d), dtype=np.int64)
+    sw = np.empty((n, d))
+    link_cells(Y, Hinv, n_cells, cstr, head, nxt, cell_of, wrap, sw)
+    return head, nxt, wrap, sw
+
+
+@njit(cache=True, inline="always")
+def walk_scratch(d):
+    """Scratch of a walk over the cells of :func:`_cell_range` and the images of
+    :func:`_image_range`: s, w, ds (float), lo, hi (int), wide (bool), c, image, blo, bhi, od
+    (int), all of length d, and the level offsets ``coff`` of the single-level grid."""
+    return (np.empty(d), np.empty(d), np.empty(d), np.empty(d, dtype=np.int64), np.empty(d, dtype=np.int64),
+            np.empty(d, dtype=np.bool_), np.empty(d, dtype=np.int64), np.empty(d, dtype=np.int64),
+            np.empty(d, dtype=np.int64), np.empty(d, dtype=np.int64), np.empty(d, dtype=np.int64),
+            np.zeros(2, dtype=np.int64))
+
+
 @njit(cache=True)
 def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, lmin, rmax, n_cells, cstr,
                        head, nxt, wrap, sw, ent):
@@ -422,23 +512,12 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, 
     ri = bs[i, d]
     if 2.0 * ri >= lmin:  # i's bounding sphere would reach its own periodic image
         return DeformingStatus.SELF_IMAGE
-    s = np.empty(d)
-    w = np.empty(d)
-    ds = np.empty(d)
-    lo = np.empty(d, dtype=np.int64)
-    hi = np.empty(d, dtype=np.int64)
-    wide = np.empty(d, dtype=np.bool_)
-    c = np.empty(d, dtype=np.int64)
-    image = np.empty(d, dtype=np.int64)
-    blo = np.empty(d, dtype=np.int64)
-    bhi = np.empty(d, dtype=np.int64)
-    od = np.empty(d, dtype=np.int64)
-    coff = np.zeros(2, dtype=np.int64)
+    s, w, ds, lo, hi, wide, c, image, blo, bhi, od, coff = walk_scratch(d)
     _fractional(bs, i, Hinv, s)
     every = _cell_range(s, ri + rmax, cfac, n_cells, w, lo, hi, wide)
     j = 0  # every: the candidates are 0 .. jstop - 1
-    more = not every  # else those of the cells of the range, in turn
-    if more:
+    more = not every  # else those of the cells of the range, in turn (the walk is written out in
+    if more:  # each kernel: a numba helper called per candidate costs ~5x the walk, measured)
         for k in range(d):
             c[k] = lo[k]
         j = -1
@@ -459,11 +538,7 @@ def list_particle_grid(i, jstop, bs, H, Hinv, M, strides, nb, nn, m, mul, cfac, 
             total = _image_range(s, w, sw[j], wide, image, blo, bhi, od)
         if total > 0:
             reach = ri + bs[j, d]
-            for k in range(d):
-                acc = 0.0
-                for q in range(d):
-                    acc += Hinv[k, q] * (bs[j, q] - bs[i, q])
-                ds[k] = acc
+            _fractional_difference(bs, i, j, Hinv, ds)
         for _ in range(total):
             d2 = 0.0
             for q in range(d):
@@ -830,31 +905,10 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
         Smallest relative gap (|r| - sigma) / sigma among the pairs within reach (inf if none).
     """
     n, d = X.shape
-    cfac = np.empty(d)
-    for k in range(d):
-        s2 = 0.0
-        for q in range(d):
-            s2 += Hinv[k, q] * Hinv[k, q]
-        cfac[k] = np.sqrt(s2)
-    head = np.empty(n_cells[0].prod(), dtype=np.int64)
-    nxt = np.empty(n, dtype=np.int64)
-    cell_of = np.empty(n, dtype=np.int64)
-    wrap = np.empty((n, d), dtype=np.int64)
-    sw = np.empty((n, d))
-    link_cells(X, Hinv, n_cells, cstr, head, nxt, cell_of, wrap, sw)
-    coff = np.zeros(2, dtype=np.int64)
-    s = np.empty(d)
-    w = np.empty(d)
-    ds = np.empty(d)
+    cfac = cell_heights_inverse(Hinv)
+    head, nxt, wrap, sw = linked_grid(X, Hinv, n_cells, cstr)
+    s, w, ds, lo, hi, wide, c, image, blo, bhi, od, coff = walk_scratch(d)
     r = np.empty(d)
-    lo = np.empty(d, dtype=np.int64)
-    hi = np.empty(d, dtype=np.int64)
-    wide = np.empty(d, dtype=np.bool_)
-    c = np.empty(d, dtype=np.int64)
-    image = np.empty(d, dtype=np.int64)
-    blo = np.empty(d, dtype=np.int64)
-    bhi = np.empty(d, dtype=np.int64)
-    od = np.empty(d, dtype=np.int64)
     nv = np.empty(d, dtype=np.int64)
     smax = 1.0
     gmin = np.inf
@@ -884,11 +938,7 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
                 continue
             total = _image_range(s, w, sw[jj], wide, image, blo, bhi, od)
             if total > 0:
-                for k in range(d):
-                    acc = 0.0
-                    for q in range(d):
-                        acc += Hinv[k, q] * (X[jj, q] - X[i, q])
-                    ds[k] = acc
+                _fractional_difference(X, i, jj, Hinv, ds)
             for _ in range(total):
                 skip = i == jj
                 for k in range(d):
@@ -898,13 +948,7 @@ def strain_limit(X, A, H, Hinv, strain, reach, self_sigma, n_cells, cstr):
                 next_cell(od, blo, bhi)
                 if skip:
                     continue
-                rr = 0.0
-                for q in range(d):
-                    acc = 0.0
-                    for k in range(d):
-                        acc += H[q, k] * (ds[k] + nv[k])
-                    r[q] = acc
-                    rr += acc * acc
+                rr = _image_vector(H, ds, nv, r)
                 if rr >= reach * reach:
                     continue
                 sigma = self_sigma if i == jj else A[i] + A[jj]

@@ -532,33 +532,13 @@ def near_pairs(P, H, Hinv, scale, n_cells, cstr):
     n = P.shape[0]
     d = H.shape[0]
     _, _, cr, _, _, _, _, _ = ek.columns(d)
-    cfac = np.empty(d)
-    for k in range(d):
-        s2 = 0.0
-        for q in range(d):
-            s2 += Hinv[k, q] * Hinv[k, q]
-        cfac[k] = np.sqrt(s2)
+    cfac = dk.cell_heights_inverse(Hinv)
     rmax = 0.0
     for i in range(n):
         rmax = max(rmax, P[i, cr])
-    head = np.empty(n_cells[0].prod(), dtype=np.int64)
-    nxt = np.empty(n, dtype=np.int64)
-    cell_of = np.empty(n, dtype=np.int64)
-    wrap = np.empty((n, d), dtype=np.int64)
-    sw = np.empty((n, d))
-    dk.link_cells(P, Hinv, n_cells, cstr, head, nxt, cell_of, wrap, sw)
-    coff = np.zeros(2, dtype=np.int64)
-    s = np.empty(d)
-    w = np.empty(d)
-    ds = np.empty(d)
-    lo = np.empty(d, dtype=np.int64)
-    hi = np.empty(d, dtype=np.int64)
-    wide = np.empty(d, dtype=np.bool_)
-    c = np.empty(d, dtype=np.int64)
-    image = np.empty(d, dtype=np.int64)
-    blo = np.empty(d, dtype=np.int64)
-    bhi = np.empty(d, dtype=np.int64)
-    od = np.empty(d, dtype=np.int64)
+    head, nxt, wrap, sw = dk.linked_grid(P, Hinv, n_cells, cstr)
+    s, w, ds, lo, hi, wide, c, image, blo, bhi, od, coff = dk.walk_scratch(d)
+    r = np.empty(d)
     nv = np.empty(d, dtype=np.int64)
     fcap = 64  # the pairs of one i, before sorting
     fj = np.empty(fcap, dtype=np.int64)
@@ -596,7 +576,7 @@ def near_pairs(P, H, Hinv, scale, n_cells, cstr):
             total = dk._image_range(s, w, sw[jj], wide, image, blo, bhi, od)
             if total > 0:
                 reach = scale * (P[i, cr] + P[jj, cr])
-                for k in range(d):
+                for k in range(d):  # ds = H^-1 (x_j - x_i), written out (through a helper: 1.7x the call)
                     acc = 0.0
                     for q in range(d):
                         acc += Hinv[k, q] * (P[jj, q] - P[i, q])
@@ -612,12 +592,7 @@ def near_pairs(P, H, Hinv, scale, n_cells, cstr):
                             keep = nv[k] > 0
                     if not keep:
                         continue
-                rr = 0.0
-                for q in range(d):
-                    a = 0.0
-                    for k in range(d):
-                        a += H[q, k] * (ds[k] + nv[k])
-                    rr += a * a
+                rr = dk._image_vector(H, ds, nv, r)
                 if rr >= reach * reach:
                     continue
                 if found == fcap:
