@@ -128,6 +128,28 @@ NONE = -2  # nothing predicted
 CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
 WALL = -4  # event: the particle hits the wall of the spherical container
 
+#: what a pair trace (:func:`pair_trace`, :func:`predict_pair`) or a wall search
+#: (:func:`wall_predict`) found at the time it returns (plain ints: compile-time constants that
+#: numba compares as fast as literals): the collision (or nothing, with time inf); the step cap
+#: (predict again from then, a "safe time"); a lower bound at or after the yield time (the trace
+#: state is saved); nothing before tmax, which comes before the end of the overlap (saved too)
+TRACE_COLLISION, TRACE_CHECK, TRACE_SUSPENDED, TRACE_STOPPED = 0, 1, 2, 3
+
+#: where the best-first search of :func:`_predict_shared` stands with a pair of the list
+#: (``done``): NEW, its key the start of the bounding-sphere overlap; STARTED, a trace state, its
+#: key the lower bound the trace reached; FINISHED, its event known (or none); SCREENED, its key
+#: the slab bound of :func:`_screen_time`; BALL_SCREENED, its key the sphere bound of
+#: :func:`_ball_screen_time` (the slab bound comes next); SHARED, a trace state of the other
+#: particle of the collided pair (pair functions as (other, i)); SHARED_STOPPED, SHARED stopped by
+#: i's earliest event; STOPPED, STARTED stopped by i's earliest event (a shared record keeps its
+#: state). The codes from SHARED_STOPPED on are out of the search.
+(PAIR_NEW, PAIR_STARTED, PAIR_FINISHED, PAIR_SCREENED, PAIR_BALL_SCREENED, PAIR_SHARED, PAIR_SHARED_STOPPED,
+ PAIR_STOPPED) = range(8)
+
+#: the collided pair's search in :func:`_predict_shared` (``shmode``): none; the first particle of
+#: the pair searches it and writes the record; the second takes the search from the record
+SHARE_NONE, SHARE_WRITE, SHARE_READ = 0, 1, 2
+
 #: boundary modes of :func:`run_events`, tuples whose LENGTH is a compile-time constant (as in
 #: :mod:`hardpack.md._kernel`): the periodic specialisation has no wall code at all
 PERIODIC_MODE = ()
@@ -839,7 +861,8 @@ def pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st):
 def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
     """Earliest collision of i and j (shifted) in window time [t + tin, min(t + tout, tmax)) by
     trace event location (module docstring): :func:`pair_start` and :func:`pair_trace`. Returns
-    (time, kind) with kind 0 collision, 1 CHECK, and time inf when nothing happens before the end.
+    (time, kind) with kind TRACE_COLLISION or TRACE_CHECK, and time inf when nothing happens before
+    the end.
     A returned collision always approaches: its rate zeta_dot is below -GRAZE_RATE times the
     pair's rate scale (the relative surface speed bound over the smallest semiaxis), so the
     collision law never skips it for round-off.
@@ -870,16 +893,16 @@ def predict_pair(P, i, j, shift, t, tmax, tin, tout, kappa, eps_f, ws, wm):
     time : float
         Window time of the event, inf for none.
     kind : int
-        0 a collision, 1 a CHECK.
+        TRACE_COLLISION or TRACE_CHECK.
     """
     st = np.empty(PAIR_STATE)
     lower, now = pair_start(P, i, j, shift, t, tin, kappa, ws, wm, st)
     if now:
-        return t + tin, 0
+        return t + tin, TRACE_COLLISION
     if lower >= min(tout, tmax - t):
-        return np.inf, 0
+        return np.inf, TRACE_COLLISION
     tc, kind = pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, np.inf)
-    return (np.inf, 0) if kind == 3 else (tc, kind)
+    return (np.inf, TRACE_COLLISION) if kind == TRACE_STOPPED else (tc, kind)
 
 
 @njit(cache=True)
@@ -907,14 +930,14 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
     time : float
         Window time of the event or suspension bound, inf for none.
     kind : int
-        0 a collision, 1 a CHECK, 2 a suspension, 3 a stop at tmax.
+        TRACE_COLLISION, TRACE_CHECK, TRACE_SUSPENDED or TRACE_STOPPED.
     """
     end = min(tout, tmax - t)
     t0, z0, d0, lam, gap0, sep0, zc = st[0], st[1], st[2], st[3], st[4], st[5], st[6]
     touching = st[7] != 0.0
     spin0, grow_speed, rate_tol, h, hmin_step = st[8], st[9], st[10], st[11], st[12]
     if h == np.inf:  # nothing moves
-        return np.inf, 0
+        return np.inf, TRACE_COLLISION
     steps = int(st[13])
     steps0 = steps
     while True:
@@ -925,18 +948,18 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
             if end < tout:
                 st[0], st[1], st[2], st[3], st[4], st[5], st[6] = t0, z0, d0, lam, gap0, sep0, zc
                 st[7], st[8], st[11], st[13] = 1.0 if touching else 0.0, spin0, h, steps
-                return t + t0, 3
-            return np.inf, 0
+                return t + t0, TRACE_STOPPED
+            return np.inf, TRACE_COLLISION
         if steps >= MAX_TRACE_STEPS:
-            return t + t0, 1
+            return t + t0, TRACE_CHECK
         # a safe step: no contact before the distance bound is used up (Donev 2006, sec. 3.5.1)
         safe = _safe_time(gap0, sep0, spin0, grow_speed, kappa, t + t0)
         if t0 + safe >= end or (steps > steps0 and t + t0 + safe >= tyield):
             if t0 + safe < end or end < tout:
                 st[0], st[1], st[2], st[3], st[4], st[5], st[6] = t0, z0, d0, lam, gap0, sep0, zc
                 st[7], st[8], st[11], st[13] = 1.0 if touching else 0.0, spin0, h, steps
-                return t + t0 + safe, 2 if t0 + safe < end else 3
-            return np.inf, 0
+                return t + t0 + safe, TRACE_SUSPENDED if t0 + safe < end else TRACE_STOPPED
+            return np.inf, TRACE_COLLISION
         h = min(max(h, hfloor), end - t0)
         if safe > h:
             t1 = t0 + safe
@@ -965,7 +988,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
             if zm <= zc and touching:  # still in contact at the midpoint
                 if dm < -rate_tol:  # approaching: the collision is at the latest here
                     if h <= hfloor:
-                        return t + tm, 0
+                        return t + tm, TRACE_COLLISION
                     h *= 0.5
                     t1, z1, d1, lam1, gap1, sep1, spin1 = tm, zm, dm, lamm, gapm, sepm, spinm
                     continue
@@ -986,7 +1009,7 @@ def pair_trace(P, i, j, shift, t, tmax, tout, kappa, eps_f, ws, wm, st, tyield):
                         P, i, j, shift, t, kappa, zc, tm, dm, t1, z1, d1, lam1,
                         t0 + 0.5 * h * (1.0 + min(root, 1.0)), lamm, ws, wm)
                 if dc < -rate_tol:
-                    return t + tc, 0
+                    return t + tc, TRACE_COLLISION
                 # a grazing touch: the pair is touching from just past it on
                 t1, z1, d1, lam1, gap1, sep1, spin1 = thi, zhi, dhi, lamhi, 0.0, 0.0, 0.0
                 zc = min(zc, z1)
@@ -1188,12 +1211,12 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
     time : float
         Window time of the event, inf for none.
     kind : int
-        0 a collision, 1 a CHECK.
+        TRACE_COLLISION or TRACE_CHECK.
     """
     d = wq.shape[0]
     cv, _, cr, cax, _, cw, _, _ = columns(d)
     if not tmax > t:
-        return np.inf, 0
+        return np.inf, TRACE_COLLISION
     amax0 = P[i, cr]
     amin0 = P[i, cax]
     for k in range(1, d):
@@ -1209,14 +1232,14 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
     grow_speed = np.sqrt(vv) + abs(kappa) * amax0
     speed = grow_speed + spin * (1.0 + kappa * t)
     if speed == 0.0:
-        return np.inf, 0
+        return np.inf, TRACE_COLLISION
     rate_tol = GRAZE_RATE * speed
     h0, d0 = wall_gap(P, i, t, kappa, wspec, ww, wq)
     hc = 0.0
     touching = False
     if h0 <= 0.0:
         if d0 < -rate_tol:
-            return t, 0
+            return t, TRACE_COLLISION
         hc = h0
         touching = True
     step = FIRST_STEP * amin0 * (1.0 + kappa * t) / speed
@@ -1227,12 +1250,12 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
     while True:
         hfloor = max(hmin_step, 8.0 * EPS * abs(t0))
         if tmax - t0 <= hfloor:
-            return np.inf, 0
+            return np.inf, TRACE_COLLISION
         if steps >= MAX_TRACE_STEPS:
-            return t0, 1
+            return t0, TRACE_CHECK
         safe = 0.0 if touching else _safe_time(h0 - hc, 0.0, spin, grow_speed, kappa, t0)
         if t0 + safe >= tmax:
-            return np.inf, 0
+            return np.inf, TRACE_COLLISION
         if safe > step:
             t1 = t0 + safe
             h1, d1 = wall_gap(P, i, t1, kappa, wspec, ww, wq)
@@ -1250,7 +1273,7 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
         if touching and hm <= hc:  # still in contact at the midpoint
             if dm < -rate_tol:  # approaching: the collision is at the latest here
                 if step <= hfloor:
-                    return tm, 0
+                    return tm, TRACE_COLLISION
                 step *= 0.5
                 continue
             hc = min(hc, hm)  # touching, not approaching: move on
@@ -1266,7 +1289,7 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
                 tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, tm, dm, t1, h1, d1,
                                                      tm + 0.5 * step * min(root, 1.0), ww, wq)
             if dc < -rate_tol:
-                return tc, 0
+                return tc, TRACE_COLLISION
             touching = True  # a grazing touch: touching from just past it on
             hc = min(hc, hhi)
             t0, h0, d0 = thi, hhi, dhi
@@ -1359,7 +1382,7 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
              ww, wq):
     """:func:`_predict_shared` without a shared pair: (time, partner) of the next event of i."""
     return _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm, wmode,
-                           wspec, ww, wq, -1, 0, ws[10])
+                           wspec, ww, wq, -1, SHARE_NONE, ws[10])
 
 
 #: length of the record of a shared pair (:func:`_predict_shared`): key, status, result time and
@@ -1378,22 +1401,22 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
     time, then the lower bound its trace has reached; the pair of the smallest key is started
     or, if started, traced one stretch (:func:`pair_trace`, suspended once its lower bound passes
     the second smallest key), until the smallest key is after the earliest event found (``done``:
-    0 new, 4 screened by the sphere bound of :func:`_ball_screen_time` (the slab bound comes
-    next), 3 screened, 1 started, 2 finished; ``pst`` the states of the started pairs). In a
+    a PAIR_ code per pair; ``pst`` the states of the started pairs). In a
     container (``wmode``) the wall collision (:func:`wall_predict`) before the exit comes first
     and bounds the pair search (partner WALL, or CHECK when its trace reached the step cap).
     ``imgvec`` has 2^c rows for image codes of c bits (4^d for the orthorhombic box; the general
     cells of :mod:`hardpack.md._ellipsoid_deforming_kernel` use longer tables).
 
     *A shared pair.* After a collision of i and j both particles predict, and both would search the
-    pair (i, j) from the same time. With ``shmode`` 1 (i's prediction, ``other`` = j) the search
+    pair (i, j) from the same time. With ``shmode`` SHARE_WRITE (i's prediction, ``other`` = j) the search
     state of that pair at the end is written to ``share`` (SHARE_LEN entries: its key, status, the
     result of a finished trace, j's shift and the trace state; a trace stopped by i's earliest
-    event keeps its state, :func:`pair_trace` kind 3); with ``shmode`` 2 (j's prediction,
+    event keeps its state, :func:`pair_trace` kind TRACE_STOPPED); with ``shmode`` SHARE_READ (j's prediction,
     ``other`` = i) j's search takes the pair from there instead of starting it again, with the
     pair functions called as (i, j) and i's shift (the negative of j's), as i traced it (``done``
-    5, or 6 once stopped by j's earliest event; 7 for a pair of i stopped by i's earliest event,
-    whose state a shared record keeps). ``shmode`` 0: no shared pair."""
+    PAIR_SHARED, or PAIR_SHARED_STOPPED once stopped by j's earliest event; PAIR_STOPPED for a pair
+    of i stopped by i's earliest event, whose state a shared record keeps). ``shmode`` SHARE_NONE:
+    no shared pair."""
     d = bs.shape[1] - 1
     cv, ct, cr, cax, _, _, _, _ = columns(d)
     cbits = 0  # list entries are j << cbits | image code, 2^cbits the length of imgvec
@@ -1419,7 +1442,7 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
         tw, kind = wall_predict(P, i, t, best, kappa, wspec, eps_f, ww, wq)
         if tw < best:
             best = tw
-            partner = WALL if kind == 0 else CHECK
+            partner = WALL if kind == TRACE_COLLISION else CHECK
     horizon = best  # no collision of i is later than the first contact of inscribed spheres
     amin_i = P[i, cax]
     for k in range(1, d):
@@ -1449,7 +1472,7 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
         # root would skip a separating pair), else their first contact
         tin = 0.0 if c <= 0.0 else contact_root(rr, ru, uu, sig0, g, horizon - t)
         tins[m] = tin
-        done[m] = 0
+        done[m] = PAIR_NEW
         if tin < np.inf:
             amin_j = P[j, cax]
             for k in range(1, d):
@@ -1473,24 +1496,24 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
                     touts[m] = -c / den if den > 0.0 else 0.0
     sh = ws[9, :d]
     oq = -1  # the slot of the shared pair
-    o_time, o_kind = np.inf, 0
-    if shmode != 0:
+    o_time, o_kind = np.inf, TRACE_COLLISION
+    if shmode != SHARE_NONE:
         for m in range(m_n):
             if nb[i, m] >> cbits == other:
                 oq = m
                 break
-    if shmode == 2 and oq >= 0 and share[SHARE_LEN - 1] == 1.0:
+    if shmode == SHARE_READ and oq >= 0 and share[SHARE_LEN - 1] == 1.0:
         ok = True  # the same pair: j's shift is the negative of i's
         for k in range(d):
             ok = ok and share[4 + k] == -imgvec[nb[i, oq] & cmask, k]
-        if ok:  # share[1]: 3 not started, 1 a trace state (5 here: started by the other particle), 2 done
-            done[oq] = 5 if share[1] == 1.0 else np.int8(share[1])
+        if ok:  # share[1]: the PAIR_ code as a float, STARTED becoming SHARED here
+            done[oq] = PAIR_SHARED if share[1] == PAIR_STARTED else np.int8(share[1])
             tins[oq] = share[0]
             for k in range(PAIR_STATE):
                 pst[oq, k] = share[8 + k]
-            if share[1] == 2.0 and share[2] < best:
+            if share[1] == PAIR_FINISHED and share[2] < best:
                 best = share[2]
-                partner = other if share[3] == 0.0 else CHECK
+                partner = other if share[3] == TRACE_COLLISION else CHECK
         else:
             oq = -1
     # screen the pairs whose bounding spheres overlap now with cheap bounds: the sphere bound of
@@ -1498,7 +1521,7 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
     # sphere bound is 0)
     posed = False
     for m in range(m_n):
-        if tins[m] == 0.0 and done[m] == 0 and t < min(best, horizon):
+        if tins[m] == 0.0 and done[m] == PAIR_NEW and t < min(best, horizon):
             if not posed:
                 _pose(P, i, t, kappa, ws[8], ws, 11, wm, 2)
                 posed = True
@@ -1508,18 +1531,18 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
             lower = _ball_screen_time(P, i, e >> cbits, sh, t, kappa, ws, wm)
             if lower > 0.0:
                 tins[m] = lower
-                done[m] = 4
+                done[m] = PAIR_BALL_SCREENED
                 continue
             lower = _screen_time(P, i, e >> cbits, sh, t, kappa, ws, wm)
             if lower > 0.0:
                 tins[m] = lower
-                done[m] = 3
+                done[m] = PAIR_SCREENED
     while True:  # best first: each pair is (screened,) started, then traced step by step
         q = -1
         tq = np.inf
         t2 = np.inf  # the second smallest key
         for m in range(m_n):
-            if done[m] != 2 and done[m] < 6:
+            if done[m] != PAIR_FINISHED and done[m] < PAIR_SHARED_STOPPED:
                 if tins[m] < tq:
                     t2 = tq
                     tq = tins[m]
@@ -1533,29 +1556,29 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
         im = e & cmask
         for k in range(d):
             sh[k] = imgvec[im, k]
-        if done[q] == 4:  # the slab bound, no earlier than the sphere bound
+        if done[q] == PAIR_BALL_SCREENED:  # the slab bound, no earlier than the sphere bound
             tins[q] = max(tq, _screen_time(P, i, j, sh, t, kappa, ws, wm))
-            done[q] = 3
+            done[q] = PAIR_SCREENED
             continue
-        if done[q] == 0 or done[q] == 3:
+        if done[q] == PAIR_NEW or done[q] == PAIR_SCREENED:
             # no contact before the key (t_in or the screening bound): the trace starts there
             if tq >= touts[q]:
-                done[q] = 2
+                done[q] = PAIR_FINISHED
                 continue
             lower, now = pair_start(P, i, j, sh, t, tq, kappa, ws, wm, pst[q])
             if now:
-                done[q] = 2
+                done[q] = PAIR_FINISHED
                 if q == oq:
-                    o_time, o_kind = t + tq, 0
+                    o_time, o_kind = t + tq, TRACE_COLLISION
                 if t + tq < best:
                     best = t + tq
                     partner = j
             else:
                 lower = max(lower, tq)
-                done[q] = 1 if lower < touts[q] else 2
+                done[q] = PAIR_STARTED if lower < touts[q] else PAIR_FINISHED
                 tins[q] = lower
             continue
-        if done[q] == 5:  # a pair traced by the other particle: the pair functions as (other, i)
+        if done[q] == PAIR_SHARED:  # traced by the other particle: the pair functions as (other, i)
             for k in range(d):
                 sh[k] = -sh[k]
             tc, kind = pair_trace(P, j, i, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q],
@@ -1563,26 +1586,27 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
         else:
             tc, kind = pair_trace(P, i, j, sh, t, min(best, horizon), touts[q], kappa, eps_f, ws, wm, pst[q],
                                   t + t2)
-        if kind == 2 or kind == 3:  # suspended: its lower bound is now after the second smallest key
+        if kind == TRACE_SUSPENDED or kind == TRACE_STOPPED:  # its lower bound is past the second key
             tins[q] = tc - t
-            if kind == 3:  # nothing before the earliest event (a state to go on from when shared)
-                done[q] = 6 if done[q] == 5 else 7
+            if kind == TRACE_STOPPED:  # nothing before the earliest event (a state to go on from when shared)
+                done[q] = PAIR_SHARED_STOPPED if done[q] == PAIR_SHARED else PAIR_STOPPED
             continue
         if q == oq:
             o_time, o_kind = tc, kind
-        done[q] = 2
+        done[q] = PAIR_FINISHED
         if tc < best:
             best = tc
-            partner = j if kind == 0 else CHECK
+            partner = j if kind == TRACE_COLLISION else CHECK
     if horizon < best:  # the inscribed spheres of a pair touch, yet no collision was located
         best = horizon
         partner = CHECK
-    if shmode == 1:
+    if shmode == SHARE_WRITE:
         share[SHARE_LEN - 1] = 0.0
         if oq >= 0:
             dq = done[oq]
             share[0] = tins[oq]
-            share[1] = 2.0 if dq == 2 else (1.0 if dq == 1 or dq == 7 else 3.0)
+            share[1] = PAIR_FINISHED if dq == PAIR_FINISHED else (
+                PAIR_STARTED if dq == PAIR_STARTED or dq == PAIR_STOPPED else PAIR_SCREENED)
             share[2], share[3] = o_time, o_kind
             for k in range(d):
                 share[4 + k] = imgvec[nb[i, oq] & cmask, k]
@@ -1880,7 +1904,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             npred = 2
         for q in range(npred):  # after a collision the pair is searched once (_predict_shared)
             k = upd[q]
-            shmode = 0 if npred == 1 else q + 1  # 1: the first of the pair writes it, 2: the second reads it
+            shmode = SHARE_NONE if npred == 1 else SHARE_WRITE + q  # the first of the pair writes, the second reads
             key, partner = _predict_shared(k, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst,
                                            ws, wm, wmode, wspec, ww, wq, upd[1 - q], shmode, share)
             ep[k] = partner
