@@ -115,6 +115,16 @@ def test_snakemake_dry_run_lists_the_dag(configfile):
     assert out.returncode == 0, out.stderr
     _every_hardpack_command_parses(out.stdout)
     assert re.search(r"^init +\d+$", out.stdout, re.M) and "fig_size_distributions" in out.stdout
+    ellipsoids = load(configfile.split("/")[1])["ellipsoids"]
+    near = ellipsoids.get("near_sphere")
+    if near:  # the near-sphere packings take their own final rate, the others the study's
+        compress = [line for line in out.stdout.splitlines() if line.startswith("Shell command: hardpack compress")
+                    and "results/ellipsoids/" in line]
+        near_final = near.get("final_growth_rate", ellipsoids["final_growth_rate"])
+        for line in compress:
+            final = near_final if "results/ellipsoids/near_" in line else ellipsoids["final_growth_rate"]
+            assert f"--final-growth-rate {final} " in line, line
+        assert any("results/ellipsoids/near_" in line for line in compress)
     cfg = load(configfile.split("/")[1])["containers"]
     packings = len(cfg["N"]) * len(cfg["seeds"])
     bulk = len(cfg["bulk"]["seeds"])  # the periodic packings of the protocol start like the containers

@@ -245,13 +245,16 @@ def _ellipsoid_systems():
             e["N"], 3, e["seeds"], e["init_phi"], attrs={"family": family, "beta": beta, "alpha": alpha},
             semiaxes=[1.0, alpha**beta, alpha], compress=compress)
     near = e.get("near_sphere")
+    near_compress = (f"--growth-rate {e['growth_rate']}"
+                     f" --final-growth-rate {near.get('final_growth_rate', e['final_growth_rate'])}"
+                     f" --switch-pressure {e['switch_pressure']} --max-pressure {e['max_pressure']}") if near else ""
     for family in near["families"] if near else []:
         beta = e["families"][family]
         for alpha in near["alphas"]:
             systems[f"near_{family}_a{alpha:g}"] = _system(
                 near["N"], 3, near["seeds"], e["init_phi"],
                 attrs={"family": family, "beta": beta, "alpha": alpha, "part": "near_sphere"},
-                semiaxes=[1.0, alpha**beta, alpha], compress=compress, near_sphere=True)
+                semiaxes=[1.0, alpha**beta, alpha], compress=near_compress, near_sphere=True)
     ell = e.get("ellipses")
     for alpha in ell["alphas"] if ell else []:
         sizes = {"kind": "bidisperse", "size_ratio": ell["size_ratio"], "large_fraction": ell["large_fraction"]}
