@@ -391,17 +391,17 @@ def _image_vector(H, ds, n, r):
 
 @njit(cache=True)
 def cell_heights_inverse(Hinv):
-    """1 / h_k, the row norms of H^-1 (h_k the cell's height along lattice direction k).
+    """1 / h_k for every lattice direction k, h_k the cell's height along it: the row norms of H^-1.
 
     Parameters
     ----------
     Hinv : numpy.ndarray of float64, shape (d, d)
-        Inverse of the cell.
+        The inverse cell.
 
     Returns
     -------
     numpy.ndarray of float64, shape (d,)
-        The row norms.
+        1 / h_k.
     """
     d = Hinv.shape[0]
     cfac = np.empty(d)
@@ -419,12 +419,9 @@ def linked_grid(Y, Hinv, n_cells, cstr):
 
     Parameters
     ----------
-    Y : numpy.ndarray of float64, shape (N, >= d)
-        Cartesian points in columns 0 .. d - 1.
-    Hinv : numpy.ndarray of float64, shape (d, d)
-        Inverse of the cell.
-    n_cells, cstr : numpy.ndarray of int64, shape (1, d)
-        Cells per lattice direction and their flat-index strides.
+    Y, Hinv, n_cells, cstr
+        The points, the inverse cell, and the grid's cell counts and strides, as in
+        :func:`link_cells`.
 
     Returns
     -------
