@@ -237,17 +237,19 @@ def _ellipsoid_systems():
     if not ELLIPSOIDS:
         return {}
     e = ELLIPSOIDS
-    compress = (f"--growth-rate {e['growth_rate']} --final-growth-rate {e['final_growth_rate']}"
+
+    def compress_options(final_rate):
+        return (f"--growth-rate {e['growth_rate']} --final-growth-rate {final_rate}"
                 f" --switch-pressure {e['switch_pressure']} --max-pressure {e['max_pressure']}")
+
+    compress = compress_options(e["final_growth_rate"])
     systems = {}
     for family, beta, alpha in _ellipsoid_shapes():
         systems[f"{family}_a{alpha:g}"] = _system(
             e["N"], 3, e["seeds"], e["init_phi"], attrs={"family": family, "beta": beta, "alpha": alpha},
             semiaxes=[1.0, alpha**beta, alpha], compress=compress)
     near = e.get("near_sphere")
-    near_compress = (f"--growth-rate {e['growth_rate']}"
-                     f" --final-growth-rate {near.get('final_growth_rate', e['final_growth_rate'])}"
-                     f" --switch-pressure {e['switch_pressure']} --max-pressure {e['max_pressure']}") if near else ""
+    near_compress = compress_options(near.get("final_growth_rate", e["final_growth_rate"])) if near else ""
     for family in near["families"] if near else []:
         beta = e["families"][family]
         for alpha in near["alphas"]:
