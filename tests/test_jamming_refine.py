@@ -2,7 +2,8 @@
 (hardpack.jamming.refine): Newton's method on the KKT equations of growing the particles.
 
 Stored packings (tests/data): M&M-shaped oblate spheroids (alpha = 1.9, N = 80, LS at the final
-rate 1e-3 to p = 1e12, seeds 1 and 2) and near-sphere ellipsoids (1 : 1.05^(1/2) : 1.05, N = 100).
+rate 1e-3 to p = 1e12, seeds 1 and 2) and near-sphere ellipsoids (1 : 1.05^(1/2) : 1.05 and
+1 : 1.02^(1/2) : 1.02, N = 100).
 The refined configuration's gaps are checked by the pair search of Packing.overlap_report and
 ellipsoid_contacts, its balance by the verifier's own A F, and Newton's quadratic convergence
 checks the contact Hessians against the Perram-Wertheim function.
@@ -106,6 +107,23 @@ def test_near_sphere_packing_is_jammed_at_its_jamming_point():
     assert (out.verdict, out.order) == (Verdict.JAMMED, "second")
     assert out.isostaticity_gap < 0 and out.z_mean < 12 and not out.rattler.any()
     assert out.collective.n_constraints == res.collective.n_constraints + ref.added
+
+
+def test_an_unjammed_jamming_point_is_confirmed_by_the_size_ascent():
+    """Self-dual alpha = 1.02 (N = 100, LS at the final rate 1e-4 to p = 1e12, seed 1 of the full
+    config): the jamming point of its contacts is second-order flexible (lambda_min of K_V
+    -4e-4 of the stiffness scale). The size ascent along that mode finds a packing without
+    overlaps that is denser than the jamming point (measured 1.3e-6), which is an explicit
+    unjamming. Without ``confirm`` no ascent runs. (Fig. 5.5 and its flexible variant check the
+    ascent itself: tests/test_jamming_ascent.py.)"""
+    packing = _packing("self_dual_a1.02_n100_seed1_rate1e-4_p1e12")
+    out = verify_at_jamming_point(packing, delta="gaps")
+    assert out.params["refined"] == 1 and (out.verdict, out.order) == (Verdict.NOT_JAMMED, "second")
+    assert out.collective.lambda_min < 0 and out.isostaticity_gap < 0
+    assert out.params["ascent_confirmed"] == 1 and out.params["ascent_gain"] > 1e-7
+    assert "confirmed: moved by" in out.collective.reason
+    quick = verify_at_jamming_point(packing, delta="gaps", confirm=False)
+    assert quick.verdict == Verdict.NOT_JAMMED and "ascent_confirmed" not in quick.params
 
 
 def test_bad_input_is_refused():

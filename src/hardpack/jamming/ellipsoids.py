@@ -61,12 +61,14 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 import scipy.sparse as sp
+from scipy.spatial.transform import Rotation
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.contact import contact_point, inverse_shapes, pw_contact
 from hardpack.geometry.ellipsoid_container import local_farthest_body
 from hardpack.geometry.neighbours.pairs import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
+from hardpack.geometry.shapes import Ellipsoids
 from hardpack.jamming.contacts import ContactArrays
 
 __all__ = [
@@ -81,6 +83,7 @@ __all__ = [
     "wall_gap_hessian",
     "container_contacts",
     "generators",
+    "displaced",
 ]
 
 
@@ -759,3 +762,34 @@ def stiffness_matrix_full(net: EllipsoidContacts, forces: np.ndarray,
     vals = (hs * w[:, None, None]).ravel()
     k = sp.csr_matrix((vals, (rows, cols)), shape=(n * f, n * f))
     return ((k + k.T) * 0.5).tocsr()
+
+
+def displaced(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float) -> Packing:
+    """The packing of ellipses or ellipsoids moved and grown (overlaps allowed).
+
+    Parameters
+    ----------
+    packing : Packing
+        Ellipses or ellipsoids.
+    positions : numpy.ndarray of float, shape (N, d)
+        The new centres.
+    rotation : numpy.ndarray of float, shape (N, 1) in 2D or (N, 3) in 3D
+        Lab-frame rotation vectors (an angle in 2D) that turn each orientation.
+    factor : float
+        Factor of every semiaxis.
+
+    Returns
+    -------
+    Packing
+        The same cell, species, boundary and overlap tolerance.
+    """
+    shape = packing.shape
+    if packing.dim == 2:
+        orient = np.asarray(shape.orientations, float).reshape(-1) + rotation[:, 0]
+    else:
+        # orientations are (w, x, y, z) of the rotation R = Q^T (Q lab to body): R -> exp(W) R
+        current = Rotation.from_quat(np.roll(np.asarray(shape.orientations, float), -1, axis=1))
+        orient = np.roll((Rotation.from_rotvec(rotation) * current).as_quat(), 1, axis=1)
+    return Packing(positions, lattice=packing.lattice, species=packing.species,
+                   shape=Ellipsoids(shape.semiaxes * factor, orient), boundary=packing.boundary,
+                   overlap_tol=packing.overlap_tol, allow_overlap=True)

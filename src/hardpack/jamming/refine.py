@@ -53,15 +53,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.spatial.transform import Rotation
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.neighbours.pairs import wrapped_positions
 from hardpack.geometry.packing import Packing
-from hardpack.geometry.shapes import Ellipsoids
+from hardpack.jamming.ascent import CONFIRM_AMPLITUDES, confirm_unjamming
 from hardpack.jamming.ellipsoids import (
     contact_hessians,
     contacts_of_pairs,
+    displaced,
     dof_per_particle,
     ellipsoid_contacts,
     rigidity_transpose_full,
@@ -133,21 +133,6 @@ class Refinement:
     negative: int = 0
     dropped: int = 0
     pinned: int = 0
-
-
-def _turned(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float) -> Packing:
-    """The packing with new centres, orientations turned by the lab-frame rotation vectors
-    ``rotation`` (N, 1 or 3) and semiaxes scaled by ``factor``."""
-    shape = packing.shape
-    if packing.dim == 2:
-        orient = np.asarray(shape.orientations, float).reshape(-1) + rotation[:, 0]
-    else:
-        # orientations are (w, x, y, z) of the rotation R = Q^T (Q lab to body): R -> exp(W) R
-        current = Rotation.from_quat(np.roll(np.asarray(shape.orientations, float), -1, axis=1))
-        orient = np.roll((Rotation.from_rotvec(rotation) * current).as_quat(), 1, axis=1)
-    return Packing(positions, lattice=packing.lattice, species=packing.species,
-                   shape=Ellipsoids(shape.semiaxes * factor, orient), boundary=packing.boundary,
-                   overlap_tol=packing.overlap_tol, allow_overlap=True)
 
 
 def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: float = REFINE_TOL,
@@ -323,7 +308,7 @@ def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, st
             break  # beyond the reach of the linearised contacts: no jamming point of this network near
         x = x + move[:, :d]
         factor *= 1.0 + ds
-        current = _turned(current, x, move[:, d:], 1.0 + ds)
+        current = displaced(current, x, move[:, d:], 1.0 + ds)
     return current, False, forces, factor
 
 
@@ -377,7 +362,22 @@ def _obstacle(packing: Packing, result) -> str | None:
     return None
 
 
-def verify_at_jamming_point(packing: Packing, **options):
+def _confirm(packing: Packing, result) -> None:
+    """Certify the second-order flexible verdict ``result`` of the jamming point ``packing`` by the
+    size ascent along its unjamming motion (:func:`hardpack.jamming.ascent.confirm_unjamming`);
+    the outcome goes to ``result.params`` and the reason."""
+    found = confirm_unjamming(packing, result)
+    result.params.update(ascent_confirmed=int(found.confirmed), ascent_gain=found.gain,
+                         ascent_amplitude=found.amplitude, ascent_tried=found.tried)
+    result.collective.reason += (
+        f"; confirmed: moved by {found.amplitude:+g} along that mode and grown by SLP, the particles reach "
+        f"a packing without overlaps {found.gain:.3g} denser than the jamming point"
+        if found.confirmed else
+        f"; not confirmed: SLP from the jamming point moved along that mode ({found.tried} tries, "
+        f"amplitudes to {max(CONFIRM_AMPLITUDES):g}) ended at most {found.gain:.3g} denser")
+
+
+def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, **options):
     """The jamming test of an ellipsoid packing at the jamming point of its contacts, when the
     packing is near one.
 
@@ -398,10 +398,18 @@ def verify_at_jamming_point(packing: Packing, **options):
     the active-set rounds), ``refine_negative`` (negative forces at the last iterate) and
     ``refine_pinned`` (particles with fewer than d + 1 contacts held fixed as rattlers).
 
+    A verdict of the refined configuration that is second-order flexible is then checked by the
+    size ascent (:func:`hardpack.jamming.ascent.confirm_unjamming`, unless ``confirm`` is False):
+    ``ascent_confirmed`` (1 when an explicit denser packing without overlaps was found along the
+    unjamming motion), ``ascent_gain`` (its relative density gain), ``ascent_amplitude`` and
+    ``ascent_tried``.
+
     Parameters
     ----------
     packing : Packing
         Ellipses or ellipsoids in a periodic cell or a spherical container.
+    confirm : bool, default True
+        Certify a second-order flexible verdict at the jamming point by the size ascent.
     **options
         Passed to :func:`hardpack.jamming.second_order.verify_ellipsoids` for both tests.
 
@@ -443,6 +451,8 @@ def verify_at_jamming_point(packing: Packing, **options):
                    f"and {int(refined.rattler.sum())} rattlers (before: {dec.n_constraints}, "
                    f"{int(result.rattler.sum())})")), **info)
             refined.collective.reason = f"at the jamming point of the contacts: {refined.collective.reason}"
+            if confirm and refined.verdict == Verdict.NOT_JAMMED and refined.unjamming_motion() is not None:
+                _confirm(ref.packing, refined)
             return refined
         solved = ref.gap[-1] <= REFINE_TOL and ref.balance[-1] <= REFINE_TOL
         note = (f"not refined: Newton reached the stationary point of the contacts in {ref.iterations} steps "

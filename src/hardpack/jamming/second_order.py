@@ -978,6 +978,26 @@ class EllipsoidJammingResult:
         """Sum of the wall reactions (the self-stress has mean 1 over the backbone contacts)."""
         return float(self.contact_forces[self.network.is_wall].sum())
 
+    def unjamming_motion(self) -> np.ndarray | None:
+        """The collective test's floppy mode of negative (or zero) stiffness as a motion of every
+        particle: translations (in length units) and lab-frame rotation vectors, unit Euclidean
+        norm over the backbone's reduced degrees of freedom.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N, d_f), or None
+            Columns 0..d-1 translate, the others turn (one angle in 2D, a rotation vector in 3D);
+            rattlers and frozen particles do not move. None when the test found no such mode (a
+            jammed verdict, or one decided at first order).
+        """
+        motion = self.collective.motion
+        if motion is None:
+            return None
+        t_full, dof = dof_basis(self.network, ~self.frozen)
+        owner = np.repeat(np.flatnonzero(~self.frozen), dof[~self.frozen])
+        tm = t_full[:, np.flatnonzero(self.backbone[owner])]
+        return np.asarray(tm @ motion).reshape(self.network.n_particles, dof_per_particle(self.network.dim))
+
     @property
     def isostaticity_gap(self) -> int:
         """M_b - N_f: constraints minus nontrivial dof of the backbone (0 or 1: isostatic,
