@@ -3,7 +3,7 @@
 
 Stored packings (tests/data): M&M-shaped oblate spheroids (alpha = 1.9, N = 80, LS at the final
 rate 1e-3 to p = 1e12, seeds 1 and 2) and near-sphere ellipsoids (1 : 1.05^(1/2) : 1.05 and
-1 : 1.02^(1/2) : 1.02, N = 100).
+1 : 1.02^(1/2) : 1.02 and 1 : 1 : 1.02 at the final rate 1e-4, N = 100).
 The refined configuration's gaps are checked by the pair search of Packing.overlap_report and
 ellipsoid_contacts, its balance by the verifier's own A F, and Newton's quadratic convergence
 checks the contact Hessians against the Perram-Wertheim function.
@@ -124,6 +124,23 @@ def test_an_unjammed_jamming_point_is_confirmed_by_the_size_ascent():
     assert "confirmed: moved by" in out.collective.reason
     quick = verify_at_jamming_point(packing, delta="gaps", confirm=False)
     assert quick.verdict == Verdict.NOT_JAMMED and "ascent_confirmed" not in quick.params
+
+
+def test_newton_reaches_the_jamming_point_after_the_size_ascent():
+    """Prolate alpha = 1.02 (N = 100, LS at the final rate 1e-4 to p = 1e12, seed 2 of the full
+    config): Newton diverges from the packing as given (a step of 12 semiaxes: the floppy modes
+    leave the packing far from its jamming point). After the SLP size ascent it converges, and
+    the jamming point is hypostatic and jammed at second order. Without the retry the verdict
+    is undetermined."""
+    packing = _packing("prolate_a1.02_n100_seed2_rate1e-4_p1e12")
+    plain = verify_at_jamming_point(packing, delta="gaps", retry_after_ascent=False)
+    assert plain.params["refined"] == 0 and "diverged" in plain.params["refine_note"]
+    assert plain.verdict == Verdict.UNDETERMINED
+    out = verify_at_jamming_point(packing, delta="gaps")
+    assert out.params["refined"] == 1 and out.params["ascended"] == 1
+    assert 0 < out.params["ascent_phi_change"] < 1e-6
+    assert out.params["refine_note"].startswith("Newton from the packing as given failed")
+    assert (out.verdict, out.order) == (Verdict.JAMMED, "second") and out.isostaticity_gap < 0
 
 
 def test_bad_input_is_refused():
