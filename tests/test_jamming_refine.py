@@ -104,6 +104,7 @@ def test_near_sphere_packing_is_jammed_at_its_jamming_point():
     assert ref.balance[-1] < 1e-12 and ref.gap[-1] < 1e-12 and ref.forces.min() > 0
     out = verify_at_jamming_point(packing, delta="gaps")
     assert out.params["refined"] == 1 and out.params["refine_added"] == ref.added
+    assert out.params["ascended"] == 0 and out.params["ascent_confirmed"] == -1  # jammed: no ascent
     assert (out.verdict, out.order) == (Verdict.JAMMED, "second")
     assert out.isostaticity_gap < 0 and out.z_mean < 12 and not out.rattler.any()
     assert out.collective.n_constraints == res.collective.n_constraints + ref.added
@@ -123,7 +124,8 @@ def test_an_unjammed_jamming_point_is_confirmed_by_the_size_ascent():
     assert out.params["ascent_confirmed"] == 1 and out.params["ascent_gain"] > 1e-7
     assert "confirmed: moved by" in out.collective.reason
     quick = verify_at_jamming_point(packing, delta="gaps", confirm=False)
-    assert quick.verdict == Verdict.NOT_JAMMED and "ascent_confirmed" not in quick.params
+    assert quick.verdict == Verdict.NOT_JAMMED and quick.params["ascent_confirmed"] == -1
+    assert quick.params["ascended"] == 0 and "ascent_gain" not in quick.params
 
 
 def test_newton_reaches_the_jamming_point_after_the_size_ascent():

@@ -395,6 +395,11 @@ def test_ellipsoid_jamming_rows_judge_the_second_order_claims():
                                                                                  order=(2, 0, 2, 2, 2, 2))])}
     row = unknown["donev-5.6-near-sphere-hypostatic-second-order"]
     assert row.status == FAIL and "2 of 3 packings" in row.detail and "(1 undetermined)" in row.detail
+    # a second-order flexible one certified by the size ascent: the detail counts it
+    flexible = _ellipsoid_verdicts(jammed=(1, 0, 1, 1, 1, 1)).assign(
+        ascent_confirmed=("sample", np.array([-1, 1, -1, -1, -1, -1])))
+    row = {r.target: r for r in ellipsoid_jamming_rows([flexible])}["donev-5.6-near-sphere-hypostatic-second-order"]
+    assert row.status == FAIL and "1 second-order flexible at the jamming point, 1 of them certified" in row.detail
     small = {r.target: r for r in ellipsoid_jamming_rows([_ellipsoid_verdicts(n=40)])}
     assert {r.status for r in small.values()} == {NA}
     # a claim about every packing: one packing of six not jammed fails it (a standard error over

@@ -622,7 +622,8 @@ ELLIPSOID_VARIABLES = ("z_mean", "z_all", "rattler_fraction", "nematic_S", "pres
 ELLIPSOID_VERDICT_VARIABLES = ("verdict", "jammed", "order_code", "hypostatic", "z_mean", "rattler_fraction",
                                "isostaticity_gap", "n_floppy", "n_stresses", "approximate_stress",
                                "stress_residual", "stress_gap", "delta", "delta_ambiguous", "lambda_min",
-                               "stiffness_scale", "n_backbone", "jamming_distance", "refined")
+                               "stiffness_scale", "n_backbone", "jamming_distance", "refined", "ascended",
+                               "ascent_confirmed")
 
 
 def _combined(inputs, index, variables=(), attrs=None):

@@ -406,9 +406,9 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     or ended with negative forces or overlapping pairs), the packing is first brought closer to
     its jamming point by the size ascent of :mod:`hardpack.jamming.ascent` (trust radius
     ASCENT_RADIUS: every particle moves by less than 0.04 smallest semiaxes or radians), and the
-    refinement runs again from there. ``ascended`` is then 1 when that second attempt reached the
-    jamming point (its verdict is returned, with ``ascent_phi_change``, the ascent's relative
-    density gain), 0 when it did not (the first verdict is returned). Near the sphere point the
+    refinement runs again from there. ``ascended`` (always recorded) is 1 when that second attempt
+    reached the jamming point (its verdict is returned, with ``ascent_phi_change``, the ascent's
+    relative density gain), 0 otherwise (the first verdict is returned). Near the sphere point the
     LS packing's floppy modes leave it far from its jamming point, and the ascent moves along
     them using first derivatives only, where Newton's quadratic model can fail. Measured on
     prolate alpha = 1.02 (N = 100, rate 1e-4, seed 2): Newton diverged from the packing as given
@@ -417,8 +417,8 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     A verdict of the refined configuration that is second-order flexible is then checked by the
     size ascent (:func:`hardpack.jamming.ascent.confirm_unjamming`, unless ``confirm`` is False):
     ``ascent_confirmed`` (1 when an explicit denser packing without overlaps was found along the
-    unjamming motion), ``ascent_gain`` (its relative density gain), ``ascent_amplitude`` and
-    ``ascent_tried``.
+    unjamming motion, 0 when not, -1 when no ascent was tried), ``ascent_gain`` (its relative
+    density gain), ``ascent_amplitude`` and ``ascent_tried``.
 
     Parameters
     ----------
@@ -436,6 +436,7 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     EllipsoidJammingResult
     """
     first = _at_jamming_point(packing, confirm, options)
+    first.params.setdefault("ascended", 0)
     if not retry_after_ascent or first.params.get("refined") != 0 or "refine_iterations" not in first.params:
         return first  # refined, or Newton never started (no near self-stress, walls)
     climbed = ascend(packing, frozen=options.get("frozen"), radius=ASCENT_RADIUS)
@@ -466,6 +467,7 @@ def _at_jamming_point(packing: Packing, confirm: bool, options: dict):
             note, start = None, collective
             whole = ("; Newton started from the collective test of every particle (the local test of the "
                      f"packing as given found {int(result.rattler.sum())} rattler(s))")
+    result.params.update(ascent_confirmed=-1)
     if note is None:
         ref = refine_jamming_point(packing, start, max_iter=REFINE_STEPS)
         info = dict(refine_iterations=ref.iterations, refine_step=float(ref.steps.max(initial=0.0)),
@@ -475,7 +477,7 @@ def _at_jamming_point(packing: Packing, confirm: bool, options: dict):
             refined = verify_ellipsoids(ref.packing, **options)
             same = (refined.collective.n_constraints == dec.n_constraints
                     and np.array_equal(refined.rattler, result.rattler))
-            refined.params.update(refined=1, refine_note=(
+            refined.params.update(refined=1, ascent_confirmed=-1, refine_note=(
                 f"the jamming point of the contacts: Newton converged in {ref.iterations} steps "
                 f"(largest {info['refine_step']:.3g}), gaps {ref.gap[-1]:.2g}, balance {ref.balance[-1]:.2g}"
                 + (f"; {ref.added} pair(s) that overlapped at the jamming point of the packing's contacts "

@@ -209,6 +209,17 @@ def _every_packing_row(target, holds, n: int, label: str, detail: str) -> Row:
     return evaluate(target, float(np.mean(holds)), n=n, seeds=len(holds), label=label, detail=detail)
 
 
+def _certified(summary, mask) -> str:
+    """", k not jammed at second order, c of them certified by the size ascent" for the packings in
+    ``mask`` (empty without the ``ascent_confirmed`` variable of verify_at_jamming_point)."""
+    if "ascent_confirmed" not in summary:
+        return ""
+    confirmed = np.asarray(summary["ascent_confirmed"].values)[mask]
+    tried = int((confirmed >= 0).sum())
+    return (f"; {tried} second-order flexible at the jamming point, {int((confirmed == 1).sum())} of them "
+            "certified by a denser packing without overlaps (size ascent)") if tried else ""
+
+
 def ellipsoid_jamming_rows(summaries) -> list[Row]:
     """Rows of the jamming verdicts of the 3D ellipsoid packings (``ellipsoids/verdicts3d`` and
     ``ellipsoids/verdicts_near_sphere``: one sample per packing, coordinates ``beta``, ``alpha``,
@@ -248,7 +259,8 @@ def ellipsoid_jamming_rows(summaries) -> list[Row]:
             targets["donev-5.6-near-sphere-hypostatic-second-order"], near_ok[near], n,
             f"1 < alpha <= {NEAR_SPHERE_ALPHA:g}",
             f"{int(near_ok[near].sum())} of {int(near.sum())} packings near the sphere point "
-            f"hypostatic and jammed at second order ({int(undetermined[near].sum())} undetermined)"))
+            f"hypostatic and jammed at second order ({int(undetermined[near].sum())} undetermined"
+            + _certified(s, near) + ")"))
         is_jammed = aspherical & jammed
         unique = np.asarray(s["n_stresses"].values) == 1
         out.append(_every_packing_row(
