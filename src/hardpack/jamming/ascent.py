@@ -152,8 +152,29 @@ def _moving(packing: Packing, frozen) -> np.ndarray:
     return ~frozen
 
 
-def ascend(packing: Packing, *, frozen=None, radius: float = 1e-3, steps: int = ASCENT_STEPS,
-           shrink: float = ASCENT_SHRINK) -> Ascent:
+def _strain_rows(net, d: int) -> np.ndarray:
+    """(M, d(d+1)/2): the gap rate of each contact under a symmetric strain E of the cell and the
+    centres, dr = E r for the separation r (u . E r, u the unit normal); columns E_aa, then E_ab
+    (a < b) counted twice."""
+    u, r = net.normal, net.separation
+    cols = [u[:, a] * r[:, a] for a in range(d)]
+    cols += [u[:, a] * r[:, b] + u[:, b] * r[:, a] for a in range(d) for b in range(a + 1, d)]
+    return np.column_stack(cols)
+
+
+def _strain_matrix(e: np.ndarray, d: int) -> np.ndarray:
+    """The symmetric strain of the LP's variables (E_aa, then E_ab with a < b)."""
+    strain = np.diag(e[:d])
+    k = d
+    for a in range(d):
+        for b in range(a + 1, d):
+            strain[a, b] = strain[b, a] = e[k]
+            k += 1
+    return strain
+
+
+def ascend(packing: Packing, *, frozen=None, deform: bool = False, radius: float = 1e-3,
+           steps: int = ASCENT_STEPS, shrink: float = ASCENT_SHRINK) -> Ascent:
     """Grow the particles by trust-region SLP (module docstring), then shrink away the overlaps.
 
     Parameters
@@ -163,6 +184,10 @@ def ascend(packing: Packing, *, frozen=None, radius: float = 1e-3, steps: int = 
         remove them).
     frozen : array_like of bool, shape (N,), optional
         Particles that do not move (they grow with the others, about fixed centres).
+    deform : bool, default False
+        Also deform the cell: a symmetric strain E (each entry within the trust radius) moves the
+        lattice vectors and the centres affinely, and the LP maximises the growth of the
+        volume fraction, d ds - Tr E, instead of ds (the SLP of Donev et al. 2004 with rotations).
     radius : float, default 1e-3
         First trust radius: the largest move per step, in smallest semiaxes (translations),
         radians (rotations) and relative size.
@@ -198,13 +223,20 @@ def ascend(packing: Packing, *, frozen=None, radius: float = 1e-3, steps: int = 
         n = at.shape[1]
         gaps = net.zeta / net.scale
         growth = 2.0 * (net.zeta + 1.0) / net.scale
-        objective = np.zeros(n + 1)
-        objective[-1] = -1.0
-        lp = solve_lp(objective, A_ub=sp.hstack([-at, sp.csr_matrix(growth[:, None])]).tocsr(), b_ub=gaps,
-                      bounds=[(-r * a, r * a)] * n + [(-r, r)])
+        strain = _strain_rows(net, d) if deform else np.zeros((net.n_contacts, 0))
+        k = strain.shape[1]
+        objective = np.zeros(n + k + 1)
+        objective[n:n + min(k, d)] = 1.0  # Tr E
+        objective[-1] = -float(d)
+        rows = sp.hstack([-at, sp.csr_matrix(-strain), sp.csr_matrix(growth[:, None])]).tocsr()
+        lp = solve_lp(objective, A_ub=rows, b_ub=gaps, bounds=[(-r * a, r * a)] * n + [(-r, r)] * (k + 1))
         move = (t @ lp.x[:n]).reshape(packing.n_particles, f)
+        lattice = None
+        if deform:
+            affine = np.eye(d) + _strain_matrix(lp.x[n:n + k], d)
+            x, lattice = x @ affine.T, affine @ current.lattice
         x = x + move[:, :d]
-        current = displaced(current, x, move[:, d:], 1.0 + float(lp.x[-1]))
+        current = displaced(current, x, move[:, d:], 1.0 + float(lp.x[-1]), lattice)
         r *= shrink
     mu = _smallest_mu(current)
     if mu < 1.0:

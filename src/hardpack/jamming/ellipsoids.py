@@ -764,7 +764,8 @@ def stiffness_matrix_full(net: EllipsoidContacts, forces: np.ndarray,
     return ((k + k.T) * 0.5).tocsr()
 
 
-def displaced(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float) -> Packing:
+def displaced(packing: Packing, positions: np.ndarray, rotation: np.ndarray, factor: float,
+              lattice: np.ndarray | None = None) -> Packing:
     """The packing of ellipses or ellipsoids moved and grown (overlaps allowed).
 
     Parameters
@@ -777,11 +778,13 @@ def displaced(packing: Packing, positions: np.ndarray, rotation: np.ndarray, fac
         Lab-frame rotation vectors (an angle in 2D) that turn each orientation.
     factor : float
         Factor of every semiaxis.
+    lattice : numpy.ndarray of float, shape (d, d), optional
+        A new cell (lattice vectors as columns); default the packing's.
 
     Returns
     -------
     Packing
-        The same cell, species, boundary and overlap tolerance.
+        The same species, boundary and overlap tolerance (and cell, without ``lattice``).
     """
     shape = packing.shape
     if packing.dim == 2:
@@ -790,6 +793,6 @@ def displaced(packing: Packing, positions: np.ndarray, rotation: np.ndarray, fac
         # orientations are (w, x, y, z) of the rotation R = Q^T (Q lab to body): R -> exp(W) R
         current = Rotation.from_quat(np.roll(np.asarray(shape.orientations, float), -1, axis=1))
         orient = np.roll((Rotation.from_rotvec(rotation) * current).as_quat(), 1, axis=1)
-    return Packing(positions, lattice=packing.lattice, species=packing.species,
+    return Packing(positions, lattice=packing.lattice if lattice is None else lattice, species=packing.species,
                    shape=Ellipsoids(shape.semiaxes * factor, orient), boundary=packing.boundary,
                    overlap_tol=packing.overlap_tol, allow_overlap=True)

@@ -210,13 +210,14 @@ def _every_packing_row(target, holds, n: int, label: str, detail: str) -> Row:
 
 
 def _certified(summary, mask) -> str:
-    """", k not jammed at second order, c of them certified by the size ascent" for the packings in
-    ``mask`` (empty without the ``ascent_confirmed`` variable of verify_at_jamming_point)."""
+    """"k second-order flexible at the jamming point, c of them certified ..." for the packings in
+    ``mask`` (empty without such packings or the ``ascent_confirmed`` variable of
+    :func:`hardpack.jamming.refine.verify_at_jamming_point`)."""
     if "ascent_confirmed" not in summary:
         return ""
     confirmed = np.asarray(summary["ascent_confirmed"].values)[mask]
     tried = int((confirmed >= 0).sum())
-    return (f"; {tried} second-order flexible at the jamming point, {int((confirmed == 1).sum())} of them "
+    return (f"{tried} second-order flexible at the jamming point, {int((confirmed == 1).sum())} of them "
             "certified by a denser packing without overlaps (size ascent)") if tried else ""
 
 
@@ -252,7 +253,8 @@ def ellipsoid_jamming_rows(summaries) -> list[Row]:
         near = aspherical & (alpha <= NEAR_SPHERE_ALPHA)
         out.append(_every_packing_row(
             targets["donev-5.6-ls-ellipsoids-jammed"], jammed[aspherical], n, "alpha > 1",
-            f"{int(jammed[aspherical].sum())} of {int(aspherical.sum())} packings with alpha > 1 jammed"))
+            f"{int(jammed[aspherical].sum())} of {int(aspherical.sum())} packings with alpha > 1 jammed"
+            + (f" ({certified})" if (certified := _certified(s, aspherical)) else "")))
         near_ok = jammed & second & hypostatic
         undetermined = np.asarray(s["verdict"].values) == int(Verdict.UNDETERMINED)
         out.append(_every_packing_row(
@@ -260,7 +262,7 @@ def ellipsoid_jamming_rows(summaries) -> list[Row]:
             f"1 < alpha <= {NEAR_SPHERE_ALPHA:g}",
             f"{int(near_ok[near].sum())} of {int(near.sum())} packings near the sphere point "
             f"hypostatic and jammed at second order ({int(undetermined[near].sum())} undetermined"
-            + _certified(s, near) + ")"))
+            + (f"; {certified}" if (certified := _certified(s, near)) else "") + ")"))
         is_jammed = aspherical & jammed
         unique = np.asarray(s["n_stresses"].values) == 1
         out.append(_every_packing_row(
