@@ -6,7 +6,9 @@ Physics checked:
   :func:`hardpack.geometry.ellipsoid_crystals.laminate`), and some find its network, 14 contacts
   on every particle, at phi ~ 0.7707 as printed for the search;
 - one spheroid per cell ends at (some seeds) or below the densest lattice packing, phi = pi / sqrt(18),
-  which is not the laminate (the search reports no match), through the command line;
+  which is not the laminate (the search reports no match), through the command line; polished in
+  the deforming cell by the size ascent, every run reaches pi / sqrt(18);
+- the polish takes the four-per-cell runs with the laminate's contacts to phi = 0.770732;
 - the validation rows judge the densest run at sqrt 3 against Donev's phi ~ 0.7707 and 14 contacts,
   and the laminate figure draws every run;
 - bad input is refused (also spheres, alpha = 1, whose own-image contact no spin can resolve).
@@ -50,6 +52,10 @@ def test_four_spheroids_per_cell_find_the_laminate():
         if run["min_contacts"] == run["max_contacts"] == 14:
             assert run["phi"] == pytest.approx(0.7707, abs=5e-5)
             found += 1
+            # the polish in the deforming cell reaches the laminate itself, to Donev's 6 digits
+            assert run["phi_polished"] == pytest.approx(0.770732, abs=5e-7)
+            assert run["min_contacts_polished"] == run["max_contacts_polished"] == 14
+        assert run["phi"] - 1e-9 < run["phi_polished"] < 0.770732 + 1e-6
     assert found >= 1
 
 
@@ -69,6 +75,11 @@ def test_cli_search_with_one_spheroid_per_cell(tmp_path):
     assert not ds["laminate"].values.any()
     assert ds.attrs["phi_laminate"] == pytest.approx(0.770732, abs=1e-6)
     assert (ds["n_overlapping"] == 0).all()
+    # polished in the deforming cell, every run reaches the densest lattice packing, the only local
+    # maximum of the lattice density (tests/test_jamming_ascent.py), with 12 contacts
+    assert np.abs(ds["phi_polished"] - np.pi / np.sqrt(18.0)).max() < 1e-8
+    assert (ds["min_contacts_polished"] == 12).all() and (ds["max_contacts_polished"] == 12).all()
+    assert ds.attrs["phi_best_polished"] == pytest.approx(np.pi / np.sqrt(18.0), abs=1e-8)
 
 
 def test_bad_input_is_refused():

@@ -98,3 +98,49 @@ def test_bad_input_is_refused():
                         boundary=SphericalContainer((3.0, 3.0), 2.5))
     with pytest.raises(InvalidInputError, match="periodic"):
         ascend(contained)
+
+
+# ------------------------------------------------------------------------------- deforming cell
+def _free_of_overlaps(packing, margin=1e-9):
+    """The packing shrunk uniformly until no pair overlaps (mu >= 1 + margin)."""
+    near = ellipsoid_contacts(packing, 0.5)
+    mu = float(np.sqrt(near.zeta + 1.0).min()) if near.n_contacts else 1.0
+    factor = min(mu, 1.0) * (1.0 - margin)
+    return displaced(packing, wrapped_positions(packing), np.zeros((packing.n_particles, 3)), factor)
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_a_random_lattice_of_one_spheroid_ascends_to_the_affine_fcc(seed):
+    """One spheroid per cell is a lattice packing, the affine image of a sphere lattice. FCC is
+    the only perfect lattice in 3D (Korkine & Zolotarev 1877), so it is the only local maximum of
+    the lattice density, and every ascent of the deforming cell must end at pi / sqrt(18)
+    (measured: 9 digits from phi 0.07-0.31), with 12 contacts (own images)."""
+    rng = np.random.default_rng(seed)
+    quaternion = rng.normal(size=4)
+    start = Packing(np.full((1, 3), 0.1), lattice=4.0 * (np.eye(3) + 0.3 * rng.normal(size=(3, 3))),
+                    shape=Ellipsoids(np.array([[np.sqrt(3.0), 1.0, 1.0]]), (quaternion / np.linalg.norm(quaternion))[None]),
+                    allow_overlap=True)
+    start = _free_of_overlaps(start, margin=1e-2)
+    out = ascend(start, deform=True, radius=1e-2, rounds=100)
+    assert start.phi < 0.35 and out.phi == pytest.approx(np.pi / np.sqrt(18.0), abs=1e-8)
+    assert out.rounds < 100 and _no_overlap(out.packing)
+    assert (ellipsoid_contacts(out.packing, 1e-6).counts() == 12).all()
+
+
+def test_a_perturbed_laminate_ascends_back_to_it():
+    """Donev's laminate at alpha = 1.5 (phi 0.753407, 12 contacts; Donev 2006, Sec. 8.2) is a
+    strict local maximum of the density: moved by 1e-2 (centres, angles, cell strain) and shrunk
+    free of overlaps (phi 0.71-0.725), the deforming ascent returns to it to 1e-8. In a fixed cell it
+    cannot (the strain is needed)."""
+    from hardpack.geometry.ellipsoid_crystals import laminate
+
+    lam = laminate(1.5)
+    rng = np.random.default_rng(0)
+    strain = np.eye(3) + 0.01 * rng.normal(size=(3, 3))
+    x = (wrapped_positions(lam) + 0.01 * rng.normal(size=(lam.n_particles, 3))) @ strain.T
+    start = _free_of_overlaps(displaced(lam, x, 0.01 * rng.normal(size=(lam.n_particles, 3)), 1.0, strain @ lam.lattice))
+    out = ascend(start, deform=True, radius=1e-2, rounds=50)
+    assert start.phi < 0.73 and out.phi == pytest.approx(lam.phi, abs=1e-8)
+    assert (ellipsoid_contacts(out.packing, 1e-6).counts() == 12).all()
+    fixed = ascend(start, radius=1e-2, rounds=50)
+    assert fixed.phi < lam.phi - 1e-3

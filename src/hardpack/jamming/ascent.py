@@ -61,7 +61,7 @@ from hardpack.jamming.ellipsoids import (
     ellipsoid_contacts,
     rigidity_transpose_full,
 )
-from hardpack.jamming.highs import solve_lp
+from hardpack.jamming.highs import LPFailure, solve_lp
 from hardpack.jamming.second_order import dof_basis
 
 __all__ = ["Ascent", "Unjamming", "ascend", "confirm_unjamming", "CONFIRM_AMPLITUDES"]
@@ -72,6 +72,8 @@ CANDIDATE_DELTA = 2e-2
 #: radius * ASCENT_SHRINK**ASCENT_STEPS (3e-11 of the first)
 ASCENT_STEPS = 80
 ASCENT_SHRINK = 0.74
+#: a round of :func:`ascend` that gains less than this (relative phi) ends the ascent
+ROUND_GAIN = 1e-10
 #: the amplitudes (largest component of the motion, in smallest semiaxes or radians) that
 #: :func:`confirm_unjamming` tries, each with both signs, in this order
 CONFIRM_AMPLITUDES = (0.03, 0.01, 0.1)
@@ -96,6 +98,11 @@ class Ascent:
         Smallest Perram-Wertheim factor at the last configuration before the shrink.
     steps : int
         LP steps taken.
+    rounds : int
+        Schedules run.
+    repairs : int
+        Steps whose LP was infeasible, a numerical fallback: the previous step left overlaps that
+        the trust radius could not undo, and a uniform shrink by the smallest mu removed them.
     """
 
     packing: Packing
@@ -103,6 +110,8 @@ class Ascent:
     phi: float
     mu_min: float
     steps: int
+    rounds: int = 1
+    repairs: int = 0
 
 
 @dataclass
@@ -174,7 +183,7 @@ def _strain_matrix(e: np.ndarray, d: int) -> np.ndarray:
 
 
 def ascend(packing: Packing, *, frozen=None, deform: bool = False, radius: float = 1e-3,
-           steps: int = ASCENT_STEPS, shrink: float = ASCENT_SHRINK) -> Ascent:
+           steps: int = ASCENT_STEPS, shrink: float = ASCENT_SHRINK, rounds: int = 1) -> Ascent:
     """Grow the particles by trust-region SLP (module docstring), then shrink away the overlaps.
 
     Parameters
@@ -195,6 +204,11 @@ def ascend(packing: Packing, *, frozen=None, deform: bool = False, radius: float
         LP steps.
     shrink : float, default ASCENT_SHRINK
         Factor of the trust radius per step.
+    rounds : int, default 1
+        Schedules at most: each round restarts from ``radius`` at the previous round's packing, and
+        the ascent stops after a round that gains less than ROUND_GAIN (relative). One schedule
+        travels at most radius / (1 - shrink) per component, so a packing far from its maximum (an
+        LS crystal in a small deforming cell) needs several.
 
     Returns
     -------
@@ -212,10 +226,27 @@ def ascend(packing: Packing, *, frozen=None, deform: bool = False, radius: float
         raise InvalidInputError(f"steps must be a positive integer, got {steps!r}")
     if not (np.isfinite(shrink) and 0 < shrink <= 1):
         raise InvalidInputError(f"shrink must be in (0, 1], got {shrink!r}")
+    if not (isinstance(rounds, int) and rounds >= 1):
+        raise InvalidInputError(f"rounds must be a positive integer, got {rounds!r}")
+    moving = _moving(packing, frozen)
+    current, mu, done, repairs = packing, 1.0, 0, 0
+    while done < rounds:
+        start = current
+        current, mu, repaired = _round(start, moving, deform, float(radius), steps, shrink)
+        done += 1
+        repairs += repaired
+        if current.phi - start.phi <= ROUND_GAIN * start.phi:
+            break
+    return Ascent(packing=current, phi_start=float(packing.phi), phi=float(current.phi), mu_min=mu,
+                  steps=steps * done, rounds=done, repairs=repairs)
+
+
+def _round(packing: Packing, moving: np.ndarray, deform: bool, radius: float, steps: int, shrink: float):
+    """One schedule of :func:`ascend`: (the packing shrunk free of overlaps, mu_min before that,
+    repaired steps)."""
     d, f = packing.dim, dof_per_particle(packing.dim)
     a = float(np.min(packing.shape.semiaxes))
-    moving = _moving(packing, frozen)
-    current, x, r = packing, wrapped_positions(packing), float(radius)
+    current, x, r, repairs = packing, wrapped_positions(packing), radius, 0
     for _ in range(steps):
         net = ellipsoid_contacts(current, CANDIDATE_DELTA)
         t, _ = dof_basis(net, moving)
@@ -229,7 +260,17 @@ def ascend(packing: Packing, *, frozen=None, deform: bool = False, radius: float
         objective[n:n + min(k, d)] = 1.0  # Tr E
         objective[-1] = -float(d)
         rows = sp.hstack([-at, sp.csr_matrix(-strain), sp.csr_matrix(growth[:, None])]).tocsr()
-        lp = solve_lp(objective, A_ub=rows, b_ub=gaps, bounds=[(-r * a, r * a)] * n + [(-r, r)] * (k + 1))
+        try:
+            lp = solve_lp(objective, A_ub=rows, b_ub=gaps, bounds=[(-r * a, r * a)] * n + [(-r, r)] * (k + 1))
+        except LPFailure:
+            mu = _smallest_mu(current)
+            if mu >= 1.0:
+                raise  # the LP is feasible (nothing moves): a solver failure, not a repair
+            # the previous step left overlaps the trust radius cannot undo: shrink them away
+            current = displaced(current, x, np.zeros((packing.n_particles, f - d)), mu * (1.0 - 1e-12))
+            repairs += 1
+            r *= shrink
+            continue
         move = (t @ lp.x[:n]).reshape(packing.n_particles, f)
         lattice = None
         if deform:
@@ -241,7 +282,7 @@ def ascend(packing: Packing, *, frozen=None, deform: bool = False, radius: float
     mu = _smallest_mu(current)
     if mu < 1.0:
         current = displaced(current, x, np.zeros((packing.n_particles, f - d)), mu * (1.0 - 1e-12))
-    return Ascent(packing=current, phi_start=float(packing.phi), phi=float(current.phi), mu_min=mu, steps=steps)
+    return current, mu, repairs
 
 
 def confirm_unjamming(packing: Packing, result, *, amplitudes=CONFIRM_AMPLITUDES) -> Unjamming:

@@ -162,11 +162,12 @@ def cmd_crystal_search(args) -> int:
     from hardpack.io import write_dataset
     from hardpack.md.crystal_search import crystal_search
 
-    protocol = {k: getattr(args, k) for k in ("pressure", "equilibration", "growth_rate", "max_pressure")}
+    protocol = {k: getattr(args, k) for k in ("pressure", "equilibration", "growth_rate", "max_pressure", "polish")}
     ds = crystal_search(args.n, args.alpha, args.seeds, **protocol)
     write_dataset(ds, args.out)
-    log.info("wrote %s: best phi %.6f (laminate %.6f), %d of %d runs match the laminate", args.out,
-             ds.attrs["phi_best"], ds.attrs["phi_laminate"], int(ds["laminate"].sum()), ds["laminate"].size)
+    log.info("wrote %s: best phi %.6f (laminate %.6f), %d of %d runs match the laminate; polished: best %.7f, "
+             "%d match", args.out, ds.attrs["phi_best"], ds.attrs["phi_laminate"], int(ds["laminate"].sum()),
+             ds["laminate"].size, ds.attrs["phi_best_polished"], int(ds["laminate_polished"].sum()))
     return 0
 
 
@@ -248,6 +249,8 @@ def register(subparsers) -> None:
                    help=f"LS growth rate of the final compression (default {cs.GROWTH_RATE:g})")
     p.add_argument("--max-pressure", type=float, default=cs.MAX_PRESSURE,
                    help=f"reduced pressure ending the compression (default {cs.MAX_PRESSURE:g})")
+    p.add_argument("--no-polish", dest="polish", action="store_false",
+                   help="skip the polish of each jammed packing by the SLP size ascent in the deforming cell")
     p.add_argument("--out", required=True, help="output netCDF (phi, contacts, laminate match per n and seed)")
     p.set_defaults(func=cmd_crystal_search)
 

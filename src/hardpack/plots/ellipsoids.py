@@ -217,11 +217,12 @@ def plot_laminate_family(family, searches=()):
 
 
 def _plot_searches(ax, searches) -> float:
-    """Markers of the crystal-search runs, one colour and sideways offset per particles per cell;
-    returns the lowest density drawn."""
+    """Markers of the crystal-search runs, one colour and sideways offset per particles per cell,
+    and a black cross at each run's polished density (when the search has it); returns the lowest
+    density drawn."""
     ns = sorted({int(n) for ds in searches for n in ds["n"].values})
     markers = "sD^vo"
-    low = np.inf
+    low, polished = np.inf, False
     for k, n in enumerate(ns):
         offset = 1.0 + 0.015 * (k - (len(ns) - 1) / 2)
         colour, marker = f"C{k + 4}", markers[k % len(markers)]
@@ -235,4 +236,8 @@ def _plot_searches(ax, searches) -> float:
             ax.plot(x[~match], phi[~match], marker, ms=4, mfc="none", color=colour)
             ax.plot(x[match], phi[match], marker, ms=4, color=colour)
             low = min(low, float(np.nanmin(phi)))
+            if "phi_polished" in ds and np.isfinite(ds["phi_polished"].sel(n=n).values).any():
+                ax.plot(x, np.asarray(ds["phi_polished"].sel(n=n).values, float), "+", ms=5, color="k",
+                        label=None if polished else "polished (SLP, deforming cell)")
+                polished = True
     return low
