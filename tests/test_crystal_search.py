@@ -95,8 +95,9 @@ def test_bad_input_is_refused():
         search_run(1, 1.0, 0)
 
 
-def _search(alpha, ns, phi, contacts):
-    """A search dataset with given phi and mean contacts on (n, seed), shaped as crystal_search's."""
+def _search(alpha, ns, phi, contacts, polished=None):
+    """A search dataset with given phi and mean contacts on (n, seed), shaped as crystal_search's;
+    ``polished`` phi with the same contacts, or none (a search without the polish)."""
     import xarray as xr
 
     phi, contacts = np.asarray(phi, float), np.asarray(contacts, float)
@@ -104,23 +105,33 @@ def _search(alpha, ns, phi, contacts):
     data = {"phi": (("n", "seed"), phi), "Z": (("n", "seed"), np.full(phi.shape, 1e9)),
             "contacts": (("n", "seed"), contacts), "min_contacts": (("n", "seed"), contacts),
             "max_contacts": (("n", "seed"), contacts), "laminate": (("n", "seed"), lam)}
+    if polished is not None:
+        polished = np.asarray(polished, float)
+        data.update({"phi_polished": (("n", "seed"), polished),
+                     "min_contacts_polished": (("n", "seed"), contacts),
+                     "max_contacts_polished": (("n", "seed"), contacts),
+                     "laminate_polished": (("n", "seed"), (np.abs(polished - 0.7707316) < 1e-4) & (contacts == 14))})
     return xr.Dataset(data, coords={"n": ns, "seed": np.arange(phi.shape[1])}, attrs={"alpha": alpha})
 
 
 def test_search_rows_judge_the_best_run_against_donevs_search():
     from hardpack.validation.ellipsoids import crystal_search_rows
 
-    found = _search(SQRT3, [2, 4], [[0.7704, 0.7405], [0.770729, 0.7381]], [[12, 12], [14, 12]])
-    assert [r.status for r in crystal_search_rows([found])] == ["pass", "pass"]
+    found = _search(SQRT3, [2, 4], [[0.7704, 0.7405], [0.770729, 0.7381]], [[12, 12], [14, 12]],
+                    polished=[[0.7705, 0.7404805], [0.7707316, 0.7404805]])
+    assert [r.status for r in crystal_search_rows([found])] == ["pass", "pass", "pass"]
+    # polished 0.770731 is 1e-6 off the printed 0.770732 (6 digits): fails; unpolished: n/a
+    short = _search(SQRT3, [4], [[0.770729, 0.7381]], [[14, 12]], polished=[[0.770731, 0.7404805]])
+    assert [r.status for r in crystal_search_rows([short])] == ["pass", "pass", "fail"]
     fcc_only = _search(SQRT3, [4], [[0.740480, 0.7381]], [[12, 10]])
-    assert [r.status for r in crystal_search_rows([fcc_only])] == ["fail", "fail"]
+    assert [r.status for r in crystal_search_rows([fcc_only])] == ["fail", "fail", "n/a"]
     # the second-best laminate-like run of phi 0.77064 is 9e-5 off the printed 0.7707: fails
     near = _search(SQRT3, [4], [[0.77064, 0.7381]], [[14, 10]])
-    assert [r.status for r in crystal_search_rows([near])] == ["fail", "pass"]
-    one_per_cell = _search(SQRT3, [1], [[0.740480]], [[12]])
-    assert [r.status for r in crystal_search_rows([one_per_cell])] == ["n/a", "n/a"]
+    assert [r.status for r in crystal_search_rows([near])] == ["fail", "pass", "n/a"]
+    one_per_cell = _search(SQRT3, [1], [[0.740480]], [[12]], polished=[[0.7404805]])
+    assert [r.status for r in crystal_search_rows([one_per_cell])] == ["n/a", "n/a", "n/a"]
     elsewhere = _search(1.5, [4], [[0.7573]], [[12]])
-    assert [r.status for r in crystal_search_rows([elsewhere])] == ["n/a", "n/a"]
+    assert [r.status for r in crystal_search_rows([elsewhere])] == ["n/a", "n/a", "n/a"]
 
 
 def test_laminate_figure_shows_the_search_runs():
