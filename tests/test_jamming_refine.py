@@ -19,6 +19,7 @@ import scipy.sparse as sp
 
 from hardpack.errors import InvalidInputError
 from hardpack.io import dataset_to_packing, load_dataset
+from hardpack.jamming import refine as refine_module
 from hardpack.jamming.ellipsoids import contacts_of_pairs, ellipsoid_contacts
 from hardpack.jamming.refine import (
     MAX_STEP,
@@ -128,7 +129,7 @@ def test_an_unjammed_jamming_point_is_confirmed_by_the_size_ascent():
     assert quick.params["ascended"] == 0 and "ascent_gain" not in quick.params
 
 
-def test_newton_reaches_the_jamming_point_after_the_size_ascent():
+def test_newton_reaches_the_jamming_point_after_the_size_ascent(monkeypatch):
     """Prolate alpha = 1.02 (N = 100, LS at the final rate 1e-4 to p = 1e12, seed 2 of the full
     config): Newton diverges from the packing as given (a step of 12 semiaxes: the floppy modes
     leave the packing far from its jamming point). After the SLP size ascent it converges, and
@@ -143,6 +144,11 @@ def test_newton_reaches_the_jamming_point_after_the_size_ascent():
     assert 0 < out.params["ascent_phi_change"] < 1e-6
     assert out.params["refine_note"].startswith("Newton from the packing as given failed")
     assert (out.verdict, out.order) == (Verdict.JAMMED, "second") and out.isostaticity_gap < 0
+    # above ASCENT_MAX_PARTICLES the retry is skipped, and the note says so
+    monkeypatch.setattr(refine_module, "ASCENT_MAX_PARTICLES", 50)
+    large = verify_at_jamming_point(packing, delta="gaps")
+    assert large.verdict == Verdict.UNDETERMINED and large.params["ascended"] == 0
+    assert "no retry after the size ascent above N = 50" in large.params["refine_note"]
 
 
 def test_bad_input_is_refused():

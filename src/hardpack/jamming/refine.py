@@ -319,6 +319,11 @@ MAX_STEP = 0.5
 #: first trust radius of the size ascent that brings a packing closer to its jamming point when
 #: Newton does not reach it from the packing as given (:func:`verify_at_jamming_point`)
 ASCENT_RADIUS = 1e-2
+#: the size ascent runs in :func:`verify_at_jamming_point` up to this many particles: one ascent
+#: took 3 s at N = 100, while at N = 1000 (M&M) one LP step took 111-372 s with HiGHS's dual
+#: simplex (14 s with its interior point method, whose different vertices left the retry of the
+#: prolate alpha = 1.02 test packing with an overlapping rattler), 80 steps a round
+ASCENT_MAX_PARTICLES = 400
 #: iterative-refinement steps of :func:`_solve` at most
 SOLVE_REFINEMENTS = 3
 
@@ -414,6 +419,9 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     prolate alpha = 1.02 (N = 100, rate 1e-4, seed 2): Newton diverged from the packing as given
     and converged in 3 steps after the ascent.
 
+    Both uses of the ascent need N <= ASCENT_MAX_PARTICLES; above it, they are skipped and the note
+    says so.
+
     A verdict of the refined configuration that is second-order flexible is then checked by the
     size ascent (:func:`hardpack.jamming.ascent.confirm_unjamming`, unless ``confirm`` is False):
     ``ascent_confirmed`` (1 when an explicit denser packing without overlaps was found along the
@@ -435,10 +443,16 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     -------
     EllipsoidJammingResult
     """
-    first = _at_jamming_point(packing, confirm, options)
+    affordable = packing.n_particles <= ASCENT_MAX_PARTICLES
+    first = _at_jamming_point(packing, confirm and affordable, options)
     first.params.setdefault("ascended", 0)
-    if not retry_after_ascent or first.params.get("refined") != 0 or "refine_iterations" not in first.params:
+    if first.params.get("refined") != 0 or "refine_iterations" not in first.params:
         return first  # refined, or Newton never started (no near self-stress, walls)
+    if retry_after_ascent and not affordable:
+        first.params["refine_note"] += (f"; no retry after the size ascent above N = {ASCENT_MAX_PARTICLES} "
+                                        "(its LPs take minutes a step at N = 1000)")
+    if not (retry_after_ascent and affordable):
+        return first
     climbed = ascend(packing, frozen=options.get("frozen"), radius=ASCENT_RADIUS)
     second = _at_jamming_point(climbed.packing, confirm, options)
     gain = (climbed.phi - packing.phi) / packing.phi
@@ -490,8 +504,12 @@ def _at_jamming_point(packing: Packing, confirm: bool, options: dict):
                    f"and {int(refined.rattler.sum())} rattlers (before: {dec.n_constraints}, "
                    f"{int(result.rattler.sum())})")), **info)
             refined.collective.reason = f"at the jamming point of the contacts: {refined.collective.reason}"
-            if confirm and refined.verdict == Verdict.NOT_JAMMED and refined.unjamming_motion() is not None:
-                _confirm(ref.packing, refined)
+            if refined.verdict == Verdict.NOT_JAMMED and refined.unjamming_motion() is not None:
+                if confirm:
+                    _confirm(ref.packing, refined)
+                elif packing.n_particles > ASCENT_MAX_PARTICLES:
+                    refined.collective.reason += (f"; not certified by the size ascent (skipped above "
+                                                  f"N = {ASCENT_MAX_PARTICLES})")
             return refined
         solved = ref.gap[-1] <= REFINE_TOL and ref.balance[-1] <= REFINE_TOL
         note = (f"not refined: Newton reached the stationary point of the contacts in {ref.iterations} steps "
