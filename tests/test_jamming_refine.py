@@ -21,6 +21,7 @@ from hardpack.errors import InvalidInputError
 from hardpack.io import dataset_to_packing, load_dataset
 from hardpack.jamming import refine as refine_module
 from hardpack.jamming.ellipsoids import contacts_of_pairs, ellipsoid_contacts
+from hardpack.jamming.highs import LPFailure
 from hardpack.jamming.refine import (
     MAX_STEP,
     _next_network,
@@ -149,6 +150,15 @@ def test_newton_reaches_the_jamming_point_after_the_size_ascent(monkeypatch):
     large = verify_at_jamming_point(packing, delta="gaps")
     assert large.verdict == Verdict.UNDETERMINED and large.params["ascended"] == 0
     assert "no retry after the size ascent above N = 50" in large.params["refine_note"]
+    # a solver failure inside the ascent leaves the first verdict, with a note, not a crash
+    monkeypatch.setattr(refine_module, "ASCENT_MAX_PARTICLES", 400)
+
+    def failing(*args, **kwargs):
+        raise LPFailure("HiGHS returned status 4: numerical trouble")
+
+    monkeypatch.setattr(refine_module, "ascend", failing)
+    failed = verify_at_jamming_point(packing, delta="gaps")
+    assert failed.verdict == Verdict.UNDETERMINED and "the size ascent failed" in failed.params["refine_note"]
 
 
 def test_bad_input_is_refused():

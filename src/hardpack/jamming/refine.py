@@ -67,6 +67,7 @@ from hardpack.jamming.ellipsoids import (
     rigidity_transpose_full,
     stiffness_matrix_full,
 )
+from hardpack.jamming.highs import LPFailure
 from hardpack.jamming.result import Verdict
 from hardpack.jamming.second_order import dof_basis, trivial_motions, verify_ellipsoids
 
@@ -374,7 +375,11 @@ def _confirm(packing: Packing, result) -> None:
     """Certify the second-order flexible verdict ``result`` of the jamming point ``packing`` by the
     size ascent along its unjamming motion (:func:`hardpack.jamming.ascent.confirm_unjamming`);
     the outcome goes to ``result.params`` and the reason."""
-    found = confirm_unjamming(packing, result)
+    try:
+        found = confirm_unjamming(packing, result)
+    except LPFailure as exc:
+        result.collective.reason += f"; not certified: the size ascent failed ({exc})"
+        return
     result.params.update(ascent_confirmed=int(found.confirmed), ascent_gain=found.gain,
                          ascent_amplitude=found.amplitude, ascent_tried=found.tried)
     result.collective.reason += (
@@ -453,7 +458,11 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
                                         "(its LPs take minutes a step at N = 1000)")
     if not (retry_after_ascent and affordable):
         return first
-    climbed = ascend(packing, frozen=options.get("frozen"), radius=ASCENT_RADIUS)
+    try:
+        climbed = ascend(packing, frozen=options.get("frozen"), radius=ASCENT_RADIUS)
+    except LPFailure as exc:
+        first.params["refine_note"] += f"; the size ascent failed ({exc}), so Newton was not retried"
+        return first
     second = _at_jamming_point(climbed.packing, confirm, options)
     gain = (climbed.phi - packing.phi) / packing.phi
     if second.params.get("refined") != 1:
