@@ -63,7 +63,9 @@ def register(subparsers) -> None:
     p.add_argument("--refine", action="store_true",
                    help="ellipses and ellipsoids near their jamming point (LS packings): test the "
                         "jamming point of the contacts, found by Newton's method, when it converges "
-                        "with no overlap (hardpack.jamming.refine)")
+                        "with no overlap, if need be after an SLP ascent of the size; certify a "
+                        "second-order flexible verdict there by an explicit denser packing "
+                        "(hardpack.jamming.refine, hardpack.jamming.ascent; N <= 400)")
     p.set_defaults(func=cmd_verify)
 
 
