@@ -63,6 +63,7 @@ from hardpack.jamming.ellipsoids import (
     rigidity_transpose_full,
 )
 from hardpack.jamming.highs import LPFailure, solve_lp
+from hardpack.jamming.rigidity import strain_pairs
 from hardpack.jamming.second_order import dof_basis
 
 __all__ = ["Ascent", "Unjamming", "ascend", "confirm_unjamming", "CONFIRM_AMPLITUDES"]
@@ -147,9 +148,17 @@ def _check_periodic_ellipsoids(packing: Packing) -> None:
                                 f"this packing's boundary is {packing.boundary}")
 
 
-def _smallest_mu(packing: Packing) -> float:
-    near = ellipsoid_contacts(packing, CANDIDATE_DELTA)
-    return float(np.sqrt(near.zeta + 1.0).min()) if near.n_contacts else 1.0 + CANDIDATE_DELTA
+def _smallest_mu(net) -> float:
+    """The smallest Perram-Wertheim factor mu of the pairs of ``net`` (pairs beyond CANDIDATE_DELTA
+    do not overlap)."""
+    return float(np.sqrt(net.zeta.min() + 1.0)) if net.n_contacts else 1.0 + CANDIDATE_DELTA
+
+
+def _shrunk(packing: Packing, positions: np.ndarray, mu: float) -> Packing:
+    """``packing`` at ``positions`` with every semiaxis scaled by mu (1 - 1e-12): no pair whose
+    smallest factor was mu overlaps."""
+    spins = np.zeros((packing.n_particles, dof_per_particle(packing.dim) - packing.dim))
+    return displaced(packing, positions, spins, mu * (1.0 - 1e-12))
 
 
 def _moving(packing: Packing, frozen) -> np.ndarray:
@@ -164,22 +173,18 @@ def _moving(packing: Packing, frozen) -> np.ndarray:
 
 def _strain_rows(net, d: int) -> np.ndarray:
     """(M, d(d+1)/2): the gap rate of each contact under a symmetric strain E of the cell and the
-    centres, dr = E r for the separation r (u . E r, u the unit normal); columns E_aa, then E_ab
-    (a < b) counted twice."""
+    centres, dr = E r for the separation r (u . E r, u the unit normal); columns in the order of
+    :func:`hardpack.jamming.rigidity.strain_pairs`, E_pq with p < q counted twice."""
     u, r = net.normal, net.separation
-    cols = [u[:, a] * r[:, a] for a in range(d)]
-    cols += [u[:, a] * r[:, b] + u[:, b] * r[:, a] for a in range(d) for b in range(a + 1, d)]
-    return np.column_stack(cols)
+    return np.column_stack([u[:, p] * r[:, q] + (u[:, q] * r[:, p] if p != q else 0.0)
+                            for p, q in strain_pairs(d)])
 
 
 def _strain_matrix(e: np.ndarray, d: int) -> np.ndarray:
-    """The symmetric strain of the LP's variables (E_aa, then E_ab with a < b)."""
-    strain = np.diag(e[:d])
-    k = d
-    for a in range(d):
-        for b in range(a + 1, d):
-            strain[a, b] = strain[b, a] = e[k]
-            k += 1
+    """The symmetric strain of the LP's variables (in the order of ``strain_pairs``)."""
+    strain = np.zeros((d, d))
+    for value, (p, q) in zip(e, strain_pairs(d)):
+        strain[p, q] = strain[q, p] = value
     return strain
 
 
@@ -264,11 +269,11 @@ def _round(packing: Packing, moving: np.ndarray, deform: bool, radius: float, st
         try:
             lp = solve_lp(objective, A_ub=rows, b_ub=gaps, bounds=[(-r * a, r * a)] * n + [(-r, r)] * (k + 1))
         except LPFailure:
-            mu = _smallest_mu(current)
+            mu = _smallest_mu(net)
             if mu >= 1.0:
                 raise  # the LP is feasible (nothing moves): a solver failure, not a repair
             # the previous step left overlaps the trust radius cannot undo: shrink them away
-            current = displaced(current, x, np.zeros((packing.n_particles, f - d)), mu * (1.0 - 1e-12))
+            current = _shrunk(current, x, mu)
             repairs += 1
             r *= shrink
             continue
@@ -280,9 +285,9 @@ def _round(packing: Packing, moving: np.ndarray, deform: bool, radius: float, st
         x = x + move[:, :d]
         current = displaced(current, x, move[:, d:], 1.0 + float(lp.x[-1]), lattice)
         r *= shrink
-    mu = _smallest_mu(current)
+    mu = _smallest_mu(ellipsoid_contacts(current, CANDIDATE_DELTA))
     if mu < 1.0:
-        current = displaced(current, x, np.zeros((packing.n_particles, f - d)), mu * (1.0 - 1e-12))
+        current = _shrunk(current, x, mu)
     return current, mu, repairs
 
 
