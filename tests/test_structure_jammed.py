@@ -3,8 +3,9 @@
 N = 2000 monodisperse spheres from RSA at phi = 0.3, compressed with hardpack.md at the fast
 rate Gamma = 1e-2 to reduced pressure 1e10 (about 15 s; phi ~ 0.645, amorphous). Published
 targets (Donev 2006, secs. 9.3.1.2 and 9.3.1.3, Figs. 9.6-9.7; sec. 10.3, Fig. 10.2):
-- backbone (rattlers removed) Z(l) - Z_c ~ 11 l^0.6: we accept alpha = 0.6 +- 0.1;
-- with rattlers kept the exponent is smaller ("closer to 0.5");
+- backbone (rattlers removed) Z(l) - Z_c ~ 11 l^0.6: alpha within the printed digits (+-0.05)
+  plus twice the fit's standard error, the validation row's rule (measured: 0.544 +- 0.012);
+- with rattlers kept the exponent is smaller ("closer to 0.5"), outside that band (measured 0.478);
 - split second peak of g2: maxima at sqrt(3) D and at 2 D with a sharp drop at 2 D+;
 - S(0) far below the fluid: the hard-sphere fluid at phi = 0.49 has S(0) = 0.019
   (Carnahan-Starling compressibility). Donev reports S(0) < 1e-3 for N = 1e5..1e6; at N = 2000
@@ -53,7 +54,8 @@ def test_near_contact_power_law(jammed):
     z = cumulative_coordination(packing, gap_max=0.3, rattlers=rattlers)
     backbone = fit_coordination_power_law(z, 1e-5, 0.1)
     kept = fit_coordination_power_law(z, 1e-5, 0.1, backbone=False)
-    assert abs(backbone.alpha - 0.6) < 0.1
+    assert abs(backbone.alpha - 0.6) <= 0.05 + 2 * backbone.alpha_err
+    assert abs(kept.alpha - 0.6) > 0.05 + 2 * kept.alpha_err
     assert 5.5 < backbone.z_contact < 6.05
     assert 7 < backbone.amplitude < 15  # Donev: a ~ 11
     assert kept.alpha < backbone.alpha - 3 * backbone.alpha_err
