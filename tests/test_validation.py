@@ -362,6 +362,18 @@ def test_ellipsoid_rows_judge_the_published_shape_dependence():
     assert {r.status for r in small.values()} == {NA}
 
 
+def test_sphere_point_row_counts_seeds_not_families():
+    """At alpha = 1 the three families hold the same spheres, and one seed gives one packing in
+    each: the row's samples are the 2 seeds (0.641, 0.642: mean 0.6415, standard error 0.0005),
+    not 6 packings (which would give 0.00022)."""
+    from hardpack.validation.ellipsoids import ellipsoid_rows
+
+    row = {r.target: r for r in ellipsoid_rows([_ellipsoid_summary()])}["donev-5.2-phij-sphere-point"]
+    assert row.reproduced == pytest.approx(0.6415)
+    assert row.uncertainty == pytest.approx(0.0005)
+    assert "2 seeds" in row.detail
+
+
 def _ellipsoid_verdicts(n=100, jammed=(1, 1, 1, 1, 1, 1), order=(2, 2, 2, 2, 2, 2), gap=1e-2):
     """Six 3D packings: three at alpha = 1.05 and three at 1.5 (beta = 0.5), hypostatic."""
     k = len(jammed)
