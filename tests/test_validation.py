@@ -352,8 +352,9 @@ def test_ellipsoid_rows_judge_the_published_shape_dependence():
     assert rows["donev-5.4-z-max-non-spheroids"].status == PASS
     assert rows["donev-5.2-z-plateau-spheroids"].status == PASS  # 9.6 within the printed 10 +- 0.5
     assert rows["donev-5.2-prolate-oblate-duality"].status == PASS
-    assert {rows[t].status for t in ("donev-fig5.1-mm-nematic", "donev-ch7-mm-z")} == {PASS}
-    assert rows["donev-fig5.1-mm-phi"].status == DEVIATION_PASSES  # a known deviation (the growth rate)
+    assert rows["donev-fig5.1-mm-nematic"].status == PASS
+    # known deviations (both rise with slower growth): at the printed values they pass, which the gate reports
+    assert {rows[t].status for t in ("donev-fig5.1-mm-phi", "donev-ch7-mm-z")} == {DEVIATION_PASSES}
     assert rows["donev-5.2-phij-max-self-dual"].reproduced == pytest.approx(0.7415)
     shifted = {r.target: r for r in ellipsoid_rows([_ellipsoid_summary(oblate_shift=0.01, mm_phi=(0.72, 0.721))])}
     assert shifted["donev-5.2-prolate-oblate-duality"].status == FAIL
