@@ -540,3 +540,68 @@ def test_continued_run_without_the_start_attribute_extrapolates_the_first_window
     del late.attrs["phi_start"]
     with pytest.raises(InvalidInputError, match="where no stage of its parent ends"):
         study.continued_run([late], parent)
+
+
+def test_excess_difference_is_the_eos_integral_between_off_grid_limits():
+    phi = np.linspace(0.70, 0.85, 151)
+    value, _ = thermo.excess_difference(phi, henderson(phi), None, 0.7485, 0.7984)
+    exact = float(thermo.henderson_excess(0.7984) - thermo.henderson_excess(0.7485))
+    assert value == pytest.approx(exact, rel=3e-5)   # the trapezoid's h^2 error: 2.3e-4 at h = 0.005
+    # on the grid it is the difference of the tabulated integral from the ideal gas
+    full = np.linspace(0.005, 0.85, 170)
+    f, _ = thermo.excess_free_energy(full, henderson(full))
+    assert thermo.excess_difference(full, henderson(full), None, full[140], full[160])[0] == pytest.approx(
+        f[160] - f[140], rel=1e-12)
+    with pytest.raises(InvalidInputError, match="range"):
+        thermo.excess_difference(phi, henderson(phi), None, 0.65, 0.80)
+    with pytest.raises(InvalidInputError, match="range"):
+        thermo.excess_difference(phi, henderson(phi), None, 0.80, 0.75)
+
+
+def test_excess_difference_error_matches_the_scatter_of_noisy_tables():
+    rng = np.random.default_rng(11)
+    phi = np.linspace(0.70, 0.85, 16)
+    z = henderson(phi)
+    err = 0.05 + 0.1 * rng.random(phi.size)
+    _, predicted = thermo.excess_difference(phi, z, err, 0.733, 0.811)
+    samples = [thermo.excess_difference(phi, z + err * rng.standard_normal(phi.size), None, 0.733, 0.811)[0]
+               for _ in range(4000)]
+    assert np.std(samples) == pytest.approx(predicted, rel=0.05)
+
+
+def _crystal_inputs(shift_hi=0.0, seeds=(1, 2, 3), with_branch=True):
+    import xarray as xr
+
+    grid = np.arange(0.6025, 0.88, 0.005)
+    z = henderson(grid) * (1 + 0.2 * (grid - 0.6))   # any smooth EOS: the row integrates what it is given
+    branches = ["1e-06", "decompression"] if with_branch else ["1e-06"]
+    eos = xr.Dataset({"phi_mean": (("branch", "phi"), np.tile(grid, (len(branches), 1))),
+                      "Z": (("branch", "phi"), np.tile(z, (len(branches), 1))),
+                      "Z_err": (("branch", "phi"), np.full((len(branches), grid.size), 1e-3)),
+                      "excess": (("branch", "phi"), np.tile(thermo.excess_free_energy(grid, z)[0], (len(branches), 1))),
+                      "excess_err": (("branch", "phi"), np.full((len(branches), grid.size), 1e-4))},
+                     coords={"branch": branches, "phi": grid},
+                     attrs={"hardpack_kind": "glass_eos", "cubic_branch": "1e-06"})
+    exact = thermo.excess_difference(grid, z, None, 0.75, 0.80)[0]
+    phi = np.repeat([0.75, 0.80], len(seeds))
+    scatter = np.tile([1e-4, -1e-4, 0.0][:len(seeds)], 2)   # seed scatter with an exact mean
+    excess = np.where(phi == 0.75, 4.0, 4.0 + exact + shift_hi) + scatter
+    bcmd = xr.Dataset({"excess": ("sample", excess), "n_particles": ("sample", np.full(phi.size, 4096)),
+                       "seconds": ("sample", np.full(phi.size, 50.0))},
+                      coords={"phi": ("sample", phi), "seed": ("sample", np.tile(seeds, 2))})
+    return bcmd, eos
+
+
+def test_crystal_row_passes_agreeing_free_energies_and_fails_a_shifted_one():
+    from hardpack.validation.glass import disk_crystal_rows
+
+    (row,) = disk_crystal_rows(*_crystal_inputs())
+    assert row.status == "pass" and row.reproduced == pytest.approx(0.0, abs=5e-4)
+    assert "phi = 0.75 .. 0.8" in row.label and "3 and 3 seeds" in row.detail
+    # a disagreement of 0.01 (the glass snapshots' defect-driven offset is of this size) fails it
+    (shifted,) = disk_crystal_rows(*_crystal_inputs(shift_hi=0.01))
+    assert shifted.status == "fail"
+    # one seed has no spread: not applicable; a summary without the decompression branch has no value: fails
+    assert disk_crystal_rows(*_crystal_inputs(seeds=(1,)))[0].status == "n/a"
+    (missing,) = disk_crystal_rows(*_crystal_inputs(with_branch=False))
+    assert missing.status == "fail" and "no decompression branch" in missing.detail

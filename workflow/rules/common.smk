@@ -554,6 +554,14 @@ def glass_bcmd_files(system):
             for phi in sorted(GLASS["snapshots"]) for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
 
 
+def glass_crystal_bcmd_files():
+    """BCMD of the defect-free monodisperse crystal (glass.mono.crystal_bcmd), per density and seed."""
+    spec = GLASS["mono"].get("crystal_bcmd")
+    if not spec:
+        return []
+    return [f"results/glass/mono/crystal_bcmd/phi{phi}/seed{seed}.nc" for phi in spec["phis"] for seed in spec["seeds"]]
+
+
 def glass_crystal_cells():
     """(nx, ny) of the triangular crystal of N = 2 nx ny disks, the box closest to square (nx ~ 2 ny)."""
     half = GLASS["N"] // 2
@@ -678,6 +686,9 @@ def _combined_summaries():
                 ellipse_bcmd_files(), ["seed"],
                 ["f_j_minus_fcj", "exact", "bcmd", "exact_in_cells", "inside_fraction", "inside_fraction_err",
                  "n_eff", "n_particles", "n_fixed_translation", "n_events", "seconds", "next_gap"])
+    if GLASS and glass_crystal_bcmd_files():
+        table["glass/mono/crystal_bcmd"] = _combined(glass_crystal_bcmd_files(), ["phi", "seed"],
+                                                     ["excess", "n_particles", "n_events", "seconds"])
     for dim in (2, 3):
         files = ellipsoid_files(dim, "contacts")
         if files:
@@ -793,6 +804,8 @@ def validation_inputs():
         inputs["glass_eos"] = [summary("glass/binary/eos"), summary("glass/mono/eos")]
         inputs["glass_entropy"] = [summary("glass/binary/entropy"), summary("glass/mono/entropy")]
         inputs["glass_freezing"] = [summary("glass/freezing")]
+        if glass_crystal_bcmd_files():
+            inputs["glass_crystal"] = [summary("glass/mono/crystal_bcmd"), summary("glass/mono/eos")]
         if GLASS.get("relaxed"):
             inputs["glass_relaxed"] = [summary("glass/binary/relaxed")]
     if MICROSEG:

@@ -115,6 +115,34 @@ rule glass_decompress:
         " --checkpoint {params.checkpoint} > {log} 2>&1"
 
 
+rule glass_crystal_bcmd:
+    """BCMD free energy of the defect-free triangular crystal at {phi} (the glass.mono.crystal_phi
+    crystal with its radii rescaled; Donev 2006, Fig. 13.2), with the glass snapshots' BCMD settings."""
+    input:
+        "results/glass/mono/crystal.nc",
+    output:
+        "results/glass/mono/crystal_bcmd/phi{phi}/seed{seed}.nc",
+    params:
+        b=GLASS["bcmd"] if GLASS else None,
+        thermostat=glass_bcmd_thermostat,
+    wildcard_constraints:
+        phi=GLASS_PHI,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_bcmd"),
+        runtime=job_runtime("glass_bcmd"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_crystal_bcmd/phi{phi}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_crystal_bcmd/phi{phi}/seed{seed}.tsv"
+    shell:
+        "hardpack bcmd {input} --out {output} --phi {wildcards.phi} --dmu-max {params.b[dmu_max]}"
+        " --gamma0 {params.b[gamma0]} --theta {params.b[theta]} {params.thermostat} --seed {wildcards.seed}"
+        " > {log} 2>&1"
+
+
 rule glass_eos:
     """Binned EOS of a glass system, its EOS integral from the ideal gas and the fits of Eqs. 13.3-13.4."""
     input:

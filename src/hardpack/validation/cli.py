@@ -31,6 +31,7 @@ from hardpack.validation.freeenergy import (
     simplex_rows,
 )
 from hardpack.validation.glass import (
+    disk_crystal_rows,
     entropy_rows,
     eos_rows,
     freezing_rows,
@@ -72,6 +73,7 @@ ROW_BUILDERS = {
     "polydisperse": polydisperse_rows,
     "glass_eos": lambda datasets: [row for ds in datasets for row in eos_rows(ds)],
     "glass_entropy": lambda datasets: [row for ds in datasets for row in entropy_rows(ds)],
+    "glass_crystal": lambda datasets: _disk_crystal_rows(datasets),
     "glass_freezing": lambda datasets: [row for ds in datasets for row in freezing_rows(ds)],
     "glass_relaxed": lambda datasets: [row for ds in datasets for row in relaxed_rows(ds)],
     "glass_microsegregated": lambda datasets: [row for ds in datasets for row in microsegregated_rows(ds)],
@@ -81,6 +83,15 @@ ROW_BUILDERS = {
     "crystal_search": crystal_search_rows,
     "containers": container_rows,
 }
+
+
+def _disk_crystal_rows(datasets) -> list:
+    eos = [ds for ds in datasets if ds.attrs.get("hardpack_kind") == "glass_eos"]
+    bcmd = [ds for ds in datasets if ds.attrs.get("hardpack_kind") != "glass_eos"]
+    if len(eos) != 1 or len(bcmd) != 1:
+        raise InvalidInputError("glass_crystal takes the crystal's BCMD summary and the monodisperse "
+                                f"EOS summary (one each), got {len(bcmd)} and {len(eos)}")
+    return disk_crystal_rows(bcmd[0], eos[0])
 
 
 def parse_inputs(items: list[str]) -> dict[str, list[str]]:

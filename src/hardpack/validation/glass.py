@@ -1,6 +1,6 @@
 """Validation rows of the binary hard-disk glass study (Donev 2006, ch. 13): the mixing entropy,
 the Eq. 13.3 and 13.4 fits of the compression EOS, the freezing point and s_c - s_mix of the SOC
-glasses."""
+glasses, and BCMD of the defect-free monodisperse crystal against its EOS."""
 
 from __future__ import annotations
 
@@ -9,8 +9,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from hardpack.glass.thermo import mixing_entropy
-from hardpack.validation.rows import NA, Row, evaluate
+from hardpack.glass.study import liquid_excess_at
+from hardpack.glass.thermo import excess_difference, mixing_entropy
+from hardpack.validation.rows import NA, Row, evaluate, seed_statistics
 from hardpack.validation.targets import load_targets
 
 
@@ -355,6 +356,56 @@ def entropy_rows(ds) -> list[Row]:
         if np.isfinite(defects).all():
             detail += f"; % of disks without six neighbours {np.round(100 * defects, 2).tolist()}"
     return [evaluate(target, samples=samples, n=n, detail=detail)]
+
+
+def disk_crystal_rows(crystal_bcmd, eos) -> list[Row]:
+    """BCMD of the defect-free triangular crystal against the integral of the crystal's EOS
+    (Donev 2006, sec. 13.1: "BCMD and EOS integration agree in the solid"): the change of the
+    BCMD excess free energy between the lowest and the highest density of ``crystal_bcmd`` minus
+    int (Z - 1)/phi dphi of the decompression branch over the same range (both at the same N, so
+    the finite-N offsets of the two BCMD points cancel to O(ln N / N) of their difference).
+
+    Parameters
+    ----------
+    crystal_bcmd : xarray.Dataset
+        BCMD of the crystal over (phi, seed) with ``excess``, ``n_particles``, ``seconds``.
+    eos : xarray.Dataset
+        The monodisperse EOS summary (:func:`hardpack.glass.study.eos_dataset`) with a
+        ``decompression`` branch.
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
+    target = load_targets()["bcmd-disk-crystal-vs-eos"]
+    phi = np.round(crystal_bcmd["phi"].values.astype(float), 6)
+    excess = crystal_bcmd["excess"].values.astype(float)
+    n = int(np.asarray(crystal_bcmd["n_particles"].values).max())
+    lo, hi = float(phi.min()), float(phi.max())
+    if lo == hi:
+        return [evaluate(target, n=n, detail=f"BCMD at one density only (phi = {lo})")]
+    if "decompression" not in eos["branch"].values:
+        return [evaluate(target, n=n, detail="the EOS summary has no decompression branch")]
+    low, low_err, n_low, _ = seed_statistics(excess[phi == lo])
+    high, high_err, n_high, _ = seed_statistics(excess[phi == hi])
+    row = eos.sel(branch="decompression")
+    p, z, z_err = (row[k].values for k in ("phi_mean", "Z", "Z_err"))
+    ok = np.isfinite(p) & np.isfinite(z)
+    if not ok.any() or not p[ok].min() <= lo < hi <= p[ok].max():
+        return [evaluate(target, n=n, detail=f"the decompression EOS does not cover phi = {lo} .. {hi}")]
+    integral, integral_err = excess_difference(p[ok], z[ok], z_err[ok], lo, hi)
+    difference = (high - low) - integral
+    err = math.sqrt(sum(e**2 for e in (low_err, high_err, integral_err) if math.isfinite(e)))
+    seconds = float(np.nansum(crystal_bcmd["seconds"].values))
+    absolute = [f"{excess[phi == x].mean() - liquid_excess_at(eos, x)[0]:.4f}" for x in (lo, hi)]
+    return [evaluate(
+        target, difference, err, n=n, seeds=min(n_low, n_high), label=f"phi = {lo:g} .. {hi:g}",
+        detail=f"N = {n}; BCMD {high - low:.4f} ({n_low} and {n_high} seeds) against the decompression "
+               f"EOS integral {integral:.4f} +- {integral_err:.2g}; BCMD {seconds:.0f} CPU-s in all; BCMD minus the "
+               f"slowest compression's EOS integral from the ideal gas (Fig. 13.2): {absolute[0]} at phi = {lo:g}, "
+               f"{absolute[1]} at {hi:g}",
+    )]
 
 
 def microsegregated_rows(ds) -> list[Row]:
