@@ -761,6 +761,7 @@ def figures():
     names += ["ellipsoid_snapshot"] if ELLIPSOIDS and "mm" in ELLIPSOIDS else []
     names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
     names += ["glass_eos", "glass_entropy"] if GLASS else []
+    names += ["glass_crystal"] if GLASS and glass_crystal_bcmd_files() else []
     names += ["glass_jamming"] if GLASS and GLASS.get("relaxed") else []
     names += ["microsegregated", "microsegregated_maps"] if MICROSEG else []
     names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []

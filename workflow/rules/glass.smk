@@ -365,6 +365,30 @@ rule fig_glass_entropy:
         "../scripts/plot_glass_entropy.py"
 
 
+rule fig_glass_crystal:
+    """Free energy of monodisperse disks by EOS integration and by BCMD of the defect-free crystal (Donev 2006, Fig. 13.2)."""
+    input:
+        eos="results/glass/mono/eos_summary.nc",
+        crystal="results/glass/mono/crystal_bcmd_summary.nc",
+    output:
+        pdf="results/figures/glass_crystal.pdf",
+        png=report("results/figures/glass_crystal.png", caption="../report/glass_crystal.rst", category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_crystal"),
+        runtime=job_runtime("fig_glass_crystal"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_crystal.log",
+    benchmark:
+        "results/benchmarks/fig_glass_crystal.tsv"
+    script:
+        "../scripts/plot_glass_crystal.py"
+
+
 rule fig_glass_jamming:
     """Jamming densities of the mixture vs growth rate, before and after relaxation (Donev 2006, Fig. 13.8)."""
     input:

@@ -134,6 +134,63 @@ def plot_glass_jamming(eos, relaxed):
     return fig
 
 
+def plot_glass_crystal(eos, crystal_bcmd):
+    """Free energy of monodisperse disks by EOS integration and by BCMD (after Donev 2006, Fig.
+    13.2). Left: Delta f(phi) integrated from the ideal gas along the slowest compression, and the
+    BCMD points of the defect-free crystal. Right: the differences from that integral: the BCMD
+    points, and the decompression EOS integrated from the lowest BCMD point (the crystal's own
+    EOS; where it meets the higher BCMD points, BCMD and EOS integration agree).
+
+    Parameters
+    ----------
+    eos : xarray.Dataset
+        The monodisperse EOS summary (:func:`hardpack.glass.study.eos_dataset`) with a
+        ``decompression`` branch.
+    crystal_bcmd : xarray.Dataset
+        BCMD of the crystal over (phi, seed) with ``excess``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
+    from hardpack.glass.study import liquid_excess_at
+    from hardpack.glass.thermo import excess_difference
+
+    fig, axes = figure(1, 2, figsize=(9.0, 3.6))
+    slow = eos.sel(branch=eos.attrs["cubic_branch"])
+    ok = np.isfinite(slow["excess"].values)
+    p, f = slow["phi_mean"].values[ok], slow["excess"].values[ok]
+    axes[0].plot(p, f, "-", color="C0", label=f"EOS integral, compression at {slow['growth_rate'].item():g}")
+    phi = np.round(crystal_bcmd["phi"].values.astype(float), 6)
+    excess = crystal_bcmd["excess"].values.astype(float)
+    levels = np.unique(phi)
+    mean = np.array([excess[phi == x].mean() for x in levels])
+    err = np.array([excess[phi == x].std(ddof=1) / np.sqrt((phi == x).sum()) if (phi == x).sum() > 1 else np.nan
+                    for x in levels])
+    n = int(np.asarray(crystal_bcmd["n_particles"].values).max())
+    axes[0].errorbar(levels, mean, yerr=err, fmt="s", color="C3", ms=5, label="defect-free crystal, BCMD")
+    base = np.array([liquid_excess_at(eos, x)[0] for x in levels])
+    axes[1].errorbar(levels, mean - base, yerr=err, fmt="s", color="C3", ms=5, label="crystal, BCMD")
+    dec = eos.sel(branch="decompression")
+    good = np.isfinite(dec["Z"].values) & np.isfinite(dec["phi_mean"].values)
+    dp, dz, dze = (dec[k].values[good] for k in ("phi_mean", "Z", "Z_err"))
+    top = min(dp.max(), p.max())
+    grid = np.linspace(levels[0], top, 60)
+    curve = np.array([mean[0] + excess_difference(dp, dz, dze, levels[0], x)[0] for x in grid])
+    ref = np.array([liquid_excess_at(eos, x)[0] for x in grid])
+    axes[1].plot(grid, curve - ref, "-", color="C2", label=f"crystal: BCMD at {levels[0]:g} + decompression EOS")
+    axes[1].axhline(0.0, color="C0", lw=0.8)
+    axes[0].set_xlabel("phi")
+    axes[0].set_ylabel("excess free energy per disk (kT)")
+    axes[1].set_xlabel("phi")
+    axes[1].set_ylabel("difference from the compression's integral (kT)")
+    axes[0].set_title(f"monodisperse disks, N = {n}")
+    for ax in axes:
+        ax.legend(fontsize="small")
+    return fig
+
+
 def _value_error(value: float, error: float) -> str:
     """value +- error in mathtext, the error to two significant digits and the value to its decimals."""
     if not (np.isfinite(error) and error > 0):
