@@ -924,6 +924,9 @@ EXPECTED_MINUTES = {
     "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],
                                                          GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
     "glass_bcmd": glass_bcmd_minutes,
+    # the defect-free crystal (measured, N = 4096, gamma0 = 1e-3: 3.1e4 events per disk at phi = 0.75
+    # in 44 s, 97 s at 0.80; ~3e6 events/s): <= 1e5 dmu_max / (1e3 gamma0) events per disk
+    "glass_crystal_bcmd": lambda w: 0.3 + GLASS["N"] * 100 * GLASS["bcmd"]["dmu_max"] / GLASS["bcmd"]["gamma0"] / 3e6 / 60,
     # N = 1024, Gamma = 0.1, 1e4 collisions per particle, recompression at 1e-4 to Z = 1e4: ~20 CPU-s
     "glass_relaxed": lambda w: 0.3 + 0.5 * GLASS["N"] / 1024 * (1 + GLASS["relaxed"]["relax_collisions"] / 1e4),
     "microseg_packing": microseg_minutes,
@@ -954,7 +957,7 @@ PARTICLES = {
     "fcc_eos": lambda w: 4 * int(w.reps) ** 3,
     "bcmd_simplex": lambda w: SYSTEMS["ls"][w.ensemble]["N"],
     "poly_fluid": lambda w: POLY_FLUID["N"],
-    **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd",
+    **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd", "glass_crystal_bcmd",
                      "glass_relaxed"), lambda w: GLASS["N"]),
     **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
     **dict.fromkeys(("ellipsoid_container_init", "ellipsoid_container_profile"),

@@ -129,8 +129,8 @@ rule glass_crystal_bcmd:
         phi=GLASS_PHI,
     threads: 1
     resources:
-        mem_mb=job_mem_mb("glass_bcmd"),
-        runtime=job_runtime("glass_bcmd"),
+        mem_mb=job_mem_mb("glass_crystal_bcmd"),
+        runtime=job_runtime("glass_crystal_bcmd"),
     conda:
         "../envs/hardpack.yaml"
     log:
