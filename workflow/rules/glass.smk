@@ -389,6 +389,31 @@ rule fig_glass_crystal:
         "../scripts/plot_glass_crystal.py"
 
 
+rule fig_glass_cell_pressure:
+    """Cell-wall pressure of the SOC glasses vs cell size during BCMD (Donev 2006, Fig. 13.10)."""
+    input:
+        binary=lambda w: glass_bcmd_files("binary"),
+        mono=lambda w: glass_bcmd_files("mono"),
+    output:
+        pdf="results/figures/glass_cell_pressure.pdf",
+        png=report("results/figures/glass_cell_pressure.png", caption="../report/glass_cell_pressure.rst",
+                   category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_cell_pressure"),
+        runtime=job_runtime("fig_glass_cell_pressure"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_cell_pressure.log",
+    benchmark:
+        "results/benchmarks/fig_glass_cell_pressure.tsv"
+    script:
+        "../scripts/plot_glass_cell_pressure.py"
+
+
 rule fig_glass_jamming:
     """Jamming densities of the mixture vs growth rate, before and after relaxation (Donev 2006, Fig. 13.8)."""
     input:

@@ -191,6 +191,49 @@ def plot_glass_crystal(eos, crystal_bcmd):
     return fig
 
 
+def _snapshot_phi(ds) -> float:
+    """The snapshot's density: BCMD shrinks the radii by (1 - delta) (attribute ``delta``)."""
+    shrink = (1.0 - float(ds.attrs.get("delta", 0.0))) ** int(ds.attrs.get("dim", 2))
+    return round(float(ds.attrs["phi"]) / shrink, 3)
+
+
+def plot_glass_cell_pressure(binary, mono):
+    """Cell-wall pressure p_c of the SOC glasses as their cells shrink at fixed phi (after Donev
+    2006, Fig. 13.10): in glasses p_c vanishes at large cells (the disks never reach the walls);
+    in the liquid it stays positive, so the liquid's BCMD free energy depends on the cell size.
+
+    Parameters
+    ----------
+    binary, mono : list of xarray.Dataset
+        BCMD results (:func:`hardpack.freeenergy.run_bcmd`) of the snapshots of each system, with
+        ``dmu_mid`` and ``p_c`` per segment and the attributes ``phi``, ``delta`` and ``dim``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
+    fig, axes = figure(1, 2, figsize=(9.0, 3.6))
+    for ax, runs, name in ((axes[0], binary, "binary (1/3 large, 1.4 : 1)"), (axes[1], mono, "monodisperse")):
+        levels = sorted({_snapshot_phi(ds) for ds in runs})
+        colours = {phi: f"C{k % 10}" for k, phi in enumerate(levels)}
+        labelled = set()
+        for ds in sorted(runs, key=lambda r: float(r.attrs["phi"])):
+            phi = _snapshot_phi(ds)
+            p_c = ds["p_c"].values
+            keep = p_c > 0
+            ax.plot(ds["dmu_mid"].values[keep], p_c[keep], "-", lw=0.8, color=colours[phi],
+                    label=None if phi in labelled else f"phi_0 = {phi:.3f}")
+            labelled.add(phi)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("cell size Delta mu (disk radii)")
+        ax.set_ylabel("cell pressure p_c")
+        ax.set_title(name)
+        ax.legend(fontsize="small")
+    return fig
+
+
 def _value_error(value: float, error: float) -> str:
     """value +- error in mathtext, the error to two significant digits and the value to its decimals."""
     if not (np.isfinite(error) and error > 0):
