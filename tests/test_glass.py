@@ -605,3 +605,43 @@ def test_crystal_row_passes_agreeing_free_energies_and_fails_a_shifted_one():
     assert disk_crystal_rows(*_crystal_inputs(seeds=(1,)))[0].status == "n/a"
     (missing,) = disk_crystal_rows(*_crystal_inputs(with_branch=False))
     assert missing.status == "fail" and "no decompression branch" in missing.detail
+
+
+def _phase_of(z_of_phi, lo=0.01, hi=0.95):
+    phi = np.linspace(lo, hi, 400)
+    z = z_of_phi(phi)
+    return freezing.tabulated_phase(phi, z, thermo.excess_free_energy(phi, z)[0])
+
+
+def test_separated_crystal_of_an_ideal_gas_is_exact():
+    # Z = 1: equal pressures give phi_B = kappa^d phi_A, and the volume condition phi_A = phi / v
+    mix = freezing.Mixture(1.4, 1 / 3)
+    sc = freezing.separated_crystal(_phase_of(np.ones_like), mix, [0.2, 0.3, 0.4])
+    assert sc.phi_a == pytest.approx(sc.phi / mix.mean_volume, rel=1e-9)
+    assert sc.phi_b == pytest.approx(1.4**2 * sc.phi / mix.mean_volume, rel=1e-9)
+    assert sc.z == pytest.approx(1.0, rel=1e-9)
+
+
+def test_separated_crystal_satisfies_both_conditions_and_is_trivial_for_equal_sizes():
+    mix = freezing.Mixture(1.4, 1 / 3)
+    pure = _phase_of(henderson)
+    phi = np.array([0.5, 0.6, 0.7])
+    sc = freezing.separated_crystal(pure, mix, phi)
+    z = np.interp
+    grid = np.linspace(0.01, 0.95, 400)
+    za, zb = z(sc.phi_a, grid, henderson(grid)), z(sc.phi_b, grid, henderson(grid))
+    assert sc.phi_a * za == pytest.approx(sc.phi_b * zb / 1.4**2, rel=1e-9)   # equal pressures
+    v = mix.mean_volume
+    assert 1 / phi == pytest.approx((2 / 3) / v / sc.phi_a + (1 / 3) * 1.96 / v / sc.phi_b, rel=1e-9)
+    assert (sc.phi_a < phi).all() and (sc.phi_b > phi).all()   # the large disks are the denser phase
+    # equal sizes: both phases at the overall density; both melt where it reaches the transition
+    same = freezing.separated_crystal(pure, freezing.Mixture(1.0, 1 / 3), phi)
+    assert same.phi_a == pytest.approx(phi, rel=1e-9) and same.phi_b == pytest.approx(phi, rel=1e-9)
+    assert freezing.separated_melting(pure, freezing.Mixture(1.0, 1 / 3), 0.71) == pytest.approx((0.71, 0.71))
+    # unequal sizes: the sparser small-disk phase A reaches the transition at the higher overall phi
+    a_melts, b_melts = freezing.separated_melting(pure, mix, 0.71)
+    at_a = freezing.separated_crystal(pure, mix, [a_melts])
+    assert at_a.phi_a[0] == pytest.approx(0.71, abs=1e-6) and a_melts > 0.71 > b_melts
+    assert np.isnan(freezing.separated_crystal(pure, mix, [0.96]).phi_a).all()   # beyond the EOS table
+    with pytest.raises(InvalidInputError, match="outside"):
+        freezing.separated_melting(pure, mix, 0.97)

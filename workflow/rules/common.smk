@@ -760,7 +760,7 @@ def figures():
     names += ["ellipse_jamming"] if any(s["d"] == 2 for s in SYSTEMS["ellipsoids"].values()) else []
     names += ["ellipsoid_snapshot"] if ELLIPSOIDS and "mm" in ELLIPSOIDS else []
     names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
-    names += ["glass_eos", "glass_entropy", "glass_cell_pressure"] if GLASS else []
+    names += ["glass_eos", "glass_entropy", "glass_cell_pressure", "glass_separated"] if GLASS else []
     names += ["glass_crystal"] if GLASS and glass_crystal_bcmd_files() else []
     names += ["glass_jamming"] if GLASS and GLASS.get("relaxed") else []
     names += ["microsegregated", "microsegregated_maps"] if MICROSEG else []

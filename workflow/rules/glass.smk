@@ -414,6 +414,29 @@ rule fig_glass_cell_pressure:
         "../scripts/plot_glass_cell_pressure.py"
 
 
+rule fig_glass_separated:
+    """The fully phase-separated crystal: phase densities vs overall density (Donev 2006, Fig. 13.4)."""
+    input:
+        "results/glass/freezing_summary.nc",
+    output:
+        pdf="results/figures/glass_separated.pdf",
+        png=report("results/figures/glass_separated.png", caption="../report/glass_separated.rst", category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_separated"),
+        runtime=job_runtime("fig_glass_separated"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_separated.log",
+    benchmark:
+        "results/benchmarks/fig_glass_separated.tsv"
+    script:
+        "../scripts/plot_glass_separated.py"
+
+
 rule fig_glass_jamming:
     """Jamming densities of the mixture vs growth rate, before and after relaxation (Donev 2006, Fig. 13.8)."""
     input:

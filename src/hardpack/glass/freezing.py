@@ -239,6 +239,101 @@ def freezing_point(pure: Phase, mixture: Phase, mix: Mixture, mu_tilde: Function
     return Freezing(_phi_at(mixture, root, v), phi_b, root, mu_pure(pure, phi_b, mix))
 
 
+@dataclass(frozen=True)
+class SeparatedCrystal:
+    """The fully phase-separated crystal A + B at overall volume fractions ``phi`` (Donev 2006,
+    sec. 13.2.2.1, Fig. 13.4): the densities of the small-disk phase A and the large-disk phase B
+    at mechanical equilibrium, the pressure and the overall reduced pressure; NaN where the
+    monodisperse EOS does not cover a phase.
+
+    Attributes
+    ----------
+    phi, phi_a, phi_b, pressure, z : numpy.ndarray
+        Overall volume fraction, phase densities, P v_A / kT and Z = P V / (N kT).
+    """
+
+    phi: np.ndarray
+    phi_a: np.ndarray
+    phi_b: np.ndarray
+    pressure: np.ndarray
+    z: np.ndarray
+
+
+def separated_crystal(pure: Phase, mix: Mixture, phi) -> SeparatedCrystal:
+    """Solve the fully phase-separated crystal (Donev 2006, sec. 13.2.2.1): equal pressures
+    phi_A Z(phi_A) = phi_B Z(phi_B) / kappa^d = P v_A / kT and the overall density
+    1 / phi = (x_A / v) / phi_A + (x_B kappa^d / v) / phi_B (v = x_A + x_B kappa^d), with Z the
+    monodisperse EOS (scale free, so both phases share it). The overall density grows with the
+    pressure, so each phi has one root.
+
+    Parameters
+    ----------
+    pure : Phase
+        EOS of monodisperse disks (Z and its range; the excess is not used).
+    mix : Mixture
+        kappa, x_B and d.
+    phi : array_like of float
+        Overall volume fractions.
+
+    Returns
+    -------
+    SeparatedCrystal
+        NaN where phi is outside what the EOS's range reaches.
+    """
+    targets = np.atleast_1d(np.asarray(phi, float))
+    k_d, v = mix.kappa**mix.d, mix.mean_volume
+    w_a, w_b = (1.0 - mix.x_large) / v, mix.x_large * k_d / v
+
+    def overall(pressure):
+        return 1.0 / (w_a / _phi_at(pure, pressure, 1.0) + w_b / _phi_at(pure, pressure, k_d))
+
+    lo = pure.phi_lo * pure.z(pure.phi_lo)
+    hi = pure.phi_hi * pure.z(pure.phi_hi) / k_d
+    out = np.full((4, targets.size), np.nan)
+    if hi > lo:
+        phi_lo, phi_hi = overall(lo), overall(hi)
+        for i, target in enumerate(targets):
+            if phi_lo <= target <= phi_hi:
+                pressure = brentq(lambda p, t=target: overall(p) - t, lo, hi, xtol=1e-13)
+                out[:, i] = (_phi_at(pure, pressure, 1.0), _phi_at(pure, pressure, k_d), pressure,
+                             pressure * v / target)
+    return SeparatedCrystal(targets, *out)
+
+
+def separated_melting(pure: Phase, mix: Mixture, phi_transition: float) -> tuple[float, float]:
+    """The overall densities at which the small-disk phase A and the large-disk phase B of the
+    fully phase-separated crystal reach the monodisperse transition density (Donev 2006, sec.
+    13.2.2.1: A melts at phi ~ 0.75, B at ~0.65; the caption of Fig. 13.4 swaps the two names).
+
+    The pressure is set by the phase at the transition, P v_A = phi_t Z(phi_t) for A and
+    phi_t Z(phi_t) / kappa^d for B, and the other phase's density follows from it. No root is
+    taken inside the transition, where a finite system's EOS has a loop.
+
+    Parameters
+    ----------
+    pure : Phase
+        EOS of monodisperse disks.
+    mix : Mixture
+        kappa, x_B and d.
+    phi_transition : float
+        The monodisperse transition density (within the range of ``pure``).
+
+    Returns
+    -------
+    (float, float)
+        The overall phi at which A, then B, is at ``phi_transition``.
+    """
+    if not pure.phi_lo <= phi_transition <= pure.phi_hi:
+        raise InvalidInputError(f"phi_transition = {phi_transition} is outside the EOS range "
+                                f"[{pure.phi_lo}, {pure.phi_hi}]")
+    k_d, v = mix.kappa**mix.d, mix.mean_volume
+    w_a, w_b = (1.0 - mix.x_large) / v, mix.x_large * k_d / v
+    pressure = phi_transition * pure.z(phi_transition)
+    a_melts = 1.0 / (w_a / phi_transition + w_b / _phi_at(pure, pressure, k_d))
+    b_melts = 1.0 / (w_a / _phi_at(pure, pressure / k_d, 1.0) + w_b / phi_transition)
+    return a_melts, b_melts
+
+
 def composition_derivative(excess_plus: Function, excess_minus: Function, dx: float) -> Function:
     """mu~_B(phi) = (d Delta f_AB / d x_A)_phi by the central difference of two mixtures at
     x_A +- dx (thermodynamic integration at slightly different compositions, Donev 2006, sec. 13.2).

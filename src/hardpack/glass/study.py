@@ -23,6 +23,10 @@ from hardpack.glass import fits, thermo
 PHI_TRIANGULAR = math.pi / math.sqrt(12.0)
 #: bootstrap replicas of the freezing point's standard errors (:func:`freezing_dataset`) and their seed
 FREEZING_REPLICAS, FREEZING_SEED = 100, 20061
+#: the monodisperse transition density at which a phase of the separated crystal melts: the middle of
+#: the transition region 0.70-0.72 (Donev 2006, sec. 13.1), and the overall densities of its curves
+SEPARATED_TRANSITION, SEPARATED_TRANSITION_SPAN = 0.71, (0.70, 0.72)
+SEPARATED_PHI = np.round(np.arange(0.60, 0.8801, 0.0025), 4)
 
 
 def triangular_crystal(nx: int, ny: int, phi: float) -> Packing:
@@ -424,8 +428,8 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
                      *, kappa: float, x_large: float, dx: float, phi_join: float,
                      replicas: int = FREEZING_REPLICAS) -> xr.Dataset:
     """Freezing of the mixture against the pure large-disk crystal (Eq. 13.2): phi_F and the
-    precipitate's density. The monodisperse EOS joins the slowest compression below
-    ``phi_join`` and the decompression of the crystal above; the mixture's EOS is its slowest
+    precipitate's density, and the fully phase-separated crystal. The monodisperse EOS joins the
+    slowest compression below ``phi_join`` and the decompression of the crystal above; the mixture's EOS is its slowest
     compression; mu~_B from the mixtures at x_A +- dx (``plus``: x_A + dx, i.e. x_large - dx),
     or 0 without them (recorded in ``mu_tilde``). Data that do not allow a solution (too few
     points, no sign change) give NaN with the reason in ``status``.
@@ -460,7 +464,11 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
     -------
     xarray.Dataset
         Scalars phi_freeze, phi_precipitate, pressure, mu and their standard errors (``*_err``);
-        attributes status, mu_tilde, replicas and replicas_solved.
+        attributes status, mu_tilde, replicas and replicas_solved. The fully phase-separated
+        crystal (:func:`hardpack.glass.freezing.separated_crystal`, Fig. 13.4) from the same
+        monodisperse EOS: scalars phi_a_melts, phi_b_melts (with ``*_err``), the phase densities
+        phi_a, phi_b and the reduced pressure z_separated over ``phi``; attributes
+        separated_status and separated_replicas_solved.
 
     Raises
     ------
@@ -470,30 +478,70 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
     if isinstance(replicas, bool) or not isinstance(replicas, (int, np.integer)) or replicas < 0:
         raise InvalidInputError(f"replicas must be an integer >= 0 (0: no error estimate), got {replicas!r}")
     attrs = {"hardpack_kind": "glass_freezing", "kappa": kappa, "x_large": x_large, "phi_join": phi_join,
-             "n_particles": int(mixture.attrs.get("N", 0))}
+             "n_particles": int(mixture.attrs.get("N", 0)), "phi_transition": SEPARATED_TRANSITION}
     names = ("phi_freeze", "phi_precipitate", "pressure", "mu")
-    errors = dict.fromkeys(names, math.nan)
-    solved = 0
+    separated_names = ("phi_a_melts", "phi_b_melts")
+    values, separated = dict.fromkeys(names, math.nan), dict.fromkeys(separated_names, math.nan)
     try:
         values, how = _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join)
         attrs.update(status="solved", mu_tilde=how)
-        rng = np.random.default_rng(FREEZING_SEED)
-        draws = []
-        for _ in range(int(replicas)):
-            inputs = [None if eos is None else _perturbed_eos(eos, rng) for eos in (mono, mixture, plus, minus)]
+    except InvalidInputError as exc:
+        attrs.update(status=f"not solved: {exc}", mu_tilde="-")
+    try:
+        separated, curve, span = _solve_separated(mono, kappa, x_large, phi_join)
+        attrs.update(separated_status="solved", separated_span=span)
+    except InvalidInputError as exc:
+        curve = None
+        attrs.update(separated_status=f"not solved: {exc}")
+    draws, separated_draws = [], []
+    rng = np.random.default_rng(FREEZING_SEED)
+    for _ in range(int(replicas)):
+        inputs = [None if eos is None else _perturbed_eos(eos, rng) for eos in (mono, mixture, plus, minus)]
+        if attrs["status"] == "solved":
             try:
                 draws.append(_solve_freezing(*inputs, kappa, x_large, dx, phi_join)[0])
             except InvalidInputError:
-                continue
-        solved = len(draws)
-        if solved >= 2:
-            errors = {k: float(np.std([r[k] for r in draws], ddof=1)) for k in names}
-    except InvalidInputError as exc:
-        values = dict.fromkeys(names, math.nan)
-        attrs.update(status=f"not solved: {exc}", mu_tilde="-")
-    attrs.update(replicas=int(replicas), replicas_solved=solved)
-    data = {k: ((), values[k]) for k in names} | {f"{k}_err": ((), errors[k]) for k in names}
-    return xr.Dataset(data, attrs=attrs)
+                pass
+        if curve is not None:
+            try:
+                separated_draws.append(_solve_separated(inputs[0], kappa, x_large, phi_join, curves=False)[0])
+            except InvalidInputError:
+                pass
+
+    def spread(samples, keys):
+        if len(samples) < 2:
+            return dict.fromkeys(keys, math.nan)
+        return {k: float(np.std([r[k] for r in samples], ddof=1)) for k in keys}
+
+    errors = spread(draws, names) | spread(separated_draws, separated_names)
+    attrs.update(replicas=int(replicas), replicas_solved=len(draws), separated_replicas_solved=len(separated_draws))
+    scalars = values | separated
+    data = {k: ((), scalars[k]) for k in scalars} | {f"{k}_err": ((), errors[k]) for k in scalars}
+    coords = {}
+    if curve is not None:
+        coords["phi"] = ("phi", curve.phi)
+        data.update(phi_a=("phi", curve.phi_a), phi_b=("phi", curve.phi_b), z_separated=("phi", curve.z))
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _solve_separated(mono, kappa, x_large, phi_join, curves: bool = True):
+    """The fully phase-separated crystal of the mixture from the monodisperse EOS (Donev 2006,
+    sec. 13.2.2.1): the overall densities at which each phase reaches the transition, the
+    phase densities over SEPARATED_PHI, and the melting densities across the printed transition
+    region (text)."""
+    from hardpack.glass import freezing as fz
+
+    p, z, ze = joint_branch(mono, mono.attrs["cubic_branch"], "decompression", phi_join)
+    f, _ = thermo.excess_free_energy(p, z, ze, slope0=thermo.second_virial_slope(2))
+    pure, mix = fz.tabulated_phase(p, z, f), fz.Mixture(kappa, x_large)
+    a_melts, b_melts = fz.separated_melting(pure, mix, SEPARATED_TRANSITION)
+    if not curves:
+        return {"phi_a_melts": a_melts, "phi_b_melts": b_melts}, None, ""
+    curve = fz.separated_crystal(pure, mix, SEPARATED_PHI)
+    ends = [fz.separated_melting(pure, mix, t) for t in SEPARATED_TRANSITION_SPAN]
+    span = (f"for a transition at {SEPARATED_TRANSITION_SPAN[0]}-{SEPARATED_TRANSITION_SPAN[1]}: A melts at "
+            f"{ends[0][0]:.4f}-{ends[1][0]:.4f}, B at {ends[0][1]:.4f}-{ends[1][1]:.4f}")
+    return {"phi_a_melts": a_melts, "phi_b_melts": b_melts}, curve, span
 
 
 def _perturbed_eos(eos: xr.Dataset, rng: np.random.Generator) -> xr.Dataset:

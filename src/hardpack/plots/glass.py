@@ -191,6 +191,41 @@ def plot_glass_crystal(eos, crystal_bcmd):
     return fig
 
 
+def plot_glass_separated(freezing):
+    """The fully phase-separated crystal of the mixture (after Donev 2006, Fig. 13.4): the
+    densities of the small-disk phase A and the large-disk phase B against the overall density,
+    with the monodisperse transition region 0.70-0.72 and the overall densities at which each
+    phase reaches its middle (printed: A at ~0.75, B at ~0.65).
+
+    Parameters
+    ----------
+    freezing : xarray.Dataset
+        The freezing summary (:func:`hardpack.glass.study.freezing_dataset`) with ``phi_a``,
+        ``phi_b`` and ``phi_a_melts``, ``phi_b_melts``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
+    fig, ax = figure(1, 1, figsize=(5.0, 3.8))
+    phi = freezing["phi"].values
+    ax.axhspan(0.70, 0.72, color="0.85", label="monodisperse transition 0.70-0.72")
+    ax.plot(phi, phi, color="0.5", lw=0.8, ls=":")
+    ax.plot(phi, freezing["phi_a"], color="C0", label="phase A (small disks)")
+    ax.plot(phi, freezing["phi_b"], color="C3", label="phase B (large disks)")
+    t = float(freezing.attrs.get("phi_transition", 0.71))
+    for name, colour, printed in (("phi_a_melts", "C0", 0.75), ("phi_b_melts", "C3", 0.65)):
+        ax.plot([float(freezing[name])], [t], "o", color=colour, ms=6)
+        ax.axvline(printed, color=colour, lw=0.8, ls="--")
+    ax.plot([], [], "k--", lw=0.8, label="Donev: A melts at ~0.75, B at ~0.65")
+    ax.set_xlabel("overall phi")
+    ax.set_ylabel("density of the phase")
+    ax.set_title(f"fully phase-separated crystal, kappa = {freezing.attrs['kappa']:g}")
+    ax.legend(loc="lower right", fontsize="small")
+    return fig
+
+
 def _snapshot_phi(ds) -> float:
     """The snapshot's density: BCMD shrinks the radii by (1 - delta) (attribute ``delta``)."""
     shrink = (1.0 - float(ds.attrs.get("delta", 0.0))) ** int(ds.attrs.get("dim", 2))

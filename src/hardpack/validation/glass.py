@@ -266,8 +266,10 @@ def binary_eos_rows(ds) -> list[Row]:
 
 
 def freezing_rows(ds) -> list[Row]:
-    """phi_F and the precipitate density (Eq. 13.2) with their bootstrap standard errors
-    (:func:`hardpack.glass.study.freezing_dataset`; NaN in a summary written without them).
+    """phi_F and the precipitate density (Eq. 13.2), and the overall densities at which the
+    phases of the fully phase-separated crystal melt (sec. 13.2.2.1), with their bootstrap
+    standard errors (:func:`hardpack.glass.study.freezing_dataset`; NaN in a summary written
+    without them).
 
     Parameters
     ----------
@@ -291,7 +293,23 @@ def freezing_rows(ds) -> list[Row]:
     return [evaluate(targets["donev-13.2-phi-freeze"], float(ds["phi_freeze"]), error("phi_freeze"), n=n,
                      detail=detail),
             evaluate(targets["donev-13.2-phi-precipitate"], float(ds["phi_precipitate"]), error("phi_precipitate"),
-                     n=n, detail=detail)]
+                     n=n, detail=detail),
+            *_separated_rows(ds, targets, n)]
+
+
+def _separated_rows(ds, targets, n) -> list[Row]:
+    """The overall densities at which the phases of the fully phase-separated crystal melt."""
+    rows = []
+    for tid, name, phase in (("donev-13.2-separated-a-melts", "phi_a_melts", "A"),
+                             ("donev-13.2-separated-b-melts", "phi_b_melts", "B")):
+        if name not in ds:
+            rows.append(evaluate(targets[tid], n=n, detail="the freezing summary has no separated crystal"))
+            continue
+        detail = (f"N = {n}; {ds.attrs.get('separated_status')}; phase {phase} at phi = "
+                  f"{ds.attrs.get('phi_transition')}; error: bootstrap, {ds.attrs.get('separated_replicas_solved')} "
+                  f"of {ds.attrs.get('replicas')} replicas solved; {ds.attrs.get('separated_span', '')}")
+        rows.append(evaluate(targets[tid], float(ds[name]), float(ds[f"{name}_err"]), n=n, detail=detail))
+    return rows
 
 
 def relaxed_rows(ds) -> list[Row]:
