@@ -153,46 +153,54 @@ def excess_free_energy(phi, z, z_err=None, *, slope0: float = 2.0):
     return f, f_err
 
 
-def excess_difference(phi, z, z_err, lo: float, hi: float) -> tuple[float, float]:
-    """Delta f(hi) - Delta f(lo) = int_lo^hi (Z - 1)/phi dphi of a tabulated EOS and its standard
-    error.
+def binned_excess_difference(centres, width: float, phi_mean, z, z_err, lo: float, hi: float) -> tuple[float, float]:
+    """Delta f(hi) - Delta f(lo) = int_lo^hi (Z - 1)/phi dphi of a binned EOS (a run's samples
+    averaged in bins of phi) and its standard error, as the sum over the bins between the limits
+    of width (Z_k - 1) / phi_k.
 
-    The integrand y = (Z - 1) / phi is interpolated linearly between the points (as in
-    :func:`excess_free_energy`) and the interpolant is integrated exactly between ``lo`` and
-    ``hi``. The result is linear in the Z_i, so its error propagates exactly from the independent
-    errors of Z: var = sum_i (dI/dZ_i)^2 err_i^2.
+    The bins tile [lo, hi], so the sum is the integral of the bin averages, exact but for the
+    difference between (<Z> - 1)/<phi> and <(Z - 1)/phi> within a bin, of order width^2 Z'/phi^2
+    (derived here; ~2e-5 per 0.05 of phi for the hard-disk crystal at 0.75-0.80 in bins of
+    0.005). The trapezoid rule through the bin means instead errs by width^2 y''/12 per unit
+    phi with y = (Z - 1)/phi, ten times more there (2e-4: y is convex near close packing).
 
     Parameters
     ----------
-    phi, z, z_err : array_like, shape (n,)
-        The EOS table (strictly increasing phi; NaN errors count as 0).
+    centres : array_like, shape (n,)
+        Bin centres (evenly spaced by ``width``).
+    width : float
+        Bin width.
+    phi_mean, z, z_err : array_like, shape (n,)
+        Mean phi, mean Z and its standard error per bin (NaN: an empty bin).
     lo, hi : float
-        The limits, phi[0] <= lo <= hi <= phi[-1].
+        The limits, bin edges with lo < hi.
 
     Returns
     -------
     (float, float)
-        The integral and its standard error.
+        The integral and its standard error (bins independent).
 
     Raises
     ------
     InvalidInputError
-        If the table is malformed or the limits leave it.
+        If a limit is not a bin edge, the bins do not cover the range, or one of them is empty.
     """
-    phi, z, err = _tabulated(phi, z, z_err)
-    if not phi[0] <= lo <= hi <= phi[-1]:
-        raise InvalidInputError(f"the limits {lo} .. {hi} must lie in the EOS table's range "
-                                f"{phi[0]:.4f} .. {phi[-1]:.4f} in increasing order")
-    inside = (phi > lo) & (phi < hi)
-    x = np.concatenate([[lo], phi[inside], [hi]])
-
-    def integral(zz):
-        y = (zz - 1.0) / phi
-        return float(np.trapezoid(np.interp(x, phi, y), x))
-
-    value = integral(z)
-    weights = np.array([integral(z + np.eye(z.size)[i]) - value for i in range(z.size)])
-    return value, float(np.sqrt(np.sum((weights * err) ** 2)))
+    centres, phi_mean, z, z_err = (np.asarray(a, float) for a in (centres, phi_mean, z, z_err))
+    if not (width > 0 and lo < hi):
+        raise InvalidInputError(f"need width > 0 and lo < hi, got width {width}, limits {lo} .. {hi}")
+    for limit in (lo, hi):
+        if abs(limit / width - round(limit / width)) > 1e-6 * max(1.0, abs(limit / width)):
+            raise InvalidInputError(f"{limit} is not an edge of the EOS bins (width {width}): choose densities "
+                                    f"on multiples of the bin width")
+    inside = (centres > lo) & (centres < hi)
+    expected = int(round((hi - lo) / width))
+    if inside.sum() != expected:
+        raise InvalidInputError(f"the EOS bins cover {int(inside.sum())} of the {expected} bins between {lo} and {hi}")
+    if not (np.isfinite(z[inside]).all() and np.isfinite(phi_mean[inside]).all()):
+        raise InvalidInputError(f"an EOS bin between {lo} and {hi} is empty")
+    terms = width * (z[inside] - 1.0) / phi_mean[inside]
+    errors = width * np.nan_to_num(z_err[inside]) / phi_mean[inside]
+    return float(terms.sum()), float(np.sqrt(np.sum(errors**2)))
 
 
 def integrate_eos(z_of_phi, phi, *, phi0: float = 0.0, f0: float = 0.0, slope0: float = 2.0):

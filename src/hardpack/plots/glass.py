@@ -138,8 +138,8 @@ def plot_glass_crystal(eos, crystal_bcmd):
     """Free energy of monodisperse disks by EOS integration and by BCMD (after Donev 2006, Fig.
     13.2). Left: Delta f(phi) integrated from the ideal gas along the slowest compression, and the
     BCMD points of the defect-free crystal. Right: the differences from that integral: the BCMD
-    points, and the decompression EOS integrated from the lowest BCMD point (the crystal's own
-    EOS; where it meets the higher BCMD points, BCMD and EOS integration agree).
+    points, and the decompression EOS integrated bin by bin from the lowest BCMD point (the
+    crystal's own EOS; where it meets the higher BCMD points, BCMD and EOS integration agree).
 
     Parameters
     ----------
@@ -155,7 +155,6 @@ def plot_glass_crystal(eos, crystal_bcmd):
         The figure.
     """
     from hardpack.glass.study import liquid_excess_at
-    from hardpack.glass.thermo import excess_difference
 
     fig, axes = figure(1, 2, figsize=(9.0, 3.6))
     slow = eos.sel(branch=eos.attrs["cubic_branch"])
@@ -173,18 +172,20 @@ def plot_glass_crystal(eos, crystal_bcmd):
     base = np.array([liquid_excess_at(eos, x)[0] for x in levels])
     axes[1].errorbar(levels, mean - base, yerr=err, fmt="s", color="C3", ms=5, label="crystal, BCMD")
     dec = eos.sel(branch="decompression")
-    good = np.isfinite(dec["Z"].values) & np.isfinite(dec["phi_mean"].values)
-    dp, dz, dze = (dec[k].values[good] for k in ("phi_mean", "Z", "Z_err"))
-    top = min(dp.max(), p.max())
-    grid = np.linspace(levels[0], top, 60)
-    curve = np.array([mean[0] + excess_difference(dp, dz, dze, levels[0], x)[0] for x in grid])
+    width = float(eos.attrs["bin_width"])
+    after = eos["phi"].values > levels[0]
+    steps = width * (dec["Z"].values[after] - 1.0) / dec["phi_mean"].values[after]
+    empty = ~np.isfinite(steps)
+    steps = steps[: int(np.argmax(empty)) if empty.any() else steps.size]   # up to the first empty bin
+    grid = levels[0] + width * np.arange(steps.size + 1)
+    grid, curve = grid[grid <= p.max()], (mean[0] + np.concatenate([[0.0], np.cumsum(steps)]))[grid <= p.max()]
     ref = np.array([liquid_excess_at(eos, x)[0] for x in grid])
     axes[1].plot(grid, curve - ref, "-", color="C2", label=f"crystal: BCMD at {levels[0]:g} + decompression EOS")
     axes[1].axhline(0.0, color="C0", lw=0.8)
     axes[0].set_xlabel("phi")
     axes[0].set_ylabel("excess free energy per disk (kT)")
     axes[1].set_xlabel("phi")
-    axes[1].set_ylabel("difference from the compression's integral (kT)")
+    axes[1].set_ylabel("Delta f - Delta f(compression) (kT)")
     axes[0].set_title(f"monodisperse disks, N = {n}")
     for ax in axes:
         ax.legend(fontsize="small")

@@ -9,8 +9,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from hardpack.errors import InvalidInputError
 from hardpack.glass.study import liquid_excess_at
-from hardpack.glass.thermo import excess_difference, mixing_entropy
+from hardpack.glass.thermo import binned_excess_difference, mixing_entropy
 from hardpack.validation.rows import NA, Row, evaluate, seed_statistics
 from hardpack.validation.targets import load_targets
 
@@ -380,8 +381,9 @@ def disk_crystal_rows(crystal_bcmd, eos) -> list[Row]:
     """BCMD of the defect-free triangular crystal against the integral of the crystal's EOS
     (Donev 2006, sec. 13.1: "BCMD and EOS integration agree in the solid"): the change of the
     BCMD excess free energy between the lowest and the highest density of ``crystal_bcmd`` minus
-    int (Z - 1)/phi dphi of the decompression branch over the same range (both at the same N, so
-    the finite-N offsets of the two BCMD points cancel to O(ln N / N) of their difference).
+    int (Z - 1)/phi dphi of the decompression branch over the same range, summed over its bins
+    (:func:`hardpack.glass.thermo.binned_excess_difference`; both at the same N, so the finite-N
+    offsets of the two BCMD points cancel to O(ln N / N) of their difference).
 
     Parameters
     ----------
@@ -408,11 +410,12 @@ def disk_crystal_rows(crystal_bcmd, eos) -> list[Row]:
     low, low_err, n_low, _ = seed_statistics(excess[phi == lo])
     high, high_err, n_high, _ = seed_statistics(excess[phi == hi])
     row = eos.sel(branch="decompression")
-    p, z, z_err = (row[k].values for k in ("phi_mean", "Z", "Z_err"))
-    ok = np.isfinite(p) & np.isfinite(z)
-    if not ok.any() or not p[ok].min() <= lo < hi <= p[ok].max():
-        return [evaluate(target, n=n, detail=f"the decompression EOS does not cover phi = {lo} .. {hi}")]
-    integral, integral_err = excess_difference(p[ok], z[ok], z_err[ok], lo, hi)
+    try:
+        integral, integral_err = binned_excess_difference(
+            eos["phi"].values, float(eos.attrs["bin_width"]), row["phi_mean"].values, row["Z"].values,
+            row["Z_err"].values, lo, hi)
+    except InvalidInputError as exc:
+        return [evaluate(target, n=n, detail=f"the decompression EOS: {exc}")]
     difference = (high - low) - integral
     err = math.sqrt(sum(e**2 for e in (low_err, high_err, integral_err) if math.isfinite(e)))
     seconds = float(np.nansum(crystal_bcmd["seconds"].values))
