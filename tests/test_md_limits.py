@@ -96,3 +96,16 @@ def test_rods_jam_at_phi_one_where_slp_takes_them():
     assert not verdict.rattler.any()
     ls = compress(random_packing(100, 1, monodisperse(), 0.3, seed=1), 0.1, 1).packing
     assert verify(ls).summary().startswith("verdict: not jammed")
+
+
+def test_eos_records_its_equilibration_and_can_start_measuring_at_once(tmp_path):
+    """``--equilibration 0`` measures from the first collision (a glass's relaxation, Donev 2006,
+    Fig. 13.7); the default discards a quarter of --collisions first. Both are recorded."""
+    init = tmp_path / "rods.nc"
+    save_packing(random_packing(200, 1, monodisperse(), 0.3, seed=2), init)
+    for extra, expected in (([], 10000), (["--equilibration", "0"], 0)):
+        out = tmp_path / f"eos{expected}.nc"
+        assert main(["eos", "--init", str(init), "--out", str(out), "--seed", "3", "--collisions", "40000",
+                     "--blocks", "4", *extra]) == 0
+        a = load_dataset(out).attrs
+        assert a["equilibration"] == expected and a["collisions"] == 40000

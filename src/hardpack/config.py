@@ -158,6 +158,14 @@ def _check_glass(glass: dict | None, microseg: dict | None) -> None:
             if slow["from_phi"] not in glass["snapshots"]:
                 _refuse(f"glass.slow.from_phi = {slow['from_phi']:g} must be one of glass.snapshots "
                         f"{sorted(glass['snapshots'])} (the slow branch starts from that snapshot)")
+        relaxation = glass.get("relaxation")
+        if relaxation and relaxation["phi"] not in glass["snapshots"]:
+            _refuse(f"glass.relaxation.phi = {relaxation['phi']:g} must be one of glass.snapshots "
+                    f"{sorted(glass['snapshots'])} (the relaxation starts from each rate's snapshot there)")
+        crystal = glass["mono"].get("crystal_bcmd")
+        if crystal and not max(crystal["phis"]) < glass["mono"]["crystal_phi"]:
+            _refuse("glass.mono.crystal_bcmd.phis must lie below glass.mono.crystal_phi (the crystal is "
+                    "expanded to each of them)")
     if microseg:
         rows, cols = microseg["shape"]
         if rows % 2:

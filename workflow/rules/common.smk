@@ -554,6 +554,16 @@ def glass_bcmd_files(system):
             for phi in sorted(GLASS["snapshots"]) for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
 
 
+def glass_relaxation_files():
+    """Pressure relaxation of the mixture at fixed glass.relaxation.phi, one run per compression
+    rate and seed, started from that rate's snapshot (Donev 2006, Fig. 13.7)."""
+    spec = GLASS.get("relaxation") if GLASS else None
+    if not spec:
+        return []
+    return [f"results/glass/binary/relaxation/g{rate:g}/seed{seed}.nc"
+            for rate in GLASS_SYSTEMS["binary"]["rates"] for seed in spec["seeds"]]
+
+
 def glass_crystal_bcmd_files():
     """BCMD of the defect-free monodisperse crystal (glass.mono.crystal_bcmd), per density and seed."""
     spec = GLASS["mono"].get("crystal_bcmd")
@@ -762,6 +772,7 @@ def figures():
     names += ["laminate_crystals"] if ELLIPSOID_CRYSTALS else []
     names += ["glass_eos", "glass_entropy", "glass_cell_pressure", "glass_separated"] if GLASS else []
     names += ["glass_crystal"] if GLASS and glass_crystal_bcmd_files() else []
+    names += ["glass_relaxation"] if GLASS and glass_relaxation_files() else []
     names += ["glass_jamming"] if GLASS and GLASS.get("relaxed") else []
     names += ["microsegregated", "microsegregated_maps"] if MICROSEG else []
     names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []
@@ -924,6 +935,8 @@ EXPECTED_MINUTES = {
     "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],
                                                          GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
     "glass_bcmd": glass_bcmd_minutes,
+    # 1.2e6 collisions/s for binary disks near phi = 0.8 (glass study, N = 4096)
+    "glass_relaxation": lambda w: 0.3 + GLASS["N"] * GLASS["relaxation"]["collisions_per_particle"] / 1.2e6 / 60,
     # the defect-free crystal (measured, N = 4096, gamma0 = 1e-3: 3.1e4 events per disk at phi = 0.75
     # in 44 s, 97 s at 0.80; ~3e6 events/s): <= 1e5 dmu_max / (1e3 gamma0) events per disk
     "glass_crystal_bcmd": lambda w: 0.3 + GLASS["N"] * 100 * GLASS["bcmd"]["dmu_max"] / GLASS["bcmd"]["gamma0"] / 3e6 / 60,
@@ -958,6 +971,7 @@ PARTICLES = {
     "bcmd_simplex": lambda w: SYSTEMS["ls"][w.ensemble]["N"],
     "poly_fluid": lambda w: POLY_FLUID["N"],
     **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd", "glass_crystal_bcmd",
+                     "glass_relaxation",
                      "glass_relaxed"), lambda w: GLASS["N"]),
     **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
     **dict.fromkeys(("ellipsoid_container_init", "ellipsoid_container_profile"),

@@ -143,6 +143,32 @@ rule glass_crystal_bcmd:
         " > {log} 2>&1"
 
 
+rule glass_relaxation:
+    """Pressure of the mixture's glass at fixed glass.relaxation.phi after compression at {rate}:
+    NVE MD from the snapshot, Z per block from the first collision on (Donev 2006, Fig. 13.7)."""
+    input:
+        lambda w: glass_snapshot("binary", w.rate, GLASS["relaxation"]["phi"], w.seed),
+    output:
+        "results/glass/binary/relaxation/g{rate}/seed{seed}.nc",
+    params:
+        checkpoint=checkpoint_beside,
+        collisions=lambda w: int(GLASS["relaxation"]["collisions_per_particle"] * GLASS["N"]),
+        blocks=GLASS["relaxation"]["blocks"] if GLASS and GLASS.get("relaxation") else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_relaxation"),
+        runtime=job_runtime("glass_relaxation"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_relaxation/g{rate}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_relaxation/g{rate}/seed{seed}.tsv"
+    shell:
+        "hardpack eos --init {input} --seed {wildcards.seed} --collisions {params.collisions}"
+        " --blocks {params.blocks} --equilibration 0 --out {output} --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
 rule glass_eos:
     """Binned EOS of a glass system, its EOS integral from the ideal gas and the fits of Eqs. 13.3-13.4."""
     input:
@@ -435,6 +461,30 @@ rule fig_glass_separated:
         "results/benchmarks/fig_glass_separated.tsv"
     script:
         "../scripts/plot_glass_separated.py"
+
+
+rule fig_glass_relaxation:
+    """Pressure relaxation of the mixture's glasses at fixed phi, per compression rate (Donev 2006, Fig. 13.7)."""
+    input:
+        lambda w: glass_relaxation_files(),
+    output:
+        pdf="results/figures/glass_relaxation.pdf",
+        png=report("results/figures/glass_relaxation.png", caption="../report/glass_relaxation.rst",
+                   category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_relaxation"),
+        runtime=job_runtime("fig_glass_relaxation"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_relaxation.log",
+    benchmark:
+        "results/benchmarks/fig_glass_relaxation.tsv"
+    script:
+        "../scripts/plot_glass_relaxation.py"
 
 
 rule fig_glass_jamming:

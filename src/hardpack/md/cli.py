@@ -137,7 +137,8 @@ def cmd_eos(args) -> int:
         packing = compress(packing, rate, args.seed, stop=StopCriteria(max_pressure=None, target_phi=args.phi),
                            checkpoint=checkpoints[1] if checkpoints else None, keep_checkpoint=True,
                            checkpoint_interval=args.checkpoint_interval).packing
-    res = equilibrate(packing, args.seed, args.collisions, n_blocks=args.blocks, checkpoint=args.checkpoint,
+    res = equilibrate(packing, args.seed, args.collisions, n_blocks=args.blocks, n_equilibration=args.equilibration,
+                      checkpoint=args.checkpoint,
                       checkpoint_interval=args.checkpoint_interval, keep_checkpoint=True)
     write_dataset(res.to_dataset(seed=args.seed, init=str(args.init)), args.out, seed=args.seed)
     for path in checkpoints:  # only now that the result is safely written
@@ -230,6 +231,9 @@ def register(subparsers) -> None:
     p.add_argument("--seed", type=int, required=True, help="seed of the initial velocities")
     p.add_argument("--collisions", type=int, required=True, help="collisions to average over")
     p.add_argument("--blocks", type=int, default=20, help="number of blocks for the error bar")
+    p.add_argument("--equilibration", type=int, default=None,
+                   help="collisions discarded before the measurement (default a quarter of --collisions; "
+                        "0 records the relaxation from the start, e.g. of a glass)")
     add_checkpoint_options(p, "checkpoint file (and CHECKPOINT.prep for the compression to --phi): written every "
                            "--checkpoint-interval seconds and on Ctrl-C or SIGTERM, resumed if present, removed "
                            "once --out is written")

@@ -58,6 +58,8 @@ class EquilibriumResult:
         The final configuration.
     velocities : numpy.ndarray, shape (N, d)
         The final velocities.
+    equilibration : int
+        Collisions discarded before the blocks.
     """
 
     Z: float
@@ -69,6 +71,7 @@ class EquilibriumResult:
     wall_time: float
     packing: Packing
     velocities: np.ndarray
+    equilibration: int = 0
 
     def to_dataset(self, **attrs) -> xr.Dataset:
         """The block values as a Dataset (``hardpack_kind = "md_eos"``; Z, Z_err, phi, N, d and
@@ -83,13 +86,14 @@ class EquilibriumResult:
         -------
         xarray.Dataset
             ``Z_block(block)`` with the attributes ``hardpack_kind``, ``Z``, ``Z_err``, ``phi``,
-            ``N``, ``d``, ``collisions``, ``md_time``, ``wall_time`` and ``attrs``.
+            ``N``, ``d``, ``collisions``, ``equilibration``, ``md_time``, ``wall_time`` and
+            ``attrs``.
         """
         ds = xr.Dataset({"Z_block": (("block",), self.Z_blocks)},
                         coords={"block": np.arange(len(self.Z_blocks))})
         ds.attrs.update(hardpack_kind="md_eos", Z=self.Z, Z_err=self.Z_err, phi=self.phi,
                         N=self.packing.n_particles, d=self.packing.dim, collisions=self.collisions,
-                        md_time=self.md_time, wall_time=self.wall_time, **attrs)
+                        equilibration=self.equilibration, md_time=self.md_time, wall_time=self.wall_time, **attrs)
         return ds
 
 
@@ -201,5 +205,5 @@ def equilibrate(packing: Packing, seed: int, n_collisions: int, *, n_blocks: int
     return EquilibriumResult(
         Z=float(z.mean()), Z_err=float(z.std(ddof=1) / math.sqrt(len(z))), Z_blocks=z,
         phi=sim.phi(), collisions=sim.collisions - start_coll, md_time=sim.time - start_time,
-        wall_time=sim.wall_time, packing=sim.packing(), velocities=sim.velocities(),
+        wall_time=sim.wall_time, packing=sim.packing(), velocities=sim.velocities(), equilibration=n_eq,
     )
