@@ -119,19 +119,26 @@ def test_search_rows_judge_the_best_run_against_donevs_search():
 
     found = _search(SQRT3, [2, 4], [[0.7704, 0.7405], [0.770729, 0.7381]], [[12, 12], [14, 12]],
                     polished=[[0.7705, 0.7404805], [0.7707316, 0.7404805]])
-    assert [r.status for r in crystal_search_rows([found])] == ["pass", "pass", "pass"]
+    assert [r.status for r in crystal_search_rows([found])] == ["pass", "pass", "pass", "n/a"]
     # polished 0.770731 is 1e-6 off the printed 0.770732 (6 digits): fails; unpolished: n/a
     short = _search(SQRT3, [4], [[0.770729, 0.7381]], [[14, 12]], polished=[[0.770731, 0.7404805]])
-    assert [r.status for r in crystal_search_rows([short])] == ["pass", "pass", "fail"]
+    assert [r.status for r in crystal_search_rows([short])] == ["pass", "pass", "fail", "n/a"]
     fcc_only = _search(SQRT3, [4], [[0.740480, 0.7381]], [[12, 10]])
-    assert [r.status for r in crystal_search_rows([fcc_only])] == ["fail", "fail", "n/a"]
+    assert [r.status for r in crystal_search_rows([fcc_only])] == ["fail", "fail", "n/a", "n/a"]
     # the second-best laminate-like run of phi 0.77064 is 9e-5 off the printed 0.7707: fails
     near = _search(SQRT3, [4], [[0.77064, 0.7381]], [[14, 10]])
-    assert [r.status for r in crystal_search_rows([near])] == ["fail", "pass", "n/a"]
+    assert [r.status for r in crystal_search_rows([near])] == ["fail", "pass", "n/a", "n/a"]
     one_per_cell = _search(SQRT3, [1], [[0.740480]], [[12]], polished=[[0.7404805]])
-    assert [r.status for r in crystal_search_rows([one_per_cell])] == ["n/a", "n/a", "n/a"]
+    assert [r.status for r in crystal_search_rows([one_per_cell])] == ["n/a", "n/a", "n/a", "n/a"]
     elsewhere = _search(1.5, [4], [[0.7573]], [[12]])
-    assert [r.status for r in crystal_search_rows([elsewhere])] == ["n/a", "n/a", "n/a"]
+    assert [r.status for r in crystal_search_rows([elsewhere])] == ["n/a", "n/a", "n/a", "n/a"]
+    # the oblate laminate (alpha = 1/sqrt(3)) has the same maximum; its row judges the polished run only
+    oblate = _search(1 / SQRT3, [2, 4], [[0.7404, 0.7405], [0.7071, 0.6986]], [[12, 12], [12, 14]],
+                     polished=[[0.7404805, 0.7404805], [0.7404805, 0.7707316]])
+    rows = crystal_search_rows([found, oblate])
+    assert [r.status for r in rows] == ["pass", "pass", "pass", "pass"] and rows[3].label == "alpha = 1/sqrt(3)"
+    cut_short = _search(1 / SQRT3, [4], [[0.7071, 0.6986]], [[12, 12]], polished=[[0.7404805, 0.7687773]])
+    assert crystal_search_rows([found, cut_short])[3].status == "fail"
 
 
 def test_laminate_figure_shows_the_search_runs():

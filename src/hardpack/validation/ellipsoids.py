@@ -164,7 +164,7 @@ def crystal_rows(families) -> list[Row]:
 
 
 def crystal_search_rows(searches) -> list[Row]:
-    """Rows of the small-cell crystal search at alpha = sqrt(3)
+    """Rows of the small-cell crystal search at alpha = sqrt(3) (and the polished one at 1 / sqrt(3))
     (:func:`hardpack.md.crystal_search.crystal_search`): the density and the contacts per particle
     of the densest run over every cell size and seed (Donev 2006, Sec. 8.2.1), and the density of
     the densest run after the polish by the size ascent. Cells of fewer than 4 spheroids
@@ -185,7 +185,7 @@ def crystal_search_rows(searches) -> list[Row]:
     at_peak = [ds for ds in searches if abs(float(ds.attrs["alpha"]) - math.sqrt(3.0)) < 1e-6]
     if not at_peak:
         return [evaluate(targets[tid], n=0, label="alpha = sqrt(3)", detail="no search at alpha = sqrt(3)")
-                for tid in ids]
+                for tid in ids] + _oblate_rows(searches, targets)
     out = []
     for ds in at_peak:
         phi = np.asarray(ds["phi"].values, float)
@@ -200,20 +200,34 @@ def crystal_search_rows(searches) -> list[Row]:
         out.append(evaluate(targets[ids[1]], float(best["contacts"]), n=n_max, label="alpha = sqrt(3)",
                             detail=detail))
         out.append(_polished_row(targets[ids[2]], ds, runs, n_max))
-    return out
+    return out + _oblate_rows(searches, targets)
 
 
-def _polished_row(target, search, runs: str, n_max: int) -> Row:
+def _oblate_rows(searches, targets) -> list[Row]:
+    """The polished density of the search at alpha = 1 / sqrt(3), where the laminate of oblate
+    spheroids has the same maximum (Donev 2006, Sec. 8.2, Fig. 8.2: phi(alpha) = phi(1 / alpha))."""
+    target, label = targets["donev-8.2-search-phi-polished-oblate"], "alpha = 1/sqrt(3)"
+    oblate = [ds for ds in searches if abs(float(ds.attrs["alpha"]) - 1.0 / math.sqrt(3.0)) < 1e-6]
+    if not oblate:
+        return [evaluate(target, n=0, label=label, detail="no search at alpha = 1/sqrt(3)")]
+    rows = []
+    for ds in oblate:
+        runs = f"{ds['phi'].size} runs, {', '.join(str(int(n)) for n in ds['n'].values)} per cell"
+        rows.append(_polished_row(target, ds, runs, int(ds["n"].max()), label=label))
+    return rows
+
+
+def _polished_row(target, search, runs: str, n_max: int, label: str = "alpha = sqrt(3)") -> Row:
     """The densest polished run of a search (n/a for a search run without the polish)."""
     polished = np.asarray(search["phi_polished"].values, float) if "phi_polished" in search else np.array([np.nan])
     if not np.isfinite(polished).any():
-        return evaluate(target, n=0, label="alpha = sqrt(3)", detail="the search ran without the polish")
+        return evaluate(target, n=0, label=label, detail="the search ran without the polish")
     a, b = np.unravel_index(int(np.nanargmax(polished)), polished.shape)
     best = search.isel(n=a, seed=b)
     detail = (f"best of {runs}, each polished: n = {int(best['n'])}, seed {int(best['seed'])}, contacts "
               f"{int(best['min_contacts_polished'])}-{int(best['max_contacts_polished'])} per particle, "
               f"{int(np.sum(search['laminate_polished'].values))} polished runs match the laminate")
-    return evaluate(target, float(polished[a, b]), n=n_max, label="alpha = sqrt(3)", detail=detail)
+    return evaluate(target, float(polished[a, b]), n=n_max, label=label, detail=detail)
 
 
 #: aspect ratios "near the sphere point" of the second-order claim (Donev 2006, Sec. 5.6, Fig. 5.10:
