@@ -375,6 +375,39 @@ def test_sphere_point_row_counts_seeds_not_families():
     assert "2 seeds" in row.detail
 
 
+def _family_summary(peak, alphas=(1.0, 1.25, 1.5, 2.0, 2.5), seeds=(1, 2, 3)):
+    """Self-dual packings whose phi_J is the parabola 0.74 - 0.1 (alpha - peak)^2, with a seed
+    scatter of zero mean (+-0.001, 0)."""
+    rows = [(0.5, a, seed, 0.74 - 0.1 * (a - peak) ** 2 + 0.001 * (seed - 2)) for a in alphas for seed in seeds]
+    beta, alpha, seed, phi = (np.array(v) for v in zip(*rows))
+    k = len(rows)
+    return xr.Dataset({"N": ("sample", np.full(k, 1000)), "d": ("sample", np.full(k, 3)), "phi": ("sample", phi),
+                       "z_mean": ("sample", np.full(k, 11.0)), "z_all": ("sample", np.full(k, 11.0)),
+                       "nematic_S": ("sample", np.full(k, 0.03))},
+                      coords={"beta": ("sample", beta), "alpha": ("sample", alpha), "seed": ("sample", seed)})
+
+
+def test_the_density_maximum_is_located_by_the_parabola_through_its_neighbours():
+    """Donev 2006, Sec. 5.2: the maximum lies at 1.5 < alpha < 2. A parabolic phi_J(alpha) peaking
+    at 1.7 is located exactly (the three points lie on it); a peak at 2.4 fails; a density still
+    rising at the grid's end fails at that end; a grid that stops at its densest point inside the
+    printed range cannot tell (n/a)."""
+    from hardpack.validation.ellipsoids import ellipsoid_rows
+
+    def row(summary):
+        return next(r for r in ellipsoid_rows([summary])
+                    if r.target == "donev-5.2-phij-max-location" and "self-dual" in r.label)
+
+    found = row(_family_summary(1.7))
+    assert found.status == PASS and found.reproduced == pytest.approx(1.7, abs=1e-9)
+    assert 0 < found.uncertainty < 0.05
+    assert row(_family_summary(2.4)).status == FAIL
+    rising = row(_family_summary(3.5))
+    assert rising.status == FAIL and rising.reproduced == 2.5 and "grid's end" in rising.detail
+    assert row(_family_summary(1.7, alphas=(1.0, 1.25, 1.5))).status == NA
+    assert row(_family_summary(1.7, alphas=(1.0, 1.5))).status == NA
+
+
 def _ellipsoid_verdicts(n=100, jammed=(1, 1, 1, 1, 1, 1), order=(2, 2, 2, 2, 2, 2), gap=1e-2):
     """Six 3D packings: three at alpha = 1.05 and three at 1.5 (beta = 0.5), hypostatic."""
     k = len(jammed)

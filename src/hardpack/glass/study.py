@@ -431,8 +431,8 @@ def freezing_dataset(mono: xr.Dataset, mixture: xr.Dataset, plus: xr.Dataset | N
     precipitate's density, and the fully phase-separated crystal. The monodisperse EOS joins the
     slowest compression below ``phi_join`` and the decompression of the crystal above; the
     mixture's EOS is its slowest compression; mu~_B from the mixtures at x_A +- dx (``plus``:
-    x_A + dx, i.e. x_large - dx), or 0 without them (recorded in ``mu_tilde``). Data that do not allow a solution (too few
-    points, no sign change) give NaN with the reason in ``status``.
+    x_A + dx, i.e. x_large - dx), or 0 without them (recorded in ``mu_tilde``). Data that do not
+    allow a solution (too few points, no sign change) give NaN with the reason in ``status``.
 
     Standard errors by a parametric bootstrap: ``replicas`` times, every binned Z of every
     input is drawn from a normal distribution with its standard error Z_err (bins independent,

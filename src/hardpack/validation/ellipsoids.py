@@ -81,6 +81,8 @@ def ellipsoid_rows(summaries) -> list[Row]:
         out.append(_largest(targets["donev-5.4-z-max-non-spheroids"], z,
                             [k for k in z if 0 < k[0] < 1 and k[1] > 1], n, "non-spheroids"))
         out.append(_duality(targets["donev-5.2-prolate-oblate-duality"], phi, n))
+        for beta, name in ((0.0, "prolate"), (0.5, "self-dual"), (1.0, "oblate")):
+            out.append(_maximum_location(targets["donev-5.2-phij-max-location"], phi, beta, n, name))
         if MM in phi:
             for tid, name in (("donev-fig5.1-mm-phi", "phi"), ("donev-fig5.1-mm-nematic", "nematic_S"),
                               ("donev-ch7-mm-z", "z_all")):
@@ -99,6 +101,50 @@ def _sphere_point_per_seed(summary) -> np.ndarray:
     seeds = np.asarray(summary["seed"].values)[at_one]
     values = np.asarray(summary["phi"].values, float)[at_one]
     return np.array([values[seeds == k].mean() for k in np.unique(seeds)])
+
+
+#: draws of the Monte Carlo error of the density maximum's location, and their seed
+LOCATION_DRAWS, LOCATION_SEED = 2000, 52
+
+
+def _maximum_location(target, phi: dict, beta: float, n: int, name: str) -> Row:
+    """The aspect ratio of a family's largest phi_J: the vertex of the parabola through the densest
+    grid point and its two neighbours (per-alpha means over seeds); its error from redrawing the
+    three means within their standard errors. A maximum at the grid's end is that end (no error)
+    when it lies outside the printed range, and undecided (n/a) when it does not."""
+    label = f"{name} (beta = {beta:g})"
+    alphas = sorted(k[1] for k in phi if k[0] == beta)
+    stats = [seed_statistics(phi[(beta, a)]) for a in alphas]
+    seeds = min((st[2] for st in stats), default=0)
+    if len(alphas) < 3:
+        return evaluate(target, n=n, seeds=0, label=label, detail=f"{len(alphas)} aspect ratios: need 3 or more")
+    means = np.array([st[0] for st in stats])
+    errors = np.array([st[1] for st in stats])
+    k = int(np.argmax(means))
+    grid = ", ".join(f"{a:g}: {m:.4f}" for a, m in zip(alphas, means))
+    low, high = float(target.published) - target.tolerance, float(target.published) + target.tolerance
+    if k in (0, len(alphas) - 1):
+        edge = alphas[k]
+        if low <= edge <= high:
+            return evaluate(target, n=n, seeds=0, label=label,
+                            detail=f"the densest point is the grid's end, alpha = {edge:g}: the maximum may "
+                                   f"lie beyond; {grid}")
+        return evaluate(target, edge, 0.0, n=n, seeds=seeds, label=label,
+                        detail=f"the densest point is the grid's end, alpha = {edge:g}; {grid}")
+    x = np.array(alphas[k - 1 : k + 2])
+
+    def vertex(y):
+        c2, c1, _ = np.polyfit(x, y, 2)
+        return -c1 / (2.0 * c2) if c2 < 0 else math.nan
+
+    value = vertex(means[k - 1 : k + 2])
+    rng = np.random.default_rng(LOCATION_SEED)
+    draws = np.array([vertex(means[k - 1 : k + 2] + errors[k - 1 : k + 2] * rng.standard_normal(3))
+                      for _ in range(LOCATION_DRAWS)])
+    draws = draws[np.isfinite(draws)]
+    err = float(np.std(draws, ddof=1)) if draws.size > 1 and np.isfinite(errors[k - 1 : k + 2]).all() else math.nan
+    return evaluate(target, float(value), err, n=n, seeds=seeds, label=label,
+                    detail=f"parabola through alpha = {', '.join(f'{a:g}' for a in x)}; per-alpha mean phi_J {grid}")
 
 
 def _duality(target, phi: dict, n: int) -> Row:
