@@ -205,6 +205,7 @@ def test_snakemake_refuses_unknown_config_key(tmp_path):
     (lambda c: c["glass"].update(slow={"rate": 1.0, "from_phi": 0.70}), r"glass.slow.rate = 1 must be below every"),
     (lambda c: c["glass"].update(slow={"rate": 1e-9, "from_phi": 0.71}), r"glass.slow.from_phi = 0.71 must be one of"),
     (lambda c: c["glass"]["relaxation"].update(phi=0.79), r"glass.relaxation.phi = 0.79 must be one of"),
+    (lambda c: c["glass"]["separated"].update(phi_end=0.85), "glass.separated.phi_end must lie below"),
     (lambda c: c["glass"]["mono"]["crystal_bcmd"].update(phis=[0.75, 0.89]), "crystal_bcmd.phis must lie below"),
     (lambda c: c["ellipsoids"].update(near_sphere={"families": ["cube"]}), r"near_sphere.families \['cube'\]"),
     (lambda c: c["ellipsoids"]["mm"].update(family="cube"), "ellipsoids.mm.family 'cube' is not one of"),

@@ -662,3 +662,24 @@ def test_separated_crystal_satisfies_both_conditions_and_is_trivial_for_equal_si
     assert np.isnan(freezing.separated_crystal(pure, mix, [0.96]).phi_a).all()   # beyond the EOS table
     with pytest.raises(InvalidInputError, match="outside"):
         freezing.separated_melting(pure, mix, 0.97)
+
+
+def test_phase_separated_crystal_has_two_slabs_at_the_requested_density():
+    p = study.phase_separated_crystal((7, 5), (20, 14), 1.4, 0.84)
+    assert p.n_particles == 210 and p.phi == pytest.approx(0.84, abs=1e-12)
+    assert (p.species == 1).sum() == 70 and p.overlap_report().n_overlapping == 0
+    small, large = p.radii[p.species == 0], p.radii[p.species == 1]
+    assert large[0] / small[0] == pytest.approx(1.4)
+    # each slab is a triangular crystal: every disk's nearest same-species neighbour is one lattice spacing
+    # away, and the two spacings are in the ratio kappa (the slabs are scaled copies)
+    from scipy.spatial import cKDTree
+    box = np.diag(p.lattice)
+    spacing = [cKDTree(p.positions[p.species == s] % box, boxsize=box).query(p.positions[p.species == s] % box, 2)[0][:, 1]
+               for s in (0, 1)]
+    assert np.ptp(spacing[0]) < 1e-9 and spacing[1][0] / spacing[0][0] == pytest.approx(1.4)
+    # the A slab is below close packing by the same factor as the B slab
+    assert 2 * small[0] / spacing[0][0] == pytest.approx(2 * large[0] / spacing[1][0])
+    with pytest.raises(InvalidInputError, match="close packed"):
+        study.phase_separated_crystal((7, 5), (20, 14), 1.4, 0.90)
+    with pytest.raises(InvalidInputError, match="even"):
+        study.phase_separated_crystal((7, 5), (19, 14), 1.4, 0.80)

@@ -162,6 +162,9 @@ def _check_glass(glass: dict | None, microseg: dict | None) -> None:
         if relaxation and relaxation["phi"] not in glass["snapshots"]:
             _refuse(f"glass.relaxation.phi = {relaxation['phi']:g} must be one of glass.snapshots "
                     f"{sorted(glass['snapshots'])} (the relaxation starts from each rate's snapshot there)")
+        separated = glass.get("separated")
+        if separated and not separated["phi_end"] < separated["phi"]:
+            _refuse("glass.separated.phi_end must lie below glass.separated.phi (the crystal is decompressed)")
         crystal = glass["mono"].get("crystal_bcmd")
         if crystal and not max(crystal["phis"]) < glass["mono"]["crystal_phi"]:
             _refuse("glass.mono.crystal_bcmd.phis must lie below glass.mono.crystal_phi (the crystal is "

@@ -564,6 +564,14 @@ def glass_relaxation_files():
             for rate in GLASS_SYSTEMS["binary"]["rates"] for seed in spec["seeds"]]
 
 
+def glass_separated_files():
+    """Time series of the phase-separated crystal's decompressions (glass.separated), per rate and seed."""
+    spec = GLASS.get("separated") if GLASS else None
+    if not spec:
+        return []
+    return [f"results/glass/separated/g{rate:g}/ts_seed{seed}.nc" for rate in spec["rates"] for seed in spec["seeds"]]
+
+
 def glass_crystal_bcmd_files():
     """BCMD of the defect-free monodisperse crystal (glass.mono.crystal_bcmd), per density and seed."""
     spec = GLASS["mono"].get("crystal_bcmd")
@@ -935,6 +943,9 @@ EXPECTED_MINUTES = {
     "glass_decompress": lambda w: glass_minutes_compress(GLASS["N"], GLASS["mono"]["rate"],
                                                          GLASS["mono"]["decompress_to"], GLASS["mono"]["crystal_phi"]),
     "glass_bcmd": glass_bcmd_minutes,
+    "glass_separated_decompress": lambda w: glass_minutes_compress(
+        sum(GLASS["separated"]["columns"][k] * GLASS["separated"]["rows"][k] for k in (0, 1)), float(w.rate),
+        GLASS["separated"]["phi_end"], GLASS["separated"]["phi"]),
     # measured 2.7e6 collisions/s for the mixture at phi = 0.80 (N = 4096, 4.1e8 collisions in 150 CPU-s)
     "glass_relaxation": lambda w: 0.3 + GLASS["N"] * GLASS["relaxation"]["collisions_per_particle"] / 2.5e6 / 60,
     # the defect-free crystal (measured, N = 4096, gamma0 = 1e-3: 3.1e4 events per disk at phi = 0.75
@@ -973,6 +984,8 @@ PARTICLES = {
     **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd", "glass_crystal_bcmd",
                      "glass_relaxation",
                      "glass_relaxed"), lambda w: GLASS["N"]),
+    **dict.fromkeys(("glass_separated_crystal", "glass_separated_decompress"),
+                    lambda w: sum(c * r for c, r in zip(GLASS["separated"]["columns"], GLASS["separated"]["rows"]))),
     **dict.fromkeys(("container_init", "container_profile"), lambda w: SYSTEMS["containers"][w.name]["N"]),
     **dict.fromkeys(("ellipsoid_container_init", "ellipsoid_container_profile"),
                     lambda w: SYSTEMS["ellipsoid_containers"][w.name]["N"]),

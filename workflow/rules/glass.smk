@@ -169,6 +169,57 @@ rule glass_relaxation:
         " --blocks {params.blocks} --equilibration 0 --out {output} --checkpoint {params.checkpoint} > {log} 2>&1"
 
 
+rule glass_separated_crystal:
+    """The fully phase-separated crystal of the mixture: a slab of small and a slab of large disks at glass.separated.phi (Donev 2006, sec. 13.2.2.1)."""
+    output:
+        "results/glass/separated/crystal.nc",
+    params:
+        s=GLASS.get("separated") if GLASS else None,
+        kappa=GLASS["kappa"] if GLASS else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_separated_crystal"),
+        runtime=job_runtime("glass_separated_crystal"),
+    group:
+        "setup"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_separated_crystal/crystal.log",
+    benchmark:
+        "results/benchmarks/glass_separated_crystal/crystal.tsv"
+    shell:
+        "hardpack glass-separated-crystal --columns {params.s[columns][0]} {params.s[columns][1]}"
+        " --rows {params.s[rows][0]} {params.s[rows][1]} --kappa {params.kappa} --phi {params.s[phi]}"
+        " --out {output} > {log} 2>&1"
+
+
+rule glass_separated_decompress:
+    """Decompression of the phase-separated crystal at growth rate -{rate} to glass.separated.phi_end (Donev 2006, Fig. 13.5)."""
+    input:
+        "results/glass/separated/crystal.nc",
+    output:
+        packing="results/glass/separated/g{rate}/seed{seed}.nc",
+        timeseries="results/glass/separated/g{rate}/ts_seed{seed}.nc",
+    params:
+        checkpoint=checkpoint_beside,
+        phi=GLASS["separated"]["phi_end"] if GLASS and GLASS.get("separated") else None,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_separated_decompress"),
+        runtime=job_runtime("glass_separated_decompress"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_separated_decompress/g{rate}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_separated_decompress/g{rate}/seed{seed}.tsv"
+    shell:
+        "hardpack compress --init {input} --growth-rate=-{wildcards.rate} --seed {wildcards.seed}"
+        " --target-phi {params.phi} --out {output.packing} --timeseries {output.timeseries}"
+        " --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
 rule glass_eos:
     """Binned EOS of a glass system, its EOS integral from the ideal gas and the fits of Eqs. 13.3-13.4."""
     input:
@@ -441,9 +492,10 @@ rule fig_glass_cell_pressure:
 
 
 rule fig_glass_separated:
-    """The fully phase-separated crystal: phase densities vs overall density (Donev 2006, Fig. 13.4)."""
+    """The fully phase-separated crystal: phase densities vs overall density (Donev 2006, Fig. 13.4) and its EOS on decompression (Fig. 13.5)."""
     input:
-        "results/glass/freezing_summary.nc",
+        freezing="results/glass/freezing_summary.nc",
+        decompressions=lambda w: glass_separated_files(),
     output:
         pdf="results/figures/glass_separated.pdf",
         png=report("results/figures/glass_separated.png", caption="../report/glass_separated.rst", category="5 glasses"),

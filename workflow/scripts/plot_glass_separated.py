@@ -1,4 +1,5 @@
-"""Snakemake script: the fully phase-separated crystal of the mixture (after Donev 2006, Fig. 13.4)."""
+"""Snakemake script: the fully phase-separated crystal of the mixture and its decompressions (after
+Donev 2006, Figs. 13.4-13.5)."""
 
 import logging
 
@@ -7,5 +8,6 @@ from hardpack.plots.glass import plot_glass_separated
 from hardpack.plots.style import save
 
 logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
-fig = plot_glass_separated(load_dataset(snakemake.input[0]))
+fig = plot_glass_separated(load_dataset(snakemake.input.freezing),
+                           [load_dataset(path) for path in snakemake.input.decompressions])
 save(fig, snakemake.output.pdf, snakemake.output.png)

@@ -43,6 +43,28 @@ def cmd_glass_crystal(args) -> int:
     return 0
 
 
+def cmd_glass_separated_crystal(args) -> int:
+    """Fully phase-separated binary crystal: a slab of small and a slab of large disks (Donev 2006, sec. 13.2.2.1).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-separated-crystal``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
+    from hardpack.glass.study import phase_separated_crystal
+    from hardpack.io import save_packing
+
+    packing = phase_separated_crystal(args.columns, args.rows, args.kappa, args.phi)
+    save_packing(packing, args.out, attrs={"protocol": "phase_separated_crystal", "kappa": args.kappa})
+    log.info("wrote %s: %r", args.out, packing)
+    return 0
+
+
 def _branch_name(rate: float) -> str:
     return "decompression" if rate < 0 else f"{rate:g}"
 
@@ -336,6 +358,17 @@ def register(subparsers) -> None:
     p.add_argument("--phi", type=float, required=True, help="volume fraction (< pi/sqrt(12))")
     p.add_argument("--out", required=True, help="packing netCDF")
     p.set_defaults(func=cmd_glass_crystal)
+
+    p = subparsers.add_parser("glass-separated-crystal",
+                              help=cmd_glass_separated_crystal.__doc__.split("\n\n")[0])
+    p.add_argument("--columns", type=int, nargs=2, required=True, metavar=("A", "B"),
+                   help="columns of the small-disk and the large-disk slab (their ratio is kappa: 7 k, 5 k)")
+    p.add_argument("--rows", type=int, nargs=2, required=True, metavar=("A", "B"),
+                   help="rows (even) of the two slabs (10 j, 7 j give one third large disks)")
+    p.add_argument("--kappa", type=float, required=True, help="diameter ratio large / small")
+    p.add_argument("--phi", type=float, required=True, help="overall volume fraction")
+    p.add_argument("--out", required=True, help="packing netCDF")
+    p.set_defaults(func=cmd_glass_separated_crystal)
 
     p = subparsers.add_parser("glass-eos", help=cmd_glass_eos.__doc__.split("\n\n")[0])
     p.add_argument("files", nargs="+", help="compression / decompression time series of one system")

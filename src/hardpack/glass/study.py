@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 import xarray as xr
+from scipy.optimize import brentq
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.packing import Packing
@@ -61,6 +62,74 @@ def triangular_crystal(nx: int, ny: int, phi: float) -> Packing:
     positions = (origins[:, None, :] + basis[None, :, :]).reshape(-1, 2) + 0.25
     radius = 0.5 * math.sqrt(phi / PHI_TRIANGULAR)
     return Packing(positions, np.full(len(positions), radius), np.diag([nx, s3 * ny]))
+
+
+def phase_separated_crystal(columns: tuple[int, int], rows: tuple[int, int], kappa: float, phi: float) -> Packing:
+    """A fully phase-separated binary crystal (Donev 2006, sec. 13.2.2.1, the start of Fig. 13.5):
+    a slab of small disks A (diameter 1) and a slab of large disks B (diameter kappa), each a
+    triangular crystal with rows along x, stacked along y in an orthorhombic periodic box.
+
+    Both slabs span the box along x, so the lattice spacings satisfy c_A a_A = c_B a_B; with
+    c_A / c_B = kappa both slabs are scaled copies at the same density (at kappa = 1.4: 7 k and 5 k
+    columns; 10 j and 7 j rows give x_B = 1/3). The interface rows are set apart by the larger of
+    the two half row spacings and 1.0001 (r_A + r_B): the lattices do not match across the
+    interface, so a disk may sit right above one of the other slab. The disks then grow until the
+    overall density is ``phi``.
+
+    Parameters
+    ----------
+    columns, rows : (int, int)
+        Columns and rows (even) of the A and the B slab.
+    kappa : float
+        Diameter ratio B / A, >= 1.
+    phi : float
+        Overall volume fraction; at most the density at which the slabs are close packed.
+
+    Returns
+    -------
+    Packing
+        c_A r_A + c_B r_B disks, ``species`` 0 (A) and 1 (B).
+
+    Raises
+    ------
+    InvalidInputError
+        For counts below 1, odd rows, kappa < 1, or phi outside (0, its largest value).
+    """
+    (c_a, c_b), (r_a, r_b) = (int(c) for c in columns), (int(r) for r in rows)
+    if min(c_a, c_b, r_a, r_b) < 1 or r_a % 2 or r_b % 2:
+        raise InvalidInputError(f"columns must be >= 1 and rows even and >= 2, got {columns}, {rows}")
+    if not kappa >= 1.0:
+        raise InvalidInputError(f"kappa must be >= 1, got {kappa}")
+    s3 = math.sqrt(3.0)
+    a_a, a_b = 1.0, c_a / c_b
+    h_a, h_b = s3 / 2 * a_a, s3 / 2 * a_b
+    n_a, n_b = c_a * r_a, c_b * r_b
+
+    def layout(touch: float):
+        """Positions, radii and box for A disks of diameter ``touch`` a_A."""
+        rad_a, rad_b = touch / 2, kappa * touch / 2
+        gap = max((h_a + h_b) / 2, 1.0001 * (rad_a + rad_b))
+        y_b0 = (r_a - 1) * h_a + gap
+        height = y_b0 + (r_b - 1) * h_b + gap
+        ia, ja = np.meshgrid(np.arange(c_a), np.arange(r_a), indexing="ij")
+        ib, jb = np.meshgrid(np.arange(c_b), np.arange(r_b), indexing="ij")
+        pos_a = np.column_stack([(ia + 0.5 * (ja % 2)).ravel() * a_a, ja.ravel() * h_a])
+        pos_b = np.column_stack([(ib + 0.5 * (jb % 2)).ravel() * a_b, y_b0 + jb.ravel() * h_b])
+        positions = np.vstack([pos_a, pos_b]) + 0.25
+        radii = np.concatenate([np.full(n_a, rad_a), np.full(n_b, rad_b)])
+        return positions, radii, np.diag([c_a * a_a, height])
+
+    def density(touch):
+        _, radii, box = layout(touch)
+        return float(np.pi * np.sum(radii**2) / (box[0, 0] * box[1, 1]))
+
+    largest = min(1.0, a_b / kappa)   # the A (or B) rows touch
+    top = density(largest)
+    if not 0 < phi <= top:
+        raise InvalidInputError(f"phi must be in (0, {top:.6f}] (the slabs close packed), got {phi}")
+    touch = brentq(lambda t: density(t) - phi, 1e-9, largest, xtol=1e-15)
+    positions, radii, box = layout(touch)
+    return Packing(positions, radii, box, species=np.repeat([0, 1], [n_a, n_b]))
 
 
 def window_points(ts: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:

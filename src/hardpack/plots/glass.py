@@ -192,24 +192,31 @@ def plot_glass_crystal(eos, crystal_bcmd):
     return fig
 
 
-def plot_glass_separated(freezing):
-    """The fully phase-separated crystal of the mixture (after Donev 2006, Fig. 13.4): the
+def plot_glass_separated(freezing, decompressions=()):
+    """The fully phase-separated crystal of the mixture. Left (after Donev 2006, Fig. 13.4): the
     densities of the small-disk phase A and the large-disk phase B against the overall density,
     with the monodisperse transition region 0.70-0.72 and the overall densities at which each
-    phase reaches its middle (printed: A at ~0.75, B at ~0.65).
+    phase reaches its middle (printed: A at ~0.75, B at ~0.65). Right, given decompressions (after
+    Fig. 13.5): the reduced pressure of the decompressed slab crystal per rate (windows averaged in
+    bins of 0.005) against the separated crystal's equilibrium Z from the monodisperse EOS.
 
     Parameters
     ----------
     freezing : xarray.Dataset
         The freezing summary (:func:`hardpack.glass.study.freezing_dataset`) with ``phi_a``,
-        ``phi_b`` and ``phi_a_melts``, ``phi_b_melts``.
+        ``phi_b``, ``z_separated`` and ``phi_a_melts``, ``phi_b_melts``.
+    decompressions : sequence of xarray.Dataset, optional
+        Time series of decompressions of the phase-separated crystal (``phi``, ``Z`` per window;
+        attribute ``growth_rate``).
 
     Returns
     -------
     matplotlib.figure.Figure
         The figure.
     """
-    fig, ax = figure(1, 1, figsize=(5.0, 3.8))
+    panels = 2 if len(decompressions) else 1
+    fig, axes = figure(1, panels, figsize=(5.0 * panels, 3.8))
+    ax = axes[0] if panels == 2 else axes
     phi = freezing["phi"].values
     ax.axhspan(0.70, 0.72, color="0.85", label="monodisperse transition 0.70-0.72")
     ax.plot(phi, phi, color="0.5", lw=0.8, ls=":")
@@ -224,53 +231,22 @@ def plot_glass_separated(freezing):
     ax.set_ylabel("density of the phase")
     ax.set_title(f"fully phase-separated crystal, kappa = {freezing.attrs['kappa']:g}")
     ax.legend(loc="lower right", fontsize="small")
-    return fig
-
-
-def plot_glass_relaxation(runs):
-    """Pressure relaxation of the mixture's glasses at fixed phi (after Donev 2006, Fig. 13.7):
-    Z per block of NVE MD from each compression rate's snapshot against the collisions per disk
-    since the start (the block ends).
-
-    Parameters
-    ----------
-    runs : list of xarray.Dataset
-        ``hardpack eos --equilibration 0`` results (``Z_block`` over ``block``; attributes
-        ``collisions``, ``equilibration``, ``N``, ``phi`` and ``init``, the snapshot's path, which
-        names the rate as ``g<rate>``).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        The figure.
-    """
-    import re
-
-    fig, ax = figure(1, 1, figsize=(5.2, 3.8))
-
-    def rate_of(ds):
-        match = re.search(r"/g([0-9.e+-]+)/", str(ds.attrs.get("init", "")))
-        return float(match.group(1)) if match else float("nan")
-
-    rates = sorted({rate_of(ds) for ds in runs}, reverse=True)
-    labelled = set()
-    for ds in sorted(runs, key=rate_of, reverse=True):
-        rate = rate_of(ds)
-        z = ds["Z_block"].values
-        n_disks = float(ds.attrs["N"])
-        per_block = float(ds.attrs["collisions"]) / z.size / n_disks
-        start = float(ds.attrs.get("equilibration", 0)) / n_disks
-        colour = f"C{rates.index(rate) % 10}"
-        ax.plot(start + per_block * np.arange(1, z.size + 1), z, "-", lw=1.0, color=colour,
-                label=None if rate in labelled else f"compressed at Gamma = {rate:g}")
-        labelled.add(rate)
-    ax.set_xscale("log")
-    ax.set_xlabel("collisions per disk since the snapshot")
-    ax.set_ylabel("Z = PV / NkT (block)")
-    phi = float(runs[0].attrs["phi"]) if runs else float("nan")
-    n = int(runs[0].attrs["N"]) if runs else 0
-    ax.set_title(f"binary disks at phi = {phi:.3f}, N = {n}")
-    ax.legend(fontsize="small")
+    if panels == 2:
+        right = axes[1]
+        right.plot(phi, freezing["z_separated"], "k-", lw=1.2,
+                   label="separated crystal, equilibrium (monodisperse EOS)")
+        edges = np.arange(0.5, 0.9, 0.005)
+        for k, ts in enumerate(sorted(decompressions, key=lambda t: -abs(float(t.attrs["growth_rate"])))):
+            p, z = ts["phi"].values, ts["Z"].values
+            which = np.digitize(p, edges)
+            bins = np.unique(which)
+            right.plot([p[which == b].mean() for b in bins], [z[which == b].mean() for b in bins], "-", color=f"C{k}",
+                       lw=1.0, label=f"decompression at Gamma = {abs(float(ts.attrs['growth_rate'])):g}")
+        right.set_yscale("log")
+        right.set_xlabel("phi")
+        right.set_ylabel("Z = PV / NkT")
+        right.set_title(f"N = {int(decompressions[0].attrs['N'])}")
+        right.legend(loc="upper left", fontsize="small")
     return fig
 
 
