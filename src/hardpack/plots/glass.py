@@ -250,6 +250,53 @@ def plot_glass_separated(freezing, decompressions=()):
     return fig
 
 
+def plot_glass_relaxation(runs):
+    """Pressure relaxation of the mixture's glasses at fixed phi (after Donev 2006, Fig. 13.7):
+    Z per block of NVE MD from each compression rate's snapshot against the collisions per disk
+    since the start (the block ends).
+
+    Parameters
+    ----------
+    runs : list of xarray.Dataset
+        ``hardpack eos --equilibration 0`` results (``Z_block`` over ``block``; attributes
+        ``collisions``, ``equilibration``, ``N``, ``phi`` and ``init``, the snapshot's path, which
+        names the rate as ``g<rate>``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
+    import re
+
+    fig, ax = figure(1, 1, figsize=(5.2, 3.8))
+
+    def rate_of(ds):
+        match = re.search(r"/g([0-9.e+-]+)/", str(ds.attrs.get("init", "")))
+        return float(match.group(1)) if match else float("nan")
+
+    rates = sorted({rate_of(ds) for ds in runs}, reverse=True)
+    labelled = set()
+    for ds in sorted(runs, key=rate_of, reverse=True):
+        rate = rate_of(ds)
+        z = ds["Z_block"].values
+        n_disks = float(ds.attrs["N"])
+        per_block = float(ds.attrs["collisions"]) / z.size / n_disks
+        start = float(ds.attrs.get("equilibration", 0)) / n_disks
+        colour = f"C{rates.index(rate) % 10}"
+        ax.plot(start + per_block * np.arange(1, z.size + 1), z, "-", lw=1.0, color=colour,
+                label=None if rate in labelled else f"compressed at Gamma = {rate:g}")
+        labelled.add(rate)
+    ax.set_xscale("log")
+    ax.set_xlabel("collisions per disk since the snapshot")
+    ax.set_ylabel("Z = PV / NkT (block)")
+    phi = float(runs[0].attrs["phi"]) if runs else float("nan")
+    n = int(runs[0].attrs["N"]) if runs else 0
+    ax.set_title(f"binary disks at phi = {phi:.3f}, N = {n}")
+    ax.legend(fontsize="small")
+    return fig
+
+
 def _snapshot_phi(ds) -> float:
     """The snapshot's density: BCMD shrinks the radii by (1 - delta) (attribute ``delta``)."""
     shrink = (1.0 - float(ds.attrs.get("delta", 0.0))) ** int(ds.attrs.get("dim", 2))
