@@ -282,10 +282,9 @@ def separated_crystal(pure: Phase, mix: Mixture, phi) -> SeparatedCrystal:
     """
     targets = np.atleast_1d(np.asarray(phi, float))
     k_d, v = mix.kappa**mix.d, mix.mean_volume
-    w_a, w_b = (1.0 - mix.x_large) / v, mix.x_large * k_d / v
 
     def overall(pressure):
-        return 1.0 / (w_a / _phi_at(pure, pressure, 1.0) + w_b / _phi_at(pure, pressure, k_d))
+        return _overall_phi(mix, _phi_at(pure, pressure, 1.0), _phi_at(pure, pressure, k_d))
 
     lo = pure.phi_lo * pure.z(pure.phi_lo)
     hi = pure.phi_hi * pure.z(pure.phi_hi) / k_d
@@ -326,12 +325,17 @@ def separated_melting(pure: Phase, mix: Mixture, phi_transition: float) -> tuple
     if not pure.phi_lo <= phi_transition <= pure.phi_hi:
         raise InvalidInputError(f"phi_transition = {phi_transition} is outside the EOS range "
                                 f"[{pure.phi_lo}, {pure.phi_hi}]")
-    k_d, v = mix.kappa**mix.d, mix.mean_volume
-    w_a, w_b = (1.0 - mix.x_large) / v, mix.x_large * k_d / v
+    k_d = mix.kappa**mix.d
     pressure = phi_transition * pure.z(phi_transition)
-    a_melts = 1.0 / (w_a / phi_transition + w_b / _phi_at(pure, pressure, k_d))
-    b_melts = 1.0 / (w_a / _phi_at(pure, pressure / k_d, 1.0) + w_b / phi_transition)
+    a_melts = _overall_phi(mix, phi_transition, _phi_at(pure, pressure, k_d))
+    b_melts = _overall_phi(mix, _phi_at(pure, pressure / k_d, 1.0), phi_transition)
     return a_melts, b_melts
+
+
+def _overall_phi(mix: Mixture, phi_a: float, phi_b: float) -> float:
+    """The overall density of the separated phases: 1 / phi = (x_A / v) / phi_A + (x_B kappa^d / v) / phi_B."""
+    v = mix.mean_volume
+    return 1.0 / ((1.0 - mix.x_large) / v / phi_a + mix.x_large * mix.kappa**mix.d / v / phi_b)
 
 
 def composition_derivative(excess_plus: Function, excess_minus: Function, dx: float) -> Function:

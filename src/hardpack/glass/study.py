@@ -600,9 +600,7 @@ def _solve_separated(mono, kappa, x_large, phi_join, curves: bool = True):
     region (text)."""
     from hardpack.glass import freezing as fz
 
-    p, z, ze = joint_branch(mono, mono.attrs["cubic_branch"], "decompression", phi_join)
-    f, _ = thermo.excess_free_energy(p, z, ze, slope0=thermo.second_virial_slope(2))
-    pure, mix = fz.tabulated_phase(p, z, f), fz.Mixture(kappa, x_large)
+    pure, mix = _mono_phase(mono, phi_join), fz.Mixture(kappa, x_large)
     a_melts, b_melts = fz.separated_melting(pure, mix, SEPARATED_TRANSITION)
     if not curves:
         return {"phi_a_melts": a_melts, "phi_b_melts": b_melts}, None, ""
@@ -630,13 +628,20 @@ def _perturbed_eos(eos: xr.Dataset, rng: np.random.Generator) -> xr.Dataset:
     return out
 
 
+def _mono_phase(mono, phi_join):
+    """The monodisperse disks as one phase: the slowest compression below ``phi_join``, the
+    crystal's decompression above, with the EOS integral from the ideal gas."""
+    from hardpack.glass import freezing as fz
+
+    p, z, ze = joint_branch(mono, mono.attrs["cubic_branch"], "decompression", phi_join)
+    f, _ = thermo.excess_free_energy(p, z, ze, slope0=thermo.second_virial_slope(2))
+    return fz.tabulated_phase(p, z, f)
+
+
 def _solve_freezing(mono, mixture, plus, minus, kappa, x_large, dx, phi_join):
     from hardpack.glass import freezing as fz
 
-    slope_mono = thermo.second_virial_slope(2)
-    p, z, ze = joint_branch(mono, mono.attrs["cubic_branch"], "decompression", phi_join)
-    f, _ = thermo.excess_free_energy(p, z, ze, slope0=slope_mono)
-    pure = fz.tabulated_phase(p, z, f)
+    pure = _mono_phase(mono, phi_join)
 
     def branch_phase(eos):
         row = eos.sel(branch=eos.attrs["cubic_branch"])
