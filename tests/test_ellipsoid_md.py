@@ -659,8 +659,8 @@ def test_the_contacts_at_a_window_end_and_their_normal_speeds_are_those_of_spher
     spheres, the touching pair is a contact and the distant one is not, and the normal separation
     speed is the sphere value n . (v_B - v_A) - 2 g (the surfaces approach at g a each, with the
     relative growth rate g) whatever the spins; a sphere touching a container of radius 5 from
-    inside separates from it at -(n . v + g)."""
-    from hardpack.geometry.boundaries import SphericalContainer
+    inside separates from it at -(n . v + g), and so does one touching a flat wall."""
+    from hardpack.geometry.boundaries import HardWalls, SphericalContainer
     from hardpack.md.engine import image_vectors
 
     rng = np.random.default_rng(3)
@@ -676,7 +676,7 @@ def test_the_contacts_at_a_window_end_and_their_normal_speeds_are_those_of_spher
     contacts = ek.end_contacts(eng.P, np.array([0, 2]), imgvec, nb, nn, ek.PERIODIC_MODE, eng.wspec)
     assert contacts.tolist() == [[0, 1, code]]
     g = 0.3
-    rate = ek.contact_rates(eng.P, contacts, imgvec, g, eng.wspec)
+    rate = ek.contact_rates(eng.P, contacts, imgvec, g, ek.PERIODIC_MODE, eng.wspec)
     assert rate[0] == pytest.approx(v[1, 0] - v[0, 0] - 2 * g, rel=1e-12, abs=1e-12)
 
     cont = SphericalContainer((10.0, 10, 10), 5.0)
@@ -686,5 +686,14 @@ def test_the_contacts_at_a_window_end_and_their_normal_speeds_are_those_of_spher
     contacts = ek.end_contacts(one.P, np.array([0]), one.imgvec, none, np.zeros(1, dtype=np.int32),
                                ek.SPHERE_MODE, one.wspec)
     assert contacts.tolist() == [[0, ek.WALL, 0]]
-    rate = ek.contact_rates(one.P, contacts, one.imgvec, g, one.wspec)
+    rate = ek.contact_rates(one.P, contacts, one.imgvec, g, ek.SPHERE_MODE, one.wspec)
+    assert rate[0] == pytest.approx(-(v[0, 0] + g), rel=1e-12, abs=1e-12)
+
+    # the same unit sphere touching the flat wall x_0 = L_0 = 15 of a slit: wall 1 (axis 0, side L)
+    slit = EllipsoidEngine(np.array([[14.0, 10, 10]]), v[:1], np.ones((1, 3)), np.array([[1.0, 0, 0, 0]]),
+                           w[:1], np.array([15.0, 20.0, 20.0]), boundary=HardWalls((0,)))
+    contacts = ek.end_contacts(slit.P, np.array([0]), slit.imgvec, none, np.zeros(1, dtype=np.int32),
+                               ek.FLAT_WALLS_MODE, slit.wspec)
+    assert contacts.tolist() == [[0, ek.WALL - 1, 0]]
+    rate = ek.contact_rates(slit.P, contacts, slit.imgvec, g, ek.FLAT_WALLS_MODE, slit.wspec)
     assert rate[0] == pytest.approx(-(v[0, 0] + g), rel=1e-12, abs=1e-12)

@@ -95,6 +95,14 @@ w_B += J (r_C - r_B) x n / I_B, w_A -= J (r_C - r_A) x n / I_A (2D: the cross pr
 scalars). With growth the energy rises by the growth part of v_n, as for spheres. Collisions with
 v_n >= 0 are skipped (grazing or mispredicted, Algorithm 12 step 3).
 
+**Walls** (Donev 2006, sec. 3.2.2.1: each axis of the cell periodic or a hard wall; Ch. 7: a
+spherical container). A wall is handled as a pair with an immobile partner: its gap h to the
+particle (:func:`wall_gap`: the distance from the wall of the particle's support point along the
+wall's outward normal, exact and in closed form for a flat wall, R - rho for the container) is
+traced as zeta is (:func:`wall_predict`, with the safe time of a bound on its rate), and the
+collision law is the pair law with an infinitely massive partner (:func:`wall_collide`). Flat
+walls are predicted only once the particle's bounding sphere can reach them.
+
 **Pressure.** The virial accumulates r_AB . J n (centre-to-centre vector, the molecular virial), so
 Z = PV/(NkT) = 1 + virial / (2 integral of the translational kinetic energy dt), as for spheres.
 """
@@ -126,7 +134,7 @@ from hardpack.md._kernel import (
 EXIT = -1  # event: the particle leaves its bounding sphere
 NONE = -2  # nothing predicted
 CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
-WALL = -4  # event: the particle hits the wall of the spherical container
+WALL = -4  # event: the particle hits wall 0 (the spherical container); WALL - w: flat wall w
 
 #: what a pair trace (:func:`pair_trace`, :func:`predict_pair`) or a wall search
 #: (:func:`wall_predict`) found at the time it returns (plain ints: compile-time constants that
@@ -153,6 +161,7 @@ SHARE_NONE, SHARE_WRITE, SHARE_READ = 0, 1, 2
 #: boundary modes of :func:`run_events`, tuples whose LENGTH is a compile-time constant (as in
 #: :mod:`hardpack.md._kernel`): the periodic specialisation has no wall code at all
 PERIODIC_MODE = ()
+FLAT_WALLS_MODE = (0,)
 SPHERE_MODE = (0, 0)
 
 #: extra counters (after the sphere engine's): CHECK events; the particle and partner of the
@@ -166,10 +175,11 @@ N_COUNTERS = 9
 #: a window stops as STALLED after this many consecutive events at one time without a collision,
 #: plus 10 per particle
 STALL_EVENTS = 1000
-#: extra accumulators: contact-function evaluations; the momentum given to the container wall
+#: extra accumulators: contact-function evaluations; the momentum given to the walls, from A_WALL
+#: on: the container wall's in entry A_WALL, that of the two flat walls of axis k in A_WALL + k
 A_EVAL = 5
 A_WALL = 6
-N_ACC = 7
+N_ACC = 9
 
 #: default tolerance on the Hermite interpolation error of zeta (Donev 2006, sec. 3.5.1: 1e-4..1e-3)
 EPS_F = 1e-4
@@ -1080,13 +1090,18 @@ def wall_arrays(d):
 
 
 @njit(cache=True)
-def wall_gap(P, i, t, kappa, wspec, ww, wq):
-    """(h, dh/dt) of particle i at window time t: the gap h = R - rho between the container wall
-    (centre wspec[:d], radius wspec[d]) and the particle's farthest surface point
-    (:func:`hardpack.geometry.ellipsoid_container.farthest_point_body`), and its rate by the
-    envelope theorem, dh/dt = -n . (v + w x r_c + g r_c) (n the outward unit normal at the
-    farthest point, r_c that point less the particle centre, g the relative growth rate). On
-    return ww[5, :d] holds r_c, ww[6, :d] n.
+def wall_gap(P, i, t, kappa, wmode, wspec, wid, ww, wq):
+    """(h, dh/dt) of particle i at window time t and wall ``wid`` (module docstring, *Walls*): the
+    gap h between the wall and the particle's farthest surface point along the wall's outward
+    normal n, and its rate by the envelope theorem (the point is stationary on the surface),
+    dh/dt = -n . (v + w x r_c + g r_c) (r_c that point less the particle centre, g the relative
+    growth rate). In a spherical container (SPHERE_MODE, centre wspec[:d], radius wspec[d]) the
+    point is the farthest from the centre
+    (:func:`hardpack.geometry.ellipsoid_container.farthest_point_body`), h = R - rho, and n is
+    radial there; at the flat wall ``wid`` (FLAT_WALLS_MODE: x_k = 0 for wid = 2 k, x_k = L_k =
+    wspec[k] for wid = 2 k + 1) the support point along n = -e_k or +e_k,
+    r_c = X^-1 n / sqrt(n . X^-1 n), and h = x_k - n . r_c or L_k - x_k - n . r_c. On return
+    ww[5, :d] holds r_c, ww[6, :d] n.
 
     Parameters
     ----------
@@ -1098,8 +1113,13 @@ def wall_gap(P, i, t, kappa, wspec, ww, wq):
         Window time.
     kappa : float
         Relative growth rate of the semiaxes.
+    wmode : tuple
+        SPHERE_MODE or FLAT_WALLS_MODE.
     wspec : numpy.ndarray of float64, shape (d + 1,)
-        Container centre and radius.
+        Container centre and radius, or the wall positions L_k of the walled axes (0 for the
+        periodic ones) and a length scale (:func:`run_events`).
+    wid : int
+        The flat wall (unused in a container).
     ww, wq : numpy.ndarray
         Scratch of :func:`wall_arrays`, outputs as above.
 
@@ -1116,22 +1136,44 @@ def wall_gap(P, i, t, kappa, wspec, ww, wq):
     grow = 1.0 + kappa * t
     x, o, a, b, xb, rc, n = ww[0, :d], ww[1], ww[2, :d], ww[3, :d], ww[4, :d], ww[5, :d], ww[6, :d]
     for k in range(d):
-        x[k] = P[i, k] + P[i, cv + k] * dt - wspec[k]
+        x[k] = P[i, k] + P[i, cv + k] * dt
         a[k] = P[i, cax + k] * grow
     orientation_at(P, i, t, o)
     _rotation_into(o, wq)
-    for k in range(d):
-        acc = 0.0
-        for m in range(d):
-            acc += wq[k, m] * x[m]
-        b[k] = acc
-    rho = np.sqrt(farthest_point_body(b, a, xb))
-    for m in range(d):
-        acc = 0.0
+    if len(wmode) == 1:  # flat wall: the support point along n = sgn e_k, body frame b = Q n
+        kw = wid >> 1
+        sgn = 1.0 if wid & 1 else -1.0
+        ss = 0.0
         for k in range(d):
-            acc += wq[k, m] * xb[k]
-        n[m] = acc / rho
-        rc[m] = acc - x[m]
+            b[k] = sgn * wq[k, kw]
+            ss += a[k] * a[k] * b[k] * b[k]
+        sup = np.sqrt(ss)
+        for k in range(d):
+            xb[k] = a[k] * a[k] * b[k] / sup
+        for m in range(d):
+            acc = 0.0
+            for k in range(d):
+                acc += wq[k, m] * xb[k]
+            rc[m] = acc
+            n[m] = 0.0
+        n[kw] = sgn
+        h = (wspec[kw] - x[kw] if wid & 1 else x[kw]) - sup
+    else:
+        for k in range(d):
+            x[k] -= wspec[k]
+        for k in range(d):
+            acc = 0.0
+            for m in range(d):
+                acc += wq[k, m] * x[m]
+            b[k] = acc
+        rho = np.sqrt(farthest_point_body(b, a, xb))
+        for m in range(d):
+            acc = 0.0
+            for k in range(d):
+                acc += wq[k, m] * xb[k]
+            n[m] = acc / rho
+            rc[m] = acc - x[m]
+        h = wspec[d] - rho
     g = kappa / grow
     rate = 0.0
     for k in range(d):
@@ -1141,17 +1183,17 @@ def wall_gap(P, i, t, kappa, wspec, ww, wq):
     nw = 3 if d == 3 else 1
     for k in range(nw):
         rate += P[i, cw + k] * c[k]
-    return wspec[d] - rho, -rate
+    return h, -rate
 
 
 @njit(cache=True)
-def _wall_refine(P, i, kappa, wspec, hc, lo, dlo, hi, hhi, dhi, guess, ww, wq):
+def _wall_refine(P, i, kappa, wmode, wspec, wid, hc, lo, dlo, hi, hhi, dhi, guess, ww, wq):
     """First crossing of h = hc in [lo, hi] (h(lo) >= hc > h(hi)), safeguarded Newton as
     :func:`_refine`: (t_c, rate there, hi, h(hi), rate at hi)."""
     htol = H_TOL_ULPS * EPS * wspec[wspec.shape[0] - 1]
     tt = guess if lo < guess < hi else 0.5 * (lo + hi)
     for _ in range(100):
-        z, zd = wall_gap(P, i, tt, kappa, wspec, ww, wq)
+        z, zd = wall_gap(P, i, tt, kappa, wmode, wspec, wid, ww, wq)
         f = z - hc
         if f >= 0.0:
             lo, dlo = tt, zd
@@ -1173,11 +1215,11 @@ def _wall_refine(P, i, kappa, wspec, hc, lo, dlo, hi, hhi, dhi, guess, ww, wq):
 
 
 @njit(cache=True)
-def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
-    """First wall collision of particle i in window time [t, tmax): (time, kind), kind 0 a
-    collision, 1 a CHECK (step cap reached), time inf for none.
+def wall_predict(P, i, t, tmax, kappa, wmode, wspec, wid, eps_f, ww, wq):
+    """First collision of particle i with wall ``wid`` in window time [t, tmax): (time, kind),
+    kind 0 a collision, 1 a CHECK (step cap reached), time inf for none.
 
-    The gap h(t) = R - rho(t) (:func:`wall_gap`) decreases at most at the rate
+    The gap h(t) (:func:`wall_gap`) decreases at most at the rate
     |v| + |kappa| a_max(0) + |w| a_max(t) (the centre, the growth and the spin of the farthest
     point, at distance <= a_max from the centre), so no contact happens within the safe time of
     :func:`_safe_time` (Donev 2006, sec. 3.5.1: jump ahead with a bound on the rate). When the safe
@@ -1199,8 +1241,8 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
         Window-time interval searched.
     kappa : float
         Relative growth rate of the semiaxes.
-    wspec : numpy.ndarray of float64, shape (d + 1,)
-        Container centre and radius.
+    wmode, wspec, wid
+        The wall, as in :func:`wall_gap`.
     eps_f : float
         Tolerance on the Hermite interpolation error, relative to the smallest semiaxis.
     ww, wq : numpy.ndarray
@@ -1234,7 +1276,7 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
     if speed == 0.0:
         return np.inf, TRACE_COLLISION
     rate_tol = GRAZE_RATE * speed
-    h0, d0 = wall_gap(P, i, t, kappa, wspec, ww, wq)
+    h0, d0 = wall_gap(P, i, t, kappa, wmode, wspec, wid, ww, wq)
     hc = 0.0
     touching = False
     if h0 <= 0.0:
@@ -1258,7 +1300,7 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
             return np.inf, TRACE_COLLISION
         if safe > step:
             t1 = t0 + safe
-            h1, d1 = wall_gap(P, i, t1, kappa, wspec, ww, wq)
+            h1, d1 = wall_gap(P, i, t1, kappa, wmode, wspec, wid, ww, wq)
             steps += 1
             if h1 > hc:
                 t0, h0, d0 = t1, h1, d1
@@ -1267,8 +1309,8 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
         step = min(max(step, hfloor), tmax - t0)
         t1 = t0 + step
         tm = t0 + 0.5 * step
-        h1, d1 = wall_gap(P, i, t1, kappa, wspec, ww, wq)
-        hm, dm = wall_gap(P, i, tm, kappa, wspec, ww, wq)
+        h1, d1 = wall_gap(P, i, t1, kappa, wmode, wspec, wid, ww, wq)
+        hm, dm = wall_gap(P, i, tm, kappa, wmode, wspec, wid, ww, wq)
         steps += 1
         if touching and hm <= hc:  # still in contact at the midpoint
             if dm < -rate_tol:  # approaching: the collision is at the latest here
@@ -1282,11 +1324,11 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
         if hm <= hc or h1 <= hc:  # a crossing of hc from above
             if hm <= hc:
                 root = _hermite_root(h0 - hc, hm - hc, d0 * 0.5 * step, dm * 0.5 * step)
-                tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, t0, d0, tm, hm, dm,
+                tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wmode, wspec, wid, hc, t0, d0, tm, hm, dm,
                                                      t0 + 0.5 * step * min(root, 1.0), ww, wq)
             else:
                 root = _hermite_root(hm - hc, h1 - hc, dm * 0.5 * step, d1 * 0.5 * step)
-                tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wspec, hc, tm, dm, t1, h1, d1,
+                tc, dc, thi, hhi, dhi = _wall_refine(P, i, kappa, wmode, wspec, wid, hc, tm, dm, t1, h1, d1,
                                                      tm + 0.5 * step * min(root, 1.0), ww, wq)
             if dc < -rate_tol:
                 return tc, TRACE_COLLISION
@@ -1310,10 +1352,10 @@ def wall_predict(P, i, t, tmax, kappa, wspec, eps_f, ww, wq):
 
 
 @njit(cache=True)
-def wall_collide(P, i, t, kappa, wspec, ww, wq):
-    """Collision of particle i with the container wall at window time t (the particle is first
+def wall_collide(P, i, t, kappa, wmode, wspec, wid, ww, wq):
+    """Collision of particle i with wall ``wid`` at window time t (the particle is first
     advanced to t): the collision law of :func:`collide` with an infinitely massive wall, at the
-    farthest point r_C with the outward normal n: v_n = n . (v + w x (r_C - x) + g (r_C - x)) > 0
+    contact point r_C of :func:`wall_gap` with the wall's outward normal n: v_n = n . (v + w x (r_C - x) + g (r_C - x)) > 0
     for an approaching particle, impulse -J n on the particle with
     J = 2 v_n / (1/m + |(r_C - x) x n|^2 / I), which reverses v_n: v -= J n,
     w -= J (r_C - x) x n / I. Returns (J, the momentum given to the wall, >= 0; change of the
@@ -1329,8 +1371,8 @@ def wall_collide(P, i, t, kappa, wspec, ww, wq):
         Window time of the collision.
     kappa : float
         Relative growth rate of the semiaxes.
-    wspec : numpy.ndarray of float64, shape (d + 1,)
-        Container centre and radius.
+    wmode, wspec, wid
+        The wall, as in :func:`wall_gap`.
     ww, wq : numpy.ndarray
         Scratch of :func:`wall_arrays`.
 
@@ -1344,7 +1386,7 @@ def wall_collide(P, i, t, kappa, wspec, ww, wq):
     d = wq.shape[0]
     cv, _, _, _, _, cw, cii, _ = columns(d)
     advance(P, i, t, ww[1])
-    _, hd = wall_gap(P, i, t, kappa, wspec, ww, wq)
+    _, hd = wall_gap(P, i, t, kappa, wmode, wspec, wid, ww, wq)
     vn = -hd
     if not vn > 0.0:
         return 0.0, 0.0
@@ -1368,8 +1410,8 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
              bs, nb, nn, mark, oldnb, clo, cspan, codo, scratch, wmode, walled):
     """Partial NNL update of particle i at window time t (Donev 2006, Algorithm 10): advance i to
     t and :func:`hardpack.md._kernel.update_neighbour_list` with the bounding radius R_i (largest
-    semiaxis) in place of the sphere radius; in a container (``wmode``, ``walled`` all 1) without
-    periodic images and wraps. Returns 0 or a :class:`WindowStatus` to stop with."""
+    semiaxis) in place of the sphere radius; along the ``walled`` axes (all of them in a container)
+    without periodic images and wraps. Returns 0 or a :class:`WindowStatus` to stop with."""
     _, _, cr, _, _, _, _, _ = columns(L.shape[0])
     advance(P, i, t, scratch)
     return update_neighbour_list(i, P[i, cr] * (1.0 + kappa * t), P, L, invL, skin, sfac, lvl, rcap, ncl, coff,
@@ -1438,11 +1480,32 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
     best = exit_root(dd, dv, vv, bs[i, d] - ri * grow, ri * kappa)
     partner = EXIT if best < np.inf else NONE
     best += t
-    if len(wmode) > 0:
-        tw, kind = wall_predict(P, i, t, best, kappa, wspec, eps_f, ww, wq)
+    if len(wmode) == 2:
+        tw, kind = wall_predict(P, i, t, best, kappa, wmode, wspec, 0, eps_f, ww, wq)
         if tw < best:
             best = tw
             partner = WALL if kind == TRACE_COLLISION else CHECK
+    elif len(wmode) == 1:  # flat walls: each one that the bounding sphere can reach before best
+        rb = ri * grow
+        for kw in range(d):
+            if wspec[kw] <= 0.0:
+                continue
+            xk = P[i, kw] + P[i, cv + kw] * dt
+            for side in range(2):
+                # bounding sphere: gap and approach speed (exact, both linear in time)
+                gap = (wspec[kw] - xk if side else xk) - rb
+                speed = (P[i, cv + kw] if side else -P[i, cv + kw]) + ri * kappa
+                tb = 0.0
+                if gap > 0.0:
+                    if not speed > 0.0:
+                        continue
+                    tb = gap / speed
+                if t + tb >= best:
+                    continue
+                tw, kind = wall_predict(P, i, t + tb, best, kappa, wmode, wspec, 2 * kw + side, eps_f, ww, wq)
+                if tw < best:
+                    best = tw
+                    partner = WALL - (2 * kw + side) if kind == TRACE_COLLISION else CHECK
     horizon = best  # no collision of i is later than the first contact of inscribed spheres
     amin_i = P[i, cax]
     for k in range(1, d):
@@ -1746,10 +1809,13 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     CHECK events and I_STALL_PARTICLE, I_STALL_PARTNER name the last event of a STALLED window (its
     time in acc[A_T]); acc[A_KE]
     enters the current translational kinetic energy; ``acc`` has N_ACC entries: A_EVAL receives
-    the number of contact-function evaluations, A_WALL the momentum given to the container wall).
-    ``wmode`` PERIODIC_MODE or SPHERE_MODE (a spherical container of centre wspec[:d] and radius
-    wspec[d] inside the box L, which then has no periodic images: wall collisions, counted in
-    iacc[I_WALL], count towards ``coll_target``); the periodic specialisation has no wall code.
+    the number of contact-function evaluations, A_WALL + k the momentum given to the walls of
+    axis k, or to the container wall for k = 0).
+    ``wmode`` PERIODIC_MODE, FLAT_WALLS_MODE (hard walls at x_k = 0 and x_k = L_k on the axes k
+    with wspec[k] = L_k > 0, periodic images along the others, wspec[d] the largest L_k) or
+    SPHERE_MODE (a spherical container of centre wspec[:d] and radius wspec[d] inside the box L,
+    which then has no periodic images); wall collisions, counted in iacc[I_WALL], count towards
+    ``coll_target``; the periodic specialisation has no wall code.
 
     Parameters
     ----------
@@ -1776,9 +1842,9 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     rebuild_lists : bool
         Start with a complete rebuild of grid and neighbour lists.
     wmode : tuple, optional
-        PERIODIC_MODE or SPHERE_MODE.
+        PERIODIC_MODE, FLAT_WALLS_MODE or SPHERE_MODE.
     wspec : numpy.ndarray of float64, shape (d + 1,), optional
-        Container centre and radius (SPHERE_MODE).
+        Wall positions and scale (FLAT_WALLS_MODE) or container centre and radius (SPHERE_MODE).
 
     Returns
     -------
@@ -1805,12 +1871,16 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
     cap = nb.shape[1]
     cbits = 2 * d
     invL = 1.0 / L
-    lbig = 4.0 * L  # in a container: no images (every pair is within the box, |dx| < L)
+    walled = np.zeros(d, dtype=np.int8)  # axes without images: all in a container, the flat walls' axes
+    lcoll = L.copy()  # collision images: none along walled axes (every pair is within the box, |dx| < L)
+    for k in range(d):
+        if len(wmode) == 2 or (len(wmode) == 1 and wspec[k] > 0.0):
+            walled[k] = 1
+            lcoll[k] = 4.0 * L[k]
     oldnb = np.empty(cap, dtype=np.int64)
     clo = np.empty(d, dtype=np.int64)
     cspan = np.empty(d, dtype=np.int64)
     codo = np.empty(d, dtype=np.int64)
-    walled = np.ones(d, dtype=np.int8)  # in a container (wmode) no axis has images
     tins = np.empty(cap)
     touts = np.empty(cap)
     pst = np.empty((cap, PAIR_STATE))
@@ -1875,12 +1945,13 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
                 return status
         elif p == CHECK:
             iacc[I_CHECK] += 1
-        elif len(wmode) > 0 and p == WALL:
-            jimp, dke = wall_collide(P, i, t, kappa, wspec, ww, wq)
+        elif len(wmode) > 0 and p <= WALL:
+            wid = WALL - p
+            jimp, dke = wall_collide(P, i, t, kappa, wmode, wspec, wid, ww, wq)
             if jimp > 0.0:
                 same = 0
                 wall_hit = True
-                acc[A_WALL] += jimp
+                acc[A_WALL + (wid >> 1)] += jimp
                 kinetic_step(acc, t, dke)
                 cnt[i] += 1
                 iacc[I_WALL] += 1
@@ -1890,7 +1961,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
             iacc[I_STALE] += 1
         else:
             j = p
-            jimp, vir, dke = collide(P, i, j, t, L if len(wmode) == 0 else lbig, kappa, ws, wm)
+            jimp, vir, dke = collide(P, i, j, t, lcoll, kappa, ws, wm)
             if jimp > 0.0:
                 same = 0
                 acc[A_VIRIAL] += vir
@@ -2061,8 +2132,8 @@ END_CONTACT_GAP = 1e-8
 @njit(cache=True)
 def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
     """The contacts at a synchronisation point of the particles in ``ended`` (those whose last
-    event was at the window end): listed pairs with zeta <= END_CONTACT_GAP, and, in a container
-    (``wmode``), particles within END_CONTACT_GAP R_i of the wall.
+    event was at the window end): listed pairs with zeta <= END_CONTACT_GAP, and, with walls
+    (``wmode``), particles within END_CONTACT_GAP R_i of a wall.
 
     Parameters
     ----------
@@ -2077,15 +2148,15 @@ def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
     nn : numpy.ndarray of int32, shape (N,)
         List lengths.
     wmode : tuple
-        PERIODIC_MODE or SPHERE_MODE.
+        PERIODIC_MODE, FLAT_WALLS_MODE or SPHERE_MODE.
     wspec : numpy.ndarray of float64, shape (d + 1,)
-        Container centre and radius.
+        The walls (:func:`run_events`).
 
     Returns
     -------
     numpy.ndarray of int64, shape (K, 3)
         Rows (i, j, image code) of the pairs (each pair once per list it is found in) and
-        (i, WALL, 0) of the wall contacts.
+        (i, WALL - w, 0) of the contacts with wall w (w = 0 the container wall).
     """
     d = imgvec.shape[1]
     cbits = 2 * d
@@ -2094,15 +2165,18 @@ def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
     ww, wq = wall_arrays(d)
     total = 0
     for q in range(ended.shape[0]):
-        total += nn[ended[q]] + 1
+        total += nn[ended[q]] + 2 * d
     out = np.empty((total, 3), dtype=np.int64)
     k = 0
     for q in range(ended.shape[0]):
         i = np.int64(ended[q])
-        if len(wmode) > 0:
-            h, _ = wall_gap(P, i, 0.0, 0.0, wspec, ww, wq)
+        n_walls = 2 * d if len(wmode) == 1 else (1 if len(wmode) == 2 else 0)
+        for wid in range(n_walls):
+            if len(wmode) == 1 and wspec[wid >> 1] <= 0.0:
+                continue
+            h, _ = wall_gap(P, i, 0.0, 0.0, wmode, wspec, wid, ww, wq)
             if h <= END_CONTACT_GAP * P[i, cr]:
-                out[k, 0], out[k, 1], out[k, 2] = i, WALL, 0
+                out[k, 0], out[k, 1], out[k, 2] = i, WALL - wid, 0
                 k += 1
         for m in range(nn[i]):
             j = np.int64(nb[i, m] >> cbits)
@@ -2123,7 +2197,7 @@ def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
 
 
 @njit(cache=True)
-def contact_rates(P, contacts, imgvec, kappa, wspec):
+def contact_rates(P, contacts, imgvec, kappa, wmode, wspec):
     """Normal separation speed of each contact of :func:`end_contacts` at window time 0 with the
     relative growth rate ``kappa``: n . v_C (module docstring, collision law; < 0 approaching) for a
     pair, dh/dt (:func:`wall_gap`; < 0 approaching) for a wall contact.
@@ -2138,8 +2212,10 @@ def contact_rates(P, contacts, imgvec, kappa, wspec):
         Periodic shift of each image code.
     kappa : float
         Relative growth rate of the semiaxes.
+    wmode : tuple
+        PERIODIC_MODE, FLAT_WALLS_MODE or SPHERE_MODE.
     wspec : numpy.ndarray of float64, shape (d + 1,)
-        Container centre and radius.
+        The walls (:func:`run_events`).
 
     Returns
     -------
@@ -2153,8 +2229,8 @@ def contact_rates(P, contacts, imgvec, kappa, wspec):
     out = np.empty(contacts.shape[0])
     for q in range(contacts.shape[0]):
         i, j, im = contacts[q, 0], contacts[q, 1], contacts[q, 2]
-        if j == WALL:
-            _, out[q] = wall_gap(P, i, 0.0, kappa, wspec, ww, wq)
+        if j <= WALL:
+            _, out[q] = wall_gap(P, i, 0.0, kappa, wmode, wspec, WALL - j, ww, wq)
             continue
         sh = ws[9, :d]
         for c in range(d):

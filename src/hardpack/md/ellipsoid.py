@@ -38,8 +38,8 @@ log = logging.getLogger("hardpack.md")
 
 
 def check_ellipsoid_packing(packing: Packing) -> None:
-    """Refuse packings the ellipsoid engine cannot run (other shapes, hard flat walls, sheared
-    cells, fewer than 2 particles in a periodic cell, overlaps, particles outside a container).
+    """Refuse packings the ellipsoid engine cannot run (other shapes, sheared cells, fewer than 2
+    particles in a periodic cell, overlaps, particles outside the walls or the container).
 
     Parameters
     ----------
@@ -56,9 +56,6 @@ def check_ellipsoid_packing(packing: Packing) -> None:
     if packing.shape.kind != "ellipsoid":
         raise InvalidInputError(f"the ellipsoid MD engine runs ellipsoids or ellipses; this packing "
                                 f"holds {packing.shape.name} (use hardpack.md.compress for spheres)")
-    if packing.boundary.kind not in ("periodic", "spherical_container"):
-        raise InvalidInputError("the ellipsoid MD engine runs periodic cells and spherical containers "
-                                "(hard flat walls need the ellipsoid-plane potential, not implemented)")
     if not packing.is_orthorhombic:
         raise InvalidInputError("the ellipsoid MD engine supports orthorhombic (diagonal) periodic "
                                 "cells only; this lattice is sheared: pass a diagonal lattice")
@@ -115,11 +112,11 @@ class EllipsoidSimulation(Simulation):
                  growth_rate: float, overlap_tol: float = DEFAULT_OVERLAP_TOL, eps_f: float = EPS_F):
         self._setup(packing, growth_rate, overlap_tol)
         shape = packing.shape
-        container = self.boundary.kind == "spherical_container"
-        positions = packing.positions if container else packing.fractional() * self.box
+        positions = packing.fractional() * self.box
+        positions[:, ~self._periodic] = packing.positions[:, ~self._periodic]
         self.engine = EllipsoidEngine(positions, velocities, shape.semiaxes, shape.orientations,
                                       angular_velocities, self.box, eps_f=eps_f,
-                                      boundary=self.boundary if container else None)
+                                      boundary=None if self.boundary.kind == "periodic" else self.boundary)
         self.contacts = None
 
     def _inverse(self) -> np.ndarray:
@@ -134,28 +131,21 @@ class EllipsoidSimulation(Simulation):
         inv = self._inverse()
         eng = self.engine
         pos = eng.positions[inv]
-        if self.boundary.kind == "periodic":
-            pos = pos - np.floor(pos / self.box) * self.box
-            pos[pos >= self.box] = 0.0
+        wrapped = pos - np.floor(pos / self.box) * self.box
+        wrapped[wrapped >= self.box] = 0.0
+        pos[:, self._periodic] = wrapped[:, self._periodic]
         shape = Ellipsoids(eng.semiaxes[inv].copy(), eng.orientations[inv].copy())
         return Packing(pos, lattice=self.lattice, species=self.species, shape=shape, boundary=self.boundary,
                        overlap_tol=self.overlap_tol, allow_overlap=True)
 
     def _check_walls(self, res) -> None:
-        """Raise :class:`OverlapError` when a particle crosses the container wall by more than the
-        tolerance times its largest semiaxis (the exact farthest point,
-        :mod:`hardpack.geometry.ellipsoid_container`)."""
-        from hardpack.geometry.ellipsoid_container import container_gaps
-
-        eng = self.engine
-        shape = Ellipsoids(eng.semiaxes.copy(), eng.orientations.copy())
-        gap, _ = container_gaps(eng.positions, shape, self.boundary.centre, self.boundary.radius)
-        over = -gap / eng.radii
-        i = int(np.argmax(over))
-        if over[i] > self.overlap_tol:
-            raise OverlapError(f"at the end of window {self.windows - 1}: {int((over > self.overlap_tol).sum())} "
-                               f"ellipsoid(s) cross the container wall; worst (engine order) {i} by {over[i]:.3e} "
-                               f"of its largest semiaxis > tolerance {self.overlap_tol:g}")
+        """Raise :class:`OverlapError` when a particle crosses a wall by more than the tolerance
+        (:meth:`hardpack.geometry.packing.Packing.containment_report`: the exact support point
+        along a flat wall's normal, the exact farthest point from a container's centre)."""
+        report = self.packing().containment_report(self.overlap_tol)
+        if report.n_outside:
+            raise OverlapError(f"at the end of window {self.windows - 1}: {report} (caller's order) > "
+                               f"tolerance {self.overlap_tol:g}")
 
     def angular_velocities(self) -> np.ndarray:
         """Lab-frame angular velocities in the caller's particle order.
@@ -276,9 +266,9 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
     ----------
     packing : Packing
         Ellipsoids (3D) or ellipses (2D) without overlaps: N >= 2 in a periodic orthorhombic cell, or
-        N >= 1 inside a spherical container (Donev 2006, Ch. 7; the wall events of
-        :mod:`hardpack.md._ellipsoid_kernel`; the window records then hold ``Z_wall``, the pressure
-        on the wall, and ``wall_collisions``).
+        N >= 1 between hard flat walls or inside a spherical container (Donev 2006, sec. 3.2.2.1
+        and Ch. 7; the wall events of :mod:`hardpack.md._ellipsoid_kernel`; the window records then
+        hold ``Z_wall``, the pressure on the walls, and ``wall_collisions``).
     growth_rate : float
         Gamma (module docstring), finite.
     seed : int
@@ -350,7 +340,7 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
         raise OverlapError(f"the final ellipsoid packing has overlaps beyond {overlap_tol:g}: {report}")
     walls = final.containment_report(overlap_tol)
     if walls.n_outside:
-        raise OverlapError(f"the final ellipsoid packing crosses the container wall beyond {overlap_tol:g}: {walls}")
+        raise OverlapError(f"the final ellipsoid packing crosses a wall beyond {overlap_tol:g}: {walls}")
     final = final.replace(allow_overlap=False)
     last = {k: (sim.records[k][-1] if sim.records[k] else float("nan")) for k in ("Z", "phi_J_est")}
     stats = {
@@ -370,7 +360,7 @@ def compress_ellipsoids(packing: Packing, growth_rate: float, seed: int, stop: S
         "overlap_check": "passed", "mass": 1.0, "kT": 1.0,
         "moment_of_inertia": "spherically symmetric: (2/15)(a^2+b^2+c^2) in 3D, (a^2+b^2)/4 in 2D",
     }
-    if final.boundary.kind == "spherical_container":
+    if final.boundary.kind != "periodic":
         stats.update({"max_wall_overlap": float(walls.overlap), "containment_check": "passed",
                       "Z_wall": float(sim.records["Z_wall"][-1]) if sim.records["Z_wall"] else float("nan")})
     if final_growth_rate is not None:

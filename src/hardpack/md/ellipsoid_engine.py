@@ -56,9 +56,10 @@ def rotational_dof(d: int) -> int:
 
 
 class EllipsoidEngine(Engine):
-    """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box, or in a spherical
-    container (``boundary``, a :class:`hardpack.geometry.boundaries.SphericalContainer` inside the
-    box, which then only serves the cell grid).
+    """Numba state of N ellipsoids or ellipses in an orthorhombic periodic box, between hard flat
+    walls at x_k = 0 and x_k = L_k (``boundary``, a :class:`hardpack.geometry.boundaries.HardWalls`)
+    or in a spherical container (a :class:`hardpack.geometry.boundaries.SphericalContainer` inside
+    the box, which then only serves the cell grid).
 
     Parameters
     ----------
@@ -76,8 +77,8 @@ class EllipsoidEngine(Engine):
         Initial neighbour-list capacity (doubled on overflow).
     eps_f : float, optional
         Trace tolerance (:data:`hardpack.md._ellipsoid_kernel.EPS_F`).
-    boundary : SphericalContainer or None, optional
-        A spherical container inside the box; None = periodic.
+    boundary : HardWalls, SphericalContainer or None, optional
+        Hard flat walls or a spherical container inside the box; None = periodic.
     """
 
     def __init__(self, positions, velocities, semiaxes, orientations, angular_velocities, box,
@@ -87,14 +88,24 @@ class EllipsoidEngine(Engine):
         self.eps_f = float(eps_f)
         self.box = np.ascontiguousarray(box, dtype=float)
         kind = "periodic" if boundary is None else boundary.kind
-        if kind not in ("periodic", "spherical_container"):
-            raise ValueError(f"the ellipsoid engine runs periodic cells or spherical containers, not {kind}")
-        self.wmode = ek.PERIODIC_MODE if kind == "periodic" else ek.SPHERE_MODE
-        self.walled = np.full(d, 0 if kind == "periodic" else 1, dtype=np.int8)  # a container walls every axis
-        self.wspec = np.zeros(d + 1)
+        modes = {"periodic": ek.PERIODIC_MODE, "hard_walls": ek.FLAT_WALLS_MODE,
+                 "spherical_container": ek.SPHERE_MODE}
+        if kind not in modes:
+            raise ValueError(f"the ellipsoid engine runs periodic cells, hard walls or spherical containers, not {kind}")
+        self.wmode = modes[kind]
+        self.walled = np.zeros(d, dtype=np.int8)  # axes without periodic images
+        if kind == "spherical_container":
+            self.walled[:] = 1
+        elif kind == "hard_walls":
+            self.walled[list(boundary.axes)] = 1
+        self.wspec = np.zeros(d + 1)  # the walls (hardpack.md._ellipsoid_kernel.run_events)
         if kind == "spherical_container":
             self.wspec[:d] = boundary.centre
             self.wspec[d] = boundary.radius
+        elif kind == "hard_walls":
+            axes = list(boundary.axes)
+            self.wspec[axes] = self.box[axes]
+            self.wspec[d] = self.box[axes].max()
         cv, ct, cr, cax, cor, cw, cii, width = ek.columns(d)
         self.P = _aligned_rows(n, width)
         self.P[:, :d] = positions
@@ -191,8 +202,11 @@ class EllipsoidEngine(Engine):
 
     def _raise_stalled(self, acc, iacc):
         t, i, p = float(acc[0]), int(iacc[ek.I_STALL_PARTICLE]), int(iacc[ek.I_STALL_PARTNER])
-        what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK",
-                ek.WALL: "the container wall"}.get(p, f"particle {p}")
+        what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
+        if p <= ek.WALL:
+            w = ek.WALL - p
+            what = ("the container wall" if self.wmode == ek.SPHERE_MODE
+                    else f"the wall x_{w >> 1} = {'L' if w & 1 else '0'}")
         raise EngineStalledError(
             f"the ellipsoid event loop stalled at window time {t!r}: more than "
             f"{ek.STALL_EVENTS + 10 * self.n} consecutive events at that time without a "
@@ -215,7 +229,7 @@ class EllipsoidEngine(Engine):
             stale=int(iacc[2]), exits=int(iacc[3]), grazing=int(iacc[4]),
             max_overlap=float(worst), n_overlapping=int(n_over), mean_neighbours=float(self.nn.mean()),
             wall_collisions=int(iacc[ek.I_WALL]),
-            wall_momentum=np.concatenate([[acc[ek.A_WALL]], np.zeros(self.d - 1)]),
+            wall_momentum=acc[ek.A_WALL:ek.A_WALL + self.d].copy(),
         )
 
     def rescale_velocities(self, kt: float = 1.0) -> None:
@@ -294,11 +308,11 @@ class EllipsoidEngine(Engine):
             rot[~at_end] = np.sqrt((target - st * st * ker_end) / ker_rest)
             choice = 0
         if len(contacts):
-            before = ek.contact_rates(P, contacts, self.imgvec, self.end_kappa, self.wspec) >= 0.0
+            before = ek.contact_rates(P, contacts, self.imgvec, self.end_kappa, self.wmode, self.wspec) >= 0.0
             trial = P.copy()
             trial[:, cv:cv + d] *= st
             trial[:, cw:cii] *= rot[:, None]
-            after = ek.contact_rates(trial, contacts, self.imgvec, self.end_kappa, self.wspec)
+            after = ek.contact_rates(trial, contacts, self.imgvec, self.end_kappa, self.wmode, self.wspec)
             if np.any(before & (after < 0.0)):
                 st, rot, choice = 1.0, np.ones(n), 2
         self.rescalings[choice] += 1
