@@ -1355,8 +1355,8 @@ def wall_predict(P, i, t, tmax, kappa, wmode, wspec, wid, eps_f, ww, wq):
 def wall_collide(P, i, t, kappa, wmode, wspec, wid, ww, wq):
     """Collision of particle i with wall ``wid`` at window time t (the particle is first
     advanced to t): the collision law of :func:`collide` with an infinitely massive wall, at the
-    contact point r_C of :func:`wall_gap` with the wall's outward normal n: v_n = n . (v + w x (r_C - x) + g (r_C - x)) > 0
-    for an approaching particle, impulse -J n on the particle with
+    contact point r_C of :func:`wall_gap` with the wall's outward normal n:
+    v_n = n . (v + w x (r_C - x) + g (r_C - x)) > 0 for an approaching particle, impulse -J n on the particle with
     J = 2 v_n / (1/m + |(r_C - x) x n|^2 / I), which reverses v_n: v -= J n,
     w -= J (r_C - x) x n / I. Returns (J, the momentum given to the wall, >= 0; change of the
     translational kinetic energy), J = 0 for a skipped (separating) particle.

@@ -91,7 +91,8 @@ class EllipsoidEngine(Engine):
         modes = {"periodic": ek.PERIODIC_MODE, "hard_walls": ek.FLAT_WALLS_MODE,
                  "spherical_container": ek.SPHERE_MODE}
         if kind not in modes:
-            raise ValueError(f"the ellipsoid engine runs periodic cells, hard walls or spherical containers, not {kind}")
+            raise ValueError(f"the ellipsoid engine runs periodic cells, hard walls or spherical containers, "
+                             f"not {kind}")
         self.wmode = modes[kind]
         self.walled = np.zeros(d, dtype=np.int8)  # axes without periodic images
         if kind == "spherical_container":
