@@ -176,3 +176,59 @@ def test_one_particle_presses_a_slit_with_the_ideal_gas_law_of_its_mean_width(d,
     # the extreme widths are far off: the mean half-width, not the smallest or largest semiaxis
     for s in (min(semi), max(semi)):
         assert abs(mean * (width - 2 * s) / (width - 2 * mean_s) - 1) > 10 * se
+
+
+# ---------------------------------------------------------------- start, compression, storage, CLI
+def test_the_start_between_walls_is_seeded_inside_and_refuses_impossible_requests():
+    from hardpack.errors import InvalidInputError
+    from hardpack.initial import random_ellipsoid_packing
+
+    p = random_ellipsoid_packing(40, [1.0, 0.5, 0.5], 0.05, 3, boundary="hard_walls", wall_axes=[2])
+    q = random_ellipsoid_packing(40, [1.0, 0.5, 0.5], 0.05, 3, boundary="hard_walls", wall_axes=[2])
+    assert np.array_equal(p.positions, q.positions) and p.boundary.axes == (2,)
+    assert p.containment_report(0.0).n_outside == 0 and p.overlap_report().n_overlapping == 0
+    assert p.phi == pytest.approx(0.05)
+    with pytest.raises(InvalidInputError, match="wall_axes is for"):
+        random_ellipsoid_packing(4, [1.0, 0.5], 0.05, 3, wall_axes=[0])
+    with pytest.raises(InvalidInputError, match="shorter than the largest particle"):
+        random_ellipsoid_packing(1, [1.0, 0.1], 0.9, 3, boundary="hard_walls")
+
+
+@pytest.mark.parametrize("d,wall_axes", [(3, [2]), (2, None)])
+def test_compression_between_walls_jams_inside_and_round_trips(tmp_path, d, wall_axes):
+    from hardpack.initial import random_ellipsoid_packing
+    from hardpack.io import load_packing
+    from hardpack.md import StopCriteria
+    from hardpack.md.ellipsoid import compress_ellipsoids
+
+    axes = [1.0, 1.0, 1 / 1.9] if d == 3 else [1.0, 0.5]
+    p = random_ellipsoid_packing(30, axes, 0.1, 5, boundary="hard_walls", wall_axes=wall_axes)
+    res = compress_ellipsoids(p, 0.1, 1, stop=StopCriteria(max_pressure=1e6), final_growth_rate=0.01,
+                              switch_pressure=100)
+    final = res.packing
+    assert str(final.boundary) == str(p.boundary)
+    assert res.stats["containment_check"] == "passed" and res.stats["max_wall_overlap"] <= 1e-9
+    assert res.stats["Z"] >= 1e6 and res.stats["phi"] > (0.5 if d == 3 else 0.7)
+    assert np.nanmax(res.timeseries["wall_collisions"].values) > 0
+    # the wall pressure is finite and of the order of the bulk one at jamming
+    assert 0.1 < res.stats["Z_wall"] / res.stats["Z"] < 10
+    # the jammed packing touches the walls: the smallest support-point gap is far below the size
+    assert -1e-9 < -final.containment_report(1.0).overlap < 1e-4
+    res.save(tmp_path / "j.nc")
+    back = load_packing(tmp_path / "j.nc")
+    assert np.array_equal(back.positions, final.positions) and str(back.boundary) == str(final.boundary)
+
+
+def test_cli_init_and_compress_ellipses_between_walls(tmp_path):
+    from hardpack.cli import main
+    from hardpack.io import load_packing
+
+    start, out = tmp_path / "s.nc", tmp_path / "j.nc"
+    assert main(["init", "--n", "24", "--d", "2", "--phi", "0.1", "--seed", "2", "--semiaxes", "1", "0.5",
+                 "--boundary", "hard_walls", "--wall-axes", "1", "--out", str(start)]) == 0
+    p = load_packing(start)
+    assert p.shape.kind == "ellipsoid" and p.boundary.kind == "hard_walls" and p.boundary.axes == (1,)
+    assert main(["compress", "--init", str(start), "--out", str(out), "--growth-rate", "0.1",
+                 "--max-pressure", "1e5", "--seed", "1"]) == 0
+    jammed = load_packing(out)
+    assert str(jammed.boundary) == str(p.boundary) and jammed.containment_report().n_outside == 0

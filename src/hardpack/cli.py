@@ -108,16 +108,16 @@ def cmd_init(args) -> int:
             if args.wall_axes is not None:
                 config["wall_axes"] = list(args.wall_axes)
     else:
-        if args.boundary == "hard_walls":
-            raise InvalidInputError("--boundary hard_walls is implemented for spheres only; ellipsoid start "
-                                    "packings are periodic or in a spherical container")
         if len(args.semiaxes) != args.d:
             raise InvalidInputError(f"--semiaxes needs d = {args.d} numbers, one per body axis; got {args.semiaxes}")
         sizes = dist.sample(args.n, np.random.default_rng(args.seed))
         semiaxes = np.outer(sizes / sizes.min(), args.semiaxes)  # the smallest particle has --semiaxes
-        packing = random_ellipsoid_packing(args.n, semiaxes, args.phi, args.seed, boundary=args.boundary)
+        packing = random_ellipsoid_packing(args.n, semiaxes, args.phi, args.seed, boundary=args.boundary,
+                                           wall_axes=args.wall_axes)
         if args.boundary != "periodic":
             config["boundary"] = args.boundary
+            if args.wall_axes is not None:
+                config["wall_axes"] = list(args.wall_axes)
         attrs["semiaxes"] = list(args.semiaxes)
         config["semiaxes"] = list(args.semiaxes)
     attrs.update(
@@ -300,8 +300,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
                         "random orientations")
     p.add_argument("--boundary", choices=("periodic", "hard_walls", "spherical_container"), default="periodic",
                    help="periodic cube (default); hard flat walls at 0 and L on --wall-axes (all by default); "
-                        "or a hard spherical container whose volume gives --phi (Donev 2006, Ch. 7; spheres and, "
-                        "as a dilute start of bounding spheres, ellipsoids; hard walls: spheres only)")
+                        "or a hard spherical container whose volume gives --phi (Donev 2006, Ch. 7); ellipsoid "
+                        "starts with walls or a container are dilute starts of bounding spheres")
     p.add_argument("--wall-axes", type=int, nargs="+", metavar="AXIS",
                    help="with --boundary hard_walls: the walled axes (0 = x, 1 = y, ...), periodic along the others")
     p.add_argument("--seed", type=int, required=True, help="random seed")

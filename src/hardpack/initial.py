@@ -111,7 +111,7 @@ def random_packing(n: int, d: int, distribution: Distribution, phi: float, seed:
 
 
 def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=None,
-                             max_trials: int = 100_000, boundary: str = "periodic") -> Packing:
+                             max_trials: int = 100_000, boundary: str = "periodic", wall_axes=None) -> Packing:
     """Seeded RSA packing of ``n`` ellipsoids (or ellipses) with random orientations at volume fraction ``phi``.
 
     The particles are placed largest bounding radius first (a stable sort, so equal particles keep
@@ -125,6 +125,9 @@ def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=
     container (as :func:`random_packing`), with uniformly random orientations, so that no two
     particles overlap and every particle is inside; the bounding spheres fill phi times the mean
     a_max^d / prod a, which must stay below RSA saturation (e.g. phi <= 0.15 for aspect ratio 2).
+    With ``boundary="hard_walls"`` (Donev 2006, sec. 3.2.2.1) the box of ``box_shape`` has hard
+    walls at 0 and L_k on ``wall_axes`` (all axes by default), and the start is made the same way:
+    bounding spheres by sphere RSA between the walls, uniformly random orientations.
 
     Parameters
     ----------
@@ -140,14 +143,16 @@ def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=
         Relative box lengths (default a cube; not with a spherical container).
     max_trials : int, default 100000
         Trials per particle before giving up.
-    boundary : {"periodic", "spherical_container"}
-        A periodic cell or a spherical container (above); phi is over the boundary's volume.
+    boundary : {"periodic", "hard_walls", "spherical_container"}
+        A periodic cell, hard walls or a spherical container (above); phi is over the boundary's volume.
+    wall_axes : sequence of int, optional
+        The walled axes with ``boundary="hard_walls"`` (default all).
 
     Returns
     -------
     Packing
-        Ellipsoids in a periodic orthorhombic cell or a spherical container, checked for overlaps
-        and containment by the packing model.
+        Ellipsoids in a periodic orthorhombic cell, between hard walls or in a spherical container,
+        checked for overlaps and containment by the packing model.
 
     Raises
     ------
@@ -173,9 +178,11 @@ def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=
     shape = np.ones(d) if box_shape is None else np.asarray(box_shape, float)
     if shape.shape != (d,) or not (np.isfinite(shape).all() and (shape > 0).all()):
         raise InvalidInputError(f"box_shape must be {d} positive numbers, got {box_shape!r}")
-    if boundary not in ("periodic", "spherical_container"):
-        raise InvalidInputError(f"ellipsoid start packings have boundary 'periodic' or 'spherical_container', "
+    if boundary not in ("periodic", "hard_walls", "spherical_container"):
+        raise InvalidInputError(f"boundary must be 'periodic', 'hard_walls' or 'spherical_container', "
                                 f"got {boundary!r}")
+    if wall_axes is not None and boundary != "hard_walls":
+        raise InvalidInputError("wall_axes is for boundary='hard_walls' only")
     axes = axes[np.argsort(-axes.max(axis=1), kind="stable")]
     volume = Ellipsoids(axes, np.zeros(n) if d == 2 else np.tile([1.0, 0, 0, 0], (n, 1))).volumes(d).sum()
     if boundary == "spherical_container":
@@ -183,8 +190,42 @@ def random_ellipsoid_packing(n: int, semiaxes, phi: float, seed: int, box_shape=
             raise InvalidInputError("a spherical container sits in a cube: leave box_shape unset")
         return _ellipsoids_in_a_container(axes, volume / phi, phi, np.random.default_rng(seed), max_trials)
     box = shape * (volume / (phi * np.prod(shape))) ** (1.0 / d)
+    if boundary == "hard_walls":
+        return _ellipsoids_between_walls(axes, box, phi, wall_axes, np.random.default_rng(seed), max_trials)
     positions, orientations = ellipsoid_rsa(axes, box, np.random.default_rng(seed), max_trials)
     return Packing(positions, lattice=np.diag(box), shape=Ellipsoids(axes, orientations))
+
+
+def _random_orientations(rng, n: int, d: int) -> np.ndarray:
+    """Uniformly random angles (2D) or unit quaternions (3D, normalised Gaussians)."""
+    if d == 2:
+        return rng.uniform(0.0, 2.0 * np.pi, n)
+    orientations = rng.standard_normal((n, 4))
+    return orientations / np.linalg.norm(orientations, axis=1, keepdims=True)
+
+
+def _ellipsoids_between_walls(axes: np.ndarray, box: np.ndarray, phi: float, wall_axes, rng,
+                              max_trials: int) -> Packing:
+    """Dilute random start of :func:`random_ellipsoid_packing` between hard walls: bounding spheres
+    by RSA inside the walls (periodic along the other axes), random orientations."""
+    from hardpack.geometry.shapes import Ellipsoids
+
+    n, d = axes.shape
+    walls = HardWalls(tuple(range(d)) if wall_axes is None else wall_axes)
+    walls.check(np.diag(box))
+    walled = np.zeros(d, dtype=bool)
+    walled[list(walls.axes)] = True
+    bound = axes.max(axis=1)
+    if (box[walled] < 2.0 * bound.max()).any():
+        raise InvalidInputError(f"phi = {phi:g} leaves a walled box side ({box[walled].min():.4g}) shorter than "
+                                f"the largest particle (largest semiaxis {bound.max():.4g}): lower phi")
+    try:
+        positions = random_sequential_addition(bound, box, rng, max_trials, walled=walled)
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{exc}. The start places the bounding spheres (phi {phi:g} times "
+                                f"{float(np.mean(bound**d / axes.prod(axis=1))):.3g}): lower phi") from exc
+    return Packing(positions, lattice=np.diag(box), shape=Ellipsoids(axes, _random_orientations(rng, n, d)),
+                   boundary=walls)
 
 
 def _ellipsoids_in_a_container(axes: np.ndarray, volume: float, phi: float, rng, max_trials: int) -> Packing:
@@ -206,9 +247,5 @@ def _ellipsoids_in_a_container(axes: np.ndarray, volume: float, phi: float, rng,
     except InvalidInputError as exc:
         raise InvalidInputError(f"{exc}. The start places the bounding spheres (phi {phi:g} times "
                                 f"{float(np.mean(bound**d / axes.prod(axis=1))):.3g}): lower phi") from exc
-    if d == 2:
-        orientations = rng.uniform(0.0, 2.0 * np.pi, n)
-    else:
-        orientations = rng.standard_normal((n, 4))
-        orientations /= np.linalg.norm(orientations, axis=1, keepdims=True)
-    return Packing(positions, lattice=np.diag(box), shape=Ellipsoids(axes, orientations), boundary=container)
+    return Packing(positions, lattice=np.diag(box), shape=Ellipsoids(axes, _random_orientations(rng, n, d)),
+                   boundary=container)
