@@ -357,17 +357,11 @@ def test_cli_verify_stores_the_wall_contacts_of_an_ellipse_packing(tmp_path):
 
 
 # ------------------------------------------------------------------------------------ input
-def test_refuses_a_continuum_of_wall_contacts_overlaps_and_flat_walls():
+def test_refuses_a_continuum_of_wall_contacts_and_overlaps():
     """A disk (as an ellipse) centred in a container of its own radius touches it everywhere: no
-    isolated contacts, refused; a particle crossing the wall is refused; flat hard walls are not
-    implemented for ellipsoids."""
+    isolated contacts, refused; a particle crossing the wall is refused. (Flat hard walls:
+    tests/test_jamming_ellipsoid_flat_walls.py.)"""
     with pytest.raises(InvalidInputError, match="circle or sphere of farthest points"):
         verify_ellipsoids(centred([1.0, 1.0], 0.0))
     with pytest.raises(InvalidInputError, match="container wall"):
         verify_ellipsoids(centred([2.0, 1.0], 0.0, radius=1.99))
-    from hardpack.geometry.boundaries import HardWalls
-
-    walled = Packing([[2.0, 2.0]], lattice=4 * np.eye(2), shape=Ellipsoids([[1.0, 0.5]], [0.0]),
-                     boundary=HardWalls([0, 1]))
-    with pytest.raises(InvalidInputError, match="flat hard walls are not implemented"):
-        verify_ellipsoids(walled)

@@ -1,4 +1,5 @@
-"""Contact network, rigidity matrix and stress matrix of a periodic packing of ellipses or ellipsoids.
+"""Contact network, rigidity matrix and stress matrix of a packing of ellipses or ellipsoids: periodic,
+between flat hard walls or in a spherical container.
 
 Donev 2006, dissertation ch. 5 (Secs. 5.3, 5.5) with the configurational derivatives of the
 Perram-Wertheim overlap potential zeta (Sec. 2.2.4; :mod:`hardpack.geometry.contact`).
@@ -39,6 +40,26 @@ at a farthest point), lever arm r_iC = p - x_i, ``scale`` 1 and ``zeta`` chosen 
 is h / a_max. By the envelope theorem (the point on the body is stationary),
 grad_r h = -n and grad_omega h = -r_iC x n: the pair row with the wall as a fixed particle j,
 u . (-v_i - w_i x r_iC). The Hessian of h is :func:`wall_gap_hessian`.
+
+Flat hard walls (:class:`hardpack.geometry.boundaries.HardWalls`: planes x_k = 0 and x_k = L_k for
+the walled axes k, periodic along the others; Donev 2006, Sec. 3.2.2.1 for the boundary, Sec. 4.4.3
+for the wall contact as a contact with a fixed point of the wall). The wall with outward unit
+normal n (n = -e_k for x_k = 0, n = +e_k for x_k = L_k) is the plane n . y = b (b = 0 and L_k).
+The point of particle i farthest along n is p = x + X^-1 n / s with s = sqrt(n^T X^-1 n) (the
+support function of the ellipsoid y^T X y <= 1 about its centre, Donev 2006, Sec. 2.2.5.1: the
+maximiser of n . y on the surface, by a Lagrange multiplier), so the gap is
+h = b - n . x - s: x_k - s for the wall x_k = 0, L_k - x_k - s for x_k = L_k. A particle has at
+most one contact per wall (the farthest point of a strictly convex body is unique), and it is a
+contact when h <= delta a_max, as for the container. It is stored like a container contact (j = i,
+unit normal n, lever r_iC = p - x_i, ``scale`` 1, ``zeta`` with ``gap`` = h / a_max), with
+separation (b - n . x) n, from the centre to the foot of the perpendicular on the wall (as for
+spheres, :mod:`hardpack.jamming.contacts`), and the sphere code's wall numbers: ``wall`` = 2 k for
+x_k = 0 and 2 k + 1 for x_k = L_k (``centre`` None tells them from the container's wall 0).
+Derivatives: grad_r h = -n and, by the envelope theorem (p maximises n . y over the body),
+grad_omega h = -(p - x) x n = -r_iC x n, the container's row. The translations enter h linearly,
+so the r-r and r-omega blocks of Hess h vanish; the omega-omega block is -Hess s, derived in
+:func:`plane_gap_hessian`. Translations along a periodic axis (parallel to every wall) are the
+trivial motions (none in a closed box, Donev 2006, Sec. 4.4.2).
 
 Stress matrix (Sec. 5.5.2.1, Eq. 5.16). For a self-stress F (A F = 0, F >= 0, in the units of the
 rows above) the stress matrix is the force-weighted sum of the contacts' Hessians of zeta,
@@ -81,7 +102,10 @@ __all__ = [
     "contact_hessians",
     "zeta_hessian",
     "wall_gap_hessian",
+    "plane_gap_hessian",
     "container_contacts",
+    "plane_wall_contacts",
+    "wall_name",
     "generators",
     "displaced",
 ]
@@ -132,9 +156,11 @@ class EllipsoidContacts(ContactArrays):
     ``normal`` is the unit normal u from i to j; ``lever_i``/``lever_j`` are r_C - x_i and
     r_C - (x_j + L n); ``scale`` is s = 2 lam (1 - lam) |n|, the factor between grad zeta and the
     gap rows; ``zeta`` and ``lam`` come from the Perram-Wertheim function. ``shape_inv`` holds every
-    particle's X^-1 (N, d, d). ``wall`` is -1 for a pair and 0 for a contact with the container
-    wall (module docstring: j = i, lam NaN, scale 1, lever_j 0, separation p - c); ``centre`` and
-    ``radius`` describe the container (None in a periodic cell).
+    particle's X^-1 (N, d, d). ``wall`` is -1 for a pair, 0 for a contact with the container
+    wall (module docstring: j = i, lam NaN, scale 1, lever_j 0, separation p - c) and 2 k or
+    2 k + 1 for the flat wall x_k = 0 or x_k = L_k (separation (b - n . x) n); ``centre`` and
+    ``radius`` describe the container (None in a periodic cell or between flat walls), ``periodic``
+    the periodic axes.
 
     Attributes
     ----------
@@ -143,7 +169,7 @@ class EllipsoidContacts(ContactArrays):
     shift : numpy.ndarray of int, shape (M, d)
         Lattice image n of j.
     separation : numpy.ndarray of float, shape (M, d)
-        x_j + L n - x_i (for a wall contact p - c, above).
+        x_j + L n - x_i (for a wall contact p - c or (b - n . x) n, above).
     zeta, lam : numpy.ndarray of float, shape (M,)
         Perram-Wertheim overlap potential mu^2 - 1 and its maximiser (Donev 2006, sec. 2.2.2.1).
     normal, raw_normal : numpy.ndarray of float, shape (M, d)
@@ -163,11 +189,15 @@ class EllipsoidContacts(ContactArrays):
     delta : float
         Contact tolerance on mu - 1.
     wall : numpy.ndarray of int, shape (M,), or None
-        -1 for a pair, 0 for a contact with the container wall.
+        -1 for a pair, 0 for a contact with the container wall, 2 k (2 k + 1) for the flat wall
+        x_k = 0 (x_k = L_k); None in the constructor: pairs only.
     centre : numpy.ndarray of float, shape (d,), or None
-        Container centre (None in a periodic cell).
+        Container centre (None in a periodic cell or between flat walls).
     radius : float or None
         Container radius.
+    periodic : numpy.ndarray of bool, shape (d,), or None
+        The periodic axes (their uniform translations are trivial motions); None in the
+        constructor: every axis without a container, none with one.
     """
 
     i: np.ndarray
@@ -189,6 +219,17 @@ class EllipsoidContacts(ContactArrays):
     wall: np.ndarray | None = None
     centre: np.ndarray | None = None
     radius: float | None = None
+    periodic: np.ndarray | None = None
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.periodic is None:
+            object.__setattr__(self, "periodic", np.full(self.positions.shape[1], self.centre is None))
+
+    @property
+    def is_plane_wall(self) -> np.ndarray:
+        """(M,) True for the contacts with flat hard walls (wall >= 0 without a container)."""
+        return self.is_wall & (self.centre is None)
 
     @property
     def gap(self) -> np.ndarray:
@@ -206,14 +247,18 @@ class EllipsoidContacts(ContactArrays):
         Returns
         -------
         EllipsoidContacts
-            The selected contacts, with the particle data (positions, lattice, shapes, delta, container) unchanged.
+            The selected contacts, with the particle data (positions, lattice, shapes, delta,
+            container, periodic axes) unchanged.
         """
-        per = ("i", "j", "shift", "separation", "zeta", "lam", "normal", "raw_normal", "lever_i",
-               "lever_j", "scale", "wall")
-        kw = {k: getattr(self, k)[mask] for k in per}
+        kw = {k: getattr(self, k)[mask] for k in _PER_CONTACT}
         return EllipsoidContacts(**kw, positions=self.positions, lattice=self.lattice,
                                  shape_inv=self.shape_inv, semiaxes=self.semiaxes, delta=self.delta,
-                                 centre=self.centre, radius=self.radius)
+                                 centre=self.centre, radius=self.radius, periodic=self.periodic)
+
+
+#: the per-contact arrays of :class:`EllipsoidContacts`
+_PER_CONTACT = ("i", "j", "shift", "separation", "zeta", "lam", "normal", "raw_normal", "lever_i",
+                "lever_j", "scale", "wall")
 
 
 @numba.njit(cache=True)
@@ -246,12 +291,13 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids (``hardpack.geometry.shapes.Ellipsoids``) in a periodic cell or a
-        spherical container.
+        Ellipses or ellipsoids (``hardpack.geometry.shapes.Ellipsoids``) in a periodic cell,
+        between flat hard walls or in a spherical container.
     delta : float
         Relative contact tolerance, 0 < delta < 1: pairs with mu - 1 <= delta are contacts (mu the
         common factor by which both particles must be scaled to be tangent); in a container, the
-        local farthest points with gap h <= delta a_max are wall contacts (module docstring),
+        local farthest points with gap h <= delta a_max are wall contacts, and between flat walls
+        the farthest points along each wall's normal with h <= delta a_max (module docstring),
         after the pairs.
 
     Returns
@@ -262,9 +308,10 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     Raises
     ------
     InvalidInputError
-        If ``packing`` is not a periodic or container packing of ellipsoids, delta is not in
-        (0, 1), or a particle within delta of the container touches it along a continuum (a
-        disk, sphere or oblate spheroid centred so that its longest semiaxes lie on the wall).
+        If ``packing`` is not a packing of ellipsoids (periodic, between flat walls or in a
+        container), delta is not in (0, 1), a particle within delta of the container touches
+        it along a continuum (a disk, sphere or oblate spheroid centred so that its longest
+        semiaxes lie on the wall), or a centre lies beyond a flat wall.
     """
     check_ellipsoid_packing(packing)
     try:
@@ -280,8 +327,13 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
     orient = np.ascontiguousarray(np.asarray(shape.orientations, dtype=float).reshape(packing.n_particles, -1))
     inv = inverse_shapes(semiaxes, orient)
+    if packing.boundary.kind == "hard_walls":
+        _check_centres_between_walls(packing)
     pairs = pairs_within(packing, rel_gap=delta)
-    x = np.ascontiguousarray(wrapped_positions(packing))
+    x = wrapped_positions(packing)
+    walled = ~packing.boundary.periodic_axes(packing.dim)
+    x[:, walled] = packing.positions[:, walled]  # not wrapped: bit for bit (as Packing.wrapped)
+    x = np.ascontiguousarray(x)
     ii, jj = pairs.i.astype(np.int64), pairs.j.astype(np.int64)
     sep = np.ascontiguousarray(pairs.separation, dtype=float)
     zeta, lam, raw, point = _pair_contacts(x, inv, np.asarray(shape.bounding_radii, float), ii, jj, sep)
@@ -293,10 +345,12 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
         i=ii, j=jj, shift=pairs.shift[keep].astype(np.int64), separation=sep, zeta=zeta, lam=lam,
         normal=u, raw_normal=raw, lever_i=point - x[ii], lever_j=point - (x[ii] + sep),
         scale=2.0 * lam * (1.0 - lam) * norm, positions=x, lattice=np.array(packing.lattice, float),
-        shape_inv=inv, semiaxes=semiaxes, delta=delta,
+        shape_inv=inv, semiaxes=semiaxes, delta=delta, periodic=packing.boundary.periodic_axes(packing.dim),
     )
     if packing.boundary.kind == "spherical_container":
         net = _with_container(net, shape.rotations(), packing.boundary)
+    elif packing.boundary.kind == "hard_walls":
+        net = _with_plane_walls(net, packing.boundary)
     return net
 
 
@@ -386,12 +440,125 @@ def _with_container(net: EllipsoidContacts, rotations, boundary) -> EllipsoidCon
         lever_i=point - x[part], lever_j=np.zeros((m, d)), scale=np.ones(m), positions=x,
         lattice=net.lattice, shape_inv=net.shape_inv, semiaxes=net.semiaxes, delta=net.delta,
         wall=np.zeros(m, np.int64))
-    per = ("i", "j", "shift", "separation", "zeta", "lam", "normal", "raw_normal", "lever_i",
-           "lever_j", "scale", "wall")
-    kw = {k: np.concatenate([getattr(net, k), getattr(wall, k)]) for k in per}
+    kw = {k: np.concatenate([getattr(net, k), getattr(wall, k)]) for k in _PER_CONTACT}
     return EllipsoidContacts(**kw, positions=x, lattice=net.lattice, shape_inv=net.shape_inv,
                              semiaxes=net.semiaxes, delta=net.delta, centre=centre,
                              radius=float(boundary.radius))
+
+
+def plane_wall_contacts(positions, shape_inv, semiaxes, axes, lengths, delta):
+    """Contacts of ellipsoids with the flat hard walls x_k = 0 and x_k = L_k (module docstring).
+
+    The particle's farthest point along the wall's outward normal n is p = x + X^-1 n / s,
+    s = sqrt(n^T X^-1 n) = sqrt((X^-1)_kk) for n = +-e_k, and the gap is h = x_k - s (wall
+    x_k = 0) or L_k - x_k - s (wall x_k = L_k); every wall with h <= delta a_max is a contact.
+
+    Parameters
+    ----------
+    positions : numpy.ndarray of float, shape (N, d)
+        Particle centres (along the walled axes as given, not wrapped).
+    shape_inv : numpy.ndarray of float, shape (N, d, d)
+        X^-1 of every particle (:func:`hardpack.geometry.contact.inverse_shapes`).
+    semiaxes : numpy.ndarray of float, shape (N, d)
+        Semiaxes (a_max sets the contact tolerance).
+    axes : sequence of int
+        The walled axes k.
+    lengths : sequence of float
+        L_k of each walled axis (the diagonal entry of the lattice).
+    delta : float
+        Walls with h <= delta a_max are contacts.
+
+    Returns
+    -------
+    particle : numpy.ndarray of int, shape (M,)
+        The particle of each contact, sorted by particle, then by wall number.
+    wall : numpy.ndarray of int, shape (M,)
+        2 k for the wall x_k = 0, 2 k + 1 for x_k = L_k.
+    normal : numpy.ndarray of float, shape (M, d)
+        The wall's outward unit normal n (-e_k or +e_k).
+    lever : numpy.ndarray of float, shape (M, d)
+        p - x = X^-1 n / s.
+    gap : numpy.ndarray of float, shape (M,)
+        h (negative when the particle crosses the wall).
+    distance : numpy.ndarray of float, shape (M,)
+        The centre-wall distance b - n . x (x_k or L_k - x_k).
+    """
+    x = np.asarray(positions, dtype=float)
+    inv = np.asarray(shape_inv, dtype=float)
+    d = x.shape[1]
+    amax = np.asarray(semiaxes, dtype=float).max(axis=1)
+    found = [(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, d)), np.zeros((0, d)), np.zeros(0),
+              np.zeros(0))]
+    for k, length in zip(axes, lengths):
+        k = int(k)
+        s = np.sqrt(inv[:, k, k])
+        for upper, dist in ((0, x[:, k]), (1, float(length) - x[:, k])):
+            h = dist - s
+            part = np.flatnonzero(h <= delta * amax)
+            sign = 1.0 if upper else -1.0
+            normal = np.zeros((part.size, d))
+            normal[:, k] = sign
+            lever = sign * inv[part, :, k] / s[part, None]
+            found.append((part, np.full(part.size, 2 * k + upper, np.int64), normal, lever, h[part], dist[part]))
+    part, wall, normal, lever, gap, dist = (np.concatenate(column) for column in zip(*found))
+    order = np.lexsort((wall, part))
+    return part[order], wall[order], normal[order], lever[order], gap[order], dist[order]
+
+
+def _check_centres_between_walls(packing: Packing) -> None:
+    """Refuse centres beyond a flat wall (x_k < 0 or x_k > L_k on a walled axis k). Inside,
+    h = (x_k or L_k - x_k) - s >= -s >= -a_max, so the stored gap h / a_max >= -1 is encoded
+    faithfully by ``zeta`` (module docstring) and an overlap is reported with its size."""
+    axes = list(packing.boundary.axes)
+    x = packing.positions[:, axes]
+    length = np.diag(packing.lattice)[axes]
+    out = (x < 0) | (x > length)
+    if out.any():
+        i, q = (int(v[0]) for v in np.nonzero(out))
+        k = axes[q]
+        raise InvalidInputError(
+            f"the centre of particle {i} lies beyond the wall x_{k} = {0.0 if x[i, q] < 0 else length[q]:.6g} "
+            f"(x_{k} = {x[i, q]:.6g}; the walls are at 0 and {length[q]:.6g}); particles between hard "
+            "walls must lie inside them: move it in or shrink the particles")
+
+
+def _with_plane_walls(net: EllipsoidContacts, boundary) -> EllipsoidContacts:
+    """``net`` with the contacts of the flat hard walls appended (module docstring)."""
+    x, d = net.positions, net.dim
+    axes = list(boundary.axes)
+    part, wall, u, lever, h, dist = plane_wall_contacts(x, net.shape_inv, net.semiaxes, axes,
+                                                        np.diag(net.lattice)[axes], net.delta)
+    amax = net.semiaxes[part].max(axis=1)
+    m = len(part)
+    walls = dict(
+        i=part, j=part, shift=np.zeros((m, d), np.int64), separation=dist[:, None] * u,
+        zeta=(1.0 + h / amax) ** 2 - 1.0, lam=np.full(m, np.nan), normal=u, raw_normal=u.copy(),
+        lever_i=lever, lever_j=np.zeros((m, d)), scale=np.ones(m), wall=wall)
+    kw = {k: np.concatenate([getattr(net, k), walls[k]]) for k in _PER_CONTACT}
+    return EllipsoidContacts(**kw, positions=x, lattice=net.lattice, shape_inv=net.shape_inv,
+                             semiaxes=net.semiaxes, delta=net.delta, periodic=net.periodic)
+
+
+def wall_name(net: EllipsoidContacts, c: int) -> str:
+    """The wall of wall contact ``c`` in words: "the container wall" or "the wall x_k = 0" /
+    "the wall x_k = L_k" (with the value of L_k).
+
+    Parameters
+    ----------
+    net : EllipsoidContacts
+        The contact network.
+    c : int
+        Index of a wall contact (``net.wall[c] >= 0``).
+
+    Returns
+    -------
+    str
+        The name.
+    """
+    if net.centre is not None:
+        return "the container wall"
+    k, upper = divmod(int(net.wall[c]), 2)
+    return f"the wall x_{k} = {net.lattice[k, k]:.6g}" if upper else f"the wall x_{k} = 0"
 
 
 def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> EllipsoidContacts:
@@ -429,12 +596,13 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> Ellipsoi
         i=ii, j=jj, shift=shift, separation=sep, zeta=zeta, lam=lam, normal=raw / norm[:, None],
         raw_normal=raw, lever_i=point - x[ii], lever_j=point - (x[ii] + sep),
         scale=2.0 * lam * (1.0 - lam) * norm, positions=x, lattice=lattice, shape_inv=inv,
-        semiaxes=semiaxes, delta=float("inf"),
+        semiaxes=semiaxes, delta=float("inf"), periodic=packing.boundary.periodic_axes(packing.dim),
     )
 
 
 def check_ellipsoid_packing(packing) -> None:
-    """Refuse anything but a packing of ellipses or ellipsoids, periodic or in a spherical container.
+    """Refuse anything but a packing of ellipses or ellipsoids (periodic, between flat hard walls or
+    in a spherical container).
 
     Parameters
     ----------
@@ -444,7 +612,7 @@ def check_ellipsoid_packing(packing) -> None:
     Raises
     ------
     InvalidInputError
-        If it is not a packing of ellipses or ellipsoids in a periodic cell or spherical container.
+        If it is not a packing of ellipses or ellipsoids.
     """
     if not isinstance(packing, Packing):
         raise InvalidInputError(
@@ -456,10 +624,10 @@ def check_ellipsoid_packing(packing) -> None:
             f"this test is for ellipses and ellipsoids, the packing holds {packing.shape.name}; "
             "use hardpack.jamming.verify for spheres"
         )
-    if packing.boundary.kind not in ("periodic", "spherical_container"):
+    if packing.boundary.kind not in ("periodic", "hard_walls", "spherical_container"):
         raise InvalidInputError(
-            "the ellipsoid jamming tests need a periodic cell or a spherical container (flat hard "
-            "walls are not implemented); model fixed obstacles as frozen particles (argument `frozen`)"
+            f"the ellipsoid jamming tests need a periodic cell, flat hard walls or a spherical "
+            f"container, got the boundary {packing.boundary}"
         )
 
 
@@ -611,8 +779,9 @@ def zeta_hessian(r_ab, a_inv, b_inv, lam) -> np.ndarray:
 
 def contact_hessians(net: EllipsoidContacts) -> np.ndarray:
     """Hess zeta of every contact, (M, 2 d_f, 2 d_f) in the order (r_i, omega_i, r_j, omega_j)
-    (:func:`zeta_hessian`); for a wall contact the Hessian of its gap h (:func:`wall_gap_hessian`)
-    in the (r_i, omega_i) block and zeros elsewhere.
+    (:func:`zeta_hessian`); for a wall contact the Hessian of its gap h (:func:`wall_gap_hessian`
+    for the container, :func:`plane_gap_hessian` for a flat wall) in the (r_i, omega_i) block and
+    zeros elsewhere.
 
     Parameters
     ----------
@@ -633,9 +802,79 @@ def contact_hessians(net: EllipsoidContacts) -> np.ndarray:
     out[pair] = _hessians(net.separation[pair], net.shape_inv, net.i[pair], net.j[pair], net.lam[pair], gens)
     wall = np.flatnonzero(net.wall >= 0)
     p = net.i[wall]
-    out[wall, :f, :f] = _wall_hessians(np.ascontiguousarray(net.positions[p] - net.centre),
-                                       np.ascontiguousarray(net.lever_i[wall]), net.shape_inv[p], gens)
+    if net.centre is None:
+        out[wall, :f, :f] = _plane_hessians(np.ascontiguousarray(net.normal[wall]), net.shape_inv[p], gens)
+    else:
+        out[wall, :f, :f] = _wall_hessians(np.ascontiguousarray(net.positions[p] - net.centre),
+                                           np.ascontiguousarray(net.lever_i[wall]), net.shape_inv[p], gens)
     return out
+
+
+@numba.njit(cache=True)
+def _plane_hessian_one(normal, x_inv, gens):
+    """Hessian of h = b - n . x - s; see :func:`plane_gap_hessian`."""
+    d = normal.shape[0]
+    k = gens.shape[0]
+    f = d + k
+    mn = x_inv @ normal
+    s = np.sqrt(normal @ mn)
+    en = np.empty((k, d))
+    g = np.empty(k)
+    for a in range(k):
+        en[a] = gens[a] @ normal
+        g[a] = -2.0 * (mn @ en[a])
+    out = np.zeros((f, f))
+    for a in range(k):
+        for b in range(k):
+            sym = gens[a] @ gens[b] + gens[b] @ gens[a]
+            gab = 2.0 * (en[a] @ (x_inv @ en[b])) + mn @ (sym @ normal)
+            out[d + a, d + b] = -(gab / (2.0 * s) - g[a] * g[b] / (4.0 * s * s * s))
+    return out
+
+
+@numba.njit(cache=True)
+def _plane_hessians(normal, shape_inv, gens):
+    m, d = normal.shape
+    f = d + gens.shape[0]
+    out = np.empty((m, f, f))
+    for c in range(m):
+        out[c] = _plane_hessian_one(normal[c], shape_inv[c], gens)
+    return out
+
+
+def plane_gap_hessian(normal, x_inv) -> np.ndarray:
+    """Hessian of the gap h = b - n . x - s of a particle and a flat wall n . y = b with respect to
+    (r, omega) (translation, then rotation as in :func:`zeta_hessian`; derived here).
+
+    h is linear in the centre x, so the r-r and r-omega blocks vanish. With X^-1 = M now and the
+    orientation R(omega) = exp(W) times the current one (W = sum_a omega_a E_a), X^-1 becomes
+    R M R^T and s(omega) = sqrt(g), g = n^T R M R^T n = v^T M v with v = R^T n. To second order
+    R^T = I - W + W^2 / 2, so v = n - W n + W^2 n / 2 and
+
+        g = n^T M n - 2 n^T M W n + (W n)^T M (W n) + n^T M W^2 n + O(omega^3),
+
+    g_a = -2 (M n) . (E_a n),  g_ab = 2 (E_a n)^T M (E_b n) + (M n)^T (E_a E_b + E_b E_a) n.
+
+    Then s_ab = g_ab / (2 s) - g_a g_b / (4 s^3) and Hess_omega h = -Hess s. (The first derivative
+    s_a = g_a / (2 s) = -(M n / s) . (E_a n) = (r_C x n)_a with r_C = M n / s = p - x, the row
+    of A^T.) Example: an ellipse with semiaxes (a, b) along (x, y) and the wall y = b (n = e_y):
+    g = b^2 cos^2 theta + a^2 sin^2 theta, so s = b + (a^2 - b^2) theta^2 / (2 b) + O(theta^4)
+    and h_theta,theta = -(a^2 - b^2) / b.
+
+    Parameters
+    ----------
+    normal : numpy.ndarray of float, shape (d,)
+        The wall's outward unit normal n.
+    x_inv : numpy.ndarray of float, shape (d, d)
+        X^-1 of the particle.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (d_f, d_f)
+        Hess h in the order (r, omega); only the (omega, omega) block is nonzero.
+    """
+    n = np.asarray(normal, float)
+    return _plane_hessian_one(n, np.asarray(x_inv, float), generators(n.shape[0]))
 
 
 @numba.njit(cache=True)
