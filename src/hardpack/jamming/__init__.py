@@ -10,7 +10,7 @@ self-stress space of rigid, nearly isostatic backbones (the common case for LS p
 (scipy ``linprog``) does the rest. CLI: ``hardpack verify`` (:mod:`hardpack.jamming.cli`).
 Ellipses and ellipsoids (Donev 2006, ch. 5): :func:`verify_ellipsoids` (first- and second-order
 tests, :mod:`hardpack.jamming.second_order`, on the contacts and stress matrix of
-:mod:`hardpack.jamming.ellipsoids`), periodic or in a spherical container.
+:mod:`hardpack.jamming.ellipsoids`), periodic, between flat hard walls or in a spherical container.
 """
 
 from hardpack.jamming.contacts import ContactNetwork, contact_network

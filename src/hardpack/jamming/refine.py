@@ -436,7 +436,8 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell or a spherical container.
+        Ellipses or ellipsoids in a periodic cell, between flat hard walls or in a spherical
+        container (walls are not refined: their verdict is that of the packing as given).
     confirm : bool, default True
         Certify a second-order flexible verdict at the jamming point by the size ascent.
     retry_after_ascent : bool, default True

@@ -16,11 +16,13 @@ Degrees of freedom. The columns are the particles' translations and rotations, r
   symmetry axis (Donev 2006, Sec. 5.6 penalises the same spin with k u u^T instead). The dof per
   particle are then 3 (ellipses), 2 (disks), 6 (general ellipsoids), 5 (spheroids), 3 (spheres);
 - global translations: with no frozen particle in a periodic cell the d uniform translations of
-  the backbone are trivial floppy modes; they are projected out of the floppy space. In a
-  spherical container (wall contacts: :mod:`hardpack.jamming.ellipsoids`) the trivial motions
-  are instead the d(d-1)/2 rigid rotations of the backbone about the container's centre (each
-  particle's centre moves by omega x (x_i - c) and the particle turns by omega), which keep every
-  pair and wall gap; the walls stay fixed, so no translation is trivial.
+  the backbone are trivial floppy modes; they are projected out of the floppy space. Between flat
+  hard walls (wall contacts: :mod:`hardpack.jamming.ellipsoids`) only the translations along the
+  periodic axes are trivial (they keep every wall gap; none in a closed box, Donev 2006,
+  Sec. 4.4.2). In a spherical container the trivial motions are instead the d(d-1)/2 rigid
+  rotations of the backbone about the container's centre (each particle's centre moves by
+  omega x (x_i - c) and the particle turns by omega), which keep every pair and wall gap; the
+  walls stay fixed, so no translation is trivial.
 
 Procedure (Donev 2006, Sec. 5.5.3, on the rattler-free backbone; dense linear algebra). A
 first-order flex is Qdot != 0 (nontrivial) with A^T Qdot >= 0; first-order rigid = none exists,
@@ -68,7 +70,13 @@ first-order flex; it must equal ``not first_order_rigid``.
 Local test: each particle among its neighbours, which are fixed (its own columns only, no
 trivial motion); the same procedure, so a particle held only at second order (Fig. 5.5) is
 locally jammed. Particles that are not locally jammed are rattlers and are removed iteratively
-(their contacts dropped), as in the sphere code (Donev 2006, Sec. 4.2.4.1).
+(their contacts dropped), as in the sphere code (Donev 2006, Sec. 4.2.4.1). One case is decided
+before the procedure (:func:`_slides_along_walls`): a particle whose every contact is with a
+flat hard wall, and whose walls' normals do not span R^d (an ellipse between the two walls of a
+slit), keeps every gap exactly when it translates parallel to those walls; the procedure would
+see that exact unjamming motion only as a floppy mode of zero stiffness (undetermined), so it is
+decided as not locally jammed at first order, as a sphere with the same contacts is
+(Donev 2006, Sec. 4.4.3.1: d vectors cannot positively span R^d).
 
 Large packings (``method="sparse"``, default above ``DENSE_LIMIT`` dof): the same procedure with
 sparse linear algebra (:func:`decide_sparse`). N_stresses and N_floppy come from the inertia of
@@ -103,6 +111,7 @@ from hardpack.jamming.ellipsoids import (
     generators,
     rigidity_transpose_full,
     stiffness_matrix_full,
+    wall_name,
 )
 from hardpack.jamming.highs import LPFailure, recording_fallbacks, solve_lp
 from hardpack.jamming.result import Verdict
@@ -242,9 +251,10 @@ def trivial_translations(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.nd
 
 def trivial_motions(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray) -> np.ndarray:
     """Orthonormal trivial motions of the ``moving`` particles in reduced dof (module docstring):
-    the uniform translations in a periodic cell, the rigid rotations about the centre in a
-    container (those that vanish in the reduced dof, e.g. spins of spheres at the centre, are
-    dropped: (n_red, t) with t <= d(d-1)/2).
+    the uniform translations along the periodic axes (all d in a periodic cell, those without
+    walls between flat hard walls), the rigid rotations about the centre in a container (those
+    that vanish in the reduced dof, e.g. spins of spheres at the centre, are dropped: (n_red, t)
+    with t <= d(d-1)/2).
 
     Parameters
     ----------
@@ -261,7 +271,7 @@ def trivial_motions(t: sp.csr_matrix, net: EllipsoidContacts, moving: np.ndarray
         Orthonormal columns.
     """
     if net.centre is None:
-        return trivial_translations(t, net, moving)
+        return trivial_translations(t, net, moving)[:, net.periodic]
     d, n = net.dim, net.n_particles
     f = dof_per_particle(d)
     gens = generators(d)
@@ -1025,8 +1035,9 @@ class EllipsoidJammingResult:
              f"{'-' if c.lp_flex is None else 'yes' if c.lp_flex else 'no'}"),
         ]
         if self.network.n_wall_contacts:
-            lines.append(f"container: {self.network.n_wall_contacts} wall contacts, {self.n_backbone_wall_contacts} "
-                         f"of them in the backbone, total reaction {self.wall_force:.4g} (forces of mean 1)")
+            lines.append(f"{self.params.get('boundary', 'walls')}: {self.network.n_wall_contacts} wall contacts, "
+                         f"{self.n_backbone_wall_contacts} of them in the backbone, total reaction "
+                         f"{self.wall_force:.4g} (forces of mean 1)")
         if c.approx_stress is not None:
             lines.append(f"near self-stress (smallest singular vector of A, Donev 2006 Sec. 5.6): |A f| / "
                          f"(|A| |f|) = {c.stress_residual:.3g}; distance from the jamming point along the "
@@ -1039,10 +1050,11 @@ class EllipsoidJammingResult:
     def to_dataset(self) -> xr.Dataset:
         """Per-particle and per-contact arrays and scalar attributes (verdict codes of
         :class:`Verdict`: 1 jammed, 0 not jammed, -1 not run, -2 undetermined). Wall contacts
-        (container) have ``contact_wall`` 0 (-1 for a pair), j = i, ``contact_gap`` h / a_max and
-        their ``force`` is the wall's reaction; attributes ``n_wall_contacts``,
-        ``n_backbone_wall_contacts``, ``wall_force`` (sum of the reactions) and ``boundary``, as
-        for spheres (:meth:`hardpack.jamming.result.JammingResult.to_dataset`)."""
+        have ``contact_wall`` 0 (container) or 2 k / 2 k + 1 (the flat walls x_k = 0 / x_k = L_k;
+        -1 for a pair), j = i, ``contact_gap`` h / a_max and their ``force`` is the wall's
+        reaction; attributes ``n_wall_contacts``, ``n_backbone_wall_contacts``, ``wall_force`` (sum
+        of the reactions) and ``boundary``, as for spheres
+        (:meth:`hardpack.jamming.result.JammingResult.to_dataset`)."""
         net, c = self.network, self.collective
         forces = self.contact_forces
         data = {
@@ -1142,17 +1154,39 @@ def _global_near_stress(net, at_full, t_full, owner, frozen):
     return f, np.asarray(at_full.T @ f).ravel()
 
 
+def _slides_along_walls(net: EllipsoidContacts, contacts: np.ndarray, n_dof: int) -> Decision | None:
+    """The local test's decision for a particle all of whose ``contacts`` (a nonempty set) are with
+    flat hard walls whose normals n do not span R^d, None otherwise (module docstring).
+
+    Each gap h = b - n . x - s depends on the centre only through n . x (module docstring of
+    :mod:`hardpack.jamming.ellipsoids`), so a translation t with n . t = 0 for every touched wall
+    (one exists iff the normals do not span R^d) leaves every gap unchanged exactly: an
+    unjamming motion, which the second-order test would see only as a floppy mode of zero
+    stiffness. ``n_dof`` is the particle's reduced dof."""
+    if not contacts.size or not net.is_plane_wall[contacts].all():
+        return None
+    normals = net.normal[contacts]
+    if np.linalg.matrix_rank(normals) == net.dim:
+        return None
+    walls = ", ".join(sorted({wall_name(net, c) for c in contacts}))
+    return Decision(Verdict.NOT_JAMMED, "first", False,
+                    f"its only contacts are with flat walls ({walls}) whose normals do not span R^{net.dim}: "
+                    "translating parallel to them keeps every gap, an exact unjamming motion",
+                    np.zeros(contacts.size), -1, -1, n_dof, int(contacts.size))
+
+
 def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=None,
                       method: str = "auto", local: bool = True, rank_tol: float = 1e-9,
                       stress_tol: float = 1e-9, eig_tol: float = 1e-9, seed: int = 0) -> EllipsoidJammingResult:
-    """Jamming test of a packing of ellipses or ellipsoids, periodic or in a spherical container
-    (module docstring; wall contacts: :mod:`hardpack.jamming.ellipsoids`).
+    """Jamming test of a packing of ellipses or ellipsoids, periodic, between flat hard walls or in a
+    spherical container (module docstring; wall contacts: :mod:`hardpack.jamming.ellipsoids`).
 
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell or a spherical container (the contacts must be
-        exact to ``delta``; a wall contact's gap counts relative to the particle's a_max).
+        Ellipses or ellipsoids in a periodic cell, between flat hard walls or in a spherical
+        container (the contacts must be exact to ``delta``; a wall contact's gap counts relative
+        to the particle's a_max).
     delta : float or "gaps", optional
         Contact tolerance mu - 1 (default DEFAULT_DELTA, 1e-9), or "gaps": read off the gap
         distribution (:func:`contact_delta_from_gaps`; packings from a compression to high
@@ -1175,9 +1209,9 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     Raises
     ------
     InvalidInputError
-        For a packing that is not an ellipsoid packing in a periodic cell or a spherical container,
-        a particle touching the container along a continuum, overlaps (pairs: mu - 1 below
-        -packing.overlap_tol, by the Perram-Wertheim function; the wall: h / a_max below it), a
+        For a packing that is not an ellipsoid packing, a particle touching the container along a
+        continuum, overlaps (pairs: mu - 1 below -packing.overlap_tol, by the Perram-Wertheim
+        function; a wall, flat or the container's: h / a_max below it), a
         bad ``delta``, ``frozen`` of
         the wrong shape, an unknown ``method`` or non-positive tolerances.
     """
@@ -1209,7 +1243,7 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
     overlap = net.gap < -packing.overlap_tol
     if overlap.any():
         worst = int(np.argmin(net.gap))
-        what = (f"particle {net.i[worst]} and the container wall, h / a_max" if net.wall[worst] >= 0
+        what = (f"particle {net.i[worst]} and {wall_name(net, worst)}, h / a_max" if net.wall[worst] >= 0
                 else f"particles {net.i[worst]} and {net.j[worst]}, mu - 1")
         raise InvalidInputError(
             f"{int(overlap.sum())} contacts overlap beyond the tolerance {packing.overlap_tol:g} (worst: "
@@ -1239,8 +1273,10 @@ def verify_ellipsoids(packing: Packing, delta: float | None = None, *, frozen=No
                 contacts = np.flatnonzero(mine & present[net.i] & present[net.j])
                 only = np.zeros(n, dtype=bool)
                 only[p] = True
-                at, stiff, _, quad, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only, near)
-                dec = decide_dense(at, stiff, quad, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
+                dec = _slides_along_walls(net, contacts, int(dof[p]))
+                if dec is None:
+                    at, stiff, _, quad, _ = _submatrices(net, at_full, hess, t_full, owner, contacts, only, near)
+                    dec = decide_dense(at, stiff, quad, np.zeros((at.shape[1], 0)), rank_tol=rank_tol, **tols)
                 local_verdict[p] = int(dec.verdict)
                 local_order[p] = ORDER_CODES[dec.order]
                 if dec.verdict == Verdict.NOT_JAMMED:
