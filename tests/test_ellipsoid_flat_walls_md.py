@@ -232,3 +232,26 @@ def test_cli_init_and_compress_ellipses_between_walls(tmp_path):
                  "--max-pressure", "1e5", "--seed", "1"]) == 0
     jammed = load_packing(out)
     assert str(jammed.boundary) == str(p.boundary) and jammed.containment_report().n_outside == 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("d,axes,wall_axes,seed", [(2, [1.5, 1.0], None, 1), (2, [1.5, 1.0], None, 2),
+                                                    (3, [1.25, 1.0, 0.8], [2], 1)])
+def test_ls_packings_between_walls_are_hypostatic_and_jammed_at_second_order(d, axes, wall_axes, seed):
+    """Donev 2006, sec. 5.6: LS packings of ellipses and ellipsoids are jammed although hypostatic
+    (fewer contacts than degrees of freedom), which the second-order test shows. Here between hard
+    walls (a closed box of 20 ellipses, a slit of 20 ellipsoids), compressed to p = 1e12 with a
+    slow final stage; the wall contacts are constraints of the tests."""
+    from hardpack.initial import random_ellipsoid_packing
+    from hardpack.jamming.result import Verdict
+    from hardpack.jamming.second_order import verify_ellipsoids
+    from hardpack.md import StopCriteria
+    from hardpack.md.ellipsoid import compress_ellipsoids
+
+    p = random_ellipsoid_packing(20, axes, 0.1 if d == 2 else 0.05, seed, boundary="hard_walls",
+                                 wall_axes=wall_axes)
+    res = compress_ellipsoids(p, 0.1, seed, stop=StopCriteria(max_pressure=1e12), final_growth_rate=3e-3,
+                              switch_pressure=1e3)
+    r = verify_ellipsoids(res.packing)
+    assert r.verdict == Verdict.JAMMED and r.order == "second", r.summary()
+    assert r.isostaticity_gap < 0 and r.n_backbone_wall_contacts > 0
