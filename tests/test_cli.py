@@ -109,8 +109,9 @@ def test_init_in_a_container_and_compress_it_to_jamming(tmp_path, extra, boundar
 @pytest.mark.parametrize("extra, message", [
     (["--wall-axes", "1"], "--wall-axes is for --boundary hard_walls only"),
     (["--boundary", "hard_walls", "--wall-axes", "3"], "hard-wall axis 3 does not exist in 3 dimensions"),
-    (["--boundary", "hard_walls", "--semiaxes", "1", "1", "2"],
-     "--boundary hard_walls is implemented for spheres only"),
+    (["--boundary", "hard_walls", "--semiaxes", "1", "1", "2", "--wall-axes", "3"],
+     "hard-wall axis 3 does not exist in 3 dimensions"),
+    (["--semiaxes", "1", "1", "2", "--wall-axes", "1"], "--wall-axes is for --boundary hard_walls only"),
 ])
 def test_init_refuses_bad_boundaries(tmp_path, capsys, extra, message):
     out = tmp_path / "x.nc"
