@@ -135,8 +135,8 @@ def test_container_start_is_seeded_inside_and_refuses_impossible_requests():
         assert np.array_equal(p.shape.orientations, q.shape.orientations)
     with pytest.raises(InvalidInputError, match="lower phi"):
         random_ellipsoid_packing(30, [1.0, 1.0, 0.2], 0.3, 3, boundary="spherical_container", max_trials=200)
-    with pytest.raises(InvalidInputError, match="'periodic' or 'spherical_container'"):
-        random_ellipsoid_packing(3, [1.0, 0.5], 0.1, 3, boundary="hard_walls")
+    with pytest.raises(InvalidInputError, match="'periodic', 'hard_walls' or 'spherical_container'"):
+        random_ellipsoid_packing(3, [1.0, 0.5], 0.1, 3, boundary="slit")
 
 
 @pytest.mark.parametrize("d", [3, 2])
