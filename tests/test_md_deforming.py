@@ -26,6 +26,7 @@ from hardpack.distributions import monodisperse
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.lattices import lattice_packing
+from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
 from hardpack.md import StopCriteria, compress
 from hardpack.md.deforming import compress_deforming, shortest_vector
@@ -149,34 +150,50 @@ def _mean_deviatoric(deviatoric):
     return tail.mean(axis=0), blocks.std(axis=0, ddof=1) / np.sqrt(len(blocks))
 
 
+def test_a_strained_crystal_relaxes_its_cell_until_the_stress_is_isotropic():
+    # Donev 2006, sec. 3.2.4.2: the cell moves until the stress is isotropic. FCC (2 x 2 x 2
+    # conventional cells, phi = 0.6) in a cell strained by diag(1.04, 1, 1/1.04) at constant
+    # volume, run in the shape-only mode at zero growth: the mean anisotropy |sigma / p - I| of
+    # the first 10 windows is far from 0, that of the last quarter is 0 within 3 standard errors,
+    # and the cell's strain (singular values of H H0^-1 over their geometric mean; 8.3 % from
+    # the largest to the smallest at the start) falls below a quarter of its start.
+    crystal = _at_phi(lattice_packing("fcc", 2), 0.6)
+    strain = np.diag([1.04, 1.0, 1 / 1.04])
+    strained = Packing(crystal.positions @ strain.T, crystal.radii, strain @ crystal.lattice)
+    stop = StopCriteria(max_pressure=None, max_collisions=60 * crystal.n_particles * 200)
+    for seed in (3, 4):
+        res = compress_deforming(strained, 0.0, seed, stop)
+        deviatoric = res.timeseries.deviatoric.values
+        late, late_err = _mean_deviatoric(deviatoric)
+        early = np.linalg.norm(deviatoric[:10].mean(axis=0))
+        assert early > 10 * np.linalg.norm(late_err), (early, late_err)
+        assert np.linalg.norm(late) < 3 * np.linalg.norm(late_err), (late, late_err)
+        sv = np.linalg.svd(res.packing.lattice @ np.linalg.inv(crystal.lattice), compute_uv=False)
+        assert sv.max() / sv.min() - 1 < 0.25 * (1.04**2 - 1), sv
+        assert res.stats["overlap_check"] == "passed"
+
+
 @pytest.mark.slow
-def test_3d_adaptive_cell_relaxes_the_shear_stress_and_the_packing_is_strictly_jammed():
-    # Donev 2006, sec. 3.2.4.2: the cell moves until the stress is isotropic. Two-stage LS runs
-    # of the same start with and without the adaptive cell (module docstring, steps 2 and 6):
-    # over the last quarter of the windows up to Z = 1e6 the adaptive cell's mean anisotropy
-    # |<sigma / p - I>| is smaller by more than three standard errors of the difference (|.| is
-    # 1-Lipschitz, so the norm of the per-component errors bounds each norm's error). The
-    # adaptive run goes on to Z = 1e12 and is strictly jammed there. A run is deterministic and
-    # its stop criterion is only checked at window ends, so the adaptive run's windows up to the
-    # first at Z >= 1e6 are those of a run stopped at 1e6.
+def test_3d_adaptive_cell_ls_packing_is_strictly_jammed():
+    # Donev 2006, sec. 3.2.4.2 and Fig. 4.15: the two-stage LS run with the adaptive cell
+    # (module docstring, steps 2 and 6) uses mobilities above Donev's 1 / Z while it grows and
+    # ends strictly jammed at Z = 1e12. (An earlier version also required its mean anisotropy
+    # |<sigma / p - I>| over the last quarter of the windows up to Z = 1e6 to be below that of
+    # the run with Donev's fixed mobility, by 3 standard errors of the windows: one start, seed
+    # 0, passed on one host and failed on another (0.014 +- 0.002 against 0.001 +- 0.002), and
+    # over starts 0-3 the difference was 0.030 +- 0.024 in favour of the adaptive cell, not
+    # significant: the window errors do not hold the start-to-start spread. The strained crystal
+    # above tests the relaxation itself.)
     from hardpack.jamming import verify
 
     start = random_packing(30, 3, monodisperse(), 0.3, 0)
     adaptive_run = compress_deforming(start, 0.02, 0, final_growth_rate=1e-4)
-    fixed_run = compress_deforming(start, 0.02, 0, StopCriteria(max_pressure=1e6), final_growth_rate=1e-4,
-                                   adaptive_cell=False)
-    to_1e6 = int(np.argmax(adaptive_run.timeseries.Z.values >= 1e6)) + 1
-    assert adaptive_run.timeseries.Z.values[to_1e6 - 1] >= 1e6 and fixed_run.timeseries.Z.values[-1] >= 1e6
-    adaptive, adaptive_err = _mean_deviatoric(adaptive_run.timeseries.deviatoric.values[:to_1e6])
-    fixed, fixed_err = _mean_deviatoric(fixed_run.timeseries.deviatoric.values)
-    difference = np.linalg.norm(fixed) - np.linalg.norm(adaptive)
-    assert difference > 3 * np.hypot(np.linalg.norm(adaptive_err), np.linalg.norm(fixed_err)), \
-        (adaptive, adaptive_err, fixed, fixed_err)
-    assert adaptive_run.stats["adaptive_cell"] is True and fixed_run.stats["adaptive_cell"] is False
-    assert adaptive_run.timeseries.mobility.values[:to_1e6].max() > 1.0
-    assert np.all(fixed_run.timeseries.mobility.values == 1.0)
-    assert fixed_run.stats["shear_mean"] == pytest.approx(np.linalg.norm(fixed), rel=1e-9)
-    assert all(r.stats["overlap_check"] == "passed" for r in (adaptive_run, fixed_run))
+    assert adaptive_run.timeseries.Z.values[-1] >= 1e12
+    assert adaptive_run.stats["adaptive_cell"] is True
+    assert adaptive_run.timeseries.mobility.values.max() > 1.0
+    late, _ = _mean_deviatoric(adaptive_run.timeseries.deviatoric.values)
+    assert adaptive_run.stats["shear_mean"] == pytest.approx(np.linalg.norm(late), rel=1e-9)
+    assert adaptive_run.stats["overlap_check"] == "passed"
 
     result = verify(adaptive_run.packing, seed=0, method="sequential")
     assert result.collective and result.strict
