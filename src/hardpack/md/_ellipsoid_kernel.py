@@ -116,14 +116,17 @@ from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
 from hardpack.geometry.contact import pw_contact_into
 from hardpack.geometry.ellipsoid_container import farthest_point_body
-from hardpack.md._kernel import (
+from hardpack.md._kernel import (  # noqa: F401  (its boundary modes are this kernel's too)
     A_T,
     A_VIRIAL,
+    FLAT_WALLS_MODE,
     I_COLL,
     I_EVENTS,
     I_EXIT,
     I_GRAZE,
     I_STALE,
+    PERIODIC_MODE,
+    SPHERE_MODE,
     WindowStatus,
     end_window,
     kinetic_step,
@@ -158,11 +161,6 @@ TRACE_COLLISION, TRACE_CHECK, TRACE_SUSPENDED, TRACE_STOPPED = 0, 1, 2, 3
 #: the pair searches it and writes the record; the second takes the search from the record
 SHARE_NONE, SHARE_WRITE, SHARE_READ = 0, 1, 2
 
-#: boundary modes of :func:`run_events`, tuples whose LENGTH is a compile-time constant (as in
-#: :mod:`hardpack.md._kernel`): the periodic specialisation has no wall code at all
-PERIODIC_MODE = ()
-FLAT_WALLS_MODE = (0,)
-SPHERE_MODE = (0, 0)
 
 #: extra counters (after the sphere engine's): CHECK events; the particle and partner of the
 #: last event of a STALLED window

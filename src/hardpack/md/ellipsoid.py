@@ -112,9 +112,7 @@ class EllipsoidSimulation(Simulation):
                  growth_rate: float, overlap_tol: float = DEFAULT_OVERLAP_TOL, eps_f: float = EPS_F):
         self._setup(packing, growth_rate, overlap_tol)
         shape = packing.shape
-        positions = packing.fractional() * self.box
-        positions[:, ~self._periodic] = packing.positions[:, ~self._periodic]
-        self.engine = EllipsoidEngine(positions, velocities, shape.semiaxes, shape.orientations,
+        self.engine = EllipsoidEngine(self._engine_positions(packing), velocities, shape.semiaxes, shape.orientations,
                                       angular_velocities, self.box, eps_f=eps_f,
                                       boundary=None if self.boundary.kind == "periodic" else self.boundary)
         self.contacts = None
@@ -130,10 +128,7 @@ class EllipsoidSimulation(Simulation):
         Perram-Wertheim potential)."""
         inv = self._inverse()
         eng = self.engine
-        pos = eng.positions[inv]
-        wrapped = pos - np.floor(pos / self.box) * self.box
-        wrapped[wrapped >= self.box] = 0.0
-        pos[:, self._periodic] = wrapped[:, self._periodic]
+        pos = self._wrapped_positions(inv)
         shape = Ellipsoids(eng.semiaxes[inv].copy(), eng.orientations[inv].copy())
         return Packing(pos, lattice=self.lattice, species=self.species, shape=shape, boundary=self.boundary,
                        overlap_tol=self.overlap_tol, allow_overlap=True)

@@ -13,7 +13,7 @@ import numpy as np
 
 from hardpack.md import _ellipsoid_kernel as ek
 from hardpack.md._kernel import WindowStatus
-from hardpack.md.engine import Engine, WindowResult, _aligned_rows
+from hardpack.md.engine import Engine, WindowResult, _aligned_rows, wall_arrays
 
 
 class EngineStalledError(RuntimeError):
@@ -88,22 +88,13 @@ class EllipsoidEngine(Engine):
         self.eps_f = float(eps_f)
         self.box = np.ascontiguousarray(box, dtype=float)
         kind = "periodic" if boundary is None else boundary.kind
-        modes = {"periodic": ek.PERIODIC_MODE, "hard_walls": ek.FLAT_WALLS_MODE,
-                 "spherical_container": ek.SPHERE_MODE}
-        if kind not in modes:
+        if kind not in ("periodic", "hard_walls", "spherical_container"):
             raise ValueError(f"the ellipsoid engine runs periodic cells, hard walls or spherical containers, "
                              f"not {kind}")
-        self.wmode = modes[kind]
-        self.walled = np.zeros(d, dtype=np.int8)  # axes without periodic images
-        if kind == "spherical_container":
-            self.walled[:] = 1
-        elif kind == "hard_walls":
-            self.walled[list(boundary.axes)] = 1
-        self.wspec = np.zeros(d + 1)  # the walls (hardpack.md._ellipsoid_kernel.run_events)
-        if kind == "spherical_container":
-            self.wspec[:d] = boundary.centre
-            self.wspec[d] = boundary.radius
-        elif kind == "hard_walls":
+        # the sphere kernel's modes, walled axes and container; the flat walls' positions added
+        # (hardpack.md._ellipsoid_kernel.run_events)
+        self.wmode, self.walled, self.wspec = wall_arrays(boundary, d)
+        if kind == "hard_walls":
             axes = list(boundary.axes)
             self.wspec[axes] = self.box[axes]
             self.wspec[d] = self.box[axes].max()

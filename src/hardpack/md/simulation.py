@@ -166,9 +166,8 @@ class Simulation:
         last ``contact_windows`` windows in :attr:`contacts` (:mod:`hardpack.md.contacts`)."""
         check_packing(packing)
         self._setup(packing, growth_rate, overlap_tol)
-        positions = packing.fractional() * self.box
-        positions[:, ~self._periodic] = packing.positions[:, ~self._periodic]
-        self.engine = Engine(positions, velocities, packing.radii, self.box, boundary=self.boundary)
+        self.engine = Engine(self._engine_positions(packing), velocities, packing.radii, self.box,
+                             boundary=self.boundary)
         self.contacts = ContactAccumulator(self.n, self.d, contact_windows) if contact_windows else None
 
     def _setup(self, packing: Packing, growth_rate: float, overlap_tol: float) -> None:
@@ -223,17 +222,29 @@ class Simulation:
         """
         return unit_ball_volume(self.d) * self.engine.totals()[2] / self.volume
 
+    def _engine_positions(self, packing: Packing) -> np.ndarray:
+        """The packing's centres in the engine's box frame: wrapped along the periodic axes, as
+        they stand along walled ones (and in a container)."""
+        positions = packing.fractional() * self.box
+        positions[:, ~self._periodic] = packing.positions[:, ~self._periodic]
+        return positions
+
+    def _wrapped_positions(self, inv: np.ndarray) -> np.ndarray:
+        """The engine's centres in the caller's order (``inv``, the inverse of :attr:`perm`),
+        wrapped into the box along the periodic axes only."""
+        pos = self.engine.positions[inv]
+        wrapped = pos - np.floor(pos / self.box) * self.box
+        wrapped[wrapped >= self.box] = 0.0
+        pos[:, self._periodic] = wrapped[:, self._periodic]
+        return pos
+
     def packing(self) -> Packing:
         """The current configuration in the caller's particle order, centres wrapped into the box
         (all particles are synchronised between windows)."""
         inv = np.empty(self.n, dtype=np.int64)
         inv[self.perm] = np.arange(self.n)
-        pos = self.engine.positions[inv]
-        wrapped = pos - np.floor(pos / self.box) * self.box
-        wrapped[wrapped >= self.box] = 0.0
-        pos[:, self._periodic] = wrapped[:, self._periodic]
-        return Packing(pos, self.engine.radii[inv].copy(), self.lattice, species=self.species,
-                       boundary=self.boundary, overlap_tol=self.overlap_tol)
+        return Packing(self._wrapped_positions(inv), self.engine.radii[inv].copy(), self.lattice,
+                       species=self.species, boundary=self.boundary, overlap_tol=self.overlap_tol)
 
     def velocities(self) -> np.ndarray:
         """Velocities in the caller's particle order.
