@@ -673,10 +673,10 @@ def test_the_contacts_at_a_window_end_and_their_normal_speeds_are_those_of_spher
                    [0 << 6 | code, 1 << 6 | code]], dtype=np.int32)
     nn = np.full(3, 2, dtype=np.int32)
     imgvec = image_vectors(box)
-    contacts = ek.end_contacts(eng.P, np.array([0, 2]), imgvec, nb, nn, ek.PERIODIC_MODE, eng.wspec)
+    contacts = ek.end_contacts(eng.P, np.array([0, 2]), imgvec, nb, nn, ek.PERIODIC_CODE, eng.wspec)
     assert contacts.tolist() == [[0, 1, code]]
     g = 0.3
-    rate = ek.contact_rates(eng.P, contacts, imgvec, g, ek.PERIODIC_MODE, eng.wspec)
+    rate = ek.contact_rates(eng.P, contacts, imgvec, g, ek.PERIODIC_CODE, eng.wspec)
     assert rate[0] == pytest.approx(v[1, 0] - v[0, 0] - 2 * g, rel=1e-12, abs=1e-12)
 
     cont = SphericalContainer((10.0, 10, 10), 5.0)
@@ -684,16 +684,16 @@ def test_the_contacts_at_a_window_end_and_their_normal_speeds_are_those_of_spher
                           w[:1], np.full(3, 20.0), boundary=cont)
     none = np.zeros((1, 0), dtype=np.int32)
     contacts = ek.end_contacts(one.P, np.array([0]), one.imgvec, none, np.zeros(1, dtype=np.int32),
-                               ek.SPHERE_MODE, one.wspec)
+                               ek.SPHERE_CODE, one.wspec)
     assert contacts.tolist() == [[0, ek.WALL, 0]]
-    rate = ek.contact_rates(one.P, contacts, one.imgvec, g, ek.SPHERE_MODE, one.wspec)
+    rate = ek.contact_rates(one.P, contacts, one.imgvec, g, ek.SPHERE_CODE, one.wspec)
     assert rate[0] == pytest.approx(-(v[0, 0] + g), rel=1e-12, abs=1e-12)
 
     # the same unit sphere touching the flat wall x_0 = L_0 = 15 of a slit: wall 1 (axis 0, side L)
     slit = EllipsoidEngine(np.array([[14.0, 10, 10]]), v[:1], np.ones((1, 3)), np.array([[1.0, 0, 0, 0]]),
                            w[:1], np.array([15.0, 20.0, 20.0]), boundary=HardWalls((0,)))
     contacts = ek.end_contacts(slit.P, np.array([0]), slit.imgvec, none, np.zeros(1, dtype=np.int32),
-                               ek.FLAT_WALLS_MODE, slit.wspec)
+                               ek.FLAT_WALLS_CODE, slit.wspec)
     assert contacts.tolist() == [[0, ek.WALL - 1, 0]]
-    rate = ek.contact_rates(slit.P, contacts, slit.imgvec, g, ek.FLAT_WALLS_MODE, slit.wspec)
+    rate = ek.contact_rates(slit.P, contacts, slit.imgvec, g, ek.FLAT_WALLS_CODE, slit.wspec)
     assert rate[0] == pytest.approx(-(v[0, 0] + g), rel=1e-12, abs=1e-12)

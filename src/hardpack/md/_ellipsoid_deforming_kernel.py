@@ -362,7 +362,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, n_cells, cstr, kappa, eps
     hsize = 0
     for i in range(n):
         key, partner = ek._predict(i, 0.0, P, kappa, eps_f, img, bs, nb, nn, tins, touts, done, pst, ws, wm,
-                                   ek.PERIODIC_MODE, wspec, ww, wq)
+                                   np.int64(ek.PERIODIC_CODE), wspec, ww, wq)
         ep[i] = partner
         if partner >= 0:
             ec[i] = cnt[partner]
@@ -472,7 +472,7 @@ def run_events(P, H, Hinv, M, img, cbits, cfac, reach, n_cells, cstr, kappa, eps
         for q in range(npred):
             k = upd[q]
             key, partner = ek._predict(k, t, P, kappa, eps_f, img, bs, nb, nn, tins, touts, done, pst, ws, wm,
-                                       ek.PERIODIC_MODE, wspec, ww, wq)
+                                       np.int64(ek.PERIODIC_CODE), wspec, ww, wq)
             ep[k] = partner
             if partner >= 0:
                 ec[k] = cnt[partner]

@@ -139,6 +139,11 @@ NONE = -2  # nothing predicted
 CHECK = -3  # a trace stopped at its step cap: re-predict then (a "safe time")
 WALL = -4  # event: the particle hits wall 0 (the spherical container); WALL - w: flat wall w
 
+#: The boundary of this kernel is a run-time code, the length of the sphere kernel's mode tuple,
+#: so that one compiled kernel serves every boundary (each compile-time mode would cost another
+#: ~80 s of compilation); its branches cost nothing next to a contact-function evaluation.
+PERIODIC_CODE, FLAT_WALLS_CODE, SPHERE_CODE = len(PERIODIC_MODE), len(FLAT_WALLS_MODE), len(SPHERE_MODE)
+
 #: what a pair trace (:func:`pair_trace`, :func:`predict_pair`) or a wall search
 #: (:func:`wall_predict`) found at the time it returns (plain ints: compile-time constants that
 #: numba compares as fast as literals): the collision (or nothing, with time inf); the step cap
@@ -1093,10 +1098,10 @@ def wall_gap(P, i, t, kappa, wmode, wspec, wid, ww, wq):
     gap h between the wall and the particle's farthest surface point along the wall's outward
     normal n, and its rate by the envelope theorem (the point is stationary on the surface),
     dh/dt = -n . (v + w x r_c + g r_c) (r_c that point less the particle centre, g the relative
-    growth rate). In a spherical container (SPHERE_MODE, centre wspec[:d], radius wspec[d]) the
+    growth rate). In a spherical container (SPHERE_CODE, centre wspec[:d], radius wspec[d]) the
     point is the farthest from the centre
     (:func:`hardpack.geometry.ellipsoid_container.farthest_point_body`), h = R - rho, and n is
-    radial there; at the flat wall ``wid`` (FLAT_WALLS_MODE: x_k = 0 for wid = 2 k, x_k = L_k =
+    radial there; at the flat wall ``wid`` (FLAT_WALLS_CODE: x_k = 0 for wid = 2 k, x_k = L_k =
     wspec[k] for wid = 2 k + 1) the support point along n = -e_k or +e_k,
     r_c = X^-1 n / sqrt(n . X^-1 n), and h = x_k - n . r_c or L_k - x_k - n . r_c. On return
     ww[5, :d] holds r_c, ww[6, :d] n.
@@ -1111,8 +1116,8 @@ def wall_gap(P, i, t, kappa, wmode, wspec, wid, ww, wq):
         Window time.
     kappa : float
         Relative growth rate of the semiaxes.
-    wmode : tuple
-        SPHERE_MODE or FLAT_WALLS_MODE.
+    wmode : int
+        SPHERE_CODE or FLAT_WALLS_CODE.
     wspec : numpy.ndarray of float64, shape (d + 1,)
         Container centre and radius, or the wall positions L_k of the walled axes (0 for the
         periodic ones) and a length scale (:func:`run_events`).
@@ -1138,7 +1143,7 @@ def wall_gap(P, i, t, kappa, wmode, wspec, wid, ww, wq):
         a[k] = P[i, cax + k] * grow
     orientation_at(P, i, t, o)
     _rotation_into(o, wq)
-    if len(wmode) == 1:  # flat wall: the support point along n = sgn e_k, body frame b = Q n
+    if wmode == FLAT_WALLS_CODE:  # flat wall: the support point along n = sgn e_k, body frame b = Q n
         kw = wid >> 1
         sgn = 1.0 if wid & 1 else -1.0
         ss = 0.0
@@ -1409,12 +1414,13 @@ def _rebuild(i, t, P, L, invL, kappa, skin, sfac, lvl, rcap, ncl, coff, ccount, 
     """Partial NNL update of particle i at window time t (Donev 2006, Algorithm 10): advance i to
     t and :func:`hardpack.md._kernel.update_neighbour_list` with the bounding radius R_i (largest
     semiaxis) in place of the sphere radius; along the ``walled`` axes (all of them in a container)
-    without periodic images and wraps. Returns 0 or a :class:`WindowStatus` to stop with."""
+    without periodic images and wraps (``walled`` alone decides, so the sphere kernel's flat-wall
+    mode serves every boundary). Returns 0 or a :class:`WindowStatus` to stop with."""
     _, _, cr, _, _, _, _, _ = columns(L.shape[0])
     advance(P, i, t, scratch)
     return update_neighbour_list(i, P[i, cr] * (1.0 + kappa * t), P, L, invL, skin, sfac, lvl, rcap, ncl, coff,
-                                 ccount, cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo, wmode,
-                                 walled)
+                                 ccount, cid, cbs, slot_of, bs, nb, nn, mark, oldnb, clo, cspan, codo,
+                                 FLAT_WALLS_MODE, walled)
 
 
 @njit(cache=True)
@@ -1422,7 +1428,7 @@ def _predict(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, 
              ww, wq):
     """:func:`_predict_shared` without a shared pair: (time, partner) of the next event of i."""
     return _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done, pst, ws, wm, wmode,
-                           wspec, ww, wq, -1, SHARE_NONE, ws[10])
+                           wspec, ww, wq, np.int64(-1), np.int64(SHARE_NONE), ws[10])
 
 
 #: length of the record of a shared pair (:func:`_predict_shared`): key, status, result time and
@@ -1478,12 +1484,12 @@ def _predict_shared(i, t, P, kappa, eps_f, imgvec, bs, nb, nn, tins, touts, done
     best = exit_root(dd, dv, vv, bs[i, d] - ri * grow, ri * kappa)
     partner = EXIT if best < np.inf else NONE
     best += t
-    if len(wmode) == 2:
-        tw, kind = wall_predict(P, i, t, best, kappa, wmode, wspec, 0, eps_f, ww, wq)
+    if wmode == SPHERE_CODE:
+        tw, kind = wall_predict(P, i, t, best, kappa, wmode, wspec, np.int64(0), eps_f, ww, wq)
         if tw < best:
             best = tw
             partner = WALL if kind == TRACE_COLLISION else CHECK
-    elif len(wmode) == 1:  # flat walls: each one that the bounding sphere can reach before best
+    elif wmode == FLAT_WALLS_CODE:  # flat walls: each one that the bounding sphere can reach before best
         rb = ri * grow
         for kw in range(d):
             if wspec[kw] <= 0.0:
@@ -1800,7 +1806,7 @@ def collide_at(P, i, j, t, sh, kappa, ws, wm):
 @njit(cache=True)
 def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, cid, cbs,
                slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc, iacc,
-               coll_target, t_cap, rebuild_lists, wmode=PERIODIC_MODE, wspec=None):
+               coll_target, t_cap, rebuild_lists, wmode=PERIODIC_CODE, wspec=None):
     """One window of ellipsoid MD; arguments, accumulators and return codes as in
     :func:`hardpack.md._kernel.run_events` (no ``dims``: d is the length of ``L``; ``eps_f`` the
     trace tolerance; ``iacc`` has N_COUNTERS entries: after the sphere engine's, I_CHECK counts
@@ -1809,11 +1815,11 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
     enters the current translational kinetic energy; ``acc`` has N_ACC entries: A_EVAL receives
     the number of contact-function evaluations, A_WALL + k the momentum given to the walls of
     axis k, or to the container wall for k = 0).
-    ``wmode`` PERIODIC_MODE, FLAT_WALLS_MODE (hard walls at x_k = 0 and x_k = L_k on the axes k
+    ``wmode`` PERIODIC_CODE, FLAT_WALLS_CODE (hard walls at x_k = 0 and x_k = L_k on the axes k
     with wspec[k] = L_k > 0, periodic images along the others, wspec[d] the largest L_k) or
-    SPHERE_MODE (a spherical container of centre wspec[:d] and radius wspec[d] inside the box L,
+    SPHERE_CODE (a spherical container of centre wspec[:d] and radius wspec[d] inside the box L,
     which then has no periodic images); wall collisions, counted in iacc[I_WALL], count towards
-    ``coll_target``; the periodic specialisation has no wall code.
+    ``coll_target``.
 
     Parameters
     ----------
@@ -1839,10 +1845,10 @@ def run_events(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, cco
         Stop before the first event later than this window time.
     rebuild_lists : bool
         Start with a complete rebuild of grid and neighbour lists.
-    wmode : tuple, optional
-        PERIODIC_MODE, FLAT_WALLS_MODE or SPHERE_MODE.
+    wmode : int, optional
+        PERIODIC_CODE, FLAT_WALLS_CODE or SPHERE_CODE.
     wspec : numpy.ndarray of float64, shape (d + 1,), optional
-        Wall positions and scale (FLAT_WALLS_MODE) or container centre and radius (SPHERE_MODE).
+        Wall positions and scale (FLAT_WALLS_CODE) or container centre and radius (SPHERE_CODE).
 
     Returns
     -------
@@ -1872,7 +1878,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
     walled = np.zeros(d, dtype=np.int8)  # axes without images: all in a container, the flat walls' axes
     lcoll = L.copy()  # collision images: none along walled axes (every pair is within the box, |dx| < L)
     for k in range(d):
-        if len(wmode) == 2 or (len(wmode) == 1 and wspec[k] > 0.0):
+        if wmode == SPHERE_CODE or (wmode == FLAT_WALLS_CODE and wspec[k] > 0.0):
             walled[k] = 1
             lcoll[k] = 4.0 * L[k]
     oldnb = np.empty(cap, dtype=np.int64)
@@ -1943,7 +1949,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
                 return status
         elif p == CHECK:
             iacc[I_CHECK] += 1
-        elif len(wmode) > 0 and p <= WALL:
+        elif wmode != PERIODIC_CODE and p <= WALL:
             wid = WALL - p
             jimp, dke = wall_collide(P, i, t, kappa, wmode, wspec, wid, ww, wq)
             if jimp > 0.0:
@@ -1985,7 +1991,7 @@ def _run(P, L, kappa, eps_f, skin, sfac, imgvec, lvl, rcap, ncl, coff, ccount, c
         if iacc[I_COLL] >= coll_target and npred == 2:
             end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS
-        if len(wmode) > 0 and wall_hit and iacc[I_COLL] + iacc[I_WALL] >= coll_target:
+        if wmode != PERIODIC_CODE and wall_hit and iacc[I_COLL] + iacc[I_WALL] >= coll_target:
             end_window(acc, t)
             return WindowStatus.DONE_COLLISIONS
 
@@ -2145,8 +2151,8 @@ def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
         Neighbour lists, entries j << 2d | image code.
     nn : numpy.ndarray of int32, shape (N,)
         List lengths.
-    wmode : tuple
-        PERIODIC_MODE, FLAT_WALLS_MODE or SPHERE_MODE.
+    wmode : int
+        PERIODIC_CODE, FLAT_WALLS_CODE or SPHERE_CODE.
     wspec : numpy.ndarray of float64, shape (d + 1,)
         The walls (:func:`run_events`).
 
@@ -2168,9 +2174,9 @@ def end_contacts(P, ended, imgvec, nb, nn, wmode, wspec):
     k = 0
     for q in range(ended.shape[0]):
         i = np.int64(ended[q])
-        n_walls = 2 * d if len(wmode) == 1 else (1 if len(wmode) == 2 else 0)
+        n_walls = 2 * d if wmode == FLAT_WALLS_CODE else (1 if wmode == SPHERE_CODE else 0)
         for wid in range(n_walls):
-            if len(wmode) == 1 and wspec[wid >> 1] <= 0.0:
+            if wmode == FLAT_WALLS_CODE and wspec[wid >> 1] <= 0.0:
                 continue
             h, _ = wall_gap(P, i, 0.0, 0.0, wmode, wspec, wid, ww, wq)
             if h <= END_CONTACT_GAP * P[i, cr]:
@@ -2210,8 +2216,8 @@ def contact_rates(P, contacts, imgvec, kappa, wmode, wspec):
         Periodic shift of each image code.
     kappa : float
         Relative growth rate of the semiaxes.
-    wmode : tuple
-        PERIODIC_MODE, FLAT_WALLS_MODE or SPHERE_MODE.
+    wmode : int
+        PERIODIC_CODE, FLAT_WALLS_CODE or SPHERE_CODE.
     wspec : numpy.ndarray of float64, shape (d + 1,)
         The walls (:func:`run_events`).
 

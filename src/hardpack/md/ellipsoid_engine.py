@@ -91,9 +91,10 @@ class EllipsoidEngine(Engine):
         if kind not in ("periodic", "hard_walls", "spherical_container"):
             raise ValueError(f"the ellipsoid engine runs periodic cells, hard walls or spherical containers, "
                              f"not {kind}")
-        # the sphere kernel's modes, walled axes and container; the flat walls' positions added
-        # (hardpack.md._ellipsoid_kernel.run_events)
-        self.wmode, self.walled, self.wspec = wall_arrays(boundary, d)
+        # the sphere kernel's walled axes and container, its mode as the ellipsoid kernel's run-time
+        # code; the flat walls' positions added (hardpack.md._ellipsoid_kernel.run_events)
+        mode, self.walled, self.wspec = wall_arrays(boundary, d)
+        self.wmode = len(mode)
         if kind == "hard_walls":
             axes = list(boundary.axes)
             self.wspec[axes] = self.box[axes]
@@ -197,7 +198,7 @@ class EllipsoidEngine(Engine):
         what = {ek.EXIT: "a neighbour-list exit", ek.CHECK: "a trace CHECK"}.get(p, f"particle {p}")
         if p <= ek.WALL:
             w = ek.WALL - p
-            what = ("the container wall" if self.wmode == ek.SPHERE_MODE
+            what = ("the container wall" if self.wmode == ek.SPHERE_CODE
                     else f"the wall x_{w >> 1} = {'L' if w & 1 else '0'}")
         raise EngineStalledError(
             f"the ellipsoid event loop stalled at window time {t!r}: more than "
