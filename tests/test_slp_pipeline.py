@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 import xarray as xr
 
@@ -90,6 +91,24 @@ def test_table_i_jamming_rows_judge_rattlers_contacts_and_strictness():
     # d = 5: the rattler fraction (0.006 +- 0.002) only; strict jamming was tested in d = 2, 3
     rows = mrj_jamming_rows([_jamming_summary(5, 1000, [0.0041, 0.0065], [1, 1])])
     assert [r.target for r in rows] == ["tj-t1-slp-rattlers-d5"] and rows[0].passed
+
+
+def test_the_2d_polydisperse_rattler_fraction_of_one_published_packing_carries_its_sampling_error():
+    """Sec. V.A prints ~3 % rattlers for one packing of N = 500 disks: its binomial error
+    sqrt(f (1 - f) / N) ~ 1 % belongs to the comparison with our mean over seeds, so the
+    uncertainty is the spread of one packing times sqrt(1 + 1/n), not the standard error."""
+    def poly(fractions):
+        s = _jamming_summary(2, 500, fractions, [1] * len(fractions), z=4.0)
+        s.attrs.update(ensemble="slp_poly2d", distribution='{"kind": "uniform_size", "omega": 2}')
+        return {r.target: r for r in mrj_jamming_rows([s])}["tj-sec5-poly2d-rattlers"]
+
+    row = poly([0.05] * 5)
+    one = np.sqrt(0.05 * 0.95 / 500)
+    assert row.uncertainty == pytest.approx(one * np.sqrt(1.2))
+    assert row.passed  # |0.05 - 0.03| = 0.020 <= 0.005 + 2 x 0.0107; the pooled 0.0044 would fail it
+    spread = poly([0.03, 0.07, 0.05, 0.06, 0.04])  # a seed-to-seed spread wider than binomial
+    assert spread.uncertainty == pytest.approx(np.std([0.03, 0.07, 0.05, 0.06, 0.04], ddof=1) * np.sqrt(1.2))
+    assert not poly([0.08] * 5).passed
 
 
 def test_cli_writes_a_jammed_packing_with_its_protocol(tmp_path):

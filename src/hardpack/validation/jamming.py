@@ -27,10 +27,14 @@ def _system(key) -> str | None:
     return "binary2d" if key == ("binary_1.4_equimolar", 2) else None
 
 
-def fraction_statistics(values, n_particles: int) -> tuple[float, float]:
+def fraction_statistics(values, n_particles: int, single_sample: bool = False) -> tuple[float, float]:
     """Mean of per-seed particle fractions and its uncertainty: the larger of the standard error
     over seeds and the binomial error of the pooled count (one packing of N particles still has
-    sqrt(f (1 - f) / N)). NaN values make the mean NaN (the row then fails).
+    sqrt(f (1 - f) / N)). For a published value from one packing (``single_sample``), the
+    uncertainty of its difference from our mean: the spread of one packing (the larger of the
+    standard deviation over seeds and the binomial sqrt(f (1 - f) / N)) times sqrt(1 + 1/n), as
+    :func:`hardpack.validation.rows.seed_statistics` does for other single-sample targets. NaN
+    values make the mean NaN (the row then fails).
 
     Parameters
     ----------
@@ -38,6 +42,8 @@ def fraction_statistics(values, n_particles: int) -> tuple[float, float]:
         Per-seed fractions.
     n_particles : int
         Particles per packing.
+    single_sample : bool, optional
+        The published value is one packing's.
 
     Returns
     -------
@@ -50,9 +56,12 @@ def fraction_statistics(values, n_particles: int) -> tuple[float, float]:
     mean = float(values.mean())
     if not math.isfinite(mean):
         return math.nan, math.nan
+    sd = values.std(ddof=1) if values.size > 1 else 0.0
+    if single_sample:
+        one = max(math.sqrt(max(mean * (1 - mean), 0.0) / n_particles), sd)
+        return mean, one * math.sqrt(1 + 1 / values.size)
     binomial = math.sqrt(max(mean * (1 - mean), 0.0) / (n_particles * values.size))
-    sem = values.std(ddof=1) / math.sqrt(values.size) if values.size > 1 else 0.0
-    return mean, max(binomial, sem)
+    return mean, max(binomial, sd / math.sqrt(values.size))
 
 
 def verdict_fraction(values) -> float:
@@ -148,9 +157,9 @@ def jamming_rows(summaries) -> list[Row]:
                 detail=f"{size}; the claim holds per packing, so the row takes the gap of largest magnitude; "
                        f"gaps per seed {', '.join(f'{g:g}' for g in gaps)}; backbone Z "
                        f"{', '.join(f'{z:.4f}' for z in s['z_mean'].values)}"))
-        f, unc = fraction_statistics(s["rattler_fraction"].values, n)
         for tid in (f"donev-ch9-rattlers-{system}", f"tj-t1-ls-rattlers-{system}"):
             if tid in targets:
+                f, unc = fraction_statistics(s["rattler_fraction"].values, n, targets[tid].single_sample)
                 out.append(evaluate(targets[tid], f, unc, n=n, seeds=seeds, label=label,
                                     detail=f"{size}; uncertainty: binomial or over seeds, the larger"))
         if f"donev-4.7.2-collective-{system}" in targets:

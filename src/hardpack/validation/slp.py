@@ -100,8 +100,9 @@ def mrj_jamming_rows(summaries) -> list[Row]:
         rattler_target = (f"tj-t1-slp-rattlers-d{d}" if key[0] == "monodisperse" else
                           "tj-sec5-poly2d-rattlers" if key == ("us_omega2", 2) else None)
         if rattler_target in targets:
-            f, unc = fraction_statistics(s["rattler_fraction"].values, n)
-            out.append(evaluate(targets[rattler_target], f, unc, n=n, seeds=seeds, label=label, detail=size))
+            target = targets[rattler_target]
+            f, unc = fraction_statistics(s["rattler_fraction"].values, n, target.single_sample)
+            out.append(evaluate(target, f, unc, n=n, seeds=seeds, label=label, detail=size))
         if key == ("monodisperse", 3):
             out.append(evaluate(targets["tj-sec6-slp-z-d3"], samples=s["z_mean"].values, n=n, label=label,
                                 detail=f"{size}; backbone (rattlers removed)"))
