@@ -102,7 +102,9 @@ def mrj_jamming_rows(summaries) -> list[Row]:
         if rattler_target in targets:
             target = targets[rattler_target]
             f, unc = fraction_statistics(s["rattler_fraction"].values, n, target.single_sample)
-            out.append(evaluate(target, f, unc, n=n, seeds=seeds, label=label, detail=size))
+            one = ("; the published value is one packing: uncertainty of one more packing, max(SD over seeds, "
+                   "binomial) x sqrt(1 + 1/seeds)" if target.single_sample else "")
+            out.append(evaluate(target, f, unc, n=n, seeds=seeds, label=label, detail=size + one))
         if key == ("monodisperse", 3):
             out.append(evaluate(targets["tj-sec6-slp-z-d3"], samples=s["z_mean"].values, n=n, label=label,
                                 detail=f"{size}; backbone (rattlers removed)"))
