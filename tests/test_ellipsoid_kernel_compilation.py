@@ -20,7 +20,8 @@ def _signatures(dispatcher) -> set[str]:
     """Every compiled signature of a kernel function: those in memory and those in its numba cache
     index (a function compiled inside another one that was loaded from the cache is not in memory;
     the index is that of the current source, numba drops it when the source changes)."""
-    cached = dispatcher._cache._cache_file._load_index()
+    index = getattr(dispatcher._cache, "_cache_file", None)  # none when numba's cache is off
+    cached = index._load_index() if index is not None else {}
     return {str(tuple(sig)) for sig in dispatcher.signatures} | {str(key[0]) for key in cached}
 
 
