@@ -116,7 +116,7 @@ from hardpack.events.heap import heap_set
 from hardpack.events.roots import contact_root, exit_root
 from hardpack.geometry.contact import pw_contact_into
 from hardpack.geometry.ellipsoid_container import farthest_point_body
-from hardpack.md._kernel import (  # noqa: F401  (its boundary modes are this kernel's too)
+from hardpack.md._kernel import (
     A_T,
     A_VIRIAL,
     FLAT_WALLS_MODE,

@@ -64,6 +64,25 @@ def fraction_statistics(values, n_particles: int, single_sample: bool = False) -
     return mean, max(binomial, sd / math.sqrt(values.size))
 
 
+def fraction_uncertainty_note(single_sample: bool) -> str:
+    """How :func:`fraction_statistics` made a row's uncertainty, for the row's detail.
+
+    Parameters
+    ----------
+    single_sample : bool
+        The published value is one packing's (the ``single_sample`` of the target).
+
+    Returns
+    -------
+    str
+        The explanation.
+    """
+    if single_sample:
+        return ("the published value is one packing: uncertainty of one more packing, max(SD over seeds, "
+                "binomial) x sqrt(1 + 1/seeds)")
+    return "uncertainty: binomial or over seeds, the larger"
+
+
 def verdict_fraction(values) -> float:
     """Fraction of seeds with a positive verdict (NaN when any verdict is missing).
 
@@ -159,9 +178,10 @@ def jamming_rows(summaries) -> list[Row]:
                        f"{', '.join(f'{z:.4f}' for z in s['z_mean'].values)}"))
         for tid in (f"donev-ch9-rattlers-{system}", f"tj-t1-ls-rattlers-{system}"):
             if tid in targets:
-                f, unc = fraction_statistics(s["rattler_fraction"].values, n, targets[tid].single_sample)
+                one = targets[tid].single_sample
+                f, unc = fraction_statistics(s["rattler_fraction"].values, n, one)
                 out.append(evaluate(targets[tid], f, unc, n=n, seeds=seeds, label=label,
-                                    detail=f"{size}; uncertainty: binomial or over seeds, the larger"))
+                                    detail=f"{size}; {fraction_uncertainty_note(one)}"))
         if f"donev-4.7.2-collective-{system}" in targets:
             out.append(evaluate(targets[f"donev-4.7.2-collective-{system}"],
                                 verdict_fraction(s["collective"].values), n=n, seeds=seeds, label=label,

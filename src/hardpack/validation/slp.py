@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from hardpack.jamming.result import Verdict
-from hardpack.validation.jamming import fraction_statistics, verdict_fraction, verdict_notes
+from hardpack.validation.jamming import (
+    fraction_statistics,
+    fraction_uncertainty_note,
+    verdict_fraction,
+    verdict_notes,
+)
 from hardpack.validation.packings import n_particles, system_key
 from hardpack.validation.rows import Row, evaluate
 from hardpack.validation.targets import load_targets
@@ -102,9 +107,8 @@ def mrj_jamming_rows(summaries) -> list[Row]:
         if rattler_target in targets:
             target = targets[rattler_target]
             f, unc = fraction_statistics(s["rattler_fraction"].values, n, target.single_sample)
-            one = ("; the published value is one packing: uncertainty of one more packing, max(SD over seeds, "
-                   "binomial) x sqrt(1 + 1/seeds)" if target.single_sample else "")
-            out.append(evaluate(target, f, unc, n=n, seeds=seeds, label=label, detail=size + one))
+            out.append(evaluate(target, f, unc, n=n, seeds=seeds, label=label,
+                                detail=f"{size}; {fraction_uncertainty_note(target.single_sample)}"))
         if key == ("monodisperse", 3):
             out.append(evaluate(targets["tj-sec6-slp-z-d3"], samples=s["z_mean"].values, n=n, label=label,
                                 detail=f"{size}; backbone (rattlers removed)"))
