@@ -140,6 +140,41 @@ def test_slurm_subset_covers_every_rule_with_the_cheapest_reruns(tmp_path):
     assert slurm_subset.rerun_cost("results/a/init/seed1.nc", *slurm_subset.local_jobs(metadata)) == 101.0
 
 
+def test_slurm_subset_covers_every_kind_of_job(tmp_path):
+    """With kinds (job groups, compute rules), each kind is covered once at the least cost: the
+    lattice (setup, 1 s) and the compression of seed 2 (compute, 10 s); no init, no slow
+    compression of seed 1, and not every rule."""
+    import base64
+    import json
+
+    sys.path.insert(0, str(ROOT / ".ci"))
+    try:
+        import slurm_subset
+    finally:
+        sys.path.pop(0)
+    kinds = slurm_subset.rule_kinds(ROOT / "workflow" / "rules")
+    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
+    assert set(kinds.values()) == set(profile["group-components"]) | {"shell"}
+    assert kinds["init"] == "setup" and kinds["compress"] == "shell" and kinds["validation"] == "validation"
+    jobs = {  # output: (rule, start, end, inputs)
+        "results/a/init/seed1.nc": ("init", 0.0, 1.0, []),
+        "results/a/init/seed2.nc": ("init", 0.0, 2.0, []),
+        "results/a/jammed/seed1.nc": ("compress", 2.0, 102.0, ["results/a/init/seed1.nc"]),
+        "results/a/jammed/seed2.nc": ("compress", 2.0, 12.0, ["results/a/init/seed2.nc"]),
+        "results/a/other.nc": ("lattice", 0.0, 1.0, []),
+    }
+    metadata = tmp_path / "metadata"
+    metadata.mkdir()
+    for output, (rule, start, end, inputs) in jobs.items():
+        record = metadata / base64.urlsafe_b64encode(output.encode()).decode()
+        record.write_text(json.dumps({"rule": rule, "starttime": start, "endtime": end, "input": inputs,
+                                      "job_hash": hash(output)}))
+    summary = tmp_path / "summary.tsv"
+    summary.write_text("output_file\tdate\trule\n" + "".join(f"{o}\t-\t{j[0]}\n" for o, j in jobs.items()))
+    picks = slurm_subset.one_output_per_rule(str(summary), metadata, kinds)
+    assert picks == {"setup": "results/a/other.nc", "shell": "results/a/jammed/seed2.nc"}
+
+
 def test_slurm_smoke_sizes_every_group_of_the_profile():
     """--group-components on the command line replaces the profile's whole mapping: the CI run
     must name every group of the profile, or the missing ones would run one job per cluster job."""
