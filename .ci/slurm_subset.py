@@ -41,7 +41,8 @@ def rule_kinds(rules_dir: Path = Path("workflow/rules")) -> dict[str, str]:
         for block in re.split(r"^(?=rule )", path.read_text(), flags=re.M)[1:]:
             name = re.match(r"rule (\w+):", block).group(1)
             group = re.search(r'^    group:\n        "(\w+)"', block, re.M)
-            kinds[name] = group.group(1) if group else ("script" if re.search(r"^    script:", block, re.M) else "shell")
+            script = re.search(r"^    script:", block, re.M)
+            kinds[name] = group.group(1) if group else ("script" if script else "shell")
     return kinds
 
 
