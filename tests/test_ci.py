@@ -107,10 +107,9 @@ def test_slurm_subset_deletes_one_output_per_rule_and_the_validation(tmp_path):
     assert (run / "results/a/init/seed2.nc").exists()
 
 
-def test_slurm_subset_covers_every_rule_with_the_cheapest_reruns(tmp_path):
-    """With Snakemake's records of the local run, deleting an output reruns its job and every job
-    downstream: the quick init whose compression is slow (101 s) loses to the slower init whose
-    compression is quick (12 s), and that one deletion covers both rules."""
+def _subset_records(tmp_path, jobs):
+    """.ci/slurm_subset.py as a module, and a `snakemake --summary` table and Snakemake records of
+    a local run of ``jobs`` ({output: (rule, start, end, inputs)}) in tmp_path."""
     import base64
     import json
 
@@ -119,12 +118,6 @@ def test_slurm_subset_covers_every_rule_with_the_cheapest_reruns(tmp_path):
         import slurm_subset
     finally:
         sys.path.pop(0)
-    jobs = {  # output: (rule, start, end, inputs)
-        "results/a/init/seed1.nc": ("init", 0.0, 1.0, []),
-        "results/a/init/seed2.nc": ("init", 0.0, 2.0, []),
-        "results/a/jammed/seed1.nc": ("compress", 2.0, 102.0, ["results/a/init/seed1.nc"]),
-        "results/a/jammed/seed2.nc": ("compress", 2.0, 12.0, ["results/a/init/seed2.nc"]),
-    }
     metadata = tmp_path / "metadata"
     metadata.mkdir()
     for output, (rule, start, end, inputs) in jobs.items():
@@ -133,7 +126,21 @@ def test_slurm_subset_covers_every_rule_with_the_cheapest_reruns(tmp_path):
                                       "job_hash": hash(output)}))
     summary = tmp_path / "summary.tsv"
     summary.write_text("output_file\tdate\trule\n" + "".join(f"{o}\t-\t{j[0]}\n" for o, j in jobs.items()))
-    picks = slurm_subset.one_output_per_rule(str(summary), metadata)
+    return slurm_subset, str(summary), metadata
+
+
+def test_slurm_subset_covers_every_rule_with_the_cheapest_reruns(tmp_path):
+    """With Snakemake's records of the local run, deleting an output reruns its job and every job
+    downstream: the quick init whose compression is slow (101 s) loses to the slower init whose
+    compression is quick (12 s), and that one deletion covers both rules."""
+    jobs = {  # output: (rule, start, end, inputs)
+        "results/a/init/seed1.nc": ("init", 0.0, 1.0, []),
+        "results/a/init/seed2.nc": ("init", 0.0, 2.0, []),
+        "results/a/jammed/seed1.nc": ("compress", 2.0, 102.0, ["results/a/init/seed1.nc"]),
+        "results/a/jammed/seed2.nc": ("compress", 2.0, 12.0, ["results/a/init/seed2.nc"]),
+    }
+    slurm_subset, summary, metadata = _subset_records(tmp_path, jobs)
+    picks = slurm_subset.one_output_per_rule(summary, metadata)
     assert set(picks.values()) == {"results/a/init/seed2.nc"}
     reruns = slurm_subset.rerun_jobs("results/a/init/seed2.nc", *slurm_subset.local_jobs(metadata)[::2])
     assert {job[0] for job in reruns} == {"init", "compress"}
@@ -144,18 +151,6 @@ def test_slurm_subset_covers_every_kind_of_job(tmp_path):
     """With kinds (job groups, compute rules), each kind is covered once at the least cost: the
     lattice (setup, 1 s) and the compression of seed 2 (compute, 10 s); no init, no slow
     compression of seed 1, and not every rule."""
-    import base64
-    import json
-
-    sys.path.insert(0, str(ROOT / ".ci"))
-    try:
-        import slurm_subset
-    finally:
-        sys.path.pop(0)
-    kinds = slurm_subset.rule_kinds(ROOT / "workflow" / "rules")
-    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
-    assert set(kinds.values()) == set(profile["group-components"]) | {"shell"}
-    assert kinds["init"] == "setup" and kinds["compress"] == "shell" and kinds["validation"] == "validation"
     jobs = {  # output: (rule, start, end, inputs)
         "results/a/init/seed1.nc": ("init", 0.0, 1.0, []),
         "results/a/init/seed2.nc": ("init", 0.0, 2.0, []),
@@ -163,15 +158,12 @@ def test_slurm_subset_covers_every_kind_of_job(tmp_path):
         "results/a/jammed/seed2.nc": ("compress", 2.0, 12.0, ["results/a/init/seed2.nc"]),
         "results/a/other.nc": ("lattice", 0.0, 1.0, []),
     }
-    metadata = tmp_path / "metadata"
-    metadata.mkdir()
-    for output, (rule, start, end, inputs) in jobs.items():
-        record = metadata / base64.urlsafe_b64encode(output.encode()).decode()
-        record.write_text(json.dumps({"rule": rule, "starttime": start, "endtime": end, "input": inputs,
-                                      "job_hash": hash(output)}))
-    summary = tmp_path / "summary.tsv"
-    summary.write_text("output_file\tdate\trule\n" + "".join(f"{o}\t-\t{j[0]}\n" for o, j in jobs.items()))
-    picks = slurm_subset.one_output_per_rule(str(summary), metadata, kinds)
+    slurm_subset, summary, metadata = _subset_records(tmp_path, jobs)
+    kinds = slurm_subset.rule_kinds(ROOT / "workflow" / "rules")
+    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
+    assert set(kinds.values()) == set(profile["group-components"]) | {"shell"}
+    assert kinds["init"] == "setup" and kinds["compress"] == "shell" and kinds["validation"] == "validation"
+    picks = slurm_subset.one_output_per_rule(summary, metadata, kinds)
     assert picks == {"setup": "results/a/other.nc", "shell": "results/a/jammed/seed2.nc"}
 
 
