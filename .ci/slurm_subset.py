@@ -91,7 +91,7 @@ def rerun_cost(output: str, job_of, seconds, readers) -> float:
     return sum(seconds[job] for job in jobs) if jobs else float("inf")
 
 
-def one_output_per_rule(summary_tsv: str, metadata_dir: Path = Path(".snakemake/metadata"),
+def one_output_per_kind(summary_tsv: str, metadata_dir: Path = Path(".snakemake/metadata"),
                         kinds: dict[str, str] | None = None) -> dict[str, str]:
     """Output files to delete so that a job of every kind of rule of a `snakemake --summary` table
     (tab-separated) runs again, at little cost: a greedy set cover over the recorded jobs (each
@@ -136,7 +136,7 @@ def one_output_per_rule(summary_tsv: str, metadata_dir: Path = Path(".snakemake/
 def main(summary_tsv: str, slurm_dir: str, metadata_dir: str = ".snakemake/metadata",
          rules_dir: str = "workflow/rules") -> None:
     root = Path(slurm_dir)
-    picks = one_output_per_rule(summary_tsv, Path(metadata_dir), rule_kinds(Path(rules_dir)))
+    picks = one_output_per_kind(summary_tsv, Path(metadata_dir), rule_kinds(Path(rules_dir)))
     shutil.rmtree(root / "results" / "validation", ignore_errors=True)
     for kind, output in sorted(picks.items()):
         path = root / output

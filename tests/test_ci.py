@@ -140,7 +140,7 @@ def test_slurm_subset_covers_every_rule_with_the_cheapest_reruns(tmp_path):
         "results/a/jammed/seed2.nc": ("compress", 2.0, 12.0, ["results/a/init/seed2.nc"]),
     }
     slurm_subset, summary, metadata = _subset_records(tmp_path, jobs)
-    picks = slurm_subset.one_output_per_rule(summary, metadata)
+    picks = slurm_subset.one_output_per_kind(summary, metadata)
     assert set(picks.values()) == {"results/a/init/seed2.nc"}
     reruns = slurm_subset.rerun_jobs("results/a/init/seed2.nc", *slurm_subset.local_jobs(metadata)[::2])
     assert {job[0] for job in reruns} == {"init", "compress"}
@@ -163,7 +163,7 @@ def test_slurm_subset_covers_every_kind_of_job(tmp_path):
     profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
     assert set(kinds.values()) == set(profile["group-components"]) | {"shell"}
     assert kinds["init"] == "setup" and kinds["compress"] == "shell" and kinds["validation"] == "validation"
-    picks = slurm_subset.one_output_per_rule(summary, metadata, kinds)
+    picks = slurm_subset.one_output_per_kind(summary, metadata, kinds)
     assert picks == {"setup": "results/a/other.nc", "shell": "results/a/jammed/seed2.nc"}
 
 
