@@ -1,17 +1,15 @@
 """CI helper: prepare a SLURM run of the smoke DAG in which every kind of job runs.
 
-The whole smoke DAG through SLURM costs about 6 s of Snakemake start-up per SLURM job on top of
-the work, which made CI too long, and so did one job of every rule (~600 s: the jobs downstream of
-the deleted files ran in eight generations of cluster jobs, each waiting on the executor's status
-checks, which back off while no job ends). Instead, the SLURM directory starts from a copy of the
-local run's results, from which this script deletes the validation outputs and outputs whose
-jobs, with the jobs downstream of them, cover every kind of job: each job group of the profile
-(setup, analyses, summaries, figures, validation: several tiny jobs in one cluster job) and the
-compute rules, run by a shell command or by a script, one cluster job each. It prints those files:
-named as targets beside `all`, they make Snakemake run those jobs under SLURM, plus the jobs
-downstream of the deleted files. The SLURM validation dataset is then rebuilt from SLURM outputs
-and local ones, and must equal the local dataset. (Every job's resources under the profile are
-evaluated by a dry run of the whole DAG, .ci/slurm-smoke.)
+Each SLURM job costs about 6 s of Snakemake start-up on top of its work, and each generation of
+cluster jobs waits on the executor's status checks, which back off while no job ends; so the SLURM
+directory starts from a copy of the local run's results, from which this script deletes the
+validation outputs and outputs whose jobs, with the jobs downstream of them, cover every kind of
+job: each job group of the profile (setup, analyses, summaries, figures, validation: several tiny
+jobs in one cluster job) and the compute rules, run by a shell command or by a script, one cluster
+job each. It prints those files: named as targets beside `all`, they make Snakemake run those jobs
+under SLURM, plus the jobs downstream of the deleted files. The SLURM validation dataset is then
+rebuilt from SLURM outputs and local ones, and must equal the local dataset. (Every job's resources
+under the profile are evaluated by a dry run of the whole DAG, .ci/slurm-smoke.)
 
 The deleted files are chosen so that the rerun costs little: deleting one output reruns its job
 and every job downstream of it, which covers their kinds too, so a greedy set cover over
