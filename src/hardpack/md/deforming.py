@@ -354,7 +354,8 @@ class DeformingSimulation:
         self.applied_pressure = applied_pressure
         self.cell_step = float(cell_step)
         self.overlap_tol = float(overlap_tol)
-        self.volume0 = abs(float(np.linalg.det(self.H)))
+        self._measured_cell = None
+        self.volume0 = self.volume
         self.capacity = 16
         self.bs = np.zeros((n, d + 1))
         self.nn = np.zeros(n, dtype=np.int64)
@@ -383,7 +384,21 @@ class DeformingSimulation:
 
     @property
     def volume(self) -> float:
-        return abs(float(np.linalg.det(self.H)))
+        return self._cell_measures()[1]
+
+    def _inverse(self) -> np.ndarray:
+        """H^-1 of the current cell."""
+        return self._cell_measures()[0]
+
+    def _cell_measures(self) -> tuple[np.ndarray, float]:
+        """(H^-1, |det H|) of the current cell, computed once per cell: H is replaced by a new
+        array when the cell changes, never changed in place (nor are the arrays returned), so the
+        identity of H keys them. A window asked for H^-1 up to seven times (10 % of a one-spheroid
+        crystal search, measured)."""
+        if self._measured_cell is not self.H:
+            self._measured_cell = self.H
+            self._measures = (np.linalg.inv(self.H), abs(float(np.linalg.det(self.H))))
+        return self._measures
 
     def phi(self) -> float:
         """Volume fraction V_d(1) sum_i a_i^d / V of the current radii in the current cell.
@@ -398,14 +413,14 @@ class DeformingSimulation:
     def packing(self) -> Packing:
         """The current configuration, centres wrapped into the current cell."""
         X = self.X.copy()
-        dk.wrap_into_cell(X, self.H, np.linalg.inv(self.H))
+        dk.wrap_into_cell(X, self.H, self._inverse())
         return Packing(X, self.A.copy(), self.H.copy(), species=self.species, overlap_tol=self.overlap_tol)
 
     def _reduce_cell(self) -> None:
         reduced, u = lll_reduce(self.H)
         if not np.array_equal(u, np.eye(self.d, dtype=u.dtype)):
             self.H = reduced
-        dk.wrap_into_cell(self.X, self.H, np.linalg.inv(self.H))
+        dk.wrap_into_cell(self.X, self.H, self._inverse())
 
     def relative_rates(self) -> np.ndarray:
         """kappa_i = (da_i/dt) / a_i of the next window (:mod:`hardpack.md._deforming_kernel`): all
@@ -519,7 +534,7 @@ class DeformingSimulation:
         all particles synchronised at its end; fills ``kin`` and ``vir``; returns (duration,
         collisions, bounding-sphere exits, time integral of the kinetic energy)."""
         n = self.n
-        Hinv = np.linalg.inv(self.H)
+        Hinv = self._inverse()
         lmin = shortest_vector(self.H)
         amax = float(self.A.max())
         skin = np.full(n, min(self.shell * float(self.A.mean()), 0.45 * (lmin - 2.0 * amax)))
@@ -552,7 +567,7 @@ class DeformingSimulation:
         particle's own images with sigma its diameter)."""
         amax = float(self.A.max())
         reach = 2.0 * SELF_CONTACT * 2.0 * amax
-        _, gmin = dk.strain_limit(self.X, self.A, self.H, np.linalg.inv(self.H), np.zeros((self.d, self.d)),
+        _, gmin = dk.strain_limit(self.X, self.A, self.H, self._inverse(), np.zeros((self.d, self.d)),
                                   reach, 2.0 * amax, *cell_grid(self.H, reach, self.n))
         return gmin
 
@@ -645,7 +660,7 @@ class DeformingSimulation:
         e = self.strain(sigma, z)
         if not np.any(e):
             return 0.0, 1.0
-        Hinv = np.linalg.inv(self.H)
+        Hinv = self._inverse()
         self_sigma = SELF_CONTACT * 2.0 * float(self.A.max())
         reach = 2.0 * max(self_sigma, 2.0 * float(self.A.max()))
         s, _ = dk.strain_limit(self.X, self.A, self.H, Hinv, e, reach, self_sigma, *cell_grid(self.H, reach, self.n))
@@ -656,8 +671,8 @@ class DeformingSimulation:
             f = self._cell_map(s, e, H0)
             self.H = f @ H0
             self.X = np.array(X0 @ f.T)
-            dk.wrap_into_cell(self.X, self.H, np.linalg.inv(self.H))
-            _, gmin = dk.strain_limit(self.X, self.A, self.H, np.linalg.inv(self.H),
+            dk.wrap_into_cell(self.X, self.H, self._inverse())
+            _, gmin = dk.strain_limit(self.X, self.A, self.H, self._inverse(),
                                       np.zeros((d, d)), reach, self_sigma, *cell_grid(self.H, reach, self.n))
             if gmin >= 0.0:
                 return float(s * np.linalg.norm(e)), float(s)
@@ -731,8 +746,8 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         """:func:`cell_grid` of the current cell, made once per cell: the window's events and the
         pair searches after it share it (any grid gives the same lists and pairs; ``width``, the
         first asked for in the cell, only sets how many candidates are tested)."""
-        if self._grid is None or not np.array_equal(self._grid[0], self.H):
-            self._grid = (self.H.copy(), *cell_grid(self.H, width, self.n))
+        if self._grid is None or not (self._grid[0] is self.H or np.array_equal(self._grid[0], self.H)):
+            self._grid = (self.H, *cell_grid(self.H, width, self.n))
         return self._grid[1], self._grid[2]
 
     def mean_diameter(self) -> float:
@@ -782,7 +797,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         """The current configuration, centres wrapped into the current cell (not checked for
         overlaps: callers check it with :meth:`Packing.overlap_report`)."""
         P = self.P.copy()
-        dk.wrap_into_cell(P, self.H, np.linalg.inv(self.H))
+        dk.wrap_into_cell(P, self.H, self._inverse())
         cor, cw = self._column(4), self._column(5)
         o = P[:, cor:cw]
         shape = Ellipsoids(self.semiaxes.copy(), o[:, 0].copy() if self.d == 2 else o.copy())
@@ -793,7 +808,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         reduced, u = lll_reduce(self.H)
         if not np.array_equal(u, np.eye(self.d, dtype=u.dtype)):
             self.H = reduced
-        dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
+        dk.wrap_into_cell(self.P, self.H, self._inverse())
 
     def relative_rates(self) -> np.ndarray:
         """kappa = Gamma / (2 <(prod a)^(1/d)>) for every particle (:mod:`hardpack.md.ellipsoid`)."""
@@ -805,7 +820,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         kinetic tensor integral K_end t - sum t_c Delta K and the symmetric part of the virial
         tensor into ``kin`` and ``vir``."""
         n, d = self.n, self.d
-        Hinv = np.linalg.inv(self.H)
+        Hinv = self._inverse()
         rb = self.P[:, self._column(2)]
         rmax = float(rb.max())
         skin = np.full(n, self.shell * float(rb.mean()))
@@ -854,7 +869,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
 
     def _pairs(self, scale: float):
         width = 2.0 * scale * float(self.P[:, self._column(2)].max())
-        return edk.near_pairs(self.P, self.H, np.linalg.inv(self.H), scale, *self._cell_grid(width))
+        return edk.near_pairs(self.P, self.H, self._inverse(), scale, *self._cell_grid(width))
 
     def _smallest_gap(self) -> float:
         """Smallest mu - 1 (Perram-Wertheim, relative) of the pairs at the window end."""
@@ -902,7 +917,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
             mu1, _ = edk.pair_scales(self.P, H1, *pairs, e)
             if np.all(np.where(mu0 > 1.0, mu1 - 1.0 >= 0.5 * (mu0 - 1.0), mu1 >= mu0)):
                 self.H = H1
-                dk.wrap_into_cell(self.P, self.H, np.linalg.inv(self.H))
+                dk.wrap_into_cell(self.P, self.H, self._inverse())
                 return float(s * np.linalg.norm(e)), float(s)
             self.P[:] = P0
             s *= 0.5
