@@ -14,22 +14,14 @@
   a billiard in a simplex).
 """
 
-from hardpack.freeenergy.bcmd import BCMDResult, run_bcmd
-from hardpack.freeenergy.billiard import volume_estimate
-from hardpack.freeenergy.isostatic import simplex_reference, simplex_test
-from hardpack.freeenergy.simplex import (
-    JammingSimplex,
-    jamming_simplex,
-    log_simplex_volume,
-)
+from hardpack._lazy import lazy_exports
 
-__all__ = [
-    "BCMDResult",
-    "JammingSimplex",
-    "jamming_simplex",
-    "log_simplex_volume",
-    "run_bcmd",
-    "simplex_reference",
-    "simplex_test",
-    "volume_estimate",
-]
+#: the public names and their modules, imported on first access (:mod:`hardpack._lazy`)
+_EXPORTS = {
+    "bcmd": ("BCMDResult", "run_bcmd"),
+    "billiard": ("volume_estimate",),
+    "isostatic": ("simplex_reference", "simplex_test"),
+    "simplex": ("JammingSimplex", "jamming_simplex", "log_simplex_volume"),
+}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__ = sorted(name for names in _EXPORTS.values() for name in names)

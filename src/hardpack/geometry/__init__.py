@@ -1,11 +1,12 @@
 """Geometry: the packing model (particle shapes, boundaries), d-ball volumes, the neighbour layer
 (:mod:`.neighbours`) and crystal lattices.
 
-The neighbour layer is imported on first use (``PairList``, ``pairs_within``): it compiles numba
-kernels, and a job that only reads or writes packings (``hardpack combine``, the figures) need not
-import numba at all (0.45 s of each such job's start-up, measured).
+The neighbour layer is imported on first use (``PairList``, ``pairs_within``; :mod:`hardpack._lazy`):
+it loads numba kernels, which a job that only reads datasets (``hardpack combine``, most figures)
+never calls (0.45 s of each such job's start-up, measured).
 """
 
+from hardpack._lazy import lazy_exports
 from hardpack.geometry.balls import ball_volume, unit_ball_volume
 from hardpack.geometry.boundaries import (
     ContainmentReport,
@@ -23,13 +24,4 @@ __all__ = [
     "ball_volume", "unit_ball_volume", "lattice_packing",
 ]
 
-#: names of the neighbour layer, imported from :mod:`hardpack.geometry.neighbours` on first access
-_NEIGHBOUR_NAMES = ("PairList", "pairs_within")
-
-
-def __getattr__(name: str):
-    if name in _NEIGHBOUR_NAMES:
-        from hardpack.geometry import neighbours
-
-        return getattr(neighbours, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__, __dir__ = lazy_exports(__name__, {"neighbours": ("PairList", "pairs_within")})

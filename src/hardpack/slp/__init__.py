@@ -1,9 +1,13 @@
 """Sequential linear programming (adaptive shrinking cell) packings, Torquato & Jiao (2010)."""
 
-from hardpack.slp.diluted import DilutedRound, diluted_summary, run_diluted
-from hardpack.slp.driver import SLPResult, run_slp
-from hardpack.slp.lp import Bounds, solve_step
-from hardpack.slp.ordermap import order_map_summary
+from hardpack._lazy import lazy_exports
 
-__all__ = ["Bounds", "DilutedRound", "SLPResult", "diluted_summary", "order_map_summary", "run_diluted",
-           "run_slp", "solve_step"]
+#: the public names and their modules, imported on first access (:mod:`hardpack._lazy`)
+_EXPORTS = {
+    "diluted": ("DilutedRound", "diluted_summary", "run_diluted"),
+    "driver": ("SLPResult", "run_slp"),
+    "lp": ("Bounds", "solve_step"),
+    "ordermap": ("order_map_summary",),
+}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__ = sorted(name for names in _EXPORTS.values() for name in names)
