@@ -3,12 +3,15 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from hardpack.cli import main
 from hardpack.io import load_dataset, load_packing
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_init_info_combine(tmp_path, capsys):
@@ -164,6 +167,29 @@ def test_reading_datasets_does_not_import_numba(tmp_path):
     code = "import sys; from hardpack.geometry import pairs_within; print(callable(pairs_within), 'numba' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["True", "True"]
+
+
+def test_the_console_script_tunes_the_collector_and_main_leaves_it_alone(tmp_path):
+    """A job process collects its young generation every GC_THRESHOLD allocations and freezes its
+    objects at the end (hardpack.cli.console_main); main(), which tests call in their own
+    process, changes neither. The installed `hardpack` script is console_main."""
+    import gc
+    import tomllib
+
+    from hardpack import cli
+
+    before = gc.get_threshold()
+    assert main(["-q", "init", "--n", "4", "--d", "2", "--phi", "0.1", "--seed", "1", "--out", str(tmp_path / "a.nc")]) == 0
+    assert gc.get_threshold() == before and gc.get_freeze_count() == 0
+    code = ("import atexit, gc, sys; from hardpack.cli import console_main; "
+            "atexit.register(lambda: print(gc.get_threshold()[0], gc.get_freeze_count() > 0)); "
+            f"sys.argv = ['hardpack', '-q', 'init', '--n', '4', '--d', '2', '--phi', '0.1', '--seed', '1', '--out', "
+            f"{str(tmp_path / 'b.nc')!r}]; console_main()")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == [str(cli.GC_THRESHOLD), "True"]
+    scripts = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]
+    assert scripts["hardpack"] == "hardpack.cli:console_main"
 
 
 def test_help_and_unknown_commands_still_list_every_command():

@@ -7,6 +7,7 @@ through a ``register(subparsers)`` function in ``hardpack.<subpackage>.cli``.
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import logging
 import os
@@ -450,5 +451,27 @@ def main(argv=None) -> int:
     return run_command(args)
 
 
+#: generation-0 threshold of the garbage collector in a ``hardpack`` process (Python's default 700)
+GC_THRESHOLD = 100_000
+
+
+def console_main() -> None:
+    """The ``hardpack`` console script: :func:`main` in a process of its own (a pipeline job).
+
+    Imports and numba's first dispatch leave ~1.5e5 long-lived objects, which Python's collector,
+    at its default thresholds, traverses again and again while they are made, and once more at
+    exit. So a process collects its young generation every GC_THRESHOLD allocations instead of
+    700 (reference cycles are still freed: at most that many objects wait), and freezes every
+    object once the command has finished (:func:`gc.freeze`), so that the interpreter's clean-up
+    does not traverse them; the command's files are written and closed by then. A
+    ``hardpack init`` of 64 spheres: 2.9 -> 1.9 s (measured). :func:`main` itself, which tests
+    and other programs call in their own process, leaves the collector alone.
+    """
+    gc.set_threshold(GC_THRESHOLD, *gc.get_threshold()[1:])
+    status = main()
+    gc.freeze()
+    sys.exit(status)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    console_main()
