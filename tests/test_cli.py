@@ -171,12 +171,13 @@ def test_reading_datasets_does_not_import_numba(tmp_path):
 
 def test_the_console_script_tunes_the_collector_and_main_leaves_it_alone(tmp_path):
     """A job process collects its young generation every GC_THRESHOLD allocations and freezes its
-    objects at the end (hardpack.cli.console_main); main(), which tests call in their own
-    process, changes neither. The installed `hardpack` script is console_main."""
+    objects at exit (hardpack.process.job_process, run by hardpack.cli.console_main); main(),
+    which tests call in their own process, changes neither. The installed `hardpack` script is
+    console_main."""
     import gc
     import tomllib
 
-    from hardpack import cli
+    from hardpack.process import GC_THRESHOLD
 
     before = gc.get_threshold()
     assert main(["-q", "init", "--n", "4", "--d", "2", "--phi", "0.1", "--seed", "1", "--out", str(tmp_path / "a.nc")]) == 0
@@ -187,9 +188,18 @@ def test_the_console_script_tunes_the_collector_and_main_leaves_it_alone(tmp_pat
             f"{str(tmp_path / 'b.nc')!r}]; console_main()")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.split() == [str(cli.GC_THRESHOLD), "True"]
+    assert out.stdout.split() == [str(GC_THRESHOLD), "True"]
     scripts = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]
     assert scripts["hardpack"] == "hardpack.cli:console_main"
+
+
+def test_every_workflow_script_sets_up_its_job_process():
+    """The Snakemake scripts are job processes too (hardpack.process.job_process: their log file
+    and the collector of a process that ends after one job)."""
+    scripts = sorted((ROOT / "workflow" / "scripts").glob("*.py"))
+    assert len(scripts) > 30
+    for script in scripts:
+        assert "job_process(snakemake.log[0])" in script.read_text(), script.name
 
 
 def test_help_and_unknown_commands_still_list_every_command():

@@ -7,7 +7,6 @@ through a ``register(subparsers)`` function in ``hardpack.<subpackage>.cli``.
 from __future__ import annotations
 
 import argparse
-import gc
 import json
 import logging
 import os
@@ -17,6 +16,7 @@ import numpy as np
 
 from hardpack import __version__
 from hardpack.errors import InvalidInputError
+from hardpack.process import job_process
 
 #: the subcommands registered by this module itself (no other module is imported for them)
 CORE_SUBCOMMANDS = ("init", "lattice", "laminate", "info", "combine")
@@ -451,26 +451,14 @@ def main(argv=None) -> int:
     return run_command(args)
 
 
-#: generation-0 threshold of the garbage collector in a ``hardpack`` process (Python's default 700)
-GC_THRESHOLD = 100_000
-
-
 def console_main() -> None:
-    """The ``hardpack`` console script: :func:`main` in a process of its own (a pipeline job).
-
-    Imports and numba's first dispatch leave ~1.5e5 long-lived objects, which Python's collector,
-    at its default thresholds, traverses again and again while they are made, and once more at
-    exit. So a process collects its young generation every GC_THRESHOLD allocations instead of
-    700 (reference cycles are still freed: at most that many objects wait), and freezes every
-    object once the command has finished (:func:`gc.freeze`), so that the interpreter's clean-up
-    does not traverse them; the command's files are written and closed by then. A
-    ``hardpack init`` of 64 spheres: 2.9 -> 1.9 s (measured). :func:`main` itself, which tests
-    and other programs call in their own process, leaves the collector alone.
+    """The ``hardpack`` console script: :func:`main` in a process of its own (a pipeline job),
+    set up by :func:`hardpack.process.job_process` (the garbage collector tuned for a process that
+    ends after one command). :func:`main` itself, which tests and other programs call in their
+    own process, leaves the collector alone.
     """
-    gc.set_threshold(GC_THRESHOLD, *gc.get_threshold()[1:])
-    status = main()
-    gc.freeze()
-    sys.exit(status)
+    job_process()
+    sys.exit(main())
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ import math
 
 from hardpack.io import load_dataset, write_dataset
 from hardpack.io.store import dataset_to_packing
+from hardpack.process import job_process
 from hardpack.structure.containers import (
     core_density,
     ellipsoid_radial_density_profile,
@@ -14,7 +15,7 @@ from hardpack.structure.containers import (
     radial_density_profile,
 )
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 jammed = load_dataset(snakemake.input[0])
 packing = dataset_to_packing(jammed)
 a, radius = length_unit(packing), packing.boundary.radius

@@ -4,9 +4,10 @@ periodic packings of the same protocol."""
 import logging
 
 from hardpack.io import load_dataset, write_dataset
+from hardpack.process import job_process
 from hardpack.structure.containers import container_summary
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 ds = container_summary([load_dataset(path) for path in snakemake.input.profiles], fit_min_n=snakemake.params.fit_min_n,
                        bulk=[load_dataset(path) for path in snakemake.input.bulk])
 write_dataset(ds, snakemake.output[0])

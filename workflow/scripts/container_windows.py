@@ -4,9 +4,10 @@
 import logging
 
 from hardpack.io import load_packing, write_dataset
+from hardpack.process import job_process
 from hardpack.structure.containers import window_study
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 p = snakemake.params
 ds = window_study([load_packing(path) for path in snakemake.input], n_radii=p.n_radii,
                   min_diameter=p.min_diameter, n_windows=p.n_windows, seed=p.seed)

@@ -5,8 +5,9 @@ import logging
 from hardpack.geometry.ellipsoid_stats import ellipsoid_contacts, nematic_order
 from hardpack.io import load_dataset, write_dataset
 from hardpack.io.store import dataset_to_packing
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 jammed = load_dataset(snakemake.input[0])
 packing = dataset_to_packing(jammed)
 contacts = ellipsoid_contacts(packing, tol=snakemake.params.tol)

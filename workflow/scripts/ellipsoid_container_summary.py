@@ -6,9 +6,10 @@ config (``shape_name``, which the validation rows read)."""
 import logging
 
 from hardpack.io import load_dataset, load_packing, write_dataset
+from hardpack.process import job_process
 from hardpack.structure.containers import ellipsoid_container_summary
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 paths = list(snakemake.input.packings)
 attrs = [load_dataset(p).attrs for p in paths]
 ds = ellipsoid_container_summary([load_packing(p) for p in paths], [int(a["seed"]) for a in attrs],

@@ -4,8 +4,9 @@ import logging
 
 from hardpack.io import load_dataset, write_dataset
 from hardpack.jamming.ellipsoid_verdicts import verdict_fractions
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 fractions = verdict_fractions(load_dataset(snakemake.input[0]))
 write_dataset(fractions, snakemake.output[0])
 logging.info("%s:\n%s", snakemake.output[0], fractions.to_dataframe().to_string())

@@ -1,8 +1,6 @@
 """Snakemake script: a figure of the container study (params.kind: profile, ellipsoid_profile,
 extrapolation, windows)."""
 
-import logging
-
 from hardpack.io import load_dataset
 from hardpack.plots.containers import (
     plot_ellipsoid_radial_profiles,
@@ -11,8 +9,9 @@ from hardpack.plots.containers import (
     plot_window_fluctuations,
 )
 from hardpack.plots.style import save
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 kind = snakemake.params.kind
 datasets = [load_dataset(path) for path in snakemake.input]
 if kind == "profile":

@@ -6,8 +6,9 @@ from hardpack.glass.microsegregated import grid_maps
 from hardpack.io import load_dataset
 from hardpack.plots.glass import plot_microsegregated_maps
 from hardpack.plots.style import save
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 maps = grid_maps(load_dataset(snakemake.input[0], kind="microsegregated_summary"), snakemake.params.R,
                  snakemake.params.nu)
 logging.info("%d of %d grid cells missing; off the grid: %s", maps.attrs["missing_cells"],

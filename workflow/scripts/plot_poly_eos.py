@@ -5,8 +5,9 @@ import logging
 from hardpack.io import load_dataset
 from hardpack.plots.eos import plot_eos_vs_bmcsl
 from hardpack.plots.style import save
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 save(plot_eos_vs_bmcsl(load_dataset(snakemake.input[0], kind="eos_fluid_summary")), snakemake.output.pdf,
      snakemake.output.png)
 logging.info("wrote %s", snakemake.output.pdf)

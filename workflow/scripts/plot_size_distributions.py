@@ -6,8 +6,9 @@ from hardpack.distributions import from_spec
 from hardpack.io import load_dataset
 from hardpack.plots.distributions import plot_size_distributions
 from hardpack.plots.style import save
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 samples = {}
 for path in snakemake.input:
     ds = load_dataset(path, kind="ensemble")

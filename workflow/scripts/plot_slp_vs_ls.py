@@ -3,13 +3,12 @@
 SLP and LS summaries are paired by their ``ensemble`` attribute; an SLP system without an LS
 ensemble of its name is drawn alone."""
 
-import logging
-
 from hardpack.io import load_dataset
 from hardpack.plots.slp import plot_slp_vs_ls
 from hardpack.plots.style import save
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 ls = {ds.attrs["ensemble"]: ds for ds in (load_dataset(p, kind="ensemble") for p in snakemake.input.ls)}
 pairs = {}
 for path in snakemake.input.slp:

@@ -1,14 +1,14 @@
 """Snakemake script: one structure figure (snakemake.params.kind) over the ensembles' seeds, grouped
 by the structure datasets' ``ensemble`` attribute."""
 
-import logging
 from collections import defaultdict
 
 from hardpack.io import load_dataset
 from hardpack.plots import structure
 from hardpack.plots.style import save
+from hardpack.process import job_process
 
-logging.basicConfig(filename=snakemake.log[0], level=logging.INFO)
+job_process(snakemake.log[0])
 ensembles = defaultdict(list)
 for path in snakemake.input:
     ds = load_dataset(path, kind="structure")
