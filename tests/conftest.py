@@ -8,10 +8,16 @@
   points (overlapping spheres of radii ``radii``) in a periodic cube of side ``length``.
 - ``jammed_disks``: the 64-disk bidisperse packing jammed to exact contacts, read from
   ``tests/data`` (how it was made: ``test_jamming_support.make_jammed_disks``).
+- ``no_slurm_controller`` (automatic): the Snakemake runs of the tests see a ``scontrol`` that
+  fails at once. The SLURM executor plugin asks ``scontrol show config`` for its defaults when
+  Snakemake starts, and on a host where SLURM is installed but no controller runs, that call waits
+  ~9 s (10 s timeout) in each of the tests' Snakemake runs; the plugin's answer without SLURM is
+  its defaults, which is what the tests expect.
 """
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -22,6 +28,18 @@ from hardpack.distributions import monodisperse
 from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
 from hardpack.io import save_packing
+
+
+@pytest.fixture(scope="session", autouse=True)
+def no_slurm_controller(tmp_path_factory):
+    stub_dir = tmp_path_factory.mktemp("no-slurm")
+    stub = stub_dir / "scontrol"
+    stub.write_text("#!/bin/sh\necho 'scontrol: no SLURM controller in the tests' >&2\nexit 1\n")
+    stub.chmod(0o755)
+    saved = os.environ.get("PATH", "")
+    os.environ["PATH"] = f"{stub_dir}{os.pathsep}{saved}"
+    yield stub
+    os.environ["PATH"] = saved
 
 
 @pytest.fixture(scope="session")
