@@ -115,3 +115,29 @@ def test_diluted_rows_take_the_least_dense_strictly_jammed_packing():
     rows = _statuses(diluted_rows(_diluted([0.602], [0.5952], [6.31], [1], n=500)))
     assert rows.pop("tj-sec6-diluted-strict") == PASS
     assert set(rows.values()) == {NA}
+
+
+BINARY = {"kind": "bidisperse", "size_ratio": 1.4, "large_fraction": 0.5}
+
+
+@pytest.mark.parametrize(("phi", "n", "status"), [
+    (0.849, 1000, PASS),
+    (0.842, 100, PASS),
+    (0.842, 1000, FAIL),  # Table 4.2's N = 100 value is not the N = 1000 one
+    (0.840, 1000, FAIL),  # the single "0.84" the row used before would have passed it
+])
+def test_binary_disk_row_takes_table_4_2_at_its_own_n(phi, n, status):
+    """Donev 2006, Table 4.2: one LS packing of equimolar binary disks (diameter ratio 1.4) per N,
+    phi = 0.842 at N = 100 and 0.849 at N = 1000 (printed digits)."""
+    (row,) = ls_rows([_summary(phi, n, 2, BINARY)])
+    assert row.target == f"donev-t4.2-phi-n{n}"
+    assert row.status == status
+
+
+def test_collective_jamming_rows_cite_the_section_on_disordered_packings():
+    """Donev 2006, Sec. 4.7.2 reports the LP tests of disordered LS packings; Sec. 4.5 (cited
+    before) is about transition states and paths."""
+    targets = load_targets()
+    for tid in ("donev-4.7.2-collective-d3", "donev-4.7.2-collective-binary2d"):
+        assert targets[tid].citation.startswith("Donev 2006, Sec. 4.7.2")
+    assert not any("Sec. 4.5" in t.citation or "sec. 4.5" in t.citation for t in targets.values())
