@@ -37,10 +37,15 @@ def timed(command: list[str], env: dict[str, str]) -> tuple[float, float]:
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+def init_command(workdir: Path, seed: int) -> list[str]:
+    """``hardpack init`` of 64 spheres (RSA at phi = 0.2) into ``workdir/seed<seed>.nc``."""
+    return [sys.executable, "-m", "hardpack.cli", "-q", "init", "--n", "64", "--d", "3", "--phi", "0.2",
+            "--seed", str(seed), "--out", str(workdir / f"seed{seed}.nc")]
+
+
 def ladder(workdir: Path) -> list[tuple[str, list[str]]]:
     """The commands timed, each one layer above the previous."""
     py = sys.executable
-    init = [py, "-m", "hardpack.cli", "-q", "init", "--n", "64", "--d", "3", "--phi", "0.2"]
     seeds = [workdir / f"seed{s}.nc" for s in (1, 2)]
     return [
         ("python (interpreter)", [py, "-c", "pass"]),
@@ -51,8 +56,7 @@ def ladder(workdir: Path) -> list[tuple[str, list[str]]]:
         ("hardpack combine (2 files, no numba)",
          [py, "-m", "hardpack.cli", "-q", "combine", *map(str, seeds), "--index", "seed",
           "--out", str(workdir / "combined.nc")]),
-        ("hardpack init (RSA, N = 64: numba's first dispatch)",
-         [*init, "--seed", "3", "--out", str(workdir / "seed3.nc")]),
+        ("hardpack init (RSA, N = 64: numba's first dispatch)", init_command(workdir, 3)),
     ]
 
 
@@ -64,9 +68,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         workdir = Path(tmp)
         for seed in (1, 2):  # the inputs of the combine
-            subprocess.run([sys.executable, "-m", "hardpack.cli", "-q", "init", "--n", "64", "--d", "3",
-                            "--phi", "0.2", "--seed", str(seed), "--out", str(workdir / f"seed{seed}.nc")],
-                           env=env, check=True)
+            subprocess.run(init_command(workdir, seed), env=env, check=True)
         print(f"job start-up, {args.runs} runs per command (medians), {os.cpu_count()} CPUs, "
               f"load average {os.getloadavg()[0]:.1f}")
         print("| command | wall s | CPU s |")
