@@ -8,8 +8,11 @@ and rattler fractions up to ~2.5 % in 3D and ~5 % in 2D (sec. 5.2). The free-vol
 pressure p = d / (1 - phi/phi_J) (Eq. 5.24, "verified numerically for disordered isostatic hard
 sphere packings") ties the jamming gap of the force network to the MD pressure.
 
-Protocol: 250 particles, RSA, LS growth at Gamma = 1e-2 to a reduced pressure of 1e3, then
-Gamma = 1e-4 to 1e12 (hardpack.md.compress). Faster final rates leave larger packings
+Protocol (:func:`make_ls_packing`): 250 particles, RSA, LS growth at Gamma = 1e-2 to a reduced
+pressure of 1e3, then Gamma = 1e-4 to 1e12 (hardpack.md.compress). The two packings (86 million
+collisions for the spheres, about 90 s of LS) are stored in tests/data with their MD pressure and
+the call that made them: these tests check the verifier on LS packings, and the LS engine's own
+packings are checked by tests/test_md_protocol.py and the smoke DAG's jamming rows. Faster final rates leave larger packings
 incompletely jammed (at N = 500-1000 and Gamma = 3e-4 the delta = 1e-6 network is 2 contacts
 short of isostatic), as Donev's Table 4.5 shows for few collisions per particle. At N = 250
 the 3D rattler fraction scatters by about +-1 % between seeds (1.2-3.2 % seen). Tolerance delta = 1e-6: contact gaps are ~1e-12 at that pressure,
@@ -18,32 +21,44 @@ the next neighbours ~1e-5 and beyond.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from hardpack import md
-from hardpack.distributions import bidisperse, monodisperse
 from hardpack.initial import random_packing
+from hardpack.io import dataset_to_packing, load_dataset
 from hardpack.jamming import verify
 
 pytestmark = pytest.mark.slow
 
+DATA = Path(__file__).parent / "data"
 
-def _ls(n, d, distribution, seed):
+
+def make_ls_packing(n, d, distribution, seed):
+    """The protocol of the module docstring: (packing, reduced MD pressure). It wrote the stored
+    packings (their ``protocol`` attribute names the call), with ``md_pressure`` the second value."""
     start = random_packing(n, d, distribution, 0.3 if d == 3 else 0.5, seed=seed)
     fast = md.compress(start, 1e-2, seed, md.StopCriteria(max_pressure=1e3))
     slow = md.compress(fast.packing, 1e-4, seed + 1, md.StopCriteria(max_pressure=1e12))
     return slow.packing, slow.stats["Z"]  # hardpack.md calls the reduced pressure Z
 
 
+def _stored(name):
+    ds = load_dataset(DATA / f"{name}.nc")
+    assert "make_ls_packing(250" in ds.attrs["protocol"]
+    return dataset_to_packing(ds), float(ds.attrs["md_pressure"])
+
+
 @pytest.fixture(scope="module")
 def spheres():
-    return _ls(250, 3, monodisperse(), seed=1)
+    return _stored("ls_spheres_n250_seed1_p1e12")
 
 
 @pytest.fixture(scope="module")
 def disks():
-    return _ls(250, 2, bidisperse(1.4, 0.5), seed=1)
+    return _stored("ls_binary_disks_n250_seed1_p1e12")
 
 
 def _common_checks(r, d):
