@@ -64,12 +64,14 @@ def test_cli_search_with_one_spheroid_per_cell(tmp_path):
     from hardpack.io import load_dataset
 
     out = tmp_path / "search.nc"
-    assert main(["crystal-search", "--alpha", str(SQRT3), "--n", "1", "--seeds", "0", "1", "2", "3",
+    assert main(["crystal-search", "--alpha", str(SQRT3), "--n", "1", "--seeds", "0", "1",
                  "--out", str(out)]) == 0
     ds = load_dataset(out)
-    assert ds["phi"].shape == (1, 4)
-    # some seeds reach the densest lattice packing, others jam their cell early (three of four
-    # reached it, measured); none beats it
+    assert ds["phi"].shape == (1, 2)
+    # a seed may jam its cell early (which one depends on the host's last bits; both reached the
+    # densest lattice packing here): the claim over four seeds is
+    # tests/test_md_deforming_ellipsoids.py::test_one_spheroid_per_cell_ends_at_the_densest_lattice_packing,
+    # the same runs; none beats it
     assert float(ds["phi"].max()) == pytest.approx(np.pi / np.sqrt(18.0), abs=2e-5)
     assert (ds["phi"] < np.pi / np.sqrt(18.0) + 1e-7).all()
     assert not ds["laminate"].values.any()
