@@ -1,7 +1,9 @@
-"""Structure of a small jammed 3D packing (slow: one Lubachevsky-Stillinger compression).
+"""Structure of a small jammed 3D packing (one Lubachevsky-Stillinger compression, stored).
 
 N = 2000 monodisperse spheres from RSA at phi = 0.3, compressed with hardpack.md at the fast
-rate Gamma = 1e-2 to reduced pressure 1e10 (about 15 s; phi ~ 0.645, amorphous). Published
+rate Gamma = 1e-2 to reduced pressure 1e10 (:func:`make_jammed`, about 8 s; phi ~ 0.645,
+amorphous), stored in tests/data with the call that made it: these tests check the structure
+analyses, not the compression. Published
 targets (Donev 2006, secs. 9.3.1.2 and 9.3.1.3, Figs. 9.6-9.7; sec. 10.3, Fig. 10.2):
 - backbone (rattlers removed) Z(l) - Z_c ~ 11 l^0.6: alpha within the printed digits (+-0.05)
   plus twice the fit's standard error, the validation row's rule (measured: 0.544 +- 0.012);
@@ -15,11 +17,14 @@ Rattlers: the contact-count rule (< d + 1 contacts within a relative gap 1e-6, i
 hardpack.jamming.remove_rattlers.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from hardpack.distributions import monodisperse
 from hardpack.initial import random_packing
+from hardpack.io import load_packing
 from hardpack.structure import (
     cumulative_coordination,
     extrapolate_s0,
@@ -28,20 +33,27 @@ from hardpack.structure import (
     structure_factor,
 )
 
-pytestmark = pytest.mark.slow
-
 
 def carnahan_starling_s0(phi):
     return (1 - phi) ** 4 / (1 + 4 * phi + 4 * phi**2 - 4 * phi**3 + phi**4)
 
 
-@pytest.fixture(scope="module")
-def jammed():
-    from hardpack.jamming import contact_network, remove_rattlers
+JAMMED = Path(__file__).parent / "data" / "ls_spheres_n2000_seed7_p1e10.nc"
+
+
+def make_jammed():
+    """The packing of the module docstring (it wrote JAMMED)."""
     from hardpack.md.compress import StopCriteria, compress
 
     start = random_packing(2000, 3, monodisperse(), 0.3, seed=7)
-    packing = compress(start, 1e-2, 7, StopCriteria(max_pressure=1e10)).packing
+    return compress(start, 1e-2, 7, StopCriteria(max_pressure=1e10)).packing
+
+
+@pytest.fixture(scope="module")
+def jammed():
+    from hardpack.jamming import contact_network, remove_rattlers
+
+    packing = load_packing(JAMMED)
     net = contact_network(packing, 1e-6)
     active, _ = remove_rattlers(net, np.ones(packing.n_particles, bool), dr_large=0.1, box=1.0,
                                 rng=np.random.default_rng(0), use_lp=False)
