@@ -31,7 +31,6 @@ from hardpack.initial import random_packing
 from hardpack.io import dataset_to_packing, load_dataset
 from hardpack.jamming import verify
 
-
 DATA = Path(__file__).parent / "data"
 
 
