@@ -39,10 +39,12 @@ def test_laminate_reference_is_donevs_densest_crystal():
 
 @pytest.mark.slow
 def test_four_spheroids_per_cell_find_the_laminate():
-    # a claim over seeds (which seed finds what depends on the host's last bits): none is denser
-    # than the laminate, and at least one run finds its contact network (14 on every particle)
-    # at Donev's phi ~ 0.7707 for the search, to its printed digits (measured on seeds 0-3: two
-    # at 0.770720 and 0.770700 with 14 contacts, two at 0.74045 with 12, the affine FCC)
+    # a claim over seeds (which seed finds what depends on the host's last bits): one of seeds
+    # 0-3 finds the laminate's contact network (14 on every particle) at Donev's phi ~ 0.7707 for
+    # the search, to its printed digits, and no run before it is denser than the laminate
+    # (measured on seeds 0-3: two at 0.770720 and 0.770700 with 14 contacts, two at 0.74045 with
+    # 12, the affine FCC). The seeds stop at the first that finds it: the best of all four is the
+    # smoke DAG's (the same runs, validation rows donev-8.2-search-*)
     found = 0
     for seed in range(4):
         run = search_run(4, SQRT3, seed)
@@ -56,6 +58,8 @@ def test_four_spheroids_per_cell_find_the_laminate():
             assert run["phi_polished"] == pytest.approx(0.770732, abs=5e-7)
             assert run["min_contacts_polished"] == run["max_contacts_polished"] == 14
         assert run["phi"] - 1e-9 < run["phi_polished"] < 0.770732 + 1e-6
+        if found:
+            break
     assert found >= 1
 
 
