@@ -107,7 +107,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
-from hardpack.geometry.neighbours.grid import MAX_CELLS_PER_PARTICLE, c_strides, cell_counts, perpendicular_widths
+from hardpack.geometry.neighbours.grid import MAX_CELLS_PER_PARTICLE, perpendicular_widths
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
 from hardpack.geometry.shapes import Ellipsoids
@@ -179,7 +179,7 @@ def cell_window(growth_rate: float, d: int, cell_step: float = CELL_STEP) -> flo
     return float(min(window, max(1.0, CELL_LAG * cell_step / abs(growth_rate))))
 
 
-def shortest_vector(lattice: np.ndarray) -> float:
+def shortest_vector(lattice: np.ndarray, heights: np.ndarray | None = None) -> float:
     """Length of the shortest non-zero lattice vector |H n| (exhaustive over the n that can beat
     the shortest basis vector: |n_k| <= l / h_k).
 
@@ -187,6 +187,9 @@ def shortest_vector(lattice: np.ndarray) -> float:
     ----------
     lattice : numpy.ndarray of float, shape (d, d)
         The cell H, lattice vectors as columns.
+    heights : numpy.ndarray of float, shape (d,), optional
+        The cell's perpendicular widths h_k (:func:`hardpack.geometry.neighbours.grid.perpendicular_widths`),
+        if known.
 
     Returns
     -------
@@ -194,7 +197,8 @@ def shortest_vector(lattice: np.ndarray) -> float:
         min over integer n != 0 of |H n|.
     """
     best = float(np.linalg.norm(lattice, axis=0).min())
-    heights = 1.0 / np.linalg.norm(np.linalg.inv(lattice), axis=1)
+    if heights is None:
+        heights = perpendicular_widths(lattice)
     ranges = [range(-int(best / h), int(best / h) + 1) for h in heights]
     ns = np.array(list(itertools.product(*ranges)), dtype=float)
     ns = ns[np.any(ns != 0, axis=1)]
@@ -203,10 +207,13 @@ def shortest_vector(lattice: np.ndarray) -> float:
     return best
 
 
-def cell_grid(lattice: np.ndarray, width: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+def cell_grid(lattice: np.ndarray, width: float, n: int,
+              heights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The single-level cell grid of the deforming-cell kernels' pair searches: cells at least
-    ``width`` wide along every lattice direction (at most MAX_CELLS_PER_PARTICLE per particle,
-    :func:`hardpack.geometry.neighbours.cell_counts`).
+    ``width`` wide along every lattice direction (at most MAX_CELLS_PER_PARTICLE per particle),
+    the one level of :func:`hardpack.geometry.neighbours.cell_counts` and
+    :func:`hardpack.geometry.neighbours.c_strides` (the same counts, in scalar arithmetic: a run
+    asks for a few grids per window, and the array calls cost more than the window's Python).
 
     Parameters
     ----------
@@ -216,14 +223,27 @@ def cell_grid(lattice: np.ndarray, width: float, n: int) -> tuple[np.ndarray, np
         Smallest cell width (the largest pair reach searched).
     n : int
         Number of particles.
+    heights : numpy.ndarray of float, shape (d,), optional
+        The cell's perpendicular widths (:func:`hardpack.geometry.neighbours.grid.perpendicular_widths`),
+        if known.
 
     Returns
     -------
     n_cells, strides : numpy.ndarray of int64, shape (1, d)
         Cells per lattice direction and their flat-index strides.
     """
-    n_cells = cell_counts(perpendicular_widths(lattice), [width], [n], MAX_CELLS_PER_PARTICLE)
-    return n_cells, c_strides(n_cells)
+    if heights is None:
+        heights = perpendicular_widths(lattice)
+    d = len(heights)
+    counts = [max(math.floor(float(h) / width), 1) for h in heights]
+    excess = math.prod(float(c) for c in counts) / (MAX_CELLS_PER_PARTICLE * n)
+    if excess > 1.0:
+        root = excess ** (1.0 / d)
+        counts = [max(math.floor(c / root), 1) for c in counts]
+    strides = [1] * d
+    for a in range(d - 2, -1, -1):
+        strides[a] = strides[a + 1] * counts[a + 1]
+    return np.array([counts], dtype=np.int64), np.array([strides], dtype=np.int64)
 
 
 def check_cell_options(applied_pressure, cell_step) -> None:
@@ -390,15 +410,25 @@ class DeformingSimulation:
         """H^-1 of the current cell."""
         return self._cell_measures()[0]
 
-    def _cell_measures(self) -> tuple[np.ndarray, float]:
-        """(H^-1, |det H|) of the current cell, computed once per cell: H is replaced by a new
-        array when the cell changes, never changed in place (nor are the arrays returned), so the
-        identity of H keys them. A window asked for H^-1 up to seven times (10 % of a one-spheroid
-        crystal search, measured)."""
+    def _cell_measures(self) -> tuple[np.ndarray, float, np.ndarray, dict]:
+        """(H^-1, |det H|, perpendicular widths, grids by width) of the current cell, computed
+        once per cell: H is replaced by a new array when the cell changes, never changed in place
+        (nor are the arrays returned), so the identity of H keys them. A window asked for H^-1 up
+        to seven times (10 % of a one-spheroid crystal search, measured), and a sphere window for
+        four grids, two of them the same."""
         if self._measured_cell is not self.H:
             self._measured_cell = self.H
-            self._measures = (np.linalg.inv(self.H), abs(float(np.linalg.det(self.H))))
+            inverse = np.linalg.inv(self.H)
+            self._measures = (inverse, abs(float(np.linalg.det(self.H))),
+                              1.0 / np.linalg.norm(inverse, axis=1), {})
         return self._measures
+
+    def _search_grid(self, width: float) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`cell_grid` of the current cell for cells at least ``width`` wide."""
+        _, _, heights, grids = self._cell_measures()
+        if width not in grids:
+            grids[width] = cell_grid(self.H, width, self.n, heights)
+        return grids[width]
 
     def phi(self) -> float:
         """Volume fraction V_d(1) sum_i a_i^d / V of the current radii in the current cell.
@@ -535,13 +565,13 @@ class DeformingSimulation:
         collisions, bounding-sphere exits, time integral of the kinetic energy)."""
         n = self.n
         Hinv = self._inverse()
-        lmin = shortest_vector(self.H)
+        lmin = shortest_vector(self.H, self._cell_measures()[2])
         amax = float(self.A.max())
         skin = np.full(n, min(self.shell * float(self.A.mean()), 0.45 * (lmin - 2.0 * amax)))
         M = dk.image_ranges(self.H, lmin)
         img = dk.image_table(self.H, M)
         cfac = np.linalg.norm(Hinv, axis=1)
-        n_cells, cstr = cell_grid(self.H, 2.0 * (amax + float(skin.max())), n)
+        n_cells, cstr = self._search_grid(2.0 * (amax + float(skin.max())))
         saved = (self.X.copy(), self.V.copy())
         while True:
             nb = np.zeros((n, self.capacity), dtype=np.int64)
@@ -568,7 +598,7 @@ class DeformingSimulation:
         amax = float(self.A.max())
         reach = 2.0 * SELF_CONTACT * 2.0 * amax
         _, gmin = dk.strain_limit(self.X, self.A, self.H, self._inverse(), np.zeros((self.d, self.d)),
-                                  reach, 2.0 * amax, *cell_grid(self.H, reach, self.n))
+                                  reach, 2.0 * amax, *self._search_grid(reach))
         return gmin
 
     def _rescale(self) -> None:
@@ -663,7 +693,7 @@ class DeformingSimulation:
         Hinv = self._inverse()
         self_sigma = SELF_CONTACT * 2.0 * float(self.A.max())
         reach = 2.0 * max(self_sigma, 2.0 * float(self.A.max()))
-        s, _ = dk.strain_limit(self.X, self.A, self.H, Hinv, e, reach, self_sigma, *cell_grid(self.H, reach, self.n))
+        s, _ = dk.strain_limit(self.X, self.A, self.H, Hinv, e, reach, self_sigma, *self._search_grid(reach))
         H0, X0 = self.H.copy(), self.X.copy()
         for _ in range(MAX_HALVINGS + 1):
             if s <= 0.0:
@@ -673,7 +703,7 @@ class DeformingSimulation:
             self.X = np.array(X0 @ f.T)
             dk.wrap_into_cell(self.X, self.H, self._inverse())
             _, gmin = dk.strain_limit(self.X, self.A, self.H, self._inverse(),
-                                      np.zeros((d, d)), reach, self_sigma, *cell_grid(self.H, reach, self.n))
+                                      np.zeros((d, d)), reach, self_sigma, *self._search_grid(reach))
             if gmin >= 0.0:
                 return float(s * np.linalg.norm(e)), float(s)
             s *= 0.5
@@ -747,7 +777,7 @@ class EllipsoidDeformingSimulation(DeformingSimulation):
         pair searches after it share it (any grid gives the same lists and pairs; ``width``, the
         first asked for in the cell, only sets how many candidates are tested)."""
         if self._grid is None or not (self._grid[0] is self.H or np.array_equal(self._grid[0], self.H)):
-            self._grid = (self.H, *cell_grid(self.H, width, self.n))
+            self._grid = (self.H, *cell_grid(self.H, width, self.n, self._cell_measures()[2]))
         return self._grid[1], self._grid[2]
 
     def mean_diameter(self) -> float:
