@@ -166,22 +166,21 @@ def rotation_basis(semiaxes: np.ndarray, shape_inv: np.ndarray) -> list[np.ndarr
         rotations (0 for a sphere or circle, 2 for a spheroid, k otherwise).
     """
     d = semiaxes.shape[1]
-    out = []
-    for axes, inv in zip(semiaxes, shape_inv):
-        s = np.sort(axes)
-        close = np.isclose(s[1:], s[:-1], rtol=SYMMETRY_RTOL, atol=0.0)
-        if d == 2:
-            out.append(np.zeros((1, 0)) if close[0] else np.ones((1, 1)))
-            continue
-        if close.all():
-            out.append(np.zeros((3, 0)))
-        elif not close.any():
-            out.append(np.eye(3))
-        else:
-            w, vecs = np.linalg.eigh(inv)  # eigenvalues a_k^2, ascending
-            axis = vecs[:, 2] if close[0] else vecs[:, 0]  # the distinct semiaxis
-            q, _ = np.linalg.qr(np.column_stack([axis, np.eye(3)]))
-            out.append(q[:, 1:3])
+    s = np.sort(semiaxes, axis=1)
+    close = np.isclose(s[:, 1:], s[:, :-1], rtol=SYMMETRY_RTOL, atol=0.0)
+    if d == 2:
+        return [np.zeros((1, 0)) if c else np.ones((1, 1)) for c in close[:, 0]]
+    out = [np.zeros((3, 0)) if c.all() else np.eye(3) for c in close]
+    # spheroids: the rotations about the two axes normal to the distinct semiaxis, all at once
+    # (the same LAPACK calls per particle as one at a time)
+    spheroids = np.flatnonzero(close.any(axis=1) & ~close.all(axis=1))
+    if spheroids.size:
+        _, vecs = np.linalg.eigh(shape_inv[spheroids])  # eigenvalues a_k^2, ascending
+        axis = np.where(close[spheroids, 0][:, None], vecs[:, :, 2], vecs[:, :, 0])  # the distinct semiaxis
+        q, _ = np.linalg.qr(np.concatenate([axis[:, :, None], np.broadcast_to(np.eye(3), (spheroids.size, 3, 3))],
+                                           axis=2))
+        for k, p in enumerate(spheroids):
+            out[p] = q[k, :, 1:3]
     return out
 
 
