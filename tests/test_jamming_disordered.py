@@ -10,13 +10,14 @@ sphere packings") ties the jamming gap of the force network to the MD pressure.
 
 Protocol (:func:`make_ls_packing`): 250 particles, RSA, LS growth at Gamma = 1e-2 to a reduced
 pressure of 1e3, then Gamma = 1e-4 to 1e12 (hardpack.md.compress). The two packings (86 million
-collisions for the spheres, about 90 s of LS) are stored in tests/data with their MD pressure and
-the call that made them: these tests check the verifier on LS packings, and the LS engine's own
-packings are checked by tests/test_md_protocol.py and the smoke DAG's jamming rows. Faster final rates leave larger packings
-incompletely jammed (at N = 500-1000 and Gamma = 3e-4 the delta = 1e-6 network is 2 contacts
-short of isostatic), as Donev's Table 4.5 shows for few collisions per particle. At N = 250
-the 3D rattler fraction scatters by about +-1 % between seeds (1.2-3.2 % seen). Tolerance delta = 1e-6: contact gaps are ~1e-12 at that pressure,
-the next neighbours ~1e-5 and beyond.
+collisions for the spheres, about 90 s of LS) are stored in tests/data with their MD pressure
+and the call that made them: these tests check the verifier on LS packings, and the LS engine's
+own packings are checked by tests/test_md_protocol.py, tests/test_jamming_md_forces.py and the
+smoke DAG's jamming rows. Faster final rates leave larger packings incompletely jammed (at
+N = 500-1000 and Gamma = 3e-4 the delta = 1e-6 network is 2 contacts short of isostatic), as
+Donev's Table 4.5 shows for few collisions per particle. At N = 250 the 3D rattler fraction
+scatters by about +-1 % between seeds (1.2-3.2 % seen). Tolerance delta = 1e-6: contact gaps are
+~1e-12 at that pressure, the next neighbours ~1e-5 and beyond.
 """
 
 from __future__ import annotations

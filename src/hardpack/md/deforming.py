@@ -212,8 +212,9 @@ def cell_grid(lattice: np.ndarray, width: float, n: int,
     """The single-level cell grid of the deforming-cell kernels' pair searches: cells at least
     ``width`` wide along every lattice direction (at most MAX_CELLS_PER_PARTICLE per particle),
     the one level of :func:`hardpack.geometry.neighbours.cell_counts` and
-    :func:`hardpack.geometry.neighbours.c_strides` (the same counts, in scalar arithmetic: a run
-    asks for a few grids per window, and the array calls cost more than the window's Python).
+    :func:`hardpack.geometry.neighbours.c_strides` (the same counts in scalar arithmetic: a run
+    asks for several grids per window, and numpy calls on arrays of d elements cost more than
+    the arithmetic).
 
     Parameters
     ----------
