@@ -24,12 +24,12 @@ def test_readme_has_exactly_two_setup_commands():
     assert commands[1] == 'python -m pip install -e ".[test]" && python -m pytest'
 
 
-
 def test_readme_says_how_to_go_on_after_a_killed_run():
     """A killed Snakemake leaves its lock on the working directory: the README names the way out."""
     text = " ".join((ROOT / "README.md").read_text().split())
     after_kill = text.split("After a killed run", 1)[1].split("- **", 1)[0]
     assert "snakemake --unlock" in after_kill and "--rerun-incomplete" in after_kill
+
 
 def test_ci_runs_the_readme_test_command_and_stops_if_its_install_fails(tmp_path):
     script = (ROOT / ".ci" / "run").read_text()

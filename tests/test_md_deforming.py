@@ -26,11 +26,11 @@ from hardpack.distributions import monodisperse
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
 from hardpack.geometry.lattices import lattice_packing
-from hardpack.geometry.neighbours.grid import MAX_CELLS_PER_PARTICLE, c_strides, cell_counts, perpendicular_widths
+from hardpack.geometry.neighbours.grid import perpendicular_widths
 from hardpack.geometry.packing import Packing
 from hardpack.initial import random_packing
 from hardpack.md import StopCriteria, compress
-from hardpack.md.deforming import cell_grid, compress_deforming, shortest_vector
+from hardpack.md.deforming import compress_deforming, shortest_vector
 
 
 def _block_mean(x, n_blocks=10):
@@ -53,23 +53,6 @@ def test_shortest_vector_of_a_sheared_basis():
     assert shortest_vector(np.array([[3.0, 0.0], [0.0, 2.0]])) == pytest.approx(2.0)
     sheared = np.array([[1.0, 5.0], [0.0, 1.0]])
     assert shortest_vector(sheared, perpendicular_widths(sheared)) == shortest_vector(sheared)
-
-
-@pytest.mark.parametrize("d", [2, 3, 4])
-def test_cell_grid_is_the_single_level_of_the_static_grid(d):
-    """The deforming cell's scalar grid against the array functions of the static grids, on
-    random sheared cells, widths from a tenth of a cell to more than the cell, and particle
-    counts that do and do not coarsen the grid."""
-    rng = np.random.default_rng(d)
-    for _ in range(200):
-        lattice = np.eye(d) * rng.uniform(1.0, 10.0, d) + np.triu(rng.uniform(-3.0, 3.0, (d, d)), 1)
-        width = float(rng.uniform(0.1, 12.0))
-        n = int(rng.integers(1, 500))
-        n_cells, strides = cell_grid(lattice, width, n)
-        expected = cell_counts(perpendicular_widths(lattice), [width], [n], MAX_CELLS_PER_PARTICLE)
-        np.testing.assert_array_equal(n_cells, expected)
-        np.testing.assert_array_equal(strides, c_strides(expected))
-        assert n_cells.dtype == strides.dtype == np.int64
 
 
 @pytest.mark.slow

@@ -107,7 +107,7 @@ import xarray as xr
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.balls import unit_ball_volume
-from hardpack.geometry.neighbours.grid import MAX_CELLS_PER_PARTICLE, perpendicular_widths
+from hardpack.geometry.neighbours.grid import MAX_CELLS_PER_PARTICLE, c_strides, cell_counts, perpendicular_widths
 from hardpack.geometry.packing import DEFAULT_OVERLAP_TOL, Packing
 from hardpack.geometry.reduction import lll_reduce
 from hardpack.geometry.shapes import Ellipsoids
@@ -210,11 +210,8 @@ def shortest_vector(lattice: np.ndarray, heights: np.ndarray | None = None) -> f
 def cell_grid(lattice: np.ndarray, width: float, n: int,
               heights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The single-level cell grid of the deforming-cell kernels' pair searches: cells at least
-    ``width`` wide along every lattice direction (at most MAX_CELLS_PER_PARTICLE per particle),
-    the one level of :func:`hardpack.geometry.neighbours.cell_counts` and
-    :func:`hardpack.geometry.neighbours.c_strides` (the same counts in scalar arithmetic: a run
-    asks for several grids per window, and numpy calls on arrays of d elements cost more than
-    the arithmetic).
+    ``width`` wide along every lattice direction (at most MAX_CELLS_PER_PARTICLE per particle,
+    :func:`hardpack.geometry.neighbours.cell_counts`).
 
     Parameters
     ----------
@@ -235,16 +232,8 @@ def cell_grid(lattice: np.ndarray, width: float, n: int,
     """
     if heights is None:
         heights = perpendicular_widths(lattice)
-    d = len(heights)
-    counts = [max(math.floor(float(h) / width), 1) for h in heights]
-    excess = math.prod(float(c) for c in counts) / (MAX_CELLS_PER_PARTICLE * n)
-    if excess > 1.0:
-        root = excess ** (1.0 / d)
-        counts = [max(math.floor(c / root), 1) for c in counts]
-    strides = [1] * d
-    for a in range(d - 2, -1, -1):
-        strides[a] = strides[a + 1] * counts[a + 1]
-    return np.array([counts], dtype=np.int64), np.array([strides], dtype=np.int64)
+    n_cells = cell_counts(heights, [width], [n], MAX_CELLS_PER_PARTICLE)
+    return n_cells, c_strides(n_cells)
 
 
 def check_cell_options(applied_pressure, cell_step) -> None:
