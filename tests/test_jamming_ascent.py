@@ -21,6 +21,7 @@ from hardpack.geometry.boundaries import SphericalContainer
 from hardpack.geometry.neighbours.pairs import wrapped_positions
 from hardpack.geometry.packing import Packing
 from hardpack.geometry.shapes import Ellipsoids
+from hardpack.jamming import ascent as ascent_module
 from hardpack.jamming.ascent import ASCENT_SHRINK, ASCENT_STEPS, ascend, confirm_unjamming
 from hardpack.jamming.ellipsoids import ellipsoid_contacts
 from hardpack.jamming.refine import displaced
@@ -40,14 +41,24 @@ def _no_overlap(packing):
     return near.n_contacts == 0 or near.zeta.min() >= 0.0
 
 
+@pytest.fixture(params=["highs-ds", "highs-ipm"])
+def lp_method(request, monkeypatch):
+    """Each exact case with both LP methods of the ascent: the dual simplex of small packings and
+    the interior-point method of large ones (``ascent.IPM_ABOVE`` lowered below the trap's N)."""
+    if request.param == "highs-ipm":
+        monkeypatch.setattr(ascent_module, "IPM_ABOVE", 0)
+    return request.param
+
+
 @pytest.mark.parametrize("theta", [0.005, -0.01])
-def test_gain_of_an_unjamming_rotation_is_the_second_order_prediction(theta):
+def test_gain_of_an_unjamming_rotation_is_the_second_order_prediction(theta, lp_method):
     params, point = _y_axis_trap(0.5)
     packing = trap(params)
     res = verify_ellipsoids(packing, frozen=FROZEN, local=False)
     c = res.collective
     assert res.verdict == Verdict.NOT_JAMMED and res.order == "second" and c.lambda_min < 0
     out = ascend(_turned_about(packing, point, theta), frozen=FROZEN, radius=abs(theta))
+    assert out.lp_method == lp_method
     total = abs(theta) * (1.0 + (1.0 - ASCENT_SHRINK**ASCENT_STEPS) / (1.0 - ASCENT_SHRINK))
     rate = 2.0 / res.network.scale[res.contacts_used]
     ds = -c.lambda_min * total**2 * (1.0 + point @ point) / (2.0 * c.forces @ rate)
@@ -58,18 +69,19 @@ def test_gain_of_an_unjamming_rotation_is_the_second_order_prediction(theta):
 
 
 @pytest.mark.parametrize("theta", [0.01, -0.01, 0.04])
-def test_a_second_order_jammed_trap_does_not_grow(theta):
+def test_a_second_order_jammed_trap_does_not_grow(theta, lp_method):
     """Fig. 5.5: the rotation about I closes the contacts at second order; ascents end at the
     jamming point's density within the ascent's last radius squared."""
     params, point = _x_axis_trap(0.3)
     packing = trap(params)
     assert verify_ellipsoids(packing, frozen=FROZEN).verdict == Verdict.JAMMED
     out = ascend(_turned_about(packing, point, theta), frozen=FROZEN, radius=abs(theta))
+    assert out.lp_method == lp_method
     assert (out.phi - packing.phi) / packing.phi < 1e-9
     assert _no_overlap(out.packing)
 
 
-def test_confirm_unjamming_certifies_the_flexible_trap_and_refuses_a_jammed_one():
+def test_confirm_unjamming_certifies_the_flexible_trap_and_refuses_a_jammed_one(lp_method):
     params, _ = _y_axis_trap(0.5)
     packing = trap(params)
     res = verify_ellipsoids(packing, frozen=FROZEN, local=False)

@@ -145,14 +145,16 @@ def test_newton_reaches_the_jamming_point_after_the_size_ascent(monkeypatch):
     assert 0 < out.params["ascent_phi_change"] < 1e-6
     assert out.params["refine_note"].startswith("Newton from the packing as given failed")
     assert (out.verdict, out.order) == (Verdict.JAMMED, "second") and out.isostaticity_gap < 0
-    # above ASCENT_MAX_PARTICLES the retry is skipped, and the note says so
-    monkeypatch.setattr(refine_module, "ASCENT_MAX_PARTICLES", 50)
-    large = verify_at_jamming_point(packing, delta="gaps")
+    assert "LPs by highs-ds" in out.params["refine_note"]  # N = 100: the dual simplex (ascent.IPM_ABOVE)
+    # above ascent_max_particles the retry is skipped, and the note says so
+    large = verify_at_jamming_point(packing, delta="gaps", ascent_max_particles=50)
     assert large.verdict == Verdict.UNDETERMINED and large.params["ascended"] == 0
     assert "no retry after the size ascent above N = 50" in large.params["refine_note"]
-    # a solver failure inside the ascent leaves the first verdict, with a note, not a crash
-    monkeypatch.setattr(refine_module, "ASCENT_MAX_PARTICLES", 400)
+    for bad in (-1, 1.5, True, "400"):
+        with pytest.raises(InvalidInputError, match="ascent_max_particles"):
+            verify_at_jamming_point(packing, delta="gaps", ascent_max_particles=bad)
 
+    # a solver failure inside the ascent leaves the first verdict, with a note, not a crash
     def failing(*args, **kwargs):
         raise LPFailure("HiGHS returned status 4: numerical trouble")
 
@@ -194,6 +196,11 @@ def test_cli_refine(tmp_path, capsys):
     save_packing(lattice_packing("fcc", (2, 2, 2)), spheres)
     assert main(["verify", str(spheres), "--out", str(tmp_path / "v.nc"), "--refine"]) != 0
     assert "--refine is for ellipse and ellipsoid packings" in capsys.readouterr().err
+    assert main(["verify", str(spheres), "--out", str(tmp_path / "v.nc"), "--ascent-max-particles", "10"]) != 0
+    assert "--ascent-max-particles is for ellipse and ellipsoid packings" in capsys.readouterr().err
+    assert main(["verify", str(DATA / "mm_n80_seed2_slow_p1e12.nc"), "--out", str(tmp_path / "v.nc"),
+                 "--delta", "gaps", "--ascent-max-particles", "10"]) != 0
+    assert "--ascent-max-particles applies with --refine only" in capsys.readouterr().err
 
 
 def test_newton_step_is_solved_to_round_off():

@@ -66,7 +66,7 @@ from hardpack.jamming.highs import LPFailure, solve_lp
 from hardpack.jamming.rigidity import strain_pairs
 from hardpack.jamming.second_order import dof_basis
 
-__all__ = ["Ascent", "Unjamming", "ascend", "confirm_unjamming", "CONFIRM_AMPLITUDES"]
+__all__ = ["Ascent", "Unjamming", "ascend", "confirm_unjamming", "lp_method", "CONFIRM_AMPLITUDES", "IPM_ABOVE"]
 
 #: pairs with mu - 1 up to this enter each LP (a step moves particles by at most r a << this)
 CANDIDATE_DELTA = 2e-2
@@ -82,6 +82,16 @@ CONFIRM_AMPLITUDES = (0.03, 0.01, 0.1)
 #: a relative density gain above this certifies an unjamming (the Perram-Wertheim factors that
 #: decide "no overlap" are exact to ~1e-14)
 CERTIFICATE_GAIN = 1e-10
+#: above this many particles the LPs are solved by HiGHS's interior-point method (with crossover
+#: to a vertex) instead of its dual simplex. The LPs are highly degenerate: at N = 640 (a 2 x 2 x 2
+#: tiling of an N = 80 M&M packing, 3201 variables, 3376 rows) the dual simplex took 21828
+#: iterations and 53 CPU-s for the first LP (the primal simplex 35 s, with or without the dense
+#: growth column split into blocks), the interior-point method 3-10 s per LP and 384 CPU-s for
+#: 40 steps. Warm-starting the dual simplex from the previous step's basis took 2-47 s per LP
+#: (0-5800 iterations), no faster. Below, the dual simplex stays: its vertices are those the
+#: tests of :mod:`hardpack.jamming.refine` were measured with (an interior-point vertex left the
+#: retry of the prolate alpha = 1.02 test packing unconverged).
+IPM_ABOVE = 400
 
 
 @dataclass
@@ -105,6 +115,9 @@ class Ascent:
     repairs : int
         Steps whose LP was infeasible, a numerical fallback: the previous step left overlaps that
         the trust radius could not undo, and a uniform shrink by the smallest mu removed them.
+    lp_method : str
+        The HiGHS method tried first for every LP: "highs-ds" (dual simplex) up to IPM_ABOVE
+        particles, "highs-ipm" (interior point with crossover) above.
     """
 
     packing: Packing
@@ -114,6 +127,7 @@ class Ascent:
     steps: int
     rounds: int = 1
     repairs: int = 0
+    lp_method: str = "highs-ds"
 
 
 @dataclass
@@ -244,7 +258,23 @@ def ascend(packing: Packing, *, frozen=None, deform: bool = False, radius: float
         if current.phi - start.phi <= ROUND_GAIN * start.phi:
             break
     return Ascent(packing=current, phi_start=float(packing.phi), phi=float(current.phi), mu_min=mu,
-                  steps=steps * done, rounds=done, repairs=repairs)
+                  steps=steps * done, rounds=done, repairs=repairs, lp_method=lp_method(packing.n_particles))
+
+
+def lp_method(n_particles: int) -> str:
+    """The HiGHS method :func:`ascend` tries first for the LPs of ``n_particles`` particles.
+
+    Parameters
+    ----------
+    n_particles : int
+        Particles of the packing.
+
+    Returns
+    -------
+    str
+        "highs-ds" up to IPM_ABOVE particles, "highs-ipm" above (measured costs at IPM_ABOVE).
+    """
+    return "highs-ipm" if n_particles > IPM_ABOVE else "highs-ds"
 
 
 def _round(packing: Packing, moving: np.ndarray, deform: bool, radius: float, steps: int, shrink: float):
@@ -267,7 +297,8 @@ def _round(packing: Packing, moving: np.ndarray, deform: bool, radius: float, st
         objective[-1] = -float(d)
         rows = sp.hstack([-at, sp.csr_matrix(-strain), sp.csr_matrix(growth[:, None])]).tocsr()
         try:
-            lp = solve_lp(objective, A_ub=rows, b_ub=gaps, bounds=[(-r * a, r * a)] * n + [(-r, r)] * (k + 1))
+            lp = solve_lp(objective, method=lp_method(packing.n_particles), A_ub=rows, b_ub=gaps,
+                          bounds=[(-r * a, r * a)] * n + [(-r, r)] * (k + 1))
         except LPFailure:
             mu = _smallest_mu(net)
             if mu >= 1.0:

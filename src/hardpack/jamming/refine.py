@@ -57,7 +57,7 @@ import scipy.sparse.linalg as spla
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.neighbours.pairs import wrapped_positions
 from hardpack.geometry.packing import Packing
-from hardpack.jamming.ascent import CONFIRM_AMPLITUDES, ascend, confirm_unjamming
+from hardpack.jamming.ascent import CONFIRM_AMPLITUDES, ascend, confirm_unjamming, lp_method
 from hardpack.jamming.ellipsoids import (
     contact_hessians,
     contacts_of_pairs,
@@ -320,10 +320,11 @@ MAX_STEP = 0.5
 #: first trust radius of the size ascent that brings a packing closer to its jamming point when
 #: Newton does not reach it from the packing as given (:func:`verify_at_jamming_point`)
 ASCENT_RADIUS = 1e-2
-#: the size ascent runs in :func:`verify_at_jamming_point` up to this many particles: one ascent
-#: took 3 s at N = 100, while at N = 1000 (M&M) one LP step took 111-372 s with HiGHS's dual
-#: simplex (14 s with its interior point method, whose different vertices left the retry of the
-#: prolate alpha = 1.02 test packing with an overlapping rattler), 80 steps a round
+#: the default largest packing for which :func:`verify_at_jamming_point` runs the size ascent (its
+#: ``ascent_max_particles``): one ascent took 3 s at N = 100, but 384 CPU-s for 40 of its 80 LP
+#: steps at N = 640 with the interior-point method that :mod:`hardpack.jamming.ascent` uses above
+#: its IPM_ABOVE (3-10 s per LP; the dual simplex took 53 s per LP there, and 111-372 s at
+#: N = 1000), so an ascent at N = 1000 takes ~20 CPU-min and a certificate up to six of them
 ASCENT_MAX_PARTICLES = 400
 #: iterative-refinement steps of :func:`_solve` at most
 SOLVE_REFINEMENTS = 3
@@ -383,7 +384,8 @@ def _confirm(packing: Packing, result) -> None:
     result.params.update(ascent_confirmed=int(found.confirmed), ascent_gain=found.gain,
                          ascent_amplitude=found.amplitude, ascent_tried=found.tried)
     result.collective.reason += (
-        f"; confirmed: moved by {found.amplitude:+g} along that mode and grown by SLP, the particles reach "
+        f"; confirmed: moved by {found.amplitude:+g} along that mode and grown by SLP (LPs by "
+        f"{lp_method(packing.n_particles)}), the particles reach "
         f"a packing without overlaps {found.gain:.3g} denser than the jamming point"
         if found.confirmed else
         f"; not confirmed: SLP from the jamming point moved along that mode ({found.tried} tries, "
@@ -391,7 +393,7 @@ def _confirm(packing: Packing, result) -> None:
 
 
 def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_after_ascent: bool = True,
-                            **options):
+                            ascent_max_particles: int = ASCENT_MAX_PARTICLES, **options):
     """The jamming test of an ellipsoid packing at the jamming point of its contacts, when the
     packing is near one.
 
@@ -424,8 +426,8 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     prolate alpha = 1.02 (N = 100, rate 1e-4, seed 2): Newton diverged from the packing as given
     and converged in 3 steps after the ascent.
 
-    Both uses of the ascent need N <= ASCENT_MAX_PARTICLES; above it, they are skipped and the note
-    says so.
+    Both uses of the ascent need N <= ``ascent_max_particles``; above it, they are skipped and the
+    note says so (the cost of an ascent grows fast with N: :data:`ASCENT_MAX_PARTICLES`).
 
     A verdict of the refined configuration that is second-order flexible is then checked by the
     size ascent (:func:`hardpack.jamming.ascent.confirm_unjamming`, unless ``confirm`` is False):
@@ -442,6 +444,8 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
         Certify a second-order flexible verdict at the jamming point by the size ascent.
     retry_after_ascent : bool, default True
         When Newton fails from the packing as given, try again after the size ascent.
+    ascent_max_particles : int, default ASCENT_MAX_PARTICLES (400)
+        The largest packing for which the ascent runs (the retry and the certificate).
     **options
         Passed to :func:`hardpack.jamming.second_order.verify_ellipsoids` for both tests.
 
@@ -449,14 +453,17 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     -------
     EllipsoidJammingResult
     """
-    affordable = packing.n_particles <= ASCENT_MAX_PARTICLES
-    first = _at_jamming_point(packing, confirm and affordable, options)
+    if isinstance(ascent_max_particles, bool) or not (isinstance(ascent_max_particles, int | np.integer)
+                                                      and ascent_max_particles >= 0):
+        raise InvalidInputError(f"ascent_max_particles must be a non-negative integer, got {ascent_max_particles!r}")
+    affordable = packing.n_particles <= ascent_max_particles
+    first = _at_jamming_point(packing, confirm and affordable, options, ascent_max_particles)
     first.params.setdefault("ascended", 0)
     if first.params.get("refined") != 0 or "refine_iterations" not in first.params:
         return first  # refined, or Newton never started (no near self-stress, walls)
     if retry_after_ascent and not affordable:
-        first.params["refine_note"] += (f"; no retry after the size ascent above N = {ASCENT_MAX_PARTICLES} "
-                                        "(its LPs take minutes a step at N = 1000)")
+        first.params["refine_note"] += (f"; no retry after the size ascent above N = {ascent_max_particles} "
+                                        "(ascent_max_particles; an ascent takes ~20 CPU-min at N = 1000)")
     if not (retry_after_ascent and affordable):
         return first
     try:
@@ -464,7 +471,7 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     except LPFailure as exc:
         first.params["refine_note"] += f"; the size ascent failed ({exc}), so Newton was not retried"
         return first
-    second = _at_jamming_point(climbed.packing, confirm, options)
+    second = _at_jamming_point(climbed.packing, confirm, options, ascent_max_particles)
     gain = (climbed.phi - packing.phi) / packing.phi
     if second.params.get("refined") != 1:
         first.params.update(ascended=0, refine_note=first.params["refine_note"] + (
@@ -472,11 +479,11 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
         return first
     second.params.update(ascended=1, ascent_phi_change=gain, refine_note=(
         f"Newton from the packing as given failed ({first.params['refine_note']}); after an SLP ascent of the "
-        f"size ({gain:.2g} denser): {second.params['refine_note']}"))
+        f"size ({gain:.2g} denser, LPs by {climbed.lp_method}): {second.params['refine_note']}"))
     return second
 
 
-def _at_jamming_point(packing: Packing, confirm: bool, options: dict):
+def _at_jamming_point(packing: Packing, confirm: bool, options: dict, ascent_max_particles: int):
     """:func:`verify_at_jamming_point` without the ascent: the test of ``packing`` at the jamming
     point Newton reaches from it, or of ``packing`` itself (``refined`` 0)."""
     result = verify_ellipsoids(packing, **options)
@@ -517,9 +524,9 @@ def _at_jamming_point(packing: Packing, confirm: bool, options: dict):
             if refined.verdict == Verdict.NOT_JAMMED and refined.unjamming_motion() is not None:
                 if confirm:
                     _confirm(ref.packing, refined)
-                elif packing.n_particles > ASCENT_MAX_PARTICLES:
+                elif packing.n_particles > ascent_max_particles:
                     refined.collective.reason += (f"; not certified by the size ascent (skipped above "
-                                                  f"N = {ASCENT_MAX_PARTICLES})")
+                                                  f"N = {ascent_max_particles}, ascent_max_particles)")
             return refined
         solved = ref.gap[-1] <= REFINE_TOL and ref.balance[-1] <= REFINE_TOL
         note = (f"not refined: Newton reached the stationary point of the contacts in {ref.iterations} steps "
