@@ -75,6 +75,9 @@ def test_validate_schema_fills_defaults_and_names_the_key_it_refuses():
         (lambda c: c["containers"]["windows"].update(n_windows=1), "containers.windows.n_windows: 1 is less than"),
         (lambda c: c["ellipsoid_crystals"]["search"].update(n=[0]), "ellipsoid_crystals.search.n.0: 0 is less than"),
         (lambda c: c["ellipsoid_crystals"]["search"].update(alphas=[1.5, 1.5]), "ellipsoid_crystals.search.alphas: .*non-unique"),
+        (lambda c: c["ellipsoids"].update(ascent_max_particles=-1), "ellipsoids.ascent_max_particles: -1 is less than"),
+        (lambda c: c["ellipsoids"].update(ascent_max_particles=1.5),
+         "ellipsoids.ascent_max_particles: 1.5 is not of type 'integer'"),
     ],
 )
 def test_bad_configs_are_refused_naming_the_key(mutate, expected):
@@ -137,6 +140,35 @@ def test_snakemake_dry_run_lists_the_dag(configfile):
     for rule, count in (("ellipsoid_container_profile", shapes * len(ell["N"]) * len(ell["seeds"])),
                         ("ellipsoid_container_summary", shapes), ("fig_ellipsoid_container_profile", 1)):
         assert re.search(rf"^{rule} +{count}$", out.stdout, re.M), rule
+
+
+@pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")
+def test_the_ascent_limit_reaches_the_verify_commands(tmp_path):
+    """``ellipsoids.ascent_max_particles`` (optional) becomes every ellipsoid verdict's
+    --ascent-max-particles; without it the commands leave the library's default."""
+    from hardpack.cli import build_parser
+
+    cfg = copy.deepcopy(load("smoke.yaml"))
+    cfg["ellipsoids"]["ascent_max_particles"] = 1000
+    path = tmp_path / "ascent.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    for configfile, flag in ((path, "--ascent-max-particles 1000 "), (ROOT / "config" / "smoke.yaml", None)):
+        out = subprocess.run(["snakemake", "-n", "-p", "--forceall", "--configfile", str(configfile),
+                              "--allowed-rules", "ellipsoid_verify", "--", *_verdict_targets(cfg)],
+                             cwd=ROOT, capture_output=True, text=True, timeout=300)
+        assert out.returncode == 0, out.stderr
+        verify = [line for line in out.stdout.splitlines() if line.startswith("Shell command: hardpack verify")]
+        assert verify and all((flag in line) if flag else ("--ascent-max-particles" not in line) for line in verify)
+        for line in verify:  # the command line's parser takes them
+            words = shlex.split(line.split("Shell command: ", 1)[1])
+            build_parser("verify").parse_args(words[1:words.index(">")])
+
+
+def _verdict_targets(cfg):
+    """The verdict files of the smoke config's ellipsoid study (the main grid's first family)."""
+    family = next(iter(cfg["ellipsoids"]["families"]))
+    alpha = cfg["ellipsoids"]["alphas"][0]
+    return [f"results/ellipsoids/{family}_a{alpha:g}/verdict/seed{cfg['ellipsoids']['seeds'][0]}.nc"]
 
 
 @pytest.mark.skipif(shutil.which("snakemake") is None, reason="snakemake not installed")

@@ -40,6 +40,8 @@ rule ellipsoid_verify:
         "results/ellipsoids/{name}/verdict/seed{seed}.nc",
     params:
         attrs=lambda w: attr_options(SYSTEMS["ellipsoids"][w.name]["attrs"]),
+        ascent=lambda w: (f"--ascent-max-particles {int(ELLIPSOIDS['ascent_max_particles'])}"
+                          if "ascent_max_particles" in ELLIPSOIDS else ""),
     threads: 1
     resources:
         mem_mb=job_mem_mb("ellipsoid_verify"),
@@ -51,7 +53,8 @@ rule ellipsoid_verify:
     benchmark:
         "results/benchmarks/ellipsoid_verify/{name}/seed{seed}.tsv"
     shell:
-        "hardpack verify {input} --out {output} --delta gaps --refine --seed {wildcards.seed} {params.attrs} > {log} 2>&1"
+        "hardpack verify {input} --out {output} --delta gaps --refine {params.ascent} --seed {wildcards.seed} "
+        "{params.attrs} > {log} 2>&1"
 
 
 rule ellipsoid_verdict_fractions:
