@@ -68,7 +68,7 @@ def register(subparsers) -> None:
                         "(hardpack.jamming.refine, hardpack.jamming.ascent)")
     p.add_argument("--ascent-max-particles", type=int, default=None, metavar="N",
                    help="with --refine: the largest packing for which the SLP ascent runs (default 400; an "
-                        "ascent takes ~20 CPU-min at N = 1000 and a certificate up to six ascents)")
+                        "ascent took 6-60 CPU-min at N = 640-800 and a certificate takes up to six)")
     p.set_defaults(func=cmd_verify)
 
 

@@ -321,10 +321,11 @@ MAX_STEP = 0.5
 #: Newton does not reach it from the packing as given (:func:`verify_at_jamming_point`)
 ASCENT_RADIUS = 1e-2
 #: the default largest packing for which :func:`verify_at_jamming_point` runs the size ascent (its
-#: ``ascent_max_particles``): one ascent took 3 s at N = 100, but 384 CPU-s for 40 of its 80 LP
-#: steps at N = 640 with the interior-point method that :mod:`hardpack.jamming.ascent` uses above
-#: its IPM_ABOVE (3-10 s per LP; the dual simplex took 53 s per LP there, and 111-372 s at
-#: N = 1000), so an ascent at N = 1000 takes ~20 CPU-min and a certificate up to six of them
+#: ``ascent_max_particles``): one ascent took 3 s at N = 100. Above :mod:`hardpack.jamming.ascent`'s
+#: IPM_ABOVE its LPs go to the interior-point method: 3-10 CPU-s per LP at N = 640 (a tiling of
+#: an M&M packing; the dual simplex took 53 s per LP there, and 111-372 s at N = 1000), ~45 CPU-s
+#: per LP at N = 800 (a tiling of a prolate alpha = 1.02 packing: 39 of 80 steps in 29 min). An
+#: ascent at N ~ 1000 takes tens of CPU-minutes, and a certificate up to six ascents
 ASCENT_MAX_PARTICLES = 400
 #: iterative-refinement steps of :func:`_solve` at most
 SOLVE_REFINEMENTS = 3
@@ -463,7 +464,7 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
         return first  # refined, or Newton never started (no near self-stress, walls)
     if retry_after_ascent and not affordable:
         first.params["refine_note"] += (f"; no retry after the size ascent above N = {ascent_max_particles} "
-                                        "(ascent_max_particles; an ascent takes ~20 CPU-min at N = 1000)")
+                                        "(ascent_max_particles; an ascent takes tens of CPU-minutes at N ~ 1000)")
     if not (retry_after_ascent and affordable):
         return first
     try:
