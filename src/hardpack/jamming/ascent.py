@@ -283,6 +283,7 @@ def _round(packing: Packing, moving: np.ndarray, deform: bool, radius: float, st
     d, f = packing.dim, dof_per_particle(packing.dim)
     a = float(np.min(packing.shape.semiaxes))
     current, x, r, repairs = packing, wrapped_positions(packing), radius, 0
+    method = lp_method(packing.n_particles)
     for _ in range(steps):
         net = ellipsoid_contacts(current, CANDIDATE_DELTA)
         t, _ = dof_basis(net, moving)
@@ -297,7 +298,7 @@ def _round(packing: Packing, moving: np.ndarray, deform: bool, radius: float, st
         objective[-1] = -float(d)
         rows = sp.hstack([-at, sp.csr_matrix(-strain), sp.csr_matrix(growth[:, None])]).tocsr()
         try:
-            lp = solve_lp(objective, method=lp_method(packing.n_particles), A_ub=rows, b_ub=gaps,
+            lp = solve_lp(objective, method=method, A_ub=rows, b_ub=gaps,
                           bounds=[(-r * a, r * a)] * n + [(-r, r)] * (k + 1))
         except LPFailure:
             mu = _smallest_mu(net)

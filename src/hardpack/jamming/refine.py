@@ -454,8 +454,8 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     -------
     EllipsoidJammingResult
     """
-    if isinstance(ascent_max_particles, bool) or not (isinstance(ascent_max_particles, int | np.integer)
-                                                      and ascent_max_particles >= 0):
+    if (isinstance(ascent_max_particles, bool) or not isinstance(ascent_max_particles, (int, np.integer))
+            or ascent_max_particles < 0):
         raise InvalidInputError(f"ascent_max_particles must be a non-negative integer, got {ascent_max_particles!r}")
     affordable = packing.n_particles <= ascent_max_particles
     first = _at_jamming_point(packing, confirm and affordable, options, ascent_max_particles)
