@@ -12,6 +12,15 @@ mass 0 are frozen: never moved, never scheduled.
 State, one row per particle as in :mod:`hardpack.md._kernel`: ``P[i] = (dr_0..dr_{d-1},
 v_0..v_{d-1}, s_i)``, displacement and velocity at the particle's own last update time s_i.
 
+Growing particles in fixed cells (the SOC compression of Donev 2006, sec. 13.3.1, Fig. 13.9):
+radii a_i(s) = R_i (1 + kappa s) inside cells of fixed radius (1 + dmu0) R_i leave the centre
+the room R_i (dmu0 - kappa s), which is the shrinking wall above with gamma = kappa; the pairs
+then also grow, sigma(s) = (R_i + R_j)(1 + kappa_pair s), with ``kappa_pair`` = kappa (BCMD:
+0). Pair collision law for growing pairs (as the md engine's, derived in
+:mod:`hardpack.md._kernel`, here with masses 1 / invm): the normal velocity relative to the
+contact, u_n - g with g = d sigma / ds, is reversed, so the impulse is
+2 (g - u_n) / (invm_i + invm_j) for u_n < g (u_n = n.(v_j - v_i)).
+
 Events follow the md engine's scheme (one predicted event per particle in a 4-ary min-heap with
 the keys stored in heap order, lazy invalidation by the partner's collision counter); the
 contact-time roots are :mod:`hardpack.events.roots`': pairs use ``contact_root`` (constant radii, g = 0, with its
@@ -34,8 +43,9 @@ NONE = -2  # nothing predicted
 
 # float accumulators
 F_WALL_IMPULSE_R = 0  # sum over wall events of 2 m (v_n - w) R_i (for the cell pressure)
-F_PAIR_VIRIAL = 1  # sum over pair events of |impulse| * (R_i + R_j)
-N_FLOAT = 2
+F_PAIR_VIRIAL = 1  # sum over pair events of |impulse| * sigma_ij at the collision
+F_KE_INTEGRAL = 2  # time integral of the kinetic energy of the moving particles over the segment
+N_FLOAT = 3
 # integer counters
 C_EVENTS, C_WALL, C_PAIR, C_STALE = 0, 1, 2, 3
 N_INT = 4
@@ -77,11 +87,12 @@ def wall_time(dr, v, rho0, w):
 
 @njit(cache=True)
 def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, gamma, s_end,
-                facc, iacc, max_events):
-    """Run the events of s in [0, s_end) with cell radii R_i (dmu0 - gamma s); every particle is
-    synchronised at s = 0 on entry and at s_end on exit (P updated in place, s_i = 0 on exit).
-    Returns the number of events processed (stops after max_events; the caller then treats the
-    run as failed).
+                facc, iacc, max_events, kappa_pair=0.0):
+    """Run the events of s in [0, s_end) with cell radii R_i (dmu0 - gamma s) and pair contact
+    distances nb_sig (1 + kappa_pair s); every particle is synchronised at s = 0 on entry and at
+    s_end on exit (P updated in place, s_i = 0 on exit). facc gains the wall impulses, the pair
+    virial and the integral of the kinetic energy over the time run. Returns the number of events
+    processed (stops after max_events; the caller then treats the run as failed).
 
     Single loop in the md engine's style (no sub-call takes arrays): (1) schedule reset, one
     prediction per moving particle; (2) events: stale pair -> re-predict i; wall -> reflect,
@@ -103,6 +114,12 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
     hsize = 0
     stage = 0
     count = 0
+    ke = 0.0
+    for i in range(n):
+        if invm[i] > 0.0:
+            for k in range(d):
+                ke += 0.5 * P[i, d + k] * P[i, d + k] / invm[i]
+    s_ke = 0.0  # time up to which ke has been integrated
     while True:
         npred = 0
         if stage < n:  # (1) schedule reset
@@ -127,6 +144,8 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
             else:
                 count += 1
                 iacc[C_EVENTS] += 1
+                facc[F_KE_INTEGRAL] += ke * (s - s_ke)
+                s_ke = s
                 dti = s - P[i, ts]
                 for k in range(d):
                     P[i, k] += P[i, d + k] * dti
@@ -143,6 +162,7 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                         nrm[k] = P[i, k] / norm
                         vn += P[i, d + k] * nrm[k]
                     if vn > w:
+                        ke += 2.0 * (w - vn) * w / invm[i]  # 0.5 m (|v'|^2 - |v|^2), v_n' = 2 w - v_n
                         for k in range(d):
                             P[i, d + k] += 2.0 * (w - vn) * nrm[k]
                         facc[F_WALL_IMPULSE_R] += 2.0 * (vn - w) * radii[i] / invm[i]
@@ -162,12 +182,14 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                     for k in range(d):
                         nrm[k] /= dist
                         un += (P[j, d + k] - P[i, d + k]) * nrm[k]
-                    if un < 0.0:
-                        imp = -2.0 * un / (invm[i] + invm[j])
+                    g = nb_sig[qj] * kappa_pair
+                    if un < g:
+                        imp = 2.0 * (g - un) / (invm[i] + invm[j])
                         for k in range(d):
                             P[i, d + k] -= imp * invm[i] * nrm[k]
                             P[j, d + k] += imp * invm[j] * nrm[k]
-                        facc[F_PAIR_VIRIAL] += imp * nb_sig[qj]
+                        ke += imp * (un + 0.5 * imp * (invm[i] + invm[j]))  # = imp * g
+                        facc[F_PAIR_VIRIAL] += imp * nb_sig[qj] * (1.0 + kappa_pair * s)
                     iacc[C_PAIR] += 1
                     coll[j] += 1
                     if invm[j] > 0.0:
@@ -204,7 +226,7 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                     rr += r * r
                     ru += r * u
                     uu += u * u
-                tc = contact_root(rr, ru, uu, nb_sig[m], 0.0, best)
+                tc = contact_root(rr, ru, uu, nb_sig[m] * (1.0 + kappa_pair * s), nb_sig[m] * kappa_pair, best)
                 if tc < best:
                     best = tc
                     partner = j
@@ -215,6 +237,8 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                 ec[i] = coll[partner]
             hsize = heap_set(hkey, heap, hpos, hsize, i, s + best)
 
+    if count < max_events:
+        facc[F_KE_INTEGRAL] += ke * (s_end - s_ke)
     for i in range(n):  # synchronise at s_end
         if invm[i] > 0.0:
             dt = s_end - P[i, ts]
