@@ -176,3 +176,73 @@ def test_overlapping_or_non_sphere_packings_are_refused():
         compress_in_cells(overlapping)
     with pytest.raises(InvalidInputError, match="packing must be a hardpack Packing"):
         compress_in_cells(np.zeros((2, 2)))
+
+
+def _ts(phi0, seed, phi_j, phi_final=0.83, n=1024):
+    import xarray as xr
+
+    return xr.Dataset({"Z": ("segment", [10.0, 1000.0])},
+                      attrs={"hardpack_kind": "soc_compression", "n_particles": n, "dim": 2, "dmu": 1.0,
+                             "growth_rate": 1e-5, "max_pressure": 1e3, "phi0": phi0, "seed": seed,
+                             "phi_final": phi_final, "phi_J_est": phi_j})
+
+
+def _relaxed(z_blocks, phi=0.83, n=1024):
+    import xarray as xr
+
+    return xr.Dataset({"Z_block": ("block", np.asarray(z_blocks, float))},
+                      attrs={"hardpack_kind": "md_eos", "phi": phi, "collisions": 1e4 * n})
+
+
+def test_the_soc_summary_pairs_compressions_with_their_relaxations():
+    from hardpack.glass.soc import soc_summary
+
+    ts = [_ts(0.75, 1, 0.835), _ts(0.70, 1, 0.830), _ts(0.70, 2, 0.832)]
+    rel = [_relaxed([500, 300, 200, 100]), _relaxed([300, 120]), _relaxed([400, 90, 80, 70, 60, 50, 40, 30])]
+    ds = soc_summary(ts, rel)
+    assert list(ds["phi0"].values) == [0.70, 0.75] and list(ds["seed"].values) == [1, 2]
+    assert ds["phi_J_soc"].sel(phi0=0.70, seed=2) == 0.832
+    assert np.isnan(ds["phi_J_soc"].sel(phi0=0.75, seed=2))  # not run
+    # the last quarter of the blocks: 100 (of 4), 120 (of 2, at least one), mean(40, 30) (of 8)
+    np.testing.assert_allclose(ds["Z_relaxed"].sel(phi0=0.70).values, [120.0, 35.0])
+    assert ds["phi_J_relaxed"].sel(phi0=0.75, seed=1) == pytest.approx(0.83 / (1 - 2 / 100.0))
+    assert ds.attrs["relax_collisions"] == pytest.approx(1e4)
+
+
+@pytest.mark.parametrize("case, message", [
+    ("count", "one relaxation per SOC compression"),
+    ("phi", "does not start from the SOC packing"),
+    ("twice", "two SOC compressions"),
+    ("protocol", "differ in"),
+])
+def test_the_soc_summary_refuses_mismatched_inputs(case, message):
+    from hardpack.glass.soc import soc_summary
+
+    ts, rel = [_ts(0.70, 1, 0.83), _ts(0.75, 1, 0.84)], [_relaxed([100.0]), _relaxed([100.0])]
+    if case == "count":
+        rel = rel[:1]
+    elif case == "phi":
+        rel[1] = _relaxed([100.0], phi=0.84)
+    elif case == "twice":
+        ts[1] = _ts(0.70, 1, 0.84)
+    else:
+        ts[1] = _ts(0.75, 1, 0.84, n=512)
+        rel[1] = _relaxed([100.0], n=512)
+    with pytest.raises(InvalidInputError, match=message):
+        soc_summary(ts, rel)
+
+
+def test_the_soc_rows_judge_the_lowest_snapshot_against_the_printed_densities():
+    from hardpack.glass.soc import soc_summary
+    from hardpack.validation.glass import soc_rows
+
+    # phi_0 = 0.70: phi_J 0.831, 0.833 in cells (passes ~0.83); relaxed Z = 2 / (1 - 0.83 / 0.8405): 0.8405
+    # (fails ~0.85 by more than the printed digit); phi_0 = 0.80 is in the detail only
+    z = 2.0 / (1.0 - 0.83 / 0.8405)
+    ts = [_ts(0.70, 1, 0.831), _ts(0.70, 2, 0.833), _ts(0.80, 1, 0.845), _ts(0.80, 2, 0.846)]
+    rows = soc_rows(soc_summary(ts, [_relaxed([z])] * 4))
+    liquid, relaxed = rows
+    assert liquid.target == "donev-13.3-soc-phij-liquid" and liquid.status == "pass"
+    assert liquid.reproduced == pytest.approx(0.832)
+    assert relaxed.target == "donev-13.3-soc-phij-relaxed" and relaxed.status == "fail"
+    assert "0.8: 0.8455" in liquid.detail

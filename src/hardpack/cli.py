@@ -41,6 +41,7 @@ SUBCOMMANDS: dict[str, str] = {
     "glass-labels": "hardpack.glass.cli",
     "glass-labelled-crystal": "hardpack.glass.cli", "glass-microsegregated": "hardpack.glass.cli",
     "glass-microsegregated-summary": "hardpack.glass.cli",
+    "glass-soc": "hardpack.glass.cli", "glass-soc-summary": "hardpack.glass.cli",
 }
 #: every module of :data:`SUBCOMMANDS`, in the order of ``hardpack --help``
 SUBCOMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(SUBCOMMANDS.values()))

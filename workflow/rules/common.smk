@@ -554,6 +554,22 @@ def glass_bcmd_files(system):
             for phi in sorted(GLASS["snapshots"]) for seed in GLASS.get("bcmd_seeds", GLASS["seeds"])]
 
 
+def glass_soc_files(kind):
+    """The SOC solids of the mixture (Donev 2006, Fig. 13.9), one per snapshot of the slowest
+    compression and glass.soc seed: ``ts_`` their compressions, ``relaxed_`` their relaxations
+    without cells."""
+    spec = GLASS.get("soc") if GLASS else None
+    if not spec:
+        return []
+    return [f"results/glass/binary/soc/phi{phi:g}/{kind}seed{seed}.nc"
+            for phi in sorted(GLASS["snapshots"]) for seed in spec["seeds"]]
+
+
+def glass_soc_snapshot(wildcards):
+    """The snapshot of the mixture's slowest compression a SOC solid starts from."""
+    return glass_snapshot("binary", min(GLASS_SYSTEMS["binary"]["rates"]), wildcards.phi, wildcards.seed)
+
+
 def glass_relaxation_files():
     """Pressure relaxation of the mixture at fixed glass.relaxation.phi, one run per compression
     rate and seed, started from that rate's snapshot (Donev 2006, Fig. 13.7)."""
@@ -781,6 +797,7 @@ def figures():
     names += ["glass_eos", "glass_entropy", "glass_cell_pressure", "glass_separated"] if GLASS else []
     names += ["glass_crystal"] if GLASS and glass_crystal_bcmd_files() else []
     names += ["glass_relaxation"] if GLASS and glass_relaxation_files() else []
+    names += ["glass_soc"] if GLASS and glass_soc_files("") else []
     names += ["glass_jamming"] if GLASS and GLASS.get("relaxed") else []
     names += ["microsegregated", "microsegregated_maps"] if MICROSEG else []
     names += ["container_profile", "container_extrapolation", "container_windows"] if CONTAINERS else []
@@ -828,6 +845,8 @@ def validation_inputs():
             inputs["glass_crystal"] = [summary("glass/mono/crystal_bcmd"), summary("glass/mono/eos")]
         if GLASS.get("relaxed"):
             inputs["glass_relaxed"] = [summary("glass/binary/relaxed")]
+        if GLASS.get("soc"):
+            inputs["glass_soc"] = [summary("glass/binary/soc")]
     if MICROSEG:
         inputs["glass_microsegregated"] = [summary("microseg/phij_sc")]
     poly = [summary(key) for key in EOS_SUMMARIES]
@@ -953,6 +972,10 @@ EXPECTED_MINUTES = {
     "glass_crystal_bcmd": lambda w: 0.3 + GLASS["N"] * 100 * GLASS["bcmd"]["dmu_max"] / GLASS["bcmd"]["gamma0"] / 3e6 / 60,
     # N = 1024, Gamma = 0.1, 1e4 collisions per particle, recompression at 1e-4 to Z = 1e4: ~20 CPU-s
     "glass_relaxed": lambda w: 0.3 + 0.5 * GLASS["N"] / 1024 * (1 + GLASS["relaxed"]["relax_collisions"] / 1e4),
+    # SOC solids (N = 256 from phi0 = 0.70-0.825, rate 1e-3, to Z = 1e3): 2.9e3-4.7e3 events per disk, i.e.
+    # ~5 / rate; ~1.5e6 events/s
+    "glass_soc": lambda w: 0.3 + GLASS["N"] * 5.0 / GLASS["soc"]["rate"] / 1.5e6 / 60,
+    "glass_soc_relaxation": lambda w: 0.3 + GLASS["N"] * GLASS["soc"]["relax_collisions_per_particle"] / 2.5e6 / 60,
     "microseg_packing": microseg_minutes,
     # per run at alpha = sqrt(3), CPU s: n = 1 about 2, n = 2 about 7, n = 4 8-10; oblate slower
     "crystal_search": lambda w: 1.0 + len(CRYSTAL_SEARCH["seeds"]) * sum(0.05 * n for n in CRYSTAL_SEARCH["n"])
@@ -982,7 +1005,7 @@ PARTICLES = {
     "bcmd_simplex": lambda w: SYSTEMS["ls"][w.ensemble]["N"],
     "poly_fluid": lambda w: POLY_FLUID["N"],
     **dict.fromkeys(("glass_init", "glass_crystal", "glass_compress", "glass_decompress", "glass_bcmd", "glass_crystal_bcmd",
-                     "glass_relaxation",
+                     "glass_relaxation", "glass_soc", "glass_soc_relaxation",
                      "glass_relaxed"), lambda w: GLASS["N"]),
     **dict.fromkeys(("glass_separated_crystal", "glass_separated_decompress"),
                     lambda w: sum(c * r for c, r in zip(GLASS["separated"]["columns"], GLASS["separated"]["rows"]))),

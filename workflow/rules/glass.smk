@@ -169,6 +169,84 @@ rule glass_relaxation:
         " --blocks {params.blocks} --equilibration 0 --out {output} --checkpoint {params.checkpoint} > {log} 2>&1"
 
 
+rule glass_soc:
+    """SOC solid of the mixture (Donev 2006, sec. 13.3.1, Fig. 13.9): the slowest compression's snapshot at {phi} with every disk in a fixed cell of glass.soc.dmu radii, grown at glass.soc.rate to the pair pressure glass.soc.max_pressure."""
+    input:
+        glass_soc_snapshot,
+    output:
+        packing="results/glass/binary/soc/phi{phi}/seed{seed}.nc",
+        timeseries="results/glass/binary/soc/phi{phi}/ts_seed{seed}.nc",
+    params:
+        checkpoint=checkpoint_beside,
+        s=GLASS.get("soc") if GLASS else None,
+    wildcard_constraints:
+        phi=GLASS_PHI,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_soc"),
+        runtime=job_runtime("glass_soc"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_soc/phi{phi}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_soc/phi{phi}/seed{seed}.tsv"
+    shell:
+        "hardpack glass-soc {input} --dmu {params.s[dmu]} --growth-rate {params.s[rate]}"
+        " --max-pressure {params.s[max_pressure]} --seed {wildcards.seed} --out {output.packing}"
+        " --timeseries {output.timeseries} --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
+rule glass_soc_relaxation:
+    """The SOC solid at {phi} with its cells removed: NVE MD at its final phi for glass.soc.relax_collisions_per_particle collisions per disk, Z per block (Donev 2006, Fig. 13.9)."""
+    input:
+        "results/glass/binary/soc/phi{phi}/seed{seed}.nc",
+    output:
+        "results/glass/binary/soc/phi{phi}/relaxed_seed{seed}.nc",
+    params:
+        checkpoint=checkpoint_beside,
+        collisions=lambda w: int(GLASS["soc"]["relax_collisions_per_particle"] * GLASS["N"]),
+        blocks=GLASS["soc"]["blocks"] if GLASS and GLASS.get("soc") else None,
+    wildcard_constraints:
+        phi=GLASS_PHI,
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_soc_relaxation"),
+        runtime=job_runtime("glass_soc_relaxation"),
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_soc_relaxation/phi{phi}/seed{seed}.log",
+    benchmark:
+        "results/benchmarks/glass_soc_relaxation/phi{phi}/seed{seed}.tsv"
+    shell:
+        "hardpack eos --init {input} --seed {wildcards.seed} --collisions {params.collisions}"
+        " --blocks {params.blocks} --equilibration 0 --out {output} --checkpoint {params.checkpoint} > {log} 2>&1"
+
+
+rule glass_soc_summary:
+    """phi_J of the SOC solids in their cells and after relaxation without them, per phi_0 and seed (Donev 2006, Fig. 13.9)."""
+    input:
+        soc=lambda w: glass_soc_files("ts_"),
+        relaxed=lambda w: glass_soc_files("relaxed_"),
+    output:
+        "results/glass/binary/soc_summary.nc",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("glass_soc_summary"),
+        runtime=job_runtime("glass_soc_summary"),
+    group:
+        "summaries"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/glass_soc_summary.log",
+    benchmark:
+        "results/benchmarks/glass_soc_summary.tsv"
+    shell:
+        "hardpack glass-soc-summary --soc {input.soc} --relaxed {input.relaxed} --out {output} > {log} 2>&1"
+
+
 rule glass_separated_crystal:
     """The fully phase-separated crystal of the mixture: a slab of small and a slab of large disks at glass.separated.phi (Donev 2006, sec. 13.2.2.1)."""
     output:
@@ -561,3 +639,28 @@ rule fig_glass_jamming:
         "results/benchmarks/fig_glass_jamming.tsv"
     script:
         "../scripts/plot_glass_jamming.py"
+
+
+rule fig_glass_soc:
+    """EOS of the SOC solids against the slowest compression, and their phi_J before and after the cells are removed (Donev 2006, Fig. 13.9)."""
+    input:
+        eos="results/glass/binary/eos_summary.nc",
+        soc=lambda w: glass_soc_files("ts_"),
+        summary="results/glass/binary/soc_summary.nc",
+    output:
+        pdf="results/figures/glass_soc.pdf",
+        png=report("results/figures/glass_soc.png", caption="../report/glass_soc.rst", category="5 glasses"),
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("fig_glass_soc"),
+        runtime=job_runtime("fig_glass_soc"),
+    group:
+        "figures"
+    conda:
+        "../envs/hardpack.yaml"
+    log:
+        "results/logs/fig_glass_soc.log",
+    benchmark:
+        "results/benchmarks/fig_glass_soc.tsv"
+    script:
+        "../scripts/plot_glass_soc.py"

@@ -5,7 +5,9 @@ glasses from the EOS summary and their BCMD results; ``hardpack glass-freezing``
 chemical-potential matching (Eq. 13.2); ``hardpack glass-relaxed``: jamming densities of fast glasses
 before and after relaxation (Fig. 13.8); ``hardpack glass-labels``: level-cut Matérn labels of the
 micro-segregated packings and their window entropies (sec. 13.5); ``hardpack glass-labelled-crystal``:
-the triangular crystal carrying one realisation of those labels. Donev 2006, ch. 13
+the triangular crystal carrying one realisation of those labels; ``hardpack glass-soc``: compression of a
+snapshot with every disk in a fixed cell (Fig. 13.9); ``hardpack glass-soc-summary``: phi_J of those SOC
+solids before and after relaxation without cells. Donev 2006, ch. 13
 (:mod:`hardpack.glass`).
 """
 
@@ -317,6 +319,66 @@ def cmd_glass_microsegregated(args) -> int:
     return 0
 
 
+def cmd_glass_soc(args) -> int:
+    """SOC compression: each disk in a fixed cell around its start, grown to near jamming (Donev 2006, Fig. 13.9).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-soc``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
+    from hardpack.glass.soc import compress_in_cells
+    from hardpack.io import load_packing, save_packing, write_dataset
+    from hardpack.io.atomic import check_writable
+
+    for path in (args.out, args.timeseries):
+        check_writable(path)
+    result = compress_in_cells(load_packing(args.packing), dmu=args.dmu, growth_rate=args.growth_rate,
+                               max_pressure=args.max_pressure, seed=args.seed, window=args.window,
+                               checkpoint=args.checkpoint)
+    config = {"source": str(args.packing), "dmu": args.dmu, "growth_rate": args.growth_rate,
+              "max_pressure": args.max_pressure, "window": args.window}
+    ts = result.timeseries
+    write_dataset(ts, args.timeseries, attrs={"source": str(args.packing)}, config=config, seed=args.seed)
+    save_packing(result.packing, args.out, attrs={"protocol": "soc_compression", "source": str(args.packing),
+                                                  "phi0": ts.attrs["phi0"], "Z": ts.attrs["Z_final"],
+                                                  "phi_J_est": ts.attrs["phi_J_est"]}, config=config, seed=args.seed)
+    log.info("phi0 = %.5f -> phi = %.6f at Z = %.4g (%s): phi_J ~ %.5f", ts.attrs["phi0"], ts.attrs["phi_final"],
+             ts.attrs["Z_final"], result.stop, ts.attrs["phi_J_est"])
+    return 0
+
+
+def cmd_glass_soc_summary(args) -> int:
+    """phi_J of SOC solids after their compression and after relaxation without cells (Donev 2006, Fig. 13.9).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``hardpack glass-soc-summary``.
+
+    Returns
+    -------
+    int
+        Exit status 0 (errors raise).
+    """
+    from hardpack.glass.soc import soc_summary
+    from hardpack.io import load_dataset, write_dataset
+
+    ds = soc_summary([load_dataset(p, kind="soc_compression") for p in args.soc],
+                     [load_dataset(p, kind="md_eos") for p in args.relaxed])
+    write_dataset(ds, args.out)
+    for p in ds["phi0"].values:
+        row = ds.sel(phi0=p)
+        log.info("phi0 = %.4g: phi_J %.4f in cells -> %.4f relaxed (mean over %d seeds)", p,
+                 float(row["phi_J_soc"].mean()), float(row["phi_J_relaxed"].mean()), ds.sizes["seed"])
+    return 0
+
+
 def cmd_glass_microsegregated_summary(args) -> int:
     """phi_J and s_c per label ensemble of micro-segregated packings (Donev 2006, Figs. 13.16-13.17).
 
@@ -345,7 +407,7 @@ def cmd_glass_microsegregated_summary(args) -> int:
 def register(subparsers) -> None:
     """Add the subcommands ``glass-crystal``, ``glass-eos``, ``glass-entropy``, ``glass-freezing``, ``glass-relaxed``,
     ``glass-labels``, ``glass-labelled-crystal``, ``glass-microsegregated``,
-    ``glass-microsegregated-summary`` to the ``hardpack`` command line.
+    ``glass-microsegregated-summary``, ``glass-soc``, ``glass-soc-summary`` to the ``hardpack`` command line.
 
     Parameters
     ----------
@@ -452,6 +514,26 @@ def register(subparsers) -> None:
     p.add_argument("--timeseries", help="time series of the compression to jamming")
     p.add_argument("--growth-timeseries", help="time series of the growth (Fig. 13.14)")
     p.set_defaults(func=cmd_glass_microsegregated)
+
+    p = subparsers.add_parser("glass-soc", help=cmd_glass_soc.__doc__.split("\n\n")[0])
+    p.add_argument("packing", help="start packing netCDF (a snapshot; its positions are the cell centres)")
+    p.add_argument("--dmu", type=float, default=1.0, help="cell size Delta mu in radii (default 1: twice the disk)")
+    p.add_argument("--growth-rate", type=float, default=1e-6, help="d<D>/dt of the disks (default 1e-6)")
+    p.add_argument("--max-pressure", type=float, default=1e3,
+                   help="stop at this reduced pair-collision pressure (default 1e3)")
+    p.add_argument("--window", type=float, default=100.0, help="collisions per disk per record (default 100)")
+    p.add_argument("--seed", type=int, required=True, help="seed of the start velocities")
+    p.add_argument("--out", required=True, help="final packing netCDF")
+    p.add_argument("--timeseries", required=True, help="per-segment time series netCDF")
+    p.add_argument("--checkpoint", help="checkpoint file (resumes a stopped run)")
+    p.set_defaults(func=cmd_glass_soc)
+
+    p = subparsers.add_parser("glass-soc-summary", help=cmd_glass_soc_summary.__doc__.split("\n\n")[0])
+    p.add_argument("--soc", nargs="+", required=True, help="glass-soc time series")
+    p.add_argument("--relaxed", nargs="+", required=True,
+                   help="hardpack eos runs of their final packings, in the same order")
+    p.add_argument("--out", required=True, help="summary netCDF")
+    p.set_defaults(func=cmd_glass_soc_summary)
 
     p = subparsers.add_parser("glass-microsegregated-summary",
                               help=cmd_glass_microsegregated_summary.__doc__.split("\n\n")[0])

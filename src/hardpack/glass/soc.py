@@ -284,3 +284,78 @@ def _final_packing(packing: Packing, dr: np.ndarray, scale: float, nb, dmu: floa
 def _save(path, fp, P, scale, dt, t, rows, totals) -> None:
     ckpt.save(path, fp, {"P": P, "scale": scale, "dt": dt, "time": t,
                          "records": np.asarray(rows, float).reshape(-1, len(_COLUMNS)), "totals": totals})
+
+
+#: fraction of a relaxation's blocks (the last ones) whose mean pressure gives the relaxed phi_J
+RELAXED_TAIL = 0.25
+
+
+def soc_summary(timeseries, relaxations) -> xr.Dataset:
+    """phi_J of SOC solids at the end of their compression and after relaxation without cells, per
+    start density phi_0 and seed (Donev 2006, sec. 13.3.1, Fig. 13.9).
+
+    Parameters
+    ----------
+    timeseries : sequence of xarray.Dataset
+        SOC compressions (:func:`compress_in_cells` time series, ``hardpack_kind`` =
+        "soc_compression").
+    relaxations : sequence of xarray.Dataset
+        For each of them, in the same order, NVE MD of its final packing with the cells removed
+        (``hardpack eos``: ``Z_block`` per block, ``phi`` in its attributes).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``phi0`` and ``seed``: ``phi_soc``, ``Z_soc``, ``phi_J_soc`` (phi / (1 - d / Z)
+        at the end of the compression), ``Z_relaxed`` (mean of the last ``RELAXED_TAIL`` of the
+        blocks), ``phi_J_relaxed``; NaN where a (phi0, seed) was not run.
+
+    Raises
+    ------
+    InvalidInputError
+        If the lists differ in length, a dataset is of the wrong kind, a relaxation was run at
+        another phi than its compression ended at, or two compressions share (phi0, seed) or differ
+        in N, dmu or rate.
+    """
+    timeseries, relaxations = list(timeseries), list(relaxations)
+    if len(timeseries) != len(relaxations) or not timeseries:
+        raise InvalidInputError(f"give one relaxation per SOC compression (got {len(timeseries)} compressions "
+                                f"and {len(relaxations)} relaxations)")
+    keys = ("n_particles", "dim", "dmu", "growth_rate", "max_pressure")
+    first = timeseries[0].attrs
+    rows = {}
+    for ts, rel in zip(timeseries, relaxations):
+        if ts.attrs.get("hardpack_kind") != "soc_compression" or "Z_block" not in rel:
+            raise InvalidInputError("soc_summary takes SOC compression time series and `hardpack eos` relaxations")
+        if any(ts.attrs[k] != first[k] for k in keys):
+            raise InvalidInputError(f"the SOC compressions differ in {', '.join(keys)}: summarise one protocol")
+        if not math.isclose(float(rel.attrs["phi"]), float(ts.attrs["phi_final"]), rel_tol=1e-9):
+            raise InvalidInputError(f"a relaxation at phi = {float(rel.attrs['phi']):.8f} does not start from the SOC "
+                                    f"packing at phi = {float(ts.attrs['phi_final']):.8f}: pair them in order")
+        key = (round(float(ts.attrs["phi0"]), 6), int(ts.attrs["seed"]))
+        if key in rows:
+            raise InvalidInputError(f"two SOC compressions from phi0 = {key[0]:g}, seed {key[1]}")
+        z = np.asarray(rel["Z_block"].values, float)
+        z_rel = float(np.mean(z[-max(1, int(round(RELAXED_TAIL * z.size))):]))
+        rows[key] = (float(ts.attrs["phi_final"]), float(ts["Z"].values[-1]), float(ts.attrs["phi_J_est"]), z_rel)
+    phi0s = sorted({k[0] for k in rows})
+    seeds = sorted({k[1] for k in rows})
+    d = int(first["dim"])
+    grid = np.full((4, len(phi0s), len(seeds)), np.nan)
+    for (p, s), values in rows.items():
+        grid[:, phi0s.index(p), seeds.index(s)] = values
+    phi, z_rel = grid[0], grid[3]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        phi_j_rel = np.where(z_rel > d, phi / (1.0 - d / z_rel), np.nan)
+    dims = ("phi0", "seed")
+    return xr.Dataset(
+        {"phi_soc": (dims, phi, {"long_name": "phi at the end of the SOC compression"}),
+         "Z_soc": (dims, grid[1], {"long_name": "pair-collision Z of the last segment"}),
+         "phi_J_soc": (dims, grid[2], {"long_name": "phi / (1 - d / Z) at the end of the SOC compression"}),
+         "Z_relaxed": (dims, z_rel, {"long_name": f"Z without cells, mean of the last {RELAXED_TAIL:g} of the blocks"}),
+         "phi_J_relaxed": (dims, phi_j_rel, {"long_name": "phi / (1 - d / Z_relaxed)"})},
+        coords={"phi0": phi0s, "seed": seeds},
+        attrs={"hardpack_kind": "glass_soc", "N": int(first["n_particles"]), "d": d, "dmu": float(first["dmu"]),
+               "growth_rate": float(first["growth_rate"]), "max_pressure": float(first["max_pressure"]),
+               "relax_collisions": float(relaxations[0].attrs.get("collisions", np.nan)) / int(first["n_particles"])},
+    )

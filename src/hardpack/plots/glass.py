@@ -297,6 +297,65 @@ def plot_glass_relaxation(runs):
     return fig
 
 
+def plot_glass_soc(eos, runs, summary):
+    """SOC solids of the mixture (after Donev 2006, Fig. 13.9): left, Z(phi) of each compression in
+    cells (coloured by its start density phi_0) over the slowest unconstrained compression; right,
+    phi_J in the cells and after relaxation without them vs phi_0, with the printed ~0.83 and ~0.85.
+
+    Parameters
+    ----------
+    eos : xarray.Dataset
+        The mixture's glass_eos summary (its slowest branch is drawn).
+    runs : list of xarray.Dataset
+        SOC compression time series (:func:`hardpack.glass.soc.compress_in_cells`).
+    summary : xarray.Dataset
+        Their summary (:func:`hardpack.glass.soc.soc_summary`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
+    from matplotlib import colormaps
+
+    fig, (ax, bx) = figure(1, 2, figsize=(10.0, 4.0), layout="constrained")
+    slowest = eos["branch"].values[int(np.argmin(eos["growth_rate"].values))]
+    row = eos.sel(branch=slowest)
+    ok = np.isfinite(row["Z"].values) & (row["phi_mean"].values >= 0.65)
+    ax.plot(row["phi_mean"].values[ok], row["Z"].values[ok], "k-", lw=1.6,
+            label=f"no cells, Gamma = {float(row['growth_rate']):g}")
+    phi0s = sorted({round(float(ds.attrs["phi0"]), 4) for ds in runs})
+    cmap = colormaps["viridis"]
+    for ds in runs:
+        phi0 = round(float(ds.attrs["phi0"]), 4)
+        colour = cmap(phi0s.index(phi0) / max(1, len(phi0s) - 1))
+        first = int(ds.attrs["seed"]) == int(min(r.attrs["seed"] for r in runs))
+        ax.plot(ds["phi_mid"].values, ds["Z"].values, "-", lw=0.8, color=colour,
+                label=f"in cells from phi_0 = {phi0:g}" if first and phi0 in (phi0s[0], phi0s[-1]) else None)
+    ax.set_yscale("log")
+    ax.set_xlim(min(phi0s) - 0.01, 0.86)
+    ax.set_xlabel("phi")
+    ax.set_ylabel("Z = PV / NkT (pair collisions)")
+    a = runs[0].attrs if runs else {}
+    ax.set_title(f"N = {a.get('n_particles', 0)}, cells of Delta mu = {a.get('dmu', float('nan')):g}, "
+                 f"Gamma = {a.get('growth_rate', float('nan')):g}", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    x = summary["phi0"].values
+    for name, marker, label in (("phi_J_soc", "o", "in cells"), ("phi_J_relaxed", "s", "cells removed, relaxed")):
+        values = summary[name].values
+        mean = np.nanmean(values, axis=1)
+        count = np.sum(np.isfinite(values), axis=1)
+        err = np.where(count > 1, np.nanstd(values, axis=1, ddof=min(1, values.shape[1] - 1)) / np.sqrt(count), 0.0)
+        bx.errorbar(x, mean, yerr=err, fmt=marker + "-", ms=4, capsize=2, label=label)
+    bx.axhline(0.83, color="C0", ls=":", lw=0.8, label="Donev: ~0.83 from liquid snapshots")
+    bx.axhline(0.85, color="C1", ls=":", lw=0.8, label="Donev: ~0.85 after relaxation")
+    bx.set_xlabel("phi_0 of the snapshot")
+    bx.set_ylabel("phi_J = phi / (1 - 2/Z)")
+    bx.set_title(f"jamming densities ({summary.sizes['seed']} seed(s))", fontsize=9)
+    bx.legend(fontsize=7)
+    return fig
+
+
 def _snapshot_phi(ds) -> float:
     """The snapshot's density: BCMD shrinks the radii by (1 - delta) (attribute ``delta``)."""
     shrink = (1.0 - float(ds.attrs.get("delta", 0.0))) ** int(ds.attrs.get("dim", 2))

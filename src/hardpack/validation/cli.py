@@ -38,6 +38,7 @@ from hardpack.validation.glass import (
     microsegregated_rows,
     relaxed_rows,
     smix_rows,
+    soc_rows,
 )
 from hardpack.validation.jamming import jamming_rows, strict_ls_rows
 from hardpack.validation.packings import ls_rows, slp_mrj_rows
@@ -76,6 +77,7 @@ ROW_BUILDERS = {
     "glass_crystal": lambda datasets: _disk_crystal_rows(datasets),
     "glass_freezing": lambda datasets: [row for ds in datasets for row in freezing_rows(ds)],
     "glass_relaxed": lambda datasets: [row for ds in datasets for row in relaxed_rows(ds)],
+    "glass_soc": lambda datasets: [row for ds in datasets for row in soc_rows(ds)],
     "glass_microsegregated": lambda datasets: [row for ds in datasets for row in microsegregated_rows(ds)],
     "ellipsoids": ellipsoid_rows,
     "ellipsoid_jamming": ellipsoid_jamming_rows,

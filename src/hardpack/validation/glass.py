@@ -342,6 +342,36 @@ def relaxed_rows(ds) -> list[Row]:
     return [evaluate(target, samples=ds["phi_J"].values[fastest], n=n, detail=detail, label=f"Gamma = {rates.max():g}")]
 
 
+def soc_rows(ds) -> list[Row]:
+    """phi_J of the SOC solids from the lowest snapshot density, in their cells and after the cells
+    are removed, against the printed ~0.83 and ~0.85 (Donev 2006, sec. 13.3.1, Fig. 13.9); mean and
+    standard error over seeds, every snapshot density in the detail.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The SOC summary (:func:`hardpack.glass.soc.soc_summary`).
+
+    Returns
+    -------
+    list of Row
+        Validation rows (:class:`hardpack.validation.rows.Row`).
+    """
+    targets = load_targets()
+    n = int(ds.attrs.get("N", 0))
+    lowest = ds.sel(phi0=float(np.min(ds["phi0"].values)))
+    per_phi0 = "; ".join(f"{float(p):g}: {float(np.nanmean(ds['phi_J_soc'].sel(phi0=p))):.4f} -> "
+                         f"{float(np.nanmean(ds['phi_J_relaxed'].sel(phi0=p))):.4f}" for p in ds["phi0"].values)
+    detail = (f"N = {n}; cells of Delta mu = {ds.attrs.get('dmu'):g} compressed at {ds.attrs.get('growth_rate'):g} "
+              f"to Z = {ds.attrs.get('max_pressure'):g}, relaxed {ds.attrs.get('relax_collisions'):g} collisions per "
+              f"disk; phi_J in cells -> relaxed per phi_0: {per_phi0}")
+    label = f"phi_0 = {float(lowest['phi0']):g}"
+    return [evaluate(targets["donev-13.3-soc-phij-liquid"], samples=lowest["phi_J_soc"].values, n=n, detail=detail,
+                     label=label),
+            evaluate(targets["donev-13.3-soc-phij-relaxed"], samples=lowest["phi_J_relaxed"].values, n=n,
+                     detail=detail, label=label)]
+
+
 def entropy_rows(ds) -> list[Row]:
     """s_c - s_mix of the snapshot at phi0 = 0.80 (binary) or 0.75 (monodisperse) of the slowest
     compression that has one, mean and standard error over seeds; for the monodisperse crystal
