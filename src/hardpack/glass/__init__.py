@@ -9,10 +9,10 @@ Torquato 2006).
   large-disk crystal (Eq. 13.2).
 - :mod:`hardpack.glass.study`: the triangular start crystal, binned EOS of compressions and the
   summaries of the pipeline.
-
+- :mod:`hardpack.glass.soc`: compression of single-occupancy-cell (SOC) solids, each disk growing in
+  a fixed cell (sec. 13.3.1, Fig. 13.9), and the summary of their jamming densities.
 - :mod:`hardpack.glass.segregated`: the micro-segregated labels of sec. 13.5 (level-cut Matérn
   Gaussian random fields), their window entropies s_{n,m} and the labelled start crystal.
-
-Not implemented: growing the B disks of the labelled crystal at constant pressure and jamming the
-micro-segregated packings (sec. 13.5; needs the deforming-cell MD of :mod:`hardpack.md.deforming`).
+- :mod:`hardpack.glass.microsegregated`: growth of the labelled crystal's B disks at constant
+  pressure and compression to jamming (sec. 13.5, with :mod:`hardpack.md.deforming`).
 """
