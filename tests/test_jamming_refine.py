@@ -2,8 +2,11 @@
 (hardpack.jamming.refine): Newton's method on the KKT equations of growing the particles.
 
 Stored packings (tests/data): M&M-shaped oblate spheroids (alpha = 1.9, N = 80, LS at the final
-rate 1e-3 to p = 1e12, seeds 1 and 2) and near-sphere ellipsoids (1 : 1.05^(1/2) : 1.05 and
-1 : 1.02^(1/2) : 1.02 and 1 : 1 : 1.02 at the final rate 1e-4, N = 100).
+rate 1e-3 to p = 1e12, seeds 1 and 2), near-sphere ellipsoids (1 : 1.05^(1/2) : 1.05 and
+1 : 1.02^(1/2) : 1.02 and 1 : 1 : 1.02 at the final rate 1e-4, N = 100) and 30 ellipses of
+semiaxes 1 and 0.8 in a closed box (``random_ellipsoid_packing(30, [1, 0.8], 0.3, 1,
+boundary="hard_walls", wall_axes=[0, 1])``, then ``compress_ellipsoids`` at 1e-2 to p = 1e3 and at
+1e-4 to p = 1e10, seed 1).
 The refined configuration's gaps are checked by the pair search of Packing.overlap_report and
 ellipsoid_contacts, its balance by the verifier's own A F, and Newton's quadratic convergence
 checks the contact Hessians against the Perram-Wertheim function.
@@ -325,8 +328,10 @@ def test_the_next_network_drops_contacts_and_adds_only_overlapping_pairs():
     assert first.negative == 2
     at = contacts_of_pairs(first.packing, *pairs)
     assert np.abs(at.gap[first.forces < 0]).max() < 1e-9  # the dropped pairs touch there
-    after, forces, out, new = _next_network(first.packing, pairs, first.forces, present, res.backbone,
-                                            packing.overlap_tol)
+    no_walls = (np.zeros(0, np.int64), np.zeros(0, np.int64))
+    after, walls, forces, out, new = _next_network(first.packing, pairs, no_walls, first.forces, present,
+                                                   res.backbone, packing.overlap_tol)
+    assert len(walls[0]) == 0
     assert (out, new) == (2, 0) and len(after[0]) == len(pairs[0]) - 2
     kept = {(int(i), int(j)) for i, j in zip(*after[:2])}
     assert not kept & {(int(pairs[0][c]), int(pairs[1][c])) for c in np.flatnonzero(first.forces < 0)}
@@ -338,7 +343,95 @@ def test_the_next_network_drops_contacts_and_adds_only_overlapping_pairs():
     pairs = net.i[used], net.j[used], net.shift[used]
     one = refine_jamming_point(packing, res, rounds=1)
     assert one.converged and one.overlaps == 2
-    after, forces, out, new = _next_network(one.packing, pairs, one.forces, res.backbone | res.frozen,
-                                            res.backbone, packing.overlap_tol)
+    after, _, forces, out, new = _next_network(one.packing, pairs, no_walls, one.forces, res.backbone | res.frozen,
+                                               res.backbone, packing.overlap_tol)
     assert (out, new) == (0, 2) and np.array_equal(after[0][:-2], pairs[0])
     assert (contacts_of_pairs(one.packing, *(p[-2:] for p in after)).gap < -packing.overlap_tol).all()
+
+
+# ------------------------------------------------------------------------------ flat hard walls
+def _ellipse_in_a_square(theta, centre, factor, side=4.0):
+    from hardpack.geometry.boundaries import HardWalls
+    from hardpack.geometry.packing import Packing
+    from hardpack.geometry.shapes import Ellipsoids
+
+    return Packing(np.array([centre]), lattice=np.eye(2) * side, boundary=HardWalls((0, 1)),
+                   shape=Ellipsoids(np.array([[2.0 * factor, 1.0 * factor]]), np.array([theta])))
+
+
+def test_newton_between_walls_reaches_the_exact_jamming_point_of_an_ellipse_in_a_square():
+    """An ellipse of semiaxes 2f and f in a square box of side L, touching all four walls: its
+    widths are 2 f sqrt(a^2 cos^2 + b^2 sin^2) and 2 f sqrt(a^2 sin^2 + b^2 cos^2), the larger of
+    which is smallest at 45 degrees, so the jamming point is the centre of the box, theta = pi/4
+    and f = L / sqrt(2 (a^2 + b^2)) (a = 2, b = 1). Newton starts 1.1 degrees off, 1e-3 off centre
+    and 3 % smaller, and lands there to round-off, quadratically."""
+    side = 4.0
+    exact = side / np.sqrt(2.0 * (4.0 + 1.0))
+    start = _ellipse_in_a_square(np.pi / 4 + 0.02, [2.001, 1.999], 0.97 * exact, side)
+    res = verify_ellipsoids(start, delta=0.05)
+    assert res.network.n_wall_contacts == 4 and res.contacts_used.all()
+    ref = refine_jamming_point(start, res)
+    assert ref.converged and ref.overlaps == 0 and ref.iterations <= 4
+    assert all(b <= 100 * a**2 + 1e-13 for a, b in zip(ref.gap, ref.gap[1:]))  # quadratically
+    end = ref.packing
+    np.testing.assert_allclose(end.positions, [[2.0, 2.0]], atol=1e-12)
+    assert float(end.shape.orientations[0]) == pytest.approx(np.pi / 4, abs=1e-12)
+    np.testing.assert_allclose(end.shape.semiaxes, [[2.0 * exact, exact]], rtol=1e-12)
+    assert 1.0 + ref.size_change == pytest.approx(1.0 / 0.97, rel=1e-12)
+    np.testing.assert_allclose(ref.forces, 1.0, rtol=1e-9)  # by symmetry, four equal wall forces
+    # four contacts on three degrees of freedom: an exact (not near) self-stress already at the
+    # start, which is first-order rigid, so the verdict needs no refinement
+    out = verify_at_jamming_point(start, delta=0.05)
+    assert out.verdict == Verdict.JAMMED and out.order == "first" and out.params["refined"] == 0
+
+
+def test_newton_between_walls_refines_a_compressed_ellipse_packing_to_a_jamming_point():
+    """30 ellipses LS-compressed in a closed box to p = 1e10: the default contact tolerance misses
+    three contacts, with delta = 1e-8 the packing as given is second-order jammed with a near
+    self-stress. Newton reaches the jamming point of its contacts; checked there independently of
+    the Newton system: every contact of the network (18 with walls) touches to 1e-12 of a semiaxis
+    (the gaps recomputed by the contact search, walls by the particles' extents), nothing overlaps
+    or crosses a wall, and the verifier's self-stress balances the force and torque on every
+    particle (computed from the contact points, a wall acting on its particle only)."""
+    packing = _packing("ellipses_box_n30_seed1_p1e10")
+    out = verify_at_jamming_point(packing, delta=1e-8)
+    assert out.params["refined"] == 1 and out.verdict == Verdict.JAMMED and out.order == "second"
+    note = out.params["refine_note"]
+    assert "Newton converged" in note and out.params["refine_iterations"] <= 5
+    res = verify_ellipsoids(packing, delta=1e-8)
+    ref = refine_jamming_point(packing, res)
+    end = ref.packing
+    assert end.overlap_report(1e-12).n_overlapping == 0 and end.containment_report(1e-12).n_outside == 0
+    net = ellipsoid_contacts(end, 1e-6)
+    assert net.n_wall_contacts == res.network.subset(res.contacts_used).n_wall_contacts == 18
+    assert np.abs(net.gap).max() < 1e-12
+    at = verify_ellipsoids(end, delta=1e-9)
+    f, net = at.contact_forces, at.network
+    assert (f[at.contacts_used] > 0).all()
+    pair = ~net.is_wall
+    force, torque = np.zeros((30, 2)), np.zeros(30)
+
+    def cross(r, u):
+        return r[:, 0] * u[:, 1] - r[:, 1] * u[:, 0]
+
+    np.add.at(force, net.i, -f[:, None] * net.normal)
+    np.add.at(force, net.j[pair], f[pair, None] * net.normal[pair])
+    np.add.at(torque, net.i, cross(net.lever_i, -f[:, None] * net.normal))
+    np.add.at(torque, net.j[pair], cross(net.lever_j[pair], f[pair, None] * net.normal[pair]))
+    assert np.abs(force).max() < 1e-10 * f.max() and np.abs(torque).max() < 1e-10 * f.max()
+
+
+def test_newton_between_walls_tracks_wall_contacts_by_particle_and_wall():
+    """contacts_of_pairs appends the named flat-wall contacts with the gaps of ellipsoid_contacts and
+    refuses them where the boundary has no such wall; a container is not refined and says why."""
+    packing = _packing("ellipses_box_n30_seed1_p1e10")
+    near = ellipsoid_contacts(packing, 1e-6)
+    on_wall = near.is_wall
+    given = contacts_of_pairs(packing, near.i[~on_wall], near.j[~on_wall], near.shift[~on_wall],
+                              positions=near.positions, walls=(near.i[on_wall], near.wall[on_wall]))
+    np.testing.assert_allclose(given.zeta, near.zeta, rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(given.wall, near.wall)
+    with pytest.raises(InvalidInputError, match="between flat hard walls"):
+        contacts_of_pairs(_packing("oblate_n40_slow_p1e12"), [0], [1], [[0, 0, 0]], walls=([0], [0]))
+    with pytest.raises(InvalidInputError, match="axis without walls"):
+        contacts_of_pairs(packing, [0], [1], [[0, 0]], walls=([0], [4]))

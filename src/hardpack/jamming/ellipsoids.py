@@ -524,10 +524,30 @@ def _check_centres_between_walls(packing: Packing) -> None:
 
 def _with_plane_walls(net: EllipsoidContacts, boundary) -> EllipsoidContacts:
     """``net`` with the contacts of the flat hard walls appended (module docstring)."""
-    x, d = net.positions, net.dim
     axes = list(boundary.axes)
-    part, wall, u, lever, h, dist = plane_wall_contacts(x, net.shape_inv, net.semiaxes, axes,
-                                                        np.diag(net.lattice)[axes], net.delta)
+    found = plane_wall_contacts(net.positions, net.shape_inv, net.semiaxes, axes, np.diag(net.lattice)[axes],
+                                net.delta)
+    return _append_plane_walls(net, *found)
+
+
+def _given_plane_walls(net: EllipsoidContacts, particle: np.ndarray, wall: np.ndarray):
+    """The flat-wall contact data of the given (particle, wall number) pairs, touching or not, in
+    that order (the arrays of :func:`plane_wall_contacts`)."""
+    x, inv, d = net.positions, net.shape_inv, net.dim
+    k, upper = np.divmod(wall, 2)
+    s = np.sqrt(inv[particle, k, k])
+    dist = np.where(upper == 1, net.lattice[k, k] - x[particle, k], x[particle, k])
+    sign = np.where(upper == 1, 1.0, -1.0)
+    normal = np.zeros((len(particle), d))
+    normal[np.arange(len(particle)), k] = sign
+    lever = sign[:, None] * inv[particle, :, k] / s[:, None]
+    return particle, wall, normal, lever, dist - s, dist
+
+
+def _append_plane_walls(net: EllipsoidContacts, part, wall, u, lever, h, dist) -> EllipsoidContacts:
+    """``net`` with flat-wall contacts appended (module docstring: j = i, scale 1, zeta with
+    ``gap`` = h / a_max)."""
+    x, d = net.positions, net.dim
     amax = net.semiaxes[part].max(axis=1)
     m = len(part)
     walls = dict(
@@ -561,25 +581,43 @@ def wall_name(net: EllipsoidContacts, c: int) -> str:
     return f"the wall x_{k} = {net.lattice[k, k]:.6g}" if upper else f"the wall x_{k} = 0"
 
 
-def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> EllipsoidContacts:
-    """The contact data of given pairs (i, j, image shift), touching or not (``delta`` = inf).
+def contacts_of_pairs(packing: Packing, i, j, shift, positions=None, walls=None) -> EllipsoidContacts:
+    """The contact data of given pairs (i, j, image shift), touching or not (``delta`` = inf), and
+    of given contacts with flat hard walls after them.
 
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell.
+        Ellipses or ellipsoids in a periodic cell or between flat hard walls.
     i, j : array_like of int, shape (M,)
         The pairs.
     shift : array_like of int, shape (M, d)
         Lattice images: the separation is x_j + L shift - x_i.
     positions : ndarray, shape (N, d), optional
         The centres x the shifts refer to (default ``packing.positions`` as given, not wrapped).
+    walls : tuple of two array_like of int, shape (W,), optional
+        (particle, wall number) of flat-wall contacts (2 k for x_k = 0, 2 k + 1 for x_k = L_k),
+        appended after the pairs in this order.
 
     Returns
     -------
     EllipsoidContacts
+
+    Raises
+    ------
+    InvalidInputError
+        If ``walls`` is given for a packing that is not between flat hard walls, or names a wall
+        the boundary does not have.
     """
     check_ellipsoid_packing(packing)
+    if walls is not None and len(walls[0]):
+        if packing.boundary.kind != "hard_walls":
+            raise InvalidInputError(
+                f"flat-wall contacts need a packing between flat hard walls, not {packing.boundary}")
+        axes = set(int(k) for k in packing.boundary.axes)
+        if not set(int(k) for k in np.asarray(walls[1]) // 2) <= axes:
+            raise InvalidInputError(
+                f"a wall contact names a wall on an axis without walls (walled axes {sorted(axes)})")
     shape = packing.shape
     n = packing.n_particles
     semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
@@ -592,12 +630,16 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None) -> Ellipsoi
     sep = np.ascontiguousarray(x[jj] + shift @ lattice.T - x[ii])
     zeta, lam, raw, point = _pair_contacts(x, inv, np.asarray(shape.bounding_radii, float), ii, jj, sep)
     norm = np.linalg.norm(raw, axis=1)
-    return EllipsoidContacts(
+    net = EllipsoidContacts(
         i=ii, j=jj, shift=shift, separation=sep, zeta=zeta, lam=lam, normal=raw / norm[:, None],
         raw_normal=raw, lever_i=point - x[ii], lever_j=point - (x[ii] + sep),
         scale=2.0 * lam * (1.0 - lam) * norm, positions=x, lattice=lattice, shape_inv=inv,
         semiaxes=semiaxes, delta=float("inf"), periodic=packing.boundary.periodic_axes(packing.dim),
     )
+    if walls is None or not len(walls[0]):
+        return net
+    found = _given_plane_walls(net, np.asarray(walls[0], np.int64), np.asarray(walls[1], np.int64))
+    return _append_plane_walls(net, *found)
 
 
 def check_ellipsoid_packing(packing) -> None:

@@ -24,6 +24,14 @@ update moves the centres by the translational part of dQ and turns each orientat
 rotation vector of its rotational part (R = exp(W) applied in the lab frame, the parametrisation
 of the Hessians).
 
+Flat hard walls (:mod:`hardpack.jamming.ellipsoids`) enter as contacts of one particle with a fixed
+plane, tracked by (particle, wall number): the gap row is h = b - n . x - s (s = n . (p - x) the
+support distance of the farthest point p along the outward normal n), its gradient and Hessian
+those of the first- and second-order tests, and b_c = -dh_c / ds = n . (p - x), since the support
+distance grows with the semiaxes. The translations normal to a wall are no longer trivial motions.
+A particle in a spherical container can touch it at two points whose identity can change along
+the iteration, so containers are not refined.
+
 The refined configuration is the jamming point only if no pair outside the contact network
 overlaps there: a network whose jamming point overlaps other pairs is not the network of the
 packing's jamming point (Donev 2006, Sec. 5.6: a missed contact makes spurious floppy modes).
@@ -143,8 +151,8 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell, near a jamming point (an LS packing at a high
-        pressure).
+        Ellipses or ellipsoids in a periodic cell or between flat hard walls, near a jamming point
+        (an LS packing at a high pressure).
     result : EllipsoidJammingResult
         :func:`hardpack.jamming.second_order.verify_ellipsoids` of ``packing``: its backbone,
         contacts and self-stress (exact or near) start the iteration; rattlers stay where they are.
@@ -166,12 +174,13 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     Raises
     ------
     InvalidInputError
-        For a packing in a container (walls are not handled), a result without a self-stress
+        For a packing in a spherical container (its wall contacts are not tracked), a result without a self-stress
         (the packing is not jammed at first order: there is no jamming point to refine to) or of
         another packing, or bad ``max_iter`` / ``tol``.
     """
-    if packing.boundary.kind != "periodic":
-        raise InvalidInputError("refine_jamming_point handles periodic packings only (no walls)")
+    if packing.boundary.kind == "spherical_container":
+        raise InvalidInputError("refine_jamming_point handles periodic packings and flat hard walls, not a "
+                                "spherical container (a particle's contacts with it are not tracked from step to step)")
     for name, value in (("max_iter", max_iter), ("rounds", rounds)):
         if not (isinstance(value, int) and value >= 1):
             raise InvalidInputError(f"{name} must be a positive integer, got {value!r}")
@@ -188,7 +197,11 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     frozen = result.frozen
     used = np.flatnonzero(result.contacts_used)
     net = result.network
-    pairs = net.i[used], net.j[used], net.shift[used]
+    on_wall = net.is_wall[used]
+    pair, wall = used[~on_wall], used[on_wall]
+    pairs = net.i[pair], net.j[pair], net.shift[pair]
+    walls = net.i[wall], net.wall[wall]
+    forces = np.concatenate([forces[~on_wall], forces[on_wall]])  # the order of contacts_of_pairs
     a = float(np.min(packing.shape.semiaxes))
     current, factor, added, dropped = packing, 1.0, 0, 0
     gaps, balances, steps = [], [], []
@@ -196,91 +209,111 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     for round_ in range(rounds):
         # particles with fewer than d + 1 contacts cannot be held: their free motions would make the
         # KKT matrix singular, so they leave the network with their contacts and stay where they are
-        pairs, forces, active = _pinned(pairs, forces, active, frozen, packing.dim)
+        pairs, walls, forces, active = _pinned(pairs, walls, forces, active, frozen, packing.dim)
         present = active | frozen
         if len(forces) < 2:
             converged = False
             break
-        current, stationary, forces, growth = _newton(current, pairs, forces, active, max_iter, tol, a,
+        current, stationary, forces, growth = _newton(current, pairs, walls, forces, active, max_iter, tol, a,
                                                       gaps, balances, steps)
         factor *= growth
         # a KKT point of growing the particles only if every multiplier (force) is positive
         converged = stationary and bool(forces.min() > 0)
         if not stationary or round_ == rounds - 1:
             break
-        following, start_forces, out, new = _next_network(current, pairs, forces, present, active,
-                                                          packing.overlap_tol)
+        following, following_walls, start_forces, out, new = _next_network(current, pairs, walls, forces, present,
+                                                                           active, packing.overlap_tol)
         if not (out or new) or len(start_forces) < 2:
             break
-        pairs, forces = following, start_forces
+        pairs, walls, forces = following, following_walls, start_forces
         dropped += out
         added += new
     overlaps = current.overlap_report(packing.overlap_tol).n_overlapping
+    if current.boundary.kind != "periodic":
+        overlaps += current.containment_report(packing.overlap_tol).n_outside
     return Refinement(packing=current, converged=converged, iterations=len(steps), gap=np.array(gaps),
                       balance=np.array(balances), steps=np.array(steps), size_change=factor - 1.0,
                       forces=forces, overlaps=int(overlaps), added=added,
                       negative=int((forces < 0).sum()), dropped=dropped, pinned=backbone - int(active.sum()))
 
 
-def _pinned(pairs, forces, active: np.ndarray, frozen: np.ndarray, d: int):
-    """The network without its rattlers: active particles with fewer than d + 1 contacts (whose
-    contacts cannot balance a force, Donev 2006, Sec. 4.4.3.1) leave it with their contacts,
-    repeatedly. Returns (pairs, forces rescaled to sum M, active)."""
+def _pinned(pairs, walls, forces: np.ndarray, active: np.ndarray, frozen: np.ndarray, d: int):
+    """The network without its rattlers: active particles with fewer than d + 1 contacts (walls
+    included; whose contacts cannot balance a force, Donev 2006, Sec. 4.4.3.1) leave it with their
+    contacts, repeatedly. Returns (pairs, walls, forces rescaled to sum M, active); ``forces`` lists
+    the pairs' forces, then the walls'."""
     active = active.copy()
     n = len(active)
     while True:
         present = active | frozen
         inside = present[pairs[0]] & present[pairs[1]]
-        count = np.bincount(np.concatenate([pairs[0][inside], pairs[1][inside]]), minlength=n)
+        held = present[walls[0]]
+        count = np.bincount(np.concatenate([pairs[0][inside], pairs[1][inside], walls[0][held]]), minlength=n)
         loose = active & (count < d + 1)
         if not loose.any():
             break
         active &= ~loose
-    if inside.all():
-        return pairs, forces, active
+    if inside.all() and held.all():
+        return pairs, walls, forces, active
     pairs = tuple(p[inside] for p in pairs)
-    forces = forces[inside]
+    walls = tuple(w[held] for w in walls)
+    forces = forces[np.concatenate([inside, held])]
     if forces.size:
         forces = forces * (len(forces) / forces.sum())
-    return pairs, forces, active
+    return pairs, walls, forces, active
 
 
-def _next_network(current: Packing, pairs, forces: np.ndarray, present: np.ndarray, active: np.ndarray,
+def _next_network(current: Packing, pairs, walls, forces: np.ndarray, present: np.ndarray, active: np.ndarray,
                   overlap_tol: float):
     """The contact network of the next active-set round, from a stationary point ``current`` of
-    the network ``pairs`` with multipliers ``forces``: contacts with a force <= 0 leave (they open
-    as the particles grow), pairs outside the network that overlap by more than ``overlap_tol``
-    (between particles in ``present``, one of them ``active``) join with the mean force. Only
-    overlapping pairs join, so a contact that leaves (touching, not overlapping) stays out.
-    Returns (pairs, forces rescaled to sum M, contacts dropped, pairs added)."""
+    the network ``pairs`` and ``walls`` with multipliers ``forces`` (pairs first): contacts with a
+    force <= 0 leave (they open as the particles grow), pairs outside the network that overlap by
+    more than ``overlap_tol`` (between particles in ``present``, one of them ``active``) and active
+    particles that cross a flat wall by more than ``overlap_tol`` of a_max join with the mean force.
+    Only overlapping contacts join, so a contact that leaves (touching, not overlapping) stays out.
+    Returns (pairs, walls, forces rescaled to sum M, contacts dropped, contacts added)."""
     keep = forces > 0
+    m = len(pairs[0])
     near = ellipsoid_contacts(current, OVERLAP_SEARCH)
     inside = {(int(i), int(j), *map(int, k)) for i, j, k in zip(*pairs)}
     inside |= {(int(j), int(i), *map(int, -np.asarray(k))) for i, j, k in zip(*pairs)}
-    outside = np.array([(int(i), int(j), *map(int, k)) not in inside
-                        for i, j, k in zip(near.i, near.j, near.shift)], dtype=bool)
+    inside_walls = {(int(i), int(w)) for i, w in zip(*walls)}
+    on_wall = near.is_wall
+    outside = np.array([((int(i), int(w)) not in inside_walls) if at_wall else
+                        ((int(i), int(j), *map(int, k)) not in inside)
+                        for i, j, k, w, at_wall in zip(near.i, near.j, near.shift, near.wall, on_wall)], dtype=bool)
     join = (outside & (near.gap < -overlap_tol) & present[near.i] & present[near.j]
             & (active[near.i] | active[near.j]))
+    join_pair, join_wall = join & ~on_wall, join & on_wall
     if not keep.any():
-        return tuple(p[keep] for p in pairs), forces[keep], int(keep.size), 0
-    pairs = tuple(np.concatenate([p[keep], q[join]]) for p, q in zip(pairs, (near.i, near.j, near.shift)))
-    forces = np.concatenate([forces[keep], np.full(int(join.sum()), forces[keep].mean())])
-    return pairs, forces * (len(forces) / forces.sum()), int((~keep).sum()), int(join.sum())
+        return (tuple(p[keep[:m]] for p in pairs), tuple(w[keep[m:]] for w in walls), forces[keep],
+                int(keep.size), 0)
+    pairs = tuple(np.concatenate([p[keep[:m]], q[join_pair]]) for p, q in zip(pairs, (near.i, near.j, near.shift)))
+    walls = tuple(np.concatenate([w[keep[m:]], q[join_wall]]) for w, q in zip(walls, (near.i, near.wall)))
+    mean = forces[keep].mean()
+    forces = np.concatenate([forces[:m][keep[:m]], np.full(int(join_pair.sum()), mean),
+                             forces[m:][keep[m:]], np.full(int(join_wall.sum()), mean)])
+    return pairs, walls, forces * (len(forces) / forces.sum()), int((~keep).sum()), int(join.sum())
 
 
-def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, steps):
-    """Newton steps on the KKT equations of the contacts ``pairs`` (module docstring), appending
-    the history to ``gaps``, ``balances``, ``steps``. Returns (packing, stationary: whether the
-    gaps and the balance met ``tol``, forces, growth factor of the semiaxes)."""
+def _newton(current, pairs, walls, forces, active, max_iter, tol, a, gaps, balances, steps):
+    """Newton steps on the KKT equations of the contacts ``pairs`` and ``walls`` (module
+    docstring), appending the history to ``gaps``, ``balances``, ``steps``. Returns (packing,
+    stationary: whether the gaps and the balance met ``tol``, forces, growth factor of the
+    semiaxes)."""
     d, f = current.dim, dof_per_particle(current.dim)
-    m = len(pairs[0])
+    m = len(pairs[0]) + len(walls[0])
     x = wrapped_positions(current)
+    walled = ~current.boundary.periodic_axes(d)
+    x[:, walled] = current.positions[:, walled]  # not wrapped (as ellipsoid_contacts)
     factor = 1.0
     for it in range(max_iter + 1):
-        net = contacts_of_pairs(current, *pairs, positions=x)
+        net = contacts_of_pairs(current, *pairs, positions=x, walls=walls)
         t, _ = dof_basis(net, active)
         at = (rigidity_transpose_full(net) @ t).tocsr()
-        h = net.zeta / net.scale
+        on_wall = net.is_wall
+        amax = net.semiaxes[net.i].max(axis=1)
+        h = np.where(on_wall, net.gap * amax, net.zeta / net.scale)  # wall contacts store gap = h / a_max
         gaps.append(float(np.abs(h).max() / a))
         balances.append(float(np.linalg.norm(at.T @ forces) / (spla.norm(at) * np.linalg.norm(forces))))
         if gaps[-1] <= tol and balances[-1] <= tol:
@@ -290,7 +323,8 @@ def _newton(current, pairs, forces, active, max_iter, tol, a, gaps, balances, st
         k = (t.T @ stiffness_matrix_full(net, forces, contact_hessians(net)) @ t).tocsr()
         triv = trivial_motions(t, net, active)
         n, nt = at.shape[1], triv.shape[1]
-        b = 2.0 * (net.zeta + 1.0) / net.scale
+        # -dh/ds: pairs 2 (zeta + 1) / s; a wall n . (p - x), the support distance, grows with the semiaxes
+        b = np.where(on_wall, np.einsum("mk,mk->m", net.normal, net.lever_i), 2.0 * (net.zeta + 1.0) / net.scale)
         z = sp.csr_matrix
         kkt = sp.vstack([
             sp.hstack([-k, at.T, z((n, 1)), z(triv)]),
@@ -364,8 +398,8 @@ def _solve(kkt: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 def _obstacle(packing: Packing, result) -> str | None:
     """Why ``result`` cannot start :func:`refine_jamming_point` (None when it can)."""
     dec = result.collective
-    if packing.boundary.kind != "periodic":
-        return "not refined: walls are not handled"
+    if packing.boundary.kind == "spherical_container":
+        return "not refined: the container wall is not handled"
     if dec.approx_stress is None:
         return "not refined: no near self-stress (exact self-stresses, or none)"
     if not (dec.forces.size and dec.forces.min() > 0):
@@ -399,7 +433,7 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     packing is near one.
 
     Runs :func:`hardpack.jamming.second_order.verify_ellipsoids`; when its backbone has a strictly
-    positive near self-stress (a packing near, not at, its jamming point; periodic cells), refines
+    positive near self-stress (a packing near, not at, its jamming point; periodic cells or flat walls), refines
     the configuration with :func:`refine_jamming_point` and, when that converges with no pair
     overlapping, tests the refined configuration instead, whose balance A F = 0 is exact to
     round-off. When the local test of the packing as given finds no backbone with a near
@@ -440,7 +474,8 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     ----------
     packing : Packing
         Ellipses or ellipsoids in a periodic cell, between flat hard walls or in a spherical
-        container (walls are not refined: their verdict is that of the packing as given).
+        container (not refined: its verdict is that of the packing as given). Between flat walls
+        there is no size ascent (neither the retry nor the certificate: the notes say so).
     confirm : bool, default True
         Certify a second-order flexible verdict at the jamming point by the size ascent.
     retry_after_ascent : bool, default True
@@ -461,7 +496,10 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     first = _at_jamming_point(packing, confirm and affordable, options, ascent_max_particles)
     first.params.setdefault("ascended", 0)
     if first.params.get("refined") != 0 or "refine_iterations" not in first.params:
-        return first  # refined, or Newton never started (no near self-stress, walls)
+        return first  # refined, or Newton never started (no near self-stress, a container)
+    if retry_after_ascent and packing.boundary.kind != "periodic":
+        first.params["refine_note"] += "; no retry after the size ascent (it handles periodic packings only)"
+        return first
     if retry_after_ascent and not affordable:
         first.params["refine_note"] += (f"; no retry after the size ascent above N = {ascent_max_particles} "
                                         "(ascent_max_particles; an ascent takes tens of CPU-minutes at N ~ 1000)")
@@ -490,7 +528,7 @@ def _at_jamming_point(packing: Packing, confirm: bool, options: dict, ascent_max
     result = verify_ellipsoids(packing, **options)
     dec = result.collective
     note, start, whole = _obstacle(packing, result), result, ""
-    if note is not None and packing.boundary.kind == "periodic" and options.get("local", True):
+    if note is not None and packing.boundary.kind != "spherical_container" and options.get("local", True):
         # the local test needs each particle's own near self-stress, which an LS packing near the
         # sphere point (torques of order alpha - 1) can miss: every particle then looks like a
         # rattler; the collective test of all particles can still start the refinement
@@ -523,7 +561,10 @@ def _at_jamming_point(packing: Packing, confirm: bool, options: dict, ascent_max
                    f"{int(result.rattler.sum())})")), **info)
             refined.collective.reason = f"at the jamming point of the contacts: {refined.collective.reason}"
             if refined.verdict == Verdict.NOT_JAMMED and refined.unjamming_motion() is not None:
-                if confirm:
+                if packing.boundary.kind != "periodic":
+                    refined.collective.reason += ("; not certified by the size ascent (it handles periodic "
+                                                  "packings only)")
+                elif confirm:
                     _confirm(ref.packing, refined)
                 elif packing.n_particles > ascent_max_particles:
                     refined.collective.reason += (f"; not certified by the size ascent (skipped above "
