@@ -972,9 +972,9 @@ EXPECTED_MINUTES = {
     "glass_crystal_bcmd": lambda w: 0.3 + GLASS["N"] * 100 * GLASS["bcmd"]["dmu_max"] / GLASS["bcmd"]["gamma0"] / 3e6 / 60,
     # N = 1024, Gamma = 0.1, 1e4 collisions per particle, recompression at 1e-4 to Z = 1e4: ~20 CPU-s
     "glass_relaxed": lambda w: 0.3 + 0.5 * GLASS["N"] / 1024 * (1 + GLASS["relaxed"]["relax_collisions"] / 1e4),
-    # SOC solids (N = 256 from phi0 = 0.70-0.825, rate 1e-3, to Z = 1e3): 2.9e3-4.7e3 events per disk, i.e.
-    # ~5 / rate; ~1.5e6 events/s
-    "glass_soc": lambda w: 0.3 + GLASS["N"] * 5.0 / GLASS["soc"]["rate"] / 1.5e6 / 60,
+    # SOC solids to Z = 1e3: ~5 / rate events per disk (N = 256, rate 1e-3, phi0 = 0.70-0.825: 2.9e3-4.7e3;
+    # N = 4096, rate 1e-5, phi0 = 0.70: 4.5e5, 1.85e9 events in 2000 CPU-s, both cores busy)
+    "glass_soc": lambda w: 0.3 + GLASS["N"] * 5.0 / GLASS["soc"]["rate"] / 9e5 / 60,
     "glass_soc_relaxation": lambda w: 0.3 + GLASS["N"] * GLASS["soc"]["relax_collisions_per_particle"] / 2.5e6 / 60,
     "microseg_packing": microseg_minutes,
     # per run at alpha = sqrt(3), CPU s: n = 1 about 2, n = 2 about 7, n = 4 8-10; oblate slower
