@@ -246,3 +246,21 @@ def test_the_soc_rows_judge_the_lowest_snapshot_against_the_printed_densities():
     assert liquid.reproduced == pytest.approx(0.832)
     assert relaxed.target == "donev-13.3-soc-phij-relaxed" and relaxed.status == "fail"
     assert "0.8: 0.8455" in liquid.detail
+
+
+def test_a_cluster_jamming_in_its_cells_ends_the_run_at_max_pressure():
+    # fast growth (Gamma = 0.1) from phi = 0.5: a few disks jam against their cells at phi ~ 0.66,
+    # where their collision rate diverges; the segment ends on its event budget at the time
+    # reached, and the run goes on to the pressure cap instead of failing (it raised before)
+    from hardpack.glass import soc
+    from hardpack.md.compress import StopCriteria, compress
+
+    start = random_packing(64, 2, bidisperse(1.4, 1 / 3), 0.3, seed=1)
+    start = compress(start, growth_rate=1e-2, seed=1, stop=StopCriteria(target_phi=0.5, max_pressure=1e6)).packing
+    result = compress_in_cells(start, growth_rate=0.1, max_pressure=1e3, seed=1, window=10)
+    ts = result.timeseries
+    assert result.stop == "max_pressure" and ts["Z"].values[-1] >= 1e3
+    assert ts["events"].values.max() >= soc.EVENT_BUDGET * 10 * 64  # some segment ended on its budget
+    assert result.packing.overlap_report(tol=0.0).overlap < 1e-9
+    # jammed in the cells: phi no longer grows (phi_J from the last segment's mid-point and Z)
+    assert 0.5 < result.packing.phi < PHI_CP and ts.attrs["phi_J_est"] == pytest.approx(result.packing.phi, abs=1e-3)

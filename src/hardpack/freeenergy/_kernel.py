@@ -45,7 +45,8 @@ NONE = -2  # nothing predicted
 F_WALL_IMPULSE_R = 0  # sum over wall events of 2 m (v_n - w) R_i (for the cell pressure)
 F_PAIR_VIRIAL = 1  # sum over pair events of |impulse| * sigma_ij at the collision
 F_KE_INTEGRAL = 2  # time integral of the kinetic energy of the moving particles over the segment
-N_FLOAT = 3
+F_END_TIME = 3  # the time the segment reached: s_end, or the last event's when max_events stopped it
+N_FLOAT = 4
 # integer counters
 C_EVENTS, C_WALL, C_PAIR, C_STALE = 0, 1, 2, 3
 N_INT = 4
@@ -90,9 +91,10 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                 facc, iacc, max_events, kappa_pair=0.0):
     """Run the events of s in [0, s_end) with cell radii R_i (dmu0 - gamma s) and pair contact
     distances nb_sig (1 + kappa_pair s); every particle is synchronised at s = 0 on entry and at
-    s_end on exit (P updated in place, s_i = 0 on exit). facc gains the wall impulses, the pair
-    virial and the integral of the kinetic energy over the time run. Returns the number of events
-    processed (stops after max_events; the caller then treats the run as failed).
+    the end on exit (P updated in place, s_i = 0 on exit). The end is s_end, or the time of the
+    last event when max_events stopped the segment early; it is stored in facc[F_END_TIME]. facc
+    gains the wall impulses, the pair virial and the integral of the kinetic energy up to the end.
+    Returns the number of events processed.
 
     Single loop in the md engine's style (no sub-call takes arrays): (1) schedule reset, one
     prediction per moving particle; (2) events: stale pair -> re-predict i; wall -> reflect,
@@ -237,11 +239,12 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                 ec[i] = coll[partner]
             hsize = heap_set(hkey, heap, hpos, hsize, i, s + best)
 
-    if count < max_events:
-        facc[F_KE_INTEGRAL] += ke * (s_end - s_ke)
-    for i in range(n):  # synchronise at s_end
+    s_stop = s_end if count < max_events else s_ke  # max_events: stop at the last event processed
+    facc[F_KE_INTEGRAL] += ke * (s_stop - s_ke)
+    facc[F_END_TIME] = s_stop
+    for i in range(n):  # synchronise at s_stop
         if invm[i] > 0.0:
-            dt = s_end - P[i, ts]
+            dt = s_stop - P[i, ts]
             for k in range(d):
                 P[i, k] += P[i, d + k] * dt
         P[i, ts] = 0.0
