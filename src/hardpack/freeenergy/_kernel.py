@@ -215,6 +215,7 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
             best = _wall_root(dd, dv, vv, radii[i] * (dmu0 - gamma * s), adot)
             partner = WALL
             qbest = -1
+            grown = 1.0 + kappa_pair * s  # sigma(s) / sigma(0) of every pair
             for m in range(nb_start[i], nb_end[i]):
                 j = nb_j[m]
                 dtj = s - P[j, ts]
@@ -228,7 +229,7 @@ def run_segment(P, radii, invm, nb_start, nb_end, nb_j, nb_disp, nb_sig, dmu0, g
                     rr += r * r
                     ru += r * u
                     uu += u * u
-                tc = contact_root(rr, ru, uu, nb_sig[m] * (1.0 + kappa_pair * s), nb_sig[m] * kappa_pair, best)
+                tc = contact_root(rr, ru, uu, nb_sig[m] * grown, nb_sig[m] * kappa_pair, best)
                 if tc < best:
                     best = tc
                     partner = j

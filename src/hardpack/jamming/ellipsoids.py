@@ -96,6 +96,7 @@ __all__ = [
     "EllipsoidContacts",
     "ellipsoid_contacts",
     "contacts_of_pairs",
+    "contact_centres",
     "dof_per_particle",
     "rigidity_transpose_full",
     "stiffness_matrix_full",
@@ -330,10 +331,7 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     if packing.boundary.kind == "hard_walls":
         _check_centres_between_walls(packing)
     pairs = pairs_within(packing, rel_gap=delta)
-    x = wrapped_positions(packing)
-    walled = ~packing.boundary.periodic_axes(packing.dim)
-    x[:, walled] = packing.positions[:, walled]  # not wrapped: bit for bit (as Packing.wrapped)
-    x = np.ascontiguousarray(x)
+    x = np.ascontiguousarray(contact_centres(packing))
     ii, jj = pairs.i.astype(np.int64), pairs.j.astype(np.int64)
     sep = np.ascontiguousarray(pairs.separation, dtype=float)
     zeta, lam, raw, point = _pair_contacts(x, inv, np.asarray(shape.bounding_radii, float), ii, jj, sep)
@@ -352,6 +350,26 @@ def ellipsoid_contacts(packing: Packing, delta: float) -> EllipsoidContacts:
     elif packing.boundary.kind == "hard_walls":
         net = _with_plane_walls(net, packing.boundary)
     return net
+
+
+def contact_centres(packing: Packing) -> np.ndarray:
+    """The centres that contact separations refer to: wrapped into the cell along the periodic
+    axes, as given (bit for bit, as :meth:`Packing.wrapped`) along walled ones.
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N, d)
+        The centres.
+    """
+    x = wrapped_positions(packing)
+    walled = ~packing.boundary.periodic_axes(packing.dim)
+    x[:, walled] = packing.positions[:, walled]
+    return x
 
 
 def container_contacts(positions, semiaxes, rotations, centre, radius, delta):
@@ -485,24 +503,29 @@ def plane_wall_contacts(positions, shape_inv, semiaxes, axes, lengths, delta):
     """
     x = np.asarray(positions, dtype=float)
     inv = np.asarray(shape_inv, dtype=float)
-    d = x.shape[1]
+    n, d = x.shape
+    full = np.zeros(d)
+    full[np.asarray(axes, np.int64)] = lengths
+    walls = np.array(sorted(2 * int(k) + upper for k in axes for upper in (0, 1)), np.int64)
+    particle = np.repeat(np.arange(n, dtype=np.int64), walls.size)  # sorted by particle, then wall
+    found = _plane_wall_rows(x, inv, full, particle, np.tile(walls, n))
     amax = np.asarray(semiaxes, dtype=float).max(axis=1)
-    found = [(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, d)), np.zeros((0, d)), np.zeros(0),
-              np.zeros(0))]
-    for k, length in zip(axes, lengths):
-        k = int(k)
-        s = np.sqrt(inv[:, k, k])
-        for upper, dist in ((0, x[:, k]), (1, float(length) - x[:, k])):
-            h = dist - s
-            part = np.flatnonzero(h <= delta * amax)
-            sign = 1.0 if upper else -1.0
-            normal = np.zeros((part.size, d))
-            normal[:, k] = sign
-            lever = sign * inv[part, :, k] / s[part, None]
-            found.append((part, np.full(part.size, 2 * k + upper, np.int64), normal, lever, h[part], dist[part]))
-    part, wall, normal, lever, gap, dist = (np.concatenate(column) for column in zip(*found))
-    order = np.lexsort((wall, part))
-    return part[order], wall[order], normal[order], lever[order], gap[order], dist[order]
+    keep = found[4] <= delta * amax[particle]
+    return tuple(column[keep] for column in found)
+
+
+def _plane_wall_rows(x, inv, lengths, particle, wall):
+    """The flat-wall contact data (the arrays of :func:`plane_wall_contacts`) of the given
+    (particle, wall number) pairs, touching or not, in that order; ``lengths`` holds L_k at each
+    walled axis k."""
+    k, upper = np.divmod(wall, 2)
+    s = np.sqrt(inv[particle, k, k])
+    dist = np.where(upper == 1, lengths[k] - x[particle, k], x[particle, k])
+    sign = np.where(upper == 1, 1.0, -1.0)
+    normal = np.zeros((len(particle), x.shape[1]))
+    normal[np.arange(len(particle)), k] = sign
+    lever = sign[:, None] * inv[particle, :, k] / s[:, None]
+    return particle, wall, normal, lever, dist - s, dist
 
 
 def _check_centres_between_walls(packing: Packing) -> None:
@@ -528,20 +551,6 @@ def _with_plane_walls(net: EllipsoidContacts, boundary) -> EllipsoidContacts:
     found = plane_wall_contacts(net.positions, net.shape_inv, net.semiaxes, axes, np.diag(net.lattice)[axes],
                                 net.delta)
     return _append_plane_walls(net, *found)
-
-
-def _given_plane_walls(net: EllipsoidContacts, particle: np.ndarray, wall: np.ndarray):
-    """The flat-wall contact data of the given (particle, wall number) pairs, touching or not, in
-    that order (the arrays of :func:`plane_wall_contacts`)."""
-    x, inv, d = net.positions, net.shape_inv, net.dim
-    k, upper = np.divmod(wall, 2)
-    s = np.sqrt(inv[particle, k, k])
-    dist = np.where(upper == 1, net.lattice[k, k] - x[particle, k], x[particle, k])
-    sign = np.where(upper == 1, 1.0, -1.0)
-    normal = np.zeros((len(particle), d))
-    normal[np.arange(len(particle)), k] = sign
-    lever = sign[:, None] * inv[particle, :, k] / s[:, None]
-    return particle, wall, normal, lever, dist - s, dist
 
 
 def _append_plane_walls(net: EllipsoidContacts, part, wall, u, lever, h, dist) -> EllipsoidContacts:
@@ -638,7 +647,8 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None, walls=None)
     )
     if walls is None or not len(walls[0]):
         return net
-    found = _given_plane_walls(net, np.asarray(walls[0], np.int64), np.asarray(walls[1], np.int64))
+    found = _plane_wall_rows(x, inv, np.diag(lattice), np.asarray(walls[0], np.int64),
+                             np.asarray(walls[1], np.int64))
     return _append_plane_walls(net, *found)
 
 

@@ -63,10 +63,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from hardpack.errors import InvalidInputError
-from hardpack.geometry.neighbours.pairs import wrapped_positions
 from hardpack.geometry.packing import Packing
 from hardpack.jamming.ascent import CONFIRM_AMPLITUDES, ascend, confirm_unjamming, lp_method
 from hardpack.jamming.ellipsoids import (
+    contact_centres,
     contact_hessians,
     contacts_of_pairs,
     displaced,
@@ -303,9 +303,7 @@ def _newton(current, pairs, walls, forces, active, max_iter, tol, a, gaps, balan
     semiaxes)."""
     d, f = current.dim, dof_per_particle(current.dim)
     m = len(pairs[0]) + len(walls[0])
-    x = wrapped_positions(current)
-    walled = ~current.boundary.periodic_axes(d)
-    x[:, walled] = current.positions[:, walled]  # not wrapped (as ellipsoid_contacts)
+    x = contact_centres(current)
     factor = 1.0
     for it in range(max_iter + 1):
         net = contacts_of_pairs(current, *pairs, positions=x, walls=walls)

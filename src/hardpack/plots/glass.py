@@ -326,12 +326,13 @@ def plot_glass_soc(eos, runs, summary):
             label=f"no cells, Gamma = {float(row['growth_rate']):g}")
     phi0s = sorted({round(float(ds.attrs["phi0"]), 4) for ds in runs})
     cmap = colormaps["viridis"]
+    first_seed = min((int(ds.attrs["seed"]) for ds in runs), default=0)
     for ds in runs:
         phi0 = round(float(ds.attrs["phi0"]), 4)
         colour = cmap(phi0s.index(phi0) / max(1, len(phi0s) - 1))
-        first = int(ds.attrs["seed"]) == int(min(r.attrs["seed"] for r in runs))
+        labelled = int(ds.attrs["seed"]) == first_seed and phi0 in (phi0s[0], phi0s[-1])
         ax.plot(ds["phi_mid"].values, ds["Z"].values, "-", lw=0.8, color=colour,
-                label=f"in cells from phi_0 = {phi0:g}" if first and phi0 in (phi0s[0], phi0s[-1]) else None)
+                label=f"in cells from phi_0 = {phi0:g}" if labelled else None)
     ax.set_yscale("log")
     ax.set_xlim(min(phi0s) - 0.01, 0.86)
     ax.set_xlabel("phi")
