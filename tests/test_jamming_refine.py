@@ -6,7 +6,9 @@ rate 1e-3 to p = 1e12, seeds 1 and 2), near-sphere ellipsoids (1 : 1.05^(1/2) : 
 1 : 1.02^(1/2) : 1.02 and 1 : 1 : 1.02 at the final rate 1e-4, N = 100) and 30 ellipses of
 semiaxes 1 and 0.8 in a closed box (``random_ellipsoid_packing(30, [1, 0.8], 0.3, 1,
 boundary="hard_walls", wall_axes=[0, 1])``, then ``compress_ellipsoids`` at 1e-2 to p = 1e3 and at
-1e-4 to p = 1e10, seed 1).
+1e-4 to p = 1e10, seed 1), and, in spherical containers, 20 ellipses of semiaxes 1 and 0.5 and 24 M&M-shaped
+spheroids of semiaxes 1 : 1.9 : 1.9 (the same with ``boundary="spherical_container"`` at phi = 0.1
+and without the box options).
 The refined configuration's gaps are checked by the pair search of Packing.overlap_report and
 ellipsoid_contacts, its balance by the verifier's own A F, and Newton's quadratic convergence
 checks the contact Hessians against the Perram-Wertheim function.
@@ -177,9 +179,6 @@ def test_bad_input_is_refused():
         refine_jamming_point(packing, res, tol=float("nan"))
     with pytest.raises(InvalidInputError, match="particles"):
         refine_jamming_point(_packing("self_dual_a1.05_n100_slow_p1e12"), res)
-    container = _packing("disks_container_n12")
-    with pytest.raises(InvalidInputError, match="periodic"):
-        refine_jamming_point(container, res)
 
 
 def test_cli_refine(tmp_path, capsys):
@@ -423,7 +422,7 @@ def test_newton_between_walls_refines_a_compressed_ellipse_packing_to_a_jamming_
 
 def test_newton_between_walls_tracks_wall_contacts_by_particle_and_wall():
     """contacts_of_pairs appends the named flat-wall contacts with the gaps of ellipsoid_contacts and
-    refuses them where the boundary has no such wall; a container is not refined and says why."""
+    refuses them where the boundary has no such wall."""
     packing = _packing("ellipses_box_n30_seed1_p1e10")
     near = ellipsoid_contacts(packing, 1e-6)
     on_wall = near.is_wall
@@ -431,7 +430,130 @@ def test_newton_between_walls_tracks_wall_contacts_by_particle_and_wall():
                               positions=near.positions, walls=(near.i[on_wall], near.wall[on_wall]))
     np.testing.assert_allclose(given.zeta, near.zeta, rtol=0, atol=1e-14)
     np.testing.assert_array_equal(given.wall, near.wall)
-    with pytest.raises(InvalidInputError, match="between flat hard walls"):
+    with pytest.raises(InvalidInputError, match="need a packing with walls"):
         contacts_of_pairs(_packing("oblate_n40_slow_p1e12"), [0], [1], [[0, 0, 0]], walls=([0], [0]))
     with pytest.raises(InvalidInputError, match="axis without walls"):
         contacts_of_pairs(packing, [0], [1], [[0, 0]], walls=([0], [4]))
+
+
+# ------------------------------------------------------------------------- spherical containers
+def _ellipse_and_two_disks():
+    """The exact jamming point of an ellipse (semiaxes 0.8, 0.2) lying like a chord below the
+    centre of a unit circle and touching it at both tips, with two equal disks above it, each
+    touching the ellipse, the other disk and the circle. With the ellipse centre at (0, -rho) and
+    the disks at (+-X, Y), radius r: the farthest point of the ellipse from the centre is at 1, X = r,
+    |(X, Y)| = 1 - r and the distance of (X, Y) from the ellipse is r; the distances are found
+    on the parametrised ellipse by a bounded scalar search, independently of the contact code."""
+    from scipy.optimize import fsolve, minimize_scalar
+
+    a, b = 0.8, 0.2
+
+    def search(f, lo, hi):
+        return minimize_scalar(f, bounds=(lo, hi), method="bounded", options={"xatol": 1e-14}).fun
+
+    def equations(v):
+        rho, x, y, r = v
+        far = -search(lambda t: -np.hypot(a * np.cos(t), -rho + b * np.sin(t)), -np.pi / 2, 0.0)
+        near = search(lambda t: np.hypot(x - a * np.cos(t), y + rho - b * np.sin(t)), 0.0, np.pi / 2)
+        return [far - 1.0, x - r, np.hypot(x, y) - (1.0 - r), near - r]
+
+    solution = fsolve(equations, [0.55, 0.3, 0.2, 0.3], xtol=1e-12)
+    assert np.abs(equations(solution)).max() < 1e-14
+    return a, b, *solution
+
+
+def _in_circle(a, b, rho, x, y, r, factor=1.0, moved=0.0, turned=0.0):
+    from hardpack.geometry.boundaries import SphericalContainer
+    from hardpack.geometry.packing import Packing
+    from hardpack.geometry.shapes import Ellipsoids
+
+    centre = np.array([1.5, 1.5])
+    return Packing(centre + np.array([[0.0, -rho], [-x, y], [x, y]]) + moved, lattice=np.eye(2) * 3.0,
+                   boundary=SphericalContainer(tuple(centre), 1.0), allow_overlap=True,
+                   shape=Ellipsoids(factor * np.array([[a, b], [r, r], [r, r]]), np.array([turned, 0.0, 0.0])))
+
+
+def test_newton_in_a_container_reaches_the_exact_jamming_point_of_an_ellipse_touching_at_both_tips():
+    """The ellipse and two disks of _ellipse_and_two_disks, 0.1 % smaller, moved by 1e-4 and the
+    ellipse turned by 1e-3: seven contacts (the ellipse's two tips on the container) on six
+    degrees of freedom besides the rotation about the centre. Newton tracks both tips as two
+    contacts and lands on the exact configuration (up to that rotation) to round-off,
+    quadratically; by the mirror symmetry both tips carry the same force."""
+    a, b, rho, x, y, r = exact = _ellipse_and_two_disks()
+    assert r > 0.4 and 0 < y < 1  # the solution of the sketch, not another root
+    rng = np.random.default_rng(1)
+    start = _in_circle(*exact, factor=0.999, moved=1e-4 * rng.standard_normal((3, 2)), turned=1e-3)
+    assert start.overlap_report(1e-12).n_overlapping == 0 and start.containment_report(1e-12).n_outside == 0
+    res = verify_ellipsoids(start, delta=0.01)
+    net = res.network
+    assert res.contacts_used.all() and list(net.i[net.is_wall]) == [0, 0, 1, 2]
+    ref = refine_jamming_point(start, res)
+    assert ref.converged and ref.overlaps == 0 and ref.iterations <= 4
+    assert all(g <= 100 * f**2 + 1e-13 for f, g in zip(ref.gap, ref.gap[1:]))  # quadratically
+    end = ref.packing
+    rel = end.positions - 1.5
+    turn = np.arctan2(rel[0, 1], rel[0, 0]) + np.pi / 2  # the trivial rotation about the centre
+    back = np.array([[np.cos(turn), np.sin(turn)], [-np.sin(turn), np.cos(turn)]])
+    np.testing.assert_allclose(rel @ back.T, [[0.0, -rho], [-x, y], [x, y]], atol=1e-13)
+    assert float(end.shape.orientations[0]) == pytest.approx(turn, abs=1e-13)
+    np.testing.assert_allclose(end.shape.semiaxes, [[a, b], [r, r], [r, r]], rtol=1e-13)
+    assert 1.0 + ref.size_change == pytest.approx(1.0 / 0.999, rel=1e-13)
+    tips = ref.forces[-4:-2]  # the walls follow the pairs, the ellipse's first
+    assert (ref.forces > 0).all() and tips[0] == pytest.approx(tips[1], rel=1e-10)
+
+
+def test_container_contacts_are_tracked_by_their_tips():
+    """A centred ellipse of semiaxes 1 and 0.3, turned by 0.4 rad, in a circle of radius 1.01
+    touches it near both tips, 0.01 away: contacts_of_pairs returns, for each given body-frame
+    tip, the contact at that tip (the points c +- R^T (1, 0)), with the gaps of ellipsoid_contacts;
+    a container contact without its tip is refused."""
+    from hardpack.geometry.boundaries import SphericalContainer
+    from hardpack.geometry.packing import Packing
+    from hardpack.geometry.shapes import Ellipsoids
+
+    theta = 0.4
+    packing = Packing(np.array([[1.5, 1.5]]), lattice=np.eye(2) * 3.0, boundary=SphericalContainer((1.5, 1.5), 1.01),
+                      shape=Ellipsoids(np.array([[1.0, 0.3]]), np.array([theta])))
+    axis = np.array([np.cos(theta), np.sin(theta)])
+    for sign in (1.0, -1.0):
+        net = contacts_of_pairs(packing, [], [], np.zeros((0, 2)), walls=([0], [0], [[0.9 * sign, 0.1]]))
+        np.testing.assert_allclose(net.lever_i, [sign * axis], atol=1e-12)
+        np.testing.assert_allclose(net.gap, [0.01], atol=1e-12)
+    near = ellipsoid_contacts(packing, 0.02)
+    np.testing.assert_allclose(near.gap, [0.01, 0.01], atol=1e-12)
+    with pytest.raises(InvalidInputError, match="tip"):
+        contacts_of_pairs(packing, [], [], np.zeros((0, 2)), walls=([0], [0]))
+
+
+@pytest.mark.parametrize("name, n_wall", [("ellipses_container_n20_seed1_p1e10", 10),
+                                           ("mm_container_n24_seed1_p1e10", 18)])
+def test_newton_in_a_container_refines_a_compressed_packing_to_a_jamming_point(name, n_wall):
+    """20 ellipses and 24 M&M spheroids LS-compressed in a spherical container to p = 1e10:
+    second-order jammed with a near self-stress as given; Newton reaches the jamming point of
+    their contacts, checked there independently of the Newton system: every contact touches to
+    1e-12 of a semiaxis by the contact search, nothing overlaps or leaves the container, and the
+    verifier's self-stress balances the force and torque on every particle."""
+    packing = _packing(name)
+    out = verify_at_jamming_point(packing, delta=1e-8)
+    assert out.params["refined"] == 1 and out.verdict == Verdict.JAMMED and out.order == "second"
+    assert "Newton converged" in out.params["refine_note"] and out.params["refine_iterations"] <= 5
+    ref = refine_jamming_point(packing, verify_ellipsoids(packing, delta=1e-8))
+    end = ref.packing
+    assert end.overlap_report(1e-12).n_overlapping == 0 and end.containment_report(1e-12).n_outside == 0
+    net = ellipsoid_contacts(end, 1e-6)
+    assert net.n_wall_contacts == n_wall and np.abs(net.gap).max() < 1e-12
+    at = verify_ellipsoids(end, delta=1e-9)
+    f, net = at.contact_forces, at.network
+    assert (f[at.contacts_used] > 0).all() and net.n_wall_contacts == n_wall
+    n, d = packing.n_particles, packing.dim
+    pair = ~net.is_wall
+
+    def torque_of(r, u):  # r x u: a scalar in 2D, a vector in 3D
+        return (r[:, 0] * u[:, 1] - r[:, 1] * u[:, 0])[:, None] if d == 2 else np.cross(r, u)
+
+    force, torque = np.zeros((n, d)), np.zeros((n, 1 if d == 2 else 3))
+    np.add.at(force, net.i, -f[:, None] * net.normal)
+    np.add.at(force, net.j[pair], f[pair, None] * net.normal[pair])
+    np.add.at(torque, net.i, torque_of(net.lever_i, -f[:, None] * net.normal))
+    np.add.at(torque, net.j[pair], torque_of(net.lever_j[pair], f[pair, None] * net.normal[pair]))
+    assert np.abs(force).max() < 1e-10 * f.max() and np.abs(torque).max() < 1e-10 * f.max()

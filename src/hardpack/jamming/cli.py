@@ -65,8 +65,8 @@ def register(subparsers) -> None:
                         "jamming point of the contacts, found by Newton's method, when it converges "
                         "with no overlap, if need be after an SLP ascent of the size; certify a "
                         "second-order flexible verdict there by an explicit denser packing "
-                        "(periodic cells and flat walls; the ascent periodic cells only; not in a "
-                        "spherical container: hardpack.jamming.refine, hardpack.jamming.ascent)")
+                        "(periodic cells, flat walls and spherical containers; the ascent periodic "
+                        "cells only: hardpack.jamming.refine, hardpack.jamming.ascent)")
     p.add_argument("--ascent-max-particles", type=int, default=None, metavar="N",
                    help="with --refine: the largest packing for which the SLP ascent runs (default 400; an "
                         "ascent took 6-60 CPU-min at N = 640-800 and a certificate takes up to six)")

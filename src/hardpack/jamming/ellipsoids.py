@@ -105,6 +105,7 @@ __all__ = [
     "wall_gap_hessian",
     "plane_gap_hessian",
     "container_contacts",
+    "container_tips",
     "plane_wall_contacts",
     "wall_name",
     "generators",
@@ -439,15 +440,77 @@ def _container_contacts(positions, semiaxes, rotations, centre, radius, delta):
 
 def _with_container(net: EllipsoidContacts, rotations, boundary) -> EllipsoidContacts:
     """``net`` with the wall contacts of the container appended (module docstring)."""
-    x, d = net.positions, net.dim
     centre = np.asarray(boundary.centre, dtype=float)
-    part, point, h, continuum = container_contacts(x, net.semiaxes, rotations, centre, boundary.radius, net.delta)
+    part, point, h, continuum = container_contacts(net.positions, net.semiaxes, rotations, centre,
+                                                   boundary.radius, net.delta)
     if continuum.any():
         bad = np.flatnonzero(continuum)
         raise InvalidInputError(
             f"particles {bad.tolist()} touch the container wall (within delta = {net.delta:g}) along a "
             "circle or sphere of farthest points (equal longest semiaxes, centred on the container's "
             "plane through them): the jamming tests need isolated contact points; move or shrink them")
+    return _append_container(net, part, point, h, centre, float(boundary.radius))
+
+
+@numba.njit(cache=True)
+def _tracked_container_rows(positions, semiaxes, rotations, centre, radius, particle, tips):
+    """The container contact of each ``particle`` at the local farthest point nearest its ``tip``
+    (body frame, relative to the particle centre): (lab-frame points (W, d), gaps h = R - rho)."""
+    m = particle.shape[0]
+    d = positions.shape[1]
+    pts = np.empty((m, d))
+    gap = np.empty(m)
+    b = np.empty(d)
+    loc = np.empty((2, d))
+    for c in range(m):
+        i = particle[c]
+        for k in range(d):
+            s = 0.0
+            for q in range(d):
+                s += rotations[i, k, q] * (positions[i, q] - centre[q])
+            b[k] = s
+        count = max(local_farthest_body(b, semiaxes[i], loc), 1)  # a continuum (-1): its point loc[0]
+        best, best_dist = 0, np.inf
+        for t in range(count):
+            dist = 0.0
+            for k in range(d):
+                dist += (loc[t, k] - b[k] - tips[c, k]) ** 2
+            if dist < best_dist:
+                best, best_dist = t, dist
+        gap[c] = radius - np.sqrt((loc[best] * loc[best]).sum())
+        for q in range(d):
+            s = centre[q]
+            for k in range(d):
+                s += rotations[i, k, q] * loc[best, k]
+            pts[c, q] = s
+    return pts, gap
+
+
+def container_tips(net: EllipsoidContacts, rotations: np.ndarray) -> np.ndarray:
+    """The contact points of the container contacts in their particles' body frames, relative to
+    the particle centres: what :func:`contacts_of_pairs` tracks a container contact by (a particle
+    can touch the container at two tips, module docstring).
+
+    Parameters
+    ----------
+    net : EllipsoidContacts
+        Contacts of a packing in a spherical container.
+    rotations : numpy.ndarray of float, shape (N, d, d)
+        Lab to body rotations of the particles (``Ellipsoids.rotations``).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (W, d)
+        R_i (p - x_i) of every container contact, in the order of the network's wall contacts.
+    """
+    on_wall = net.is_wall
+    return np.einsum("mkq,mq->mk", np.asarray(rotations, float)[net.i[on_wall]], net.lever_i[on_wall])
+
+
+def _append_container(net: EllipsoidContacts, part, point, h, centre, radius: float) -> EllipsoidContacts:
+    """``net`` with container contacts of particles ``part`` at the lab-frame points ``point``
+    with gaps ``h`` appended (module docstring: j = i, scale 1, zeta with ``gap`` = h / a_max)."""
+    x, d = net.positions, net.dim
     rel = point - centre
     u = rel / np.linalg.norm(rel, axis=1)[:, None]
     amax = net.semiaxes[part].max(axis=1)
@@ -460,8 +523,7 @@ def _with_container(net: EllipsoidContacts, rotations, boundary) -> EllipsoidCon
         wall=np.zeros(m, np.int64))
     kw = {k: np.concatenate([getattr(net, k), getattr(wall, k)]) for k in _PER_CONTACT}
     return EllipsoidContacts(**kw, positions=x, lattice=net.lattice, shape_inv=net.shape_inv,
-                             semiaxes=net.semiaxes, delta=net.delta, centre=centre,
-                             radius=float(boundary.radius))
+                             semiaxes=net.semiaxes, delta=net.delta, centre=centre, radius=radius)
 
 
 def plane_wall_contacts(positions, shape_inv, semiaxes, axes, lengths, delta):
@@ -592,21 +654,24 @@ def wall_name(net: EllipsoidContacts, c: int) -> str:
 
 def contacts_of_pairs(packing: Packing, i, j, shift, positions=None, walls=None) -> EllipsoidContacts:
     """The contact data of given pairs (i, j, image shift), touching or not (``delta`` = inf), and
-    of given contacts with flat hard walls after them.
+    of given wall contacts after them.
 
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell or between flat hard walls.
+        Ellipses or ellipsoids in a periodic cell, between flat hard walls or in a spherical container.
     i, j : array_like of int, shape (M,)
         The pairs.
     shift : array_like of int, shape (M, d)
         Lattice images: the separation is x_j + L shift - x_i.
     positions : ndarray, shape (N, d), optional
         The centres x the shifts refer to (default ``packing.positions`` as given, not wrapped).
-    walls : tuple of two array_like of int, shape (W,), optional
-        (particle, wall number) of flat-wall contacts (2 k for x_k = 0, 2 k + 1 for x_k = L_k),
-        appended after the pairs in this order.
+    walls : tuple of array_like, optional
+        Wall contacts, appended after the pairs in this order: (particle, wall number) of flat
+        walls (2 k for x_k = 0, 2 k + 1 for x_k = L_k), or (particle, wall number 0, tip) in a
+        spherical container, where tip (W, d) is a point near the contact in the particle's body
+        frame relative to its centre (:func:`container_tips`): the contact is the local farthest
+        point nearest it (a particle can touch the container at two tips, module docstring).
 
     Returns
     -------
@@ -615,18 +680,22 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None, walls=None)
     Raises
     ------
     InvalidInputError
-        If ``walls`` is given for a packing that is not between flat hard walls, or names a wall
-        the boundary does not have.
+        If ``walls`` is given for a periodic packing, names a wall the boundary does not have, or
+        lacks the tips in a container.
     """
     check_ellipsoid_packing(packing)
+    boundary = packing.boundary
     if walls is not None and len(walls[0]):
-        if packing.boundary.kind != "hard_walls":
-            raise InvalidInputError(
-                f"flat-wall contacts need a packing between flat hard walls, not {packing.boundary}")
-        axes = set(int(k) for k in packing.boundary.axes)
-        if not set(int(k) for k in np.asarray(walls[1]) // 2) <= axes:
-            raise InvalidInputError(
-                f"a wall contact names a wall on an axis without walls (walled axes {sorted(axes)})")
+        if boundary.kind == "periodic":
+            raise InvalidInputError(f"wall contacts need a packing with walls, not {boundary}")
+        if boundary.kind == "hard_walls":
+            axes = set(int(k) for k in boundary.axes)
+            if not set(int(k) for k in np.asarray(walls[1]) // 2) <= axes:
+                raise InvalidInputError(
+                    f"a wall contact names a wall on an axis without walls (walled axes {sorted(axes)})")
+        elif len(walls) != 3 or np.any(np.asarray(walls[1]) != 0):
+            raise InvalidInputError("container contacts are given as (particle, 0, tip), the tip a body-frame "
+                                    "point near the contact (container_tips)")
     shape = packing.shape
     n = packing.n_particles
     semiaxes = np.ascontiguousarray(shape.semiaxes, dtype=float)
@@ -639,16 +708,24 @@ def contacts_of_pairs(packing: Packing, i, j, shift, positions=None, walls=None)
     sep = np.ascontiguousarray(x[jj] + shift @ lattice.T - x[ii])
     zeta, lam, raw, point = _pair_contacts(x, inv, np.asarray(shape.bounding_radii, float), ii, jj, sep)
     norm = np.linalg.norm(raw, axis=1)
+    container = boundary.kind == "spherical_container"
     net = EllipsoidContacts(
         i=ii, j=jj, shift=shift, separation=sep, zeta=zeta, lam=lam, normal=raw / norm[:, None],
         raw_normal=raw, lever_i=point - x[ii], lever_j=point - (x[ii] + sep),
         scale=2.0 * lam * (1.0 - lam) * norm, positions=x, lattice=lattice, shape_inv=inv,
-        semiaxes=semiaxes, delta=float("inf"), periodic=packing.boundary.periodic_axes(packing.dim),
+        semiaxes=semiaxes, delta=float("inf"), periodic=boundary.periodic_axes(packing.dim),
+        centre=np.asarray(boundary.centre, dtype=float) if container else None,
+        radius=float(boundary.radius) if container else None,
     )
     if walls is None or not len(walls[0]):
         return net
-    found = _plane_wall_rows(x, inv, np.diag(lattice), np.asarray(walls[0], np.int64),
-                             np.asarray(walls[1], np.int64))
+    part = np.asarray(walls[0], np.int64)
+    if container:
+        tips = np.ascontiguousarray(np.asarray(walls[2], dtype=float).reshape(len(part), packing.dim))
+        point, h = _tracked_container_rows(x, semiaxes, np.ascontiguousarray(shape.rotations(), dtype=float),
+                                           net.centre, net.radius, part, tips)
+        return _append_container(net, part, point, h, net.centre, net.radius)
+    found = _plane_wall_rows(x, inv, np.diag(lattice), part, np.asarray(walls[1], np.int64))
     return _append_plane_walls(net, *found)
 
 

@@ -24,13 +24,18 @@ update moves the centres by the translational part of dQ and turns each orientat
 rotation vector of its rotational part (R = exp(W) applied in the lab frame, the parametrisation
 of the Hessians).
 
-Flat hard walls (:mod:`hardpack.jamming.ellipsoids`) enter as contacts of one particle with a fixed
-plane, tracked by (particle, wall number): the gap row is h = b - n . x - s (s = n . (p - x) the
-support distance of the farthest point p along the outward normal n), its gradient and Hessian
-those of the first- and second-order tests, and b_c = -dh_c / ds = n . (p - x), since the support
-distance grows with the semiaxes. The translations normal to a wall are no longer trivial motions.
-A particle in a spherical container can touch it at two points whose identity can change along
-the iteration, so containers are not refined.
+Walls (:mod:`hardpack.jamming.ellipsoids`) enter as contacts of one particle with a fixed
+boundary. A flat wall is tracked by (particle, wall number): the gap row is h = b - n . x - s
+(s = n . (p - x) the support distance of the farthest point p along the outward normal n). A
+spherical container (centre c, radius R) is tracked by (particle, tip): the gap is h = R - |p - c|
+at the local farthest point p of the particle from c nearest the tip, a point fixed in the
+particle's body frame that follows p from iterate to iterate (a particle can touch the container
+at two tips, one at each end, which are far apart on the body, so the nearest one is the same
+contact; :func:`hardpack.jamming.ellipsoids.contacts_of_pairs`). In both cases the gradient and
+Hessian of h are those of the first- and second-order tests, and b_c = -dh_c / ds = n . (p - x)
+with n the outward normal at p (by the envelope theorem, since p is a farthest point: growing the
+semiaxes by 1 + ds about the centre moves it by ds (p - x)). The translations normal to a wall
+are no longer trivial motions; in a container the rigid rotations about c are.
 
 The refined configuration is the jamming point only if no pair outside the contact network
 overlaps there: a network whose jamming point overlaps other pairs is not the network of the
@@ -69,6 +74,7 @@ from hardpack.jamming.ellipsoids import (
     contact_centres,
     contact_hessians,
     contacts_of_pairs,
+    container_tips,
     displaced,
     dof_per_particle,
     ellipsoid_contacts,
@@ -151,8 +157,8 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     Parameters
     ----------
     packing : Packing
-        Ellipses or ellipsoids in a periodic cell or between flat hard walls, near a jamming point
-        (an LS packing at a high pressure).
+        Ellipses or ellipsoids in a periodic cell, between flat hard walls or in a spherical
+        container, near a jamming point (an LS packing at a high pressure).
     result : EllipsoidJammingResult
         :func:`hardpack.jamming.second_order.verify_ellipsoids` of ``packing``: its backbone,
         contacts and self-stress (exact or near) start the iteration; rattlers stay where they are.
@@ -174,13 +180,9 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     Raises
     ------
     InvalidInputError
-        For a packing in a spherical container (its wall contacts are not tracked), a result without a self-stress
-        (the packing is not jammed at first order: there is no jamming point to refine to) or of
-        another packing, or bad ``max_iter`` / ``tol``.
+        For a result without a self-stress (the packing is not jammed at first order: there is no
+        jamming point to refine to) or of another packing, or bad ``max_iter`` / ``tol``.
     """
-    if packing.boundary.kind == "spherical_container":
-        raise InvalidInputError("refine_jamming_point handles periodic packings and flat hard walls, not a "
-                                "spherical container (a particle's contacts with it are not tracked from step to step)")
     for name, value in (("max_iter", max_iter), ("rounds", rounds)):
         if not (isinstance(value, int) and value >= 1):
             raise InvalidInputError(f"{name} must be a positive integer, got {value!r}")
@@ -200,7 +202,7 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
     on_wall = net.is_wall[used]
     pair, wall = used[~on_wall], used[on_wall]
     pairs = net.i[pair], net.j[pair], net.shift[pair]
-    walls = net.i[wall], net.wall[wall]
+    walls = net.i[wall], net.wall[wall], container_tips(net.subset(wall), packing.shape.rotations())
     forces = np.concatenate([forces[~on_wall], forces[on_wall]])  # the order of contacts_of_pairs
     a = float(np.min(packing.shape.semiaxes))
     current, factor, added, dropped = packing, 1.0, 0, 0
@@ -214,8 +216,8 @@ def refine_jamming_point(packing: Packing, result, *, max_iter: int = 20, tol: f
         if len(forces) < 2:
             converged = False
             break
-        current, stationary, forces, growth = _newton(current, pairs, walls, forces, active, max_iter, tol, a,
-                                                      gaps, balances, steps)
+        current, stationary, forces, growth, walls = _newton(current, pairs, walls, forces, active, max_iter, tol, a,
+                                                             gaps, balances, steps)
         factor *= growth
         # a KKT point of growing the particles only if every multiplier (force) is positive
         converged = stationary and bool(forces.min() > 0)
@@ -277,11 +279,13 @@ def _next_network(current: Packing, pairs, walls, forces: np.ndarray, present: n
     near = ellipsoid_contacts(current, OVERLAP_SEARCH)
     inside = {(int(i), int(j), *map(int, k)) for i, j, k in zip(*pairs)}
     inside |= {(int(j), int(i), *map(int, -np.asarray(k))) for i, j, k in zip(*pairs)}
-    inside_walls = {(int(i), int(w)) for i, w in zip(*walls)}
     on_wall = near.is_wall
-    outside = np.array([((int(i), int(w)) not in inside_walls) if at_wall else
-                        ((int(i), int(j), *map(int, k)) not in inside)
-                        for i, j, k, w, at_wall in zip(near.i, near.j, near.shift, near.wall, on_wall)], dtype=bool)
+    outside = np.array([at_wall or (int(i), int(j), *map(int, k)) not in inside
+                        for i, j, k, at_wall in zip(near.i, near.j, near.shift, on_wall)], dtype=bool)
+    tips = np.zeros((len(near.i), current.dim))
+    tips[on_wall] = container_tips(near, current.shape.rotations())
+    outside[on_wall] = ~_tracked_walls(walls, near.i[on_wall], near.wall[on_wall], tips[on_wall],
+                                       near.semiaxes[near.i[on_wall]].max(axis=1))
     join = (outside & (near.gap < -overlap_tol) & present[near.i] & present[near.j]
             & (active[near.i] | active[near.j]))
     join_pair, join_wall = join & ~on_wall, join & on_wall
@@ -289,24 +293,41 @@ def _next_network(current: Packing, pairs, walls, forces: np.ndarray, present: n
         return (tuple(p[keep[:m]] for p in pairs), tuple(w[keep[m:]] for w in walls), forces[keep],
                 int(keep.size), 0)
     pairs = tuple(np.concatenate([p[keep[:m]], q[join_pair]]) for p, q in zip(pairs, (near.i, near.j, near.shift)))
-    walls = tuple(np.concatenate([w[keep[m:]], q[join_wall]]) for w, q in zip(walls, (near.i, near.wall)))
+    walls = tuple(np.concatenate([w[keep[m:]], q[join_wall]]) for w, q in zip(walls, (near.i, near.wall, tips)))
     mean = forces[keep].mean()
     forces = np.concatenate([forces[:m][keep[:m]], np.full(int(join_pair.sum()), mean),
                              forces[m:][keep[m:]], np.full(int(join_wall.sum()), mean)])
     return pairs, walls, forces * (len(forces) / forces.sum()), int((~keep).sum()), int(join.sum())
 
 
+#: two wall contacts of a particle are the same when their body-frame points (tips) are closer
+#: than this many of its largest semiaxes (the two tips of a particle in a container are ~2 a_max
+#: apart; at one configuration the same contact is found again to round-off)
+SAME_TIP = 1e-6
+
+
+def _tracked_walls(walls, particle: np.ndarray, wall: np.ndarray, tips: np.ndarray, amax: np.ndarray) -> np.ndarray:
+    """(K,) whether each wall contact (particle, wall number, tip) is one of ``walls`` (particle,
+    wall number, tips: the network, at the same configuration)."""
+    found = np.zeros(len(particle), dtype=bool)
+    for k in range(len(particle)):
+        same = (walls[0] == particle[k]) & (walls[1] == wall[k])
+        found[k] = bool(np.any(np.linalg.norm(walls[2][same] - tips[k], axis=1) <= SAME_TIP * amax[k]))
+    return found
+
+
 def _newton(current, pairs, walls, forces, active, max_iter, tol, a, gaps, balances, steps):
     """Newton steps on the KKT equations of the contacts ``pairs`` and ``walls`` (module
     docstring), appending the history to ``gaps``, ``balances``, ``steps``. Returns (packing,
     stationary: whether the gaps and the balance met ``tol``, forces, growth factor of the
-    semiaxes)."""
+    semiaxes, ``walls`` with the tips of the last iterate)."""
     d, f = current.dim, dof_per_particle(current.dim)
     m = len(pairs[0]) + len(walls[0])
     x = contact_centres(current)
     factor = 1.0
     for it in range(max_iter + 1):
         net = contacts_of_pairs(current, *pairs, positions=x, walls=walls)
+        walls = walls[0], walls[1], container_tips(net, current.shape.rotations())
         t, _ = dof_basis(net, active)
         at = (rigidity_transpose_full(net) @ t).tocsr()
         on_wall = net.is_wall
@@ -315,7 +336,7 @@ def _newton(current, pairs, walls, forces, active, max_iter, tol, a, gaps, balan
         gaps.append(float(np.abs(h).max() / a))
         balances.append(float(np.linalg.norm(at.T @ forces) / (spla.norm(at) * np.linalg.norm(forces))))
         if gaps[-1] <= tol and balances[-1] <= tol:
-            return current, True, forces, factor
+            return current, True, forces, factor, walls
         if it == max_iter:
             break
         k = (t.T @ stiffness_matrix_full(net, forces, contact_hessians(net)) @ t).tocsr()
@@ -342,7 +363,7 @@ def _newton(current, pairs, walls, forces, active, max_iter, tol, a, gaps, balan
         x = x + move[:, :d]
         factor *= 1.0 + ds
         current = displaced(current, x, move[:, d:], 1.0 + ds)
-    return current, False, forces, factor
+    return current, False, forces, factor, walls
 
 
 #: the largest Newton step taken (in smallest semiaxes, radians, or relative size change): a
@@ -396,8 +417,6 @@ def _solve(kkt: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 def _obstacle(packing: Packing, result) -> str | None:
     """Why ``result`` cannot start :func:`refine_jamming_point` (None when it can)."""
     dec = result.collective
-    if packing.boundary.kind == "spherical_container":
-        return "not refined: the container wall is not handled"
     if dec.approx_stress is None:
         return "not refined: no near self-stress (exact self-stresses, or none)"
     if not (dec.forces.size and dec.forces.min() > 0):
@@ -431,7 +450,7 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     packing is near one.
 
     Runs :func:`hardpack.jamming.second_order.verify_ellipsoids`; when its backbone has a strictly
-    positive near self-stress (a packing near, not at, its jamming point; periodic cells or flat walls), refines
+    positive near self-stress (a packing near, not at, its jamming point), refines
     the configuration with :func:`refine_jamming_point` and, when that converges with no pair
     overlapping, tests the refined configuration instead, whose balance A F = 0 is exact to
     round-off. When the local test of the packing as given finds no backbone with a near
@@ -472,8 +491,8 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     ----------
     packing : Packing
         Ellipses or ellipsoids in a periodic cell, between flat hard walls or in a spherical
-        container (not refined: its verdict is that of the packing as given). Between flat walls
-        there is no size ascent (neither the retry nor the certificate: the notes say so).
+        container. With walls there is no size ascent (neither the retry nor the certificate: the
+        notes say so).
     confirm : bool, default True
         Certify a second-order flexible verdict at the jamming point by the size ascent.
     retry_after_ascent : bool, default True
@@ -494,7 +513,7 @@ def verify_at_jamming_point(packing: Packing, *, confirm: bool = True, retry_aft
     first = _at_jamming_point(packing, confirm and affordable, options, ascent_max_particles)
     first.params.setdefault("ascended", 0)
     if first.params.get("refined") != 0 or "refine_iterations" not in first.params:
-        return first  # refined, or Newton never started (no near self-stress, a container)
+        return first  # refined, or Newton never started (no near self-stress)
     if retry_after_ascent and packing.boundary.kind != "periodic":
         first.params["refine_note"] += "; no retry after the size ascent (it handles periodic packings only)"
         return first
@@ -526,7 +545,7 @@ def _at_jamming_point(packing: Packing, confirm: bool, options: dict, ascent_max
     result = verify_ellipsoids(packing, **options)
     dec = result.collective
     note, start, whole = _obstacle(packing, result), result, ""
-    if note is not None and packing.boundary.kind != "spherical_container" and options.get("local", True):
+    if note is not None and options.get("local", True):
         # the local test needs each particle's own near self-stress, which an LS packing near the
         # sphere point (torques of order alpha - 1) can miss: every particle then looks like a
         # rattler; the collective test of all particles can still start the refinement
