@@ -566,19 +566,27 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
         bounding-radius cap); STUCK when no event can ever happen.
     """
     d = len(dims)
+    cap = nb.shape[1]
+    return _run_events_loop(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl, rcap,
+                            ncl, coff, ccount, cid, cbs, slot_of, bs, nb, nn, mark, cnt, ep, ec,
+                            hkey, heap, hpos, acc, iacc, coll_target, t_cap, rebuild_lists,
+                            log_pair, log_val,
+                            1.0 / L, np.empty(d), np.empty(d), np.empty(d), np.empty(2, dtype=np.int64),
+                            np.empty(cap, dtype=np.int64), np.empty(d, dtype=np.int64), np.empty(d, dtype=np.int64),
+                            np.empty(d, dtype=np.int64))
+
+
+@njit(cache=True, _nrt=False)
+def _run_events_loop(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl, rcap, ncl, coff,
+                     ccount, cid, cbs, slot_of, bs, nb, nn, mark, cnt, ep, ec, hkey, heap, hpos, acc,
+                     iacc, coll_target, t_cap, rebuild_lists, log_pair, log_val, invL, xi, vi, rv, upd,
+                     oldnb, clo, cspan, codo):
+    """:func:`run_events` on the scratch arrays it allocates, compiled without numba's reference
+    counting: the loop allocates nothing, and no array view in it pays an atomic counter update."""
+    d = len(dims)
     n = P.shape[0]
     cbits = 2 * d  # neighbour entry = j << cbits | image code (module docstring)
     cmask = (1 << cbits) - 1
-    cap = nb.shape[1]
-    invL = 1.0 / L
-    xi = np.empty(d)
-    vi = np.empty(d)
-    rv = np.empty(d)
-    upd = np.empty(2, dtype=np.int64)
-    oldnb = np.empty(cap, dtype=np.int64)
-    clo = np.empty(d, dtype=np.int64)
-    cspan = np.empty(d, dtype=np.int64)
-    codo = np.empty(d, dtype=np.int64)
     mark[:] = 0
     hpos[:] = -1
     hsize = 0
