@@ -42,7 +42,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hardpack.geometry.ellipsoid_container import farthest_point_body
+from hardpack.geometry.ellipsoid_container import body_offset, farthest_point_body
 
 #: relative size of the stand-in for an exactly zero component of the disk centre (module docstring)
 TINY = 1e-30
@@ -610,12 +610,9 @@ def covered_volumes(positions, semiaxes, rotations, centre, radii, tol):
     work = 0
     for p in range(n):
         a = semiaxes[p]
+        body_offset(rotations, p, positions, centre, rel)
         for m in range(d):
-            s = 0.0
-            for j in range(d):
-                s += rotations[p, m, j] * (positions[p, j] - centre[j])
-            rel[m] = s
-            ball[m] = -s
+            ball[m] = -rel[m]
         dist = np.sqrt(np.dot(rel, rel))
         far = np.sqrt(farthest_point_body(rel, a, x))
         vol = np.pi * a[0] * a[1] if d == 2 else 4.0 / 3.0 * np.pi * a[0] * a[1] * a[2]

@@ -38,6 +38,30 @@ from numba import njit
 MAX_ITER = 100
 
 
+
+@njit(cache=True, inline="always")
+def body_offset(rotations, i, positions, centre, out):
+    """out = Q_i (x_i - c): the centre of particle i relative to ``centre`` in its body frame
+    (``rotations`` lab to body, (N, d, d))."""
+    d = out.shape[0]
+    for k in range(d):
+        s = 0.0
+        for m in range(d):
+            s += rotations[i, k, m] * (positions[i, m] - centre[m])
+        out[k] = s
+
+
+@njit(cache=True, inline="always")
+def lab_point(rotations, i, x, centre, out, row):
+    """out[row] = c + Q_i^T x: a point x given in particle i's body frame relative to ``centre``,
+    in the lab frame."""
+    d = x.shape[0]
+    for m in range(d):
+        s = centre[m]
+        for k in range(d):
+            s += rotations[i, k, m] * x[k]
+        out[row, m] = s
+
 @njit(cache=True, inline="always")
 def _hard_case_g(b, a, a2max):
     """The secular function at mu = a_max^2 over the shorter axes, sum (a_k b_k / (a_max^2 - a_k^2))^2
@@ -182,17 +206,9 @@ def farthest_points(positions, semiaxes, rotations, centre):
     b = np.empty(d)
     x = np.empty(d)
     for i in range(n):
-        for k in range(d):
-            s = 0.0
-            for m in range(d):
-                s += rotations[i, k, m] * (positions[i, m] - centre[m])
-            b[k] = s
+        body_offset(rotations, i, positions, centre, b)
         rho[i] = np.sqrt(farthest_point_body(b, semiaxes[i], x))
-        for m in range(d):
-            s = centre[m]
-            for k in range(d):
-                s += rotations[i, k, m] * x[k]
-            pts[i, m] = s
+        lab_point(rotations, i, x, centre, pts, i)
     return rho, pts
 
 

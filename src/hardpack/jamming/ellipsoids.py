@@ -86,7 +86,7 @@ from scipy.spatial.transform import Rotation
 
 from hardpack.errors import InvalidInputError
 from hardpack.geometry.contact import contact_point, inverse_shapes, pw_contact
-from hardpack.geometry.ellipsoid_container import local_farthest_body
+from hardpack.geometry.ellipsoid_container import body_offset, lab_point, local_farthest_body
 from hardpack.geometry.neighbours.pairs import pairs_within, wrapped_positions
 from hardpack.geometry.packing import Packing
 from hardpack.geometry.shapes import Ellipsoids
@@ -415,11 +415,7 @@ def _container_contacts(positions, semiaxes, rotations, centre, radius, delta):
     m = 0
     for i in range(n):
         amax = semiaxes[i].max()
-        for k in range(d):
-            s = 0.0
-            for q in range(d):
-                s += rotations[i, k, q] * (positions[i, q] - centre[q])
-            b[k] = s
+        body_offset(rotations, i, positions, centre, b)
         count = local_farthest_body(b, semiaxes[i], loc)
         if count < 0:
             continuum[i] = radius - np.sqrt((loc[0] * loc[0]).sum()) <= delta * amax
@@ -429,11 +425,7 @@ def _container_contacts(positions, semiaxes, rotations, centre, radius, delta):
             if h <= delta * amax:
                 part[m] = i
                 gap[m] = h
-                for q in range(d):
-                    s = centre[q]
-                    for k in range(d):
-                        s += rotations[i, k, q] * loc[c, k]
-                    pts[m, q] = s
+                lab_point(rotations, i, loc[c], centre, pts, m)
                 m += 1
     return part[:m], pts[:m], gap[:m], continuum
 
@@ -464,11 +456,7 @@ def _tracked_container_rows(positions, semiaxes, rotations, centre, radius, part
     loc = np.empty((2, d))
     for c in range(m):
         i = particle[c]
-        for k in range(d):
-            s = 0.0
-            for q in range(d):
-                s += rotations[i, k, q] * (positions[i, q] - centre[q])
-            b[k] = s
+        body_offset(rotations, i, positions, centre, b)
         count = max(local_farthest_body(b, semiaxes[i], loc), 1)  # a continuum (-1): its point loc[0]
         best, best_dist = 0, np.inf
         for t in range(count):
@@ -478,11 +466,7 @@ def _tracked_container_rows(positions, semiaxes, rotations, centre, radius, part
             if dist < best_dist:
                 best, best_dist = t, dist
         gap[c] = radius - np.sqrt((loc[best] * loc[best]).sum())
-        for q in range(d):
-            s = centre[q]
-            for k in range(d):
-                s += rotations[i, k, q] * loc[best, k]
-            pts[c, q] = s
+        lab_point(rotations, i, loc[best], centre, pts, c)
     return pts, gap
 
 
