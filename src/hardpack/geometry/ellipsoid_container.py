@@ -41,8 +41,25 @@ MAX_ITER = 100
 
 @njit(cache=True, inline="always")
 def body_offset(rotations, i, positions, centre, out):
-    """out = Q_i (x_i - c): the centre of particle i relative to ``centre`` in its body frame
-    (``rotations`` lab to body, (N, d, d))."""
+    """out = Q_i (x_i - c): the centre of particle i relative to ``centre`` in its body frame.
+
+    Parameters
+    ----------
+    rotations : numpy.ndarray of float, shape (N, d, d)
+        Lab-to-body rotations Q.
+    i : int
+        The particle.
+    positions : numpy.ndarray of float, shape (N, d)
+        Particle centres.
+    centre : numpy.ndarray of float, shape (d,)
+        Container centre.
+    out : numpy.ndarray of float, shape (d,)
+        Receives Q_i (x_i - c).
+
+    Returns
+    -------
+    None
+    """
     d = out.shape[0]
     for k in range(d):
         s = 0.0
@@ -54,7 +71,27 @@ def body_offset(rotations, i, positions, centre, out):
 @njit(cache=True, inline="always")
 def lab_point(rotations, i, x, centre, out, row):
     """out[row] = c + Q_i^T x: a point x given in particle i's body frame relative to ``centre``,
-    in the lab frame."""
+    in the lab frame.
+
+    Parameters
+    ----------
+    rotations : numpy.ndarray of float, shape (N, d, d)
+        Lab-to-body rotations Q.
+    i : int
+        The particle.
+    x : numpy.ndarray of float, shape (d,)
+        The point, body frame, relative to the container centre.
+    centre : numpy.ndarray of float, shape (d,)
+        Container centre.
+    out : numpy.ndarray of float, shape (M, d)
+        Receives the lab-frame point in row ``row``.
+    row : int
+        The row of ``out``.
+
+    Returns
+    -------
+    None
+    """
     d = x.shape[0]
     for m in range(d):
         s = centre[m]
