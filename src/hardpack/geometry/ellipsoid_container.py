@@ -75,14 +75,10 @@ def lab_point(rotations, i, x, centre, out, row):
 
     Parameters
     ----------
-    rotations : numpy.ndarray of float, shape (N, d, d)
-        Lab-to-body rotations Q.
-    i : int
-        The particle.
+    rotations, i, centre
+        As in :func:`body_offset`.
     x : numpy.ndarray of float, shape (d,)
         The point, body frame, relative to the container centre.
-    centre : numpy.ndarray of float, shape (d,)
-        Container centre.
     out : numpy.ndarray of float, shape (M, d)
         Receives the lab-frame point in row ``row``.
     row : int
