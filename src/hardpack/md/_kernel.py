@@ -435,8 +435,9 @@ def run_events(P, dims, L, kappa, skin, sfac, imgvec, wmode, walled, wspec, lvl,
     """One window: reset the schedule at t = 0, then process events in time order until
     ``coll_target`` collisions happened or the next event is later than ``t_cap`` (Alg. 2).
 
-    Stages of the single loop (no sub-call takes arrays, which keeps numba's reference counting
-    out of the hot path; the heap update is :func:`hardpack.events.heap.heap_set`, inlined):
+    Stages of the single loop (:func:`_run_events_loop`, compiled without numba's reference
+    counting on the scratch arrays allocated here; the heap update is
+    :func:`hardpack.events.heap.heap_set`, inlined):
     (1) only if ``rebuild_lists``: N complete-update steps, each the partial
     NNL update of one particle (wrap, new bounding sphere, re-bin on its grid level, list every
     overlapping bounding sphere already binned; together a complete update, Alg. 9); the
